@@ -1,0 +1,25 @@
+// talus: the command-line program. Each verb is registered from its own file (commands.hpp).
+
+#include <CLI/CLI.hpp>
+#include <vector>
+
+#include "app/commands.hpp"
+#include "talus/version.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{"Talus: rockfall simulation with non-smooth contact mechanics"};
+  app.set_version_flag("--version", std::string("talus ") + talus::kVersion);
+  app.require_subcommand(1);
+
+  const std::vector<talus::app::Runner> runners = {
+      talus::app::AddDemoCommand(app),
+  };
+
+  CLI11_PARSE(app, argc, argv);
+  // A runner returns -1 when its verb was not the one chosen.
+  for (const auto& run : runners) {
+    const int status = run();
+    if (status >= 0) return status;
+  }
+  return 0;
+}

@@ -1,0 +1,11 @@
+# talus_add_test(<source> LIBS <targets...> [LABELS <labels...>])
+# One test executable per test source, named after the file, registered with CTest through gtest_discover_tests.
+include(GoogleTest)
+function(talus_add_test source)
+  cmake_parse_arguments(ARG "" "" "LIBS;LABELS" ${ARGN})
+  get_filename_component(name ${source} NAME_WE)
+  add_executable(${name} ${source})
+  target_link_libraries(${name} PRIVATE ${ARG_LIBS} GTest::gtest_main talus_warnings)
+  target_compile_definitions(${name} PRIVATE TALUS_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
+  gtest_discover_tests(${name} DISCOVERY_TIMEOUT 60 PROPERTIES LABELS "${ARG_LABELS}")
+endfunction()

@@ -1,0 +1,35 @@
+#include "scenes/scenes.hpp"
+
+#include "solver/random.hpp"
+#include "solver/shapes.hpp"
+#include "solver/simulate.hpp"
+
+namespace talus::scenes {
+
+RockShape Eota221() {
+  const double density = 2500, mass = 780;
+  const double a = 0.93, c = 0.47;
+  const double bevel = BevelForVolume(a, a, c, mass / density);
+  return MakeRockShape(MakeBevelledBox(a, a, c, bevel), density);
+}
+
+Scene Ramp40() {
+  PlaneSpec plane;  // defaults are the benchmark ramp
+  Scene scene;
+  scene.terrain = Terrain(MakePlaneHeightfield(plane), scene.ground.IndexOfName("medium_hard"));
+  scene.rock = Eota221();
+  return scene;
+}
+
+RockState Ramp40Release(const Scene& ramp, std::uint64_t seed, std::uint64_t rock_index) {
+  RockRandom random(seed, rock_index);
+  RockState state;
+  TerrainSample ground;
+  ramp.terrain.Sample(10.0, 0.0, &ground);
+  state.position_m = Eigen::Vector3d(10.0, 0.0, ground.height_m + 1.0);
+  state.orientation = random.Orientation();
+  RaiseAboveTerrain(ramp, state);
+  return state;
+}
+
+}  // namespace talus::scenes

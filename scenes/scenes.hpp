@@ -1,0 +1,23 @@
+#pragma once
+// Scenes built in code, shared by the demo, the tests and the benchmarks.
+
+#include <cstdint>
+
+#include "solver/scene.hpp"
+#include "solver/state.hpp"
+
+namespace talus::scenes {
+
+// The EOTA221 block of the Chant Sura experiments: 780 kg, 0.93 x 0.93 x 0.47 m, bevelled box of
+// density 2500 kg/m^3 (the bevel is chosen so that the volume gives the mass).
+RockShape Eota221();
+
+// The benchmark ramp: 40 degree plane, 200 m horizontal slope, 150 m flat runout, 100 m wide,
+// 2 m cells, ground "medium_hard" everywhere, default solver options, EOTA221 block.
+Scene Ramp40();
+
+// Release state of rock `rock_index` on Ramp40: centre of mass 1 m above the ground at x = 10 m,
+// y = 0, at rest, orientation uniform on SO(3) from (seed, rock_index).
+RockState Ramp40Release(const Scene& ramp, std::uint64_t seed, std::uint64_t rock_index);
+
+}  // namespace talus::scenes

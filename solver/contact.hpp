@@ -1,0 +1,44 @@
+#pragma once
+// Contact data shared by the detection and solve stages, and the per-thread step workspace.
+
+#include <Eigen/Core>
+#include <vector>
+
+namespace talus {
+
+// One closed vertex contact at the midpoint configuration.
+struct Contact {
+  int vertex = 0;                // hull vertex index
+  int ground = 0;                // ground index at the contact point
+  double mu = 0;                 // friction coefficient mu(s) for this step
+  Eigen::Matrix3d directions;    // world: columns n, t1, t2
+  Eigen::Matrix3d arms;          // body: columns b x (R' d) for d = n, t1, t2 (rotational Jacobian)
+  Eigen::Matrix3d inv_inertia_arms;  // Theta^-1 arms
+  double r_normal = 0;           // prox step lengths, 1/(kg^-1)
+  double r_tangent = 0;
+  Eigen::Vector3d restitution_term = Eigen::Vector3d::Zero();  // eps (.) gamma_B
+  Eigen::Vector3d percussion = Eigen::Vector3d::Zero();        // (P_N, P_T1, P_T2), N s
+};
+
+// Scratch space reused across steps; one per thread. Reset() before each new rock.
+struct StepWorkspace {
+  std::vector<Contact> contacts;
+  // Warm start: world percussion of each vertex in the previous step, and whether it was closed.
+  std::vector<Eigen::Vector3d> last_percussion;
+  std::vector<char> last_closed;
+  std::vector<int> last_closed_list;
+
+  void Reset(std::size_t vertex_count) {
+    contacts.clear();
+    last_percussion.assign(vertex_count, Eigen::Vector3d::Zero());
+    last_closed.assign(vertex_count, 0);
+    last_closed_list.clear();
+  }
+  // Forgets the previous step's percussions (cost proportional to the contacts it had).
+  void ForgetPercussions() {
+    for (int v : last_closed_list) last_closed[v] = 0;
+    last_closed_list.clear();
+  }
+};
+
+}  // namespace talus

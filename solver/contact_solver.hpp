@@ -1,0 +1,30 @@
+#pragma once
+// Contact solve stage: percussions from the set-valued contact laws by proximal-point
+// Gauss-Seidel iterations (Leine et al. 2014).
+
+#include <Eigen/Core>
+
+#include "solver/contact.hpp"
+#include "solver/scene.hpp"
+
+namespace talus {
+
+struct ContactSolveReport {
+  int iterations = 0;
+  bool converged = true;
+  bool loaded = false;  // at least one contact carries a positive normal percussion
+};
+
+// Solves for the percussions of workspace.contacts and updates the end velocities in place.
+// On entry velocity_m_s and omega_rad_s hold the free (contact-less) end velocities, with
+// translational mass mass_eff_kg (drag folded in implicitly); v_begin, omega_begin are the step's
+// begin velocities (needed only for restitution). Contact laws are imposed on
+// xi = gamma_E + eps gamma_B: Signorini/Newton in the normal direction, Coulomb disk in the tangent
+// plane; the iteration stops when no contact changes the velocity of any body point by more
+// than the tolerance.
+ContactSolveReport SolveContacts(const Scene& scene, const Eigen::Matrix3d& rotation,
+                                 double mass_eff_kg, const Eigen::Vector3d& v_begin,
+                                 const Eigen::Vector3d& omega_begin, Eigen::Vector3d& velocity_m_s,
+                                 Eigen::Vector3d& omega_rad_s, StepWorkspace& workspace);
+
+}  // namespace talus

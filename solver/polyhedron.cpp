@@ -1,0 +1,79 @@
+#include "solver/polyhedron.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <cmath>
+#include <sstream>
+
+namespace talus {
+
+MassProperties ComputeMassProperties(const Polyhedron& poly, double density_kg_m3) {
+  // Each triangle (a, b, c) and the origin span a signed tetrahedron of volume a.(b x c)/6 with
+  // centroid (a + b + c)/4 and second-moment tensor (V/20)(a a' + b b' + c c' + s s'), s = a + b + c.
+  double volume = 0;
+  Eigen::Vector3d first = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d second = Eigen::Matrix3d::Zero();
+  for (const auto& t : poly.triangles) {
+    const Eigen::Vector3d& a = poly.vertices_m[t[0]];
+    const Eigen::Vector3d& b = poly.vertices_m[t[1]];
+    const Eigen::Vector3d& c = poly.vertices_m[t[2]];
+    const double v = a.dot(b.cross(c)) / 6.0;
+    const Eigen::Vector3d s = a + b + c;
+    volume += v;
+    first += v * s / 4.0;
+    second += (v / 20.0) * (a * a.transpose() + b * b.transpose() + c * c.transpose() +
+                            s * s.transpose());
+  }
+  MassProperties mp;
+  mp.volume_m3 = volume;
+  if (volume == 0) return mp;
+  mp.centroid_m = first / volume;
+  // Second moment about the centroid, then inertia = trace(C) I - C, scaled by density.
+  const Eigen::Matrix3d c = second - volume * mp.centroid_m * mp.centroid_m.transpose();
+  mp.inertia_kg_m2 = density_kg_m3 * (c.trace() * Eigen::Matrix3d::Identity() - c);
+  return mp;
+}
+
+RockShape MakeRockShape(const Polyhedron& hull, double density_kg_m3) {
+  const MassProperties mp = ComputeMassProperties(hull, density_kg_m3);
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(mp.inertia_kg_m2);
+  Eigen::Matrix3d axes = eig.eigenvectors();  // columns: principal axes, ascending moments
+  if (axes.determinant() < 0) axes.col(2) = -axes.col(2);
+
+  RockShape rock;
+  rock.mass_kg = density_kg_m3 * mp.volume_m3;
+  rock.volume_m3 = mp.volume_m3;
+  rock.inertia_kg_m2 = eig.eigenvalues();
+  rock.principal_to_input = Eigen::Quaterniond(axes).normalized();
+  rock.centroid_input_m = mp.centroid_m;
+
+  std::vector<char> used(hull.vertices_m.size(), 0);
+  for (const auto& t : hull.triangles)
+    for (int k : t) used[k] = 1;
+  for (std::size_t i = 0; i < hull.vertices_m.size(); ++i) {
+    if (!used[i]) continue;
+    const Eigen::Vector3d local = axes.transpose() * (hull.vertices_m[i] - mp.centroid_m);
+    rock.vertices_m.push_back(local);
+    rock.bounding_radius_m = std::max(rock.bounding_radius_m, local.norm());
+  }
+  return rock;
+}
+
+bool RockShape::IsValid(std::string* why) const {
+  std::ostringstream msg;
+  if (vertices_m.size() < 4)
+    msg << "rock has " << vertices_m.size() << " vertices; a solid needs at least 4";
+  else if (!(mass_kg > 0) || !std::isfinite(mass_kg))
+    msg << "rock mass " << mass_kg << " kg must be positive and finite";
+  else if (!(inertia_kg_m2.minCoeff() > 0) || !inertia_kg_m2.allFinite())
+    msg << "principal moments (" << inertia_kg_m2.transpose() << ") kg m^2 must be positive";
+  else if (inertia_kg_m2(0) + inertia_kg_m2(1) < inertia_kg_m2(2) * (1 - 1e-9))
+    msg << "principal moments (" << inertia_kg_m2.transpose()
+        << ") kg m^2 violate the triangle inequality";
+  else if (!(bounding_radius_m > 0) || !std::isfinite(bounding_radius_m))
+    msg << "rock bounding radius " << bounding_radius_m << " m must be positive";
+  if (msg.str().empty()) return true;
+  if (why) *why = msg.str();
+  return false;
+}
+
+}  // namespace talus

@@ -1,0 +1,47 @@
+#pragma once
+// Closed triangulated polyhedra, their exact mass properties, and the rock shape the solver uses.
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <array>
+#include <string>
+#include <vector>
+
+namespace talus {
+
+// A closed, consistently oriented triangle mesh (counter-clockwise seen from outside).
+struct Polyhedron {
+  std::vector<Eigen::Vector3d> vertices_m;
+  std::vector<std::array<int, 3>> triangles;
+};
+
+// Mass properties of a homogeneous solid polyhedron, by exact integration over the tetrahedra
+// that its triangles span with the origin (divergence theorem).
+struct MassProperties {
+  double volume_m3 = 0;
+  Eigen::Vector3d centroid_m = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d inertia_kg_m2 = Eigen::Matrix3d::Zero();  // about the centroid, for density
+};
+MassProperties ComputeMassProperties(const Polyhedron& poly, double density_kg_m3);
+
+// The rock as the solver sees it: a convex polyhedron in its principal frame.
+struct RockShape {
+  std::vector<Eigen::Vector3d> vertices_m;   // hull vertices, principal frame, origin at the centroid
+  double mass_kg = 0;
+  double volume_m3 = 0;
+  Eigen::Vector3d inertia_kg_m2 = Eigen::Vector3d::Ones();  // principal moments, ascending
+  double bounding_radius_m = 0;                              // max |vertex|
+  // x_input = centroid_input_m + principal_to_input * x_principal: how the principal frame sits in
+  // the frame the shape was given in (point cloud axes, or a built-in's a, b, c along x, y, z).
+  Eigen::Quaterniond principal_to_input = Eigen::Quaterniond::Identity();
+  Eigen::Vector3d centroid_input_m = Eigen::Vector3d::Zero();
+
+  bool IsValid(std::string* why) const;
+};
+
+// Builds the solver's rock from a closed convex polyhedron: mass properties at the given density,
+// a right-handed principal frame with ascending moments, vertices expressed in it.
+// Hull vertices that are not used by any triangle are dropped.
+RockShape MakeRockShape(const Polyhedron& hull, double density_kg_m3);
+
+}  // namespace talus

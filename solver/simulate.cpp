@@ -1,0 +1,115 @@
+#include "solver/simulate.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace talus {
+
+const char* ToString(EndReason reason) {
+  switch (reason) {
+    case EndReason::kRest: return "rest";
+    case EndReason::kLeftDomain: return "left_domain";
+    case EndReason::kMaxTime: return "max_time";
+    case EndReason::kFailed: return "failed";
+  }
+  return "unknown";
+}
+
+std::string RockResult::BriefReport() const {
+  char line[320];
+  std::snprintf(line, sizeof line,
+                "end %s after %.2f s (%ld steps); path %.1f m; max speed %.2f m/s, energy %.1f kJ, "
+                "jump %.2f m, spin %.2f rad/s, scar %.2f m; %.1f sweeps per contact step",
+                ToString(end), travel_time_s, steps, path_length_m, max_speed_m_s,
+                max_kinetic_energy_j / 1000, max_jump_height_m, max_angular_speed_rad_s, max_scar_m,
+                contact_steps ? double(solver_iterations) / contact_steps : 0.0);
+  return message.empty() ? std::string(line) : std::string(line) + " (" + message + ")";
+}
+
+double KineticEnergy(const RockShape& rock, const RockState& state) {
+  const Eigen::Vector3d& w = state.angular_velocity_rad_s;
+  return 0.5 * rock.mass_kg * state.velocity_m_s.squaredNorm() +
+         0.5 * w.dot(rock.inertia_kg_m2.cwiseProduct(w));
+}
+
+namespace {
+bool IsFinite(const RockState& s) {
+  return s.position_m.allFinite() && s.velocity_m_s.allFinite() &&
+         s.angular_velocity_rad_s.allFinite() && s.orientation.coeffs().allFinite() &&
+         std::isfinite(s.scar_m);
+}
+}  // namespace
+
+RockResult SimulateRock(const Scene& scene, const RockState& start, SimulationWorkspace& workspace,
+                        StepObserver* observer) {
+  const SolverOptions& opt = scene.options;
+  RockResult result;
+  RockState state = start;
+  workspace.step.Reset(scene.rock.vertices_m.size());
+  auto finish = [&](EndReason end) {
+    result.end = end;
+    result.final_state = state;
+    result.travel_time_s = state.time_s - start.time_s;
+    return result;
+  };
+  if (!IsFinite(state)) {
+    result.message = "non-finite initial state";
+    return finish(EndReason::kFailed);
+  }
+  TerrainSample ground;
+  if (!scene.terrain.Sample(state.position_m.x(), state.position_m.y(), &ground))
+    return finish(EndReason::kLeftDomain);
+
+  const double end_time = start.time_s + opt.max_time_s;
+  while (true) {
+    const Eigen::Vector3d previous = state.position_m;
+    const StepReport step = Step(scene, state, workspace.step, workspace.stage_times);
+    if (step.outside_domain) return finish(EndReason::kLeftDomain);
+    ++result.steps;
+    if (!IsFinite(state)) {
+      result.message = "state became non-finite at t = " + std::to_string(state.time_s) + " s";
+      return finish(EndReason::kFailed);
+    }
+    if (!scene.terrain.Sample(state.position_m.x(), state.position_m.y(), &ground))
+      return finish(EndReason::kLeftDomain);
+
+    // Statistics along the path.
+    const double speed = state.velocity_m_s.norm();
+    const double spin = state.angular_velocity_rad_s.norm();
+    result.path_length_m += (state.position_m - previous).head<2>().norm();
+    result.max_speed_m_s = std::max(result.max_speed_m_s, speed);
+    result.max_kinetic_energy_j = std::max(result.max_kinetic_energy_j, KineticEnergy(scene.rock, state));
+    result.max_jump_height_m = std::max(
+        result.max_jump_height_m, (state.position_m.z() - ground.height_m) * ground.normal.z());
+    result.max_angular_speed_rad_s = std::max(result.max_angular_speed_rad_s, spin);
+    result.max_scar_m = std::max(result.max_scar_m, state.scar_m);
+    if (step.contacts > 0) {
+      ++result.contact_steps;
+      result.solver_iterations += step.iterations;
+      if (!step.converged) ++result.unconverged_steps;
+    }
+    if (observer) observer->OnStep(state, step, ground);
+
+    // Rest: slow and in contact for the hold time.
+    const bool slow = speed <= opt.rest_speed_m_s && spin <= opt.rest_angular_speed_rad_s;
+    state.rest_timer_s = (slow && step.contacts > 0) ? state.rest_timer_s + opt.dt_s : 0.0;
+    if (state.rest_timer_s >= opt.rest_hold_s) return finish(EndReason::kRest);
+    if (state.time_s >= end_time - 0.5 * opt.dt_s) return finish(EndReason::kMaxTime);
+  }
+}
+
+double RaiseAboveTerrain(const Scene& scene, RockState& state) {
+  const Eigen::Matrix3d rotation = state.orientation.toRotationMatrix();
+  double lift = 0;
+  for (const Eigen::Vector3d& b : scene.rock.vertices_m) {
+    const Eigen::Vector3d x = state.position_m + rotation * b;
+    TerrainSample sample;
+    if (!scene.terrain.Sample(x.x(), x.y(), &sample)) continue;
+    lift = std::max(lift, sample.height_m - x.z());
+  }
+  state.position_m.z() += lift;
+  return lift;
+}
+
+}  // namespace talus

@@ -1,0 +1,63 @@
+#pragma once
+// Running one rock from release to its end, with the statistics a hazard engineer reads.
+
+#include <string>
+
+#include "solver/contact.hpp"
+#include "solver/scene.hpp"
+#include "solver/state.hpp"
+#include "solver/step.hpp"
+
+namespace talus {
+
+enum class EndReason { kRest, kLeftDomain, kMaxTime, kFailed };
+const char* ToString(EndReason reason);  // "rest", "left_domain", "max_time", "failed"
+
+// What happened to one rock: its ending, final state and the extremes along its path.
+struct RockResult {
+  EndReason end = EndReason::kMaxTime;
+  std::string message;            // why it failed, for kFailed
+  RockState final_state;
+  double travel_time_s = 0;
+  double path_length_m = 0;       // horizontal path of the centre of mass
+  double max_speed_m_s = 0;
+  double max_kinetic_energy_j = 0;  // translational + rotational
+  double max_jump_height_m = 0;   // centre of mass above ground, along the terrain normal
+  double max_angular_speed_rad_s = 0;
+  double max_scar_m = 0;
+  long steps = 0;
+  long contact_steps = 0;         // steps with at least one closed contact
+  long solver_iterations = 0;     // Gauss-Seidel sweeps, summed over steps
+  long unconverged_steps = 0;     // steps whose contact solve hit max_iterations
+
+  // One line: ending, time, speeds, energy.
+  std::string BriefReport() const;
+};
+
+// Called after every step with the new state; recorders (trajectories, rasters) implement it.
+class StepObserver {
+ public:
+  virtual ~StepObserver() = default;
+  // ground: what the terrain says under the centre of mass.
+  virtual void OnStep(const RockState& state, const StepReport& step, const TerrainSample& ground) = 0;
+};
+
+// Per-thread scratch space for SimulateRock.
+struct SimulationWorkspace {
+  StepWorkspace step;
+  StageTimes* stage_times = nullptr;  // set to profile the step's stages
+};
+
+// Runs the rock from `start` until rest, leaving the domain, max_time or a non-finite state.
+// Requires scene.IsValid(). Never throws for numerical trouble: that is reported as kFailed.
+RockResult SimulateRock(const Scene& scene, const RockState& start, SimulationWorkspace& workspace,
+                        StepObserver* observer = nullptr);
+
+// Kinetic energy (translational + rotational), J.
+double KineticEnergy(const RockShape& rock, const RockState& state);
+
+// Raises the rock along z until no hull vertex is below the terrain; returns the lift (m, >= 0).
+// Vertices outside the DEM are ignored.
+double RaiseAboveTerrain(const Scene& scene, RockState& state);
+
+}  // namespace talus

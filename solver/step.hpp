@@ -1,0 +1,29 @@
+#pragma once
+// One time step of the Moreau-type midpoint scheme (DESIGN.md section 3).
+
+#include "solver/contact.hpp"
+#include "solver/scene.hpp"
+#include "solver/state.hpp"
+
+namespace talus {
+
+struct StepReport {
+  int contacts = 0;        // closed contacts at the midpoint
+  int iterations = 0;      // Gauss-Seidel sweeps
+  bool converged = true;   // contact solve met its tolerance
+  bool loaded = false;     // a contact carried load: the scar grew
+  bool outside_domain = false;  // a vertex near the ground is outside the DEM or over nodata
+};
+
+// Wall-clock time spent in each stage, accumulated when a StageTimes is passed to Step.
+struct StageTimes {
+  double midpoint_s = 0, free_rotation_s = 0, contacts_s = 0, solve_s = 0, end_s = 0;
+  long steps = 0;
+};
+
+// Advances state by one step of scene.options.dt_s. When outside_domain is reported the state is
+// left at the step's beginning.
+StepReport Step(const Scene& scene, RockState& state, StepWorkspace& workspace,
+                StageTimes* times = nullptr);
+
+}  // namespace talus

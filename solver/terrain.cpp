@@ -1,0 +1,144 @@
+#include "solver/terrain.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <sstream>
+
+namespace talus {
+
+bool GridGeometry::IsValid(std::string* why) const {
+  std::ostringstream msg;
+  if (nx < 2 || ny < 2)
+    msg << "grid of " << nx << " x " << ny << " nodes: at least 2 x 2 are needed";
+  else if (!(dx_m > 0) || !(dy_m > 0) || !std::isfinite(dx_m) || !std::isfinite(dy_m))
+    msg << "grid spacing " << dx_m << " x " << dy_m << " m must be positive and finite";
+  else if (!std::isfinite(x0_m) || !std::isfinite(y0_m))
+    msg << "grid origin is not finite";
+  if (msg.str().empty()) return true;
+  if (why) *why = msg.str();
+  return false;
+}
+
+Terrain::Terrain(Heightfield heights, int default_ground)
+    : heights_(std::move(heights)), default_ground_(default_ground) {}
+
+void Terrain::SetGroundGrid(GroundGrid ground) { ground_ = std::move(ground); }
+
+bool Terrain::Sample(double x_m, double y_m, TerrainSample* out) const {
+  const GridGeometry& g = heights_.grid;
+  const double fx = (x_m - g.x0_m) / g.dx_m;
+  const double fy = (y_m - g.y0_m) / g.dy_m;
+  if (!(fx >= 0 && fy >= 0 && fx <= g.nx - 1 && fy <= g.ny - 1)) return false;
+  const int i = std::min(static_cast<int>(fx), g.nx - 2);
+  const int j = std::min(static_cast<int>(fy), g.ny - 2);
+  const double u = fx - i;
+  const double w = fy - j;
+  const double* row0 = heights_.z_m.data() + static_cast<std::size_t>(j) * g.nx + i;
+  const double* row1 = row0 + g.nx;
+  const double z00 = row0[0], z10 = row0[1], z01 = row1[0], z11 = row1[1];
+  const double h = z00 * (1 - u) * (1 - w) + z10 * u * (1 - w) + z01 * (1 - u) * w + z11 * u * w;
+  if (std::isnan(h)) return false;  // a nodata corner
+  const double hx = ((z10 - z00) * (1 - w) + (z11 - z01) * w) / g.dx_m;
+  const double hy = ((z01 - z00) * (1 - u) + (z11 - z10) * u) / g.dy_m;
+  out->height_m = h;
+  out->normal = Eigen::Vector3d(-hx, -hy, 1.0) / std::sqrt(hx * hx + hy * hy + 1.0);
+  return true;
+}
+
+int Terrain::GroundAt(double x_m, double y_m) const {
+  if (ground_.index.empty()) return default_ground_;
+  const GridGeometry& g = ground_.grid;
+  const long i = std::lround((x_m - g.x0_m) / g.dx_m);
+  const long j = std::lround((y_m - g.y0_m) / g.dy_m);
+  if (i < 0 || j < 0 || i >= g.nx || j >= g.ny) return default_ground_;
+  const std::uint8_t index = ground_.index[static_cast<std::size_t>(j) * g.nx + i];
+  return index == GroundGrid::kNoGround ? default_ground_ : index;
+}
+
+double Terrain::MaxHeightAround(double x_m, double y_m, double r_m) const {
+  const GridGeometry& g = heights_.grid;
+  const double i_lo = std::floor((x_m - r_m - g.x0_m) / g.dx_m);
+  const double i_hi = std::ceil((x_m + r_m - g.x0_m) / g.dx_m);
+  const double j_lo = std::floor((y_m - r_m - g.y0_m) / g.dy_m);
+  const double j_hi = std::ceil((y_m + r_m - g.y0_m) / g.dy_m);
+  if (!(i_lo >= 0 && j_lo >= 0 && i_hi <= g.nx - 1 && j_hi <= g.ny - 1))
+    return std::numeric_limits<double>::infinity();
+  double max_z = -std::numeric_limits<double>::infinity();
+  for (int j = static_cast<int>(j_lo); j <= static_cast<int>(j_hi); ++j) {
+    const double* row = heights_.z_m.data() + static_cast<std::size_t>(j) * g.nx;
+    for (int i = static_cast<int>(i_lo); i <= static_cast<int>(i_hi); ++i) {
+      if (std::isnan(row[i])) return std::numeric_limits<double>::infinity();
+      max_z = std::max(max_z, row[i]);
+    }
+  }
+  return max_z;
+}
+
+bool Terrain::IsValid(std::string* why) const {
+  const GridGeometry& g = heights_.grid;
+  if (!g.IsValid(why)) return false;
+  if (heights_.z_m.size() != static_cast<std::size_t>(g.nx) * g.ny) {
+    if (why) *why = "heightfield has " + std::to_string(heights_.z_m.size()) + " values for a " +
+                    std::to_string(g.nx) + " x " + std::to_string(g.ny) + " grid";
+    return false;
+  }
+  for (double z : heights_.z_m) {
+    if (std::isinf(z)) {
+      if (why) *why = "heightfield contains an infinite height";
+      return false;
+    }
+  }
+  if (std::all_of(heights_.z_m.begin(), heights_.z_m.end(), [](double z) { return std::isnan(z); })) {
+    if (why) *why = "heightfield has no valid height (all nodata)";
+    return false;
+  }
+  if (!ground_.index.empty()) {
+    if (!ground_.grid.IsValid(why)) return false;
+    if (ground_.index.size() != static_cast<std::size_t>(ground_.grid.nx) * ground_.grid.ny) {
+      if (why) *why = "ground grid size does not match its geometry";
+      return false;
+    }
+  }
+  return true;
+}
+
+bool PlaneSpec::IsValid(std::string* why) const {
+  std::ostringstream msg;
+  if (!(slope_deg >= 0 && slope_deg < 89))
+    msg << "slope_deg = " << slope_deg << " must be in [0, 89)";
+  else if (!(slope_length_m >= 0 && std::isfinite(slope_length_m)))
+    msg << "slope_length_m = " << slope_length_m << " must be >= 0";
+  else if (!(runout_m >= 0 && std::isfinite(runout_m)))
+    msg << "runout_m = " << runout_m << " must be >= 0";
+  else if (!(width_m > 0 && std::isfinite(width_m)))
+    msg << "width_m = " << width_m << " must be > 0";
+  else if (!(cell_m > 0 && std::isfinite(cell_m)))
+    msg << "cell_m = " << cell_m << " must be > 0";
+  else if ((slope_length_m + runout_m) / cell_m < 1 || width_m / cell_m < 1)
+    msg << "cell_m = " << cell_m << " is larger than the plane";
+  else if ((slope_length_m + runout_m) / cell_m * (width_m / cell_m) > 4e8)
+    msg << "cell_m = " << cell_m << " gives more than 4e8 nodes";
+  if (msg.str().empty()) return true;
+  if (why) *why = msg.str();
+  return false;
+}
+
+Heightfield MakePlaneHeightfield(const PlaneSpec& spec) {
+  Heightfield hf;
+  GridGeometry& g = hf.grid;
+  g.nx = static_cast<int>(std::ceil((spec.slope_length_m + spec.runout_m) / spec.cell_m - 1e-9)) + 1;
+  g.ny = static_cast<int>(std::ceil(spec.width_m / spec.cell_m - 1e-9)) + 1;
+  g.dx_m = g.dy_m = spec.cell_m;
+  g.x0_m = 0;
+  g.y0_m = -0.5 * (g.ny - 1) * spec.cell_m;
+  const double tan_slope = std::tan(spec.slope_deg * std::numbers::pi / 180.0);
+  hf.z_m.resize(static_cast<std::size_t>(g.nx) * g.ny);
+  for (int j = 0; j < g.ny; ++j)
+    for (int i = 0; i < g.nx; ++i)
+      hf.z_m[static_cast<std::size_t>(j) * g.nx + i] =
+          std::max(0.0, spec.slope_length_m - i * spec.cell_m) * tan_slope;
+  return hf;
+}
+
+}  // namespace talus

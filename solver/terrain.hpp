@@ -1,0 +1,94 @@
+#pragma once
+// Terrain: a heightfield on a regular grid with bilinear heights, and a ground-category grid.
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace talus {
+
+// A regular grid of nodes: node (i, j) sits at (x0_m + i dx_m, y0_m + j dy_m), i along x, j along y.
+struct GridGeometry {
+  int nx = 0;
+  int ny = 0;
+  double x0_m = 0;  // x of node (0, 0)
+  double y0_m = 0;  // y of node (0, 0)
+  double dx_m = 1;  // node spacing along x, > 0
+  double dy_m = 1;  // node spacing along y, > 0
+
+  double x_max_m() const { return x0_m + (nx - 1) * dx_m; }
+  double y_max_m() const { return y0_m + (ny - 1) * dy_m; }
+  bool IsValid(std::string* why) const;
+};
+
+// Heights at grid nodes, row j (y) after row j-1: z[j * nx + i]. NaN marks nodata.
+struct Heightfield {
+  GridGeometry grid;
+  std::vector<double> z_m;
+};
+
+// Per-cell ground-category indices (into the scene's GroundTable): cell (i, j) covers
+// [x0 + (i - 1/2) dx, x0 + (i + 1/2) dx) x [...], i.e. the grid's nodes are cell centres.
+// kNoGround in a cell means "use the terrain's default category".
+struct GroundGrid {
+  static constexpr std::uint8_t kNoGround = 255;
+  GridGeometry grid;
+  std::vector<std::uint8_t> index;
+};
+
+// What the terrain says about one horizontal position.
+struct TerrainSample {
+  double height_m = 0;
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  // unit, upward, normal of the bilinear patch
+};
+
+class Terrain {
+ public:
+  Terrain() = default;
+  // heights: the DEM; default_ground: ground index used where there is no ground grid or it has
+  // no value.
+  Terrain(Heightfield heights, int default_ground);
+
+  // Optional ground-category grid on its own geometry.
+  void SetGroundGrid(GroundGrid ground);
+
+  // False outside the grid or where a corner of the cell is nodata.
+  bool Sample(double x_m, double y_m, TerrainSample* out) const;
+
+  // Ground index at a horizontal position (the default where the ground grid has none).
+  int GroundAt(double x_m, double y_m) const;
+
+  // Highest node of the cells touching the box [x - r, x + r] x [y - r, y + r]; +infinity when
+  // the box reaches beyond the grid (so that callers fall back to exact tests there).
+  double MaxHeightAround(double x_m, double y_m, double r_m) const;
+
+  const Heightfield& heights() const { return heights_; }
+  int default_ground() const { return default_ground_; }
+  bool has_ground_grid() const { return !ground_.index.empty(); }
+  const GroundGrid& ground_grid() const { return ground_; }
+
+  // Checks the grid, array sizes and that there is at least one valid cell.
+  bool IsValid(std::string* why) const;
+
+ private:
+  Heightfield heights_;
+  GroundGrid ground_;
+  int default_ground_ = 0;
+};
+
+// The analytic test slope: an inclined plane falling along +x followed by a flat runout.
+// x in [0, slope_length + runout], y in [-width/2, width/2]; height (slope_length - x) tan(slope)
+// on the slope and 0 on the runout.
+struct PlaneSpec {
+  double slope_deg = 40;
+  double slope_length_m = 200;  // horizontal length of the inclined part
+  double runout_m = 150;        // horizontal length of the flat part
+  double width_m = 100;
+  double cell_m = 2;
+  bool IsValid(std::string* why) const;
+};
+Heightfield MakePlaneHeightfield(const PlaneSpec& spec);
+
+}  // namespace talus
