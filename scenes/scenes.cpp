@@ -1,5 +1,7 @@
 #include "scenes/scenes.hpp"
 
+#include <cmath>
+
 #include "solver/random.hpp"
 #include "solver/shapes.hpp"
 #include "solver/simulate.hpp"
@@ -30,6 +32,30 @@ RockState Ramp40Release(const Scene& ramp, std::uint64_t seed, std::uint64_t roc
   state.orientation = random.Orientation();
   RaiseAboveTerrain(ramp, state);
   return state;
+}
+
+}  // namespace talus::scenes
+
+namespace talus::scenes {
+
+Scene Incline(double slope_deg, const RockShape& rock, const GroundParams& ground, double length_m,
+              double cell_m) {
+  PlaneSpec plane;
+  plane.slope_deg = slope_deg;
+  plane.slope_length_m = length_m;
+  plane.runout_m = 0;
+  plane.width_m = length_m;
+  plane.cell_m = cell_m;
+  Scene scene;
+  const int test = scene.ground.Set({"test", 100, ground});
+  scene.terrain = Terrain(MakePlaneHeightfield(plane), test);
+  scene.rock = rock;
+  return scene;
+}
+
+Eigen::Vector3d InclineNormal(double slope_deg) {
+  const double theta = slope_deg * M_PI / 180.0;
+  return Eigen::Vector3d(std::sin(theta), 0.0, std::cos(theta));
 }
 
 }  // namespace talus::scenes

@@ -20,4 +20,12 @@ Scene Ramp40();
 // y = 0, at rest, orientation uniform on SO(3) from (seed, rock_index).
 RockState Ramp40Release(const Scene& ramp, std::uint64_t seed, std::uint64_t rock_index);
 
+// A test incline: a plane falling along +x at slope_deg (0: flat), x in [0, length_m],
+// y in [-length_m/2, length_m/2], with one ground category "test" of the given parameters.
+Scene Incline(double slope_deg, const RockShape& rock, const GroundParams& ground,
+              double length_m = 200, double cell_m = 5);
+
+// The upward unit normal of Incline(slope_deg).
+Eigen::Vector3d InclineNormal(double slope_deg);
+
 }  // namespace talus::scenes

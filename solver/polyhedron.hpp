@@ -36,6 +36,15 @@ struct RockShape {
   Eigen::Quaterniond principal_to_input = Eigen::Quaterniond::Identity();
   Eigen::Vector3d centroid_input_m = Eigen::Vector3d::Zero();
 
+  // The solver's orientation (principal frame -> world) of a shape placed with `shape_orientation`
+  // (rotation of the shape as given, about its centre of mass), and back.
+  Eigen::Quaterniond PrincipalOrientation(const Eigen::Quaterniond& shape_orientation) const {
+    return (shape_orientation * principal_to_input).normalized();
+  }
+  Eigen::Quaterniond ShapeOrientation(const Eigen::Quaterniond& principal_orientation) const {
+    return (principal_orientation * principal_to_input.conjugate()).normalized();
+  }
+
   bool IsValid(std::string* why) const;
 };
 
