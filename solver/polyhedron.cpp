@@ -7,15 +7,19 @@
 namespace talus {
 
 MassProperties ComputeMassProperties(const Polyhedron& poly, double density_kg_m3) {
-  // Each triangle (a, b, c) and the origin span a signed tetrahedron of volume a.(b x c)/6 with
+  // Coordinates are taken relative to the vertex mean so that large (georeferenced) offsets
+  // cost no precision. Each triangle (a, b, c) and that origin span a signed tetrahedron of volume a.(b x c)/6 with
   // centroid (a + b + c)/4 and second-moment tensor (V/20)(a a' + b b' + c c' + s s'), s = a + b + c.
+  Eigen::Vector3d origin = Eigen::Vector3d::Zero();
+  for (const auto& v : poly.vertices_m) origin += v;
+  if (!poly.vertices_m.empty()) origin /= static_cast<double>(poly.vertices_m.size());
   double volume = 0;
   Eigen::Vector3d first = Eigen::Vector3d::Zero();
   Eigen::Matrix3d second = Eigen::Matrix3d::Zero();
   for (const auto& t : poly.triangles) {
-    const Eigen::Vector3d& a = poly.vertices_m[t[0]];
-    const Eigen::Vector3d& b = poly.vertices_m[t[1]];
-    const Eigen::Vector3d& c = poly.vertices_m[t[2]];
+    const Eigen::Vector3d a = poly.vertices_m[t[0]] - origin;
+    const Eigen::Vector3d b = poly.vertices_m[t[1]] - origin;
+    const Eigen::Vector3d c = poly.vertices_m[t[2]] - origin;
     const double v = a.dot(b.cross(c)) / 6.0;
     const Eigen::Vector3d s = a + b + c;
     volume += v;
@@ -26,9 +30,10 @@ MassProperties ComputeMassProperties(const Polyhedron& poly, double density_kg_m
   MassProperties mp;
   mp.volume_m3 = volume;
   if (volume == 0) return mp;
-  mp.centroid_m = first / volume;
+  const Eigen::Vector3d centroid = first / volume;
+  mp.centroid_m = origin + centroid;
   // Second moment about the centroid, then inertia = trace(C) I - C, scaled by density.
-  const Eigen::Matrix3d c = second - volume * mp.centroid_m * mp.centroid_m.transpose();
+  const Eigen::Matrix3d c = second - volume * centroid * centroid.transpose();
   mp.inertia_kg_m2 = density_kg_m3 * (c.trace() * Eigen::Matrix3d::Identity() - c);
   return mp;
 }

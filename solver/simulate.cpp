@@ -61,6 +61,18 @@ RockResult SimulateRock(const Scene& scene, const RockState& start, SimulationWo
   if (!scene.terrain.Sample(state.position_m.x(), state.position_m.y(), &ground))
     return finish(EndReason::kLeftDomain);
 
+  // Statistics along the path, the release state included.
+  auto record = [&](const TerrainSample& under) {
+    result.max_speed_m_s = std::max(result.max_speed_m_s, state.velocity_m_s.norm());
+    result.max_kinetic_energy_j = std::max(result.max_kinetic_energy_j, KineticEnergy(scene.rock, state));
+    result.max_jump_height_m = std::max(
+        result.max_jump_height_m, (state.position_m.z() - under.height_m) * under.normal.z());
+    result.max_angular_speed_rad_s =
+        std::max(result.max_angular_speed_rad_s, state.angular_velocity_rad_s.norm());
+    result.max_scar_m = std::max(result.max_scar_m, state.scar_m);
+  };
+  record(ground);
+
   const double end_time = start.time_s + opt.max_time_s;
   while (true) {
     const Eigen::Vector3d previous = state.position_m;
@@ -74,16 +86,8 @@ RockResult SimulateRock(const Scene& scene, const RockState& start, SimulationWo
     if (!scene.terrain.Sample(state.position_m.x(), state.position_m.y(), &ground))
       return finish(EndReason::kLeftDomain);
 
-    // Statistics along the path.
-    const double speed = state.velocity_m_s.norm();
-    const double spin = state.angular_velocity_rad_s.norm();
     result.path_length_m += (state.position_m - previous).head<2>().norm();
-    result.max_speed_m_s = std::max(result.max_speed_m_s, speed);
-    result.max_kinetic_energy_j = std::max(result.max_kinetic_energy_j, KineticEnergy(scene.rock, state));
-    result.max_jump_height_m = std::max(
-        result.max_jump_height_m, (state.position_m.z() - ground.height_m) * ground.normal.z());
-    result.max_angular_speed_rad_s = std::max(result.max_angular_speed_rad_s, spin);
-    result.max_scar_m = std::max(result.max_scar_m, state.scar_m);
+    record(ground);
     if (step.contacts > 0) {
       ++result.contact_steps;
       result.solver_iterations += step.iterations;
@@ -92,7 +96,8 @@ RockResult SimulateRock(const Scene& scene, const RockState& start, SimulationWo
     if (observer) observer->OnStep(state, step, ground);
 
     // Rest: slow and in contact for the hold time.
-    const bool slow = speed <= opt.rest_speed_m_s && spin <= opt.rest_angular_speed_rad_s;
+    const bool slow = state.velocity_m_s.norm() <= opt.rest_speed_m_s &&
+                      state.angular_velocity_rad_s.norm() <= opt.rest_angular_speed_rad_s;
     state.rest_timer_s = (slow && step.contacts > 0) ? state.rest_timer_s + opt.dt_s : 0.0;
     if (state.rest_timer_s >= opt.rest_hold_s) return finish(EndReason::kRest);
     if (state.time_s >= end_time - 0.5 * opt.dt_s) return finish(EndReason::kMaxTime);

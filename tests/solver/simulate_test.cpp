@@ -1,0 +1,139 @@
+// Endings of a rock's run and the statistics SimulateRock reports.
+
+#include "solver/simulate.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "scenes/scenes.hpp"
+#include "solver/random.hpp"
+#include "solver/shapes.hpp"
+
+namespace talus {
+namespace {
+
+Scene FlatScene() {
+  return scenes::Incline(0, MakeRockShape(MakeBox(1, 1, 0.5), 2700), GroundParams{0.5, 0.5, 150, 2, 0});
+}
+
+TEST(Simulate, FreeFallStatisticsMatchClosedForm) {
+  // Drop from 20 m over flat ground; the step just before impact has v = g t, and the largest
+  // jump height is the release height. Max kinetic energy m g h to 1 % (discrete impact step).
+  Scene scene = FlatScene();
+  SimulationWorkspace ws;
+  RockState s;
+  s.position_m = {50, 0, 20.25};
+  const RockResult r = SimulateRock(scene, s, ws);
+  EXPECT_EQ(r.end, EndReason::kRest);
+  EXPECT_NEAR(r.max_jump_height_m, 20.25, 1e-9);
+  EXPECT_NEAR(r.max_kinetic_energy_j, scene.rock.mass_kg * 9.81 * 20, 0.01 * scene.rock.mass_kg * 9.81 * 20);
+  EXPECT_NEAR(r.max_speed_m_s, std::sqrt(2 * 9.81 * 20), 0.01 * std::sqrt(2 * 9.81 * 20));
+  EXPECT_LT(r.path_length_m, 1e-6);
+  EXPECT_EQ(r.unconverged_steps, 0);
+}
+
+TEST(Simulate, LeavingTheDemEndsAsLeftDomain) {
+  Scene scene = FlatScene();
+  SimulationWorkspace ws;
+  RockState s;
+  s.position_m = {190, 0, 5};
+  s.velocity_m_s = {20, 0, 0};
+  const RockResult r = SimulateRock(scene, s, ws);
+  EXPECT_EQ(r.end, EndReason::kLeftDomain);
+  EXPECT_LT(r.travel_time_s, 1.0);
+}
+
+TEST(Simulate, NodataEndsAsLeftDomain) {
+  Scene scene = FlatScene();
+  Heightfield hf = scene.terrain.heights();
+  for (int j = 0; j < hf.grid.ny; ++j)
+    for (int i = 21; i < hf.grid.nx; ++i) hf.z_m[j * hf.grid.nx + i] = std::numeric_limits<double>::quiet_NaN();
+  scene.terrain = Terrain(hf, scene.terrain.default_ground());
+  SimulationWorkspace ws;
+  RockState s;
+  s.position_m = {90, 0, 0.3};  // cells from x = 100 m on touch nodata
+  s.velocity_m_s = {10, 0, 0};
+  EXPECT_EQ(SimulateRock(scene, s, ws).end, EndReason::kLeftDomain);
+}
+
+TEST(Simulate, MaxTimeAndNonFiniteStatesAreEndingsNotCrashes) {
+  Scene scene = FlatScene();
+  scene.options.max_time_s = 0.5;
+  SimulationWorkspace ws;
+  RockState s;
+  s.position_m = {50, 0, 1000};
+  RockResult r = SimulateRock(scene, s, ws);
+  EXPECT_EQ(r.end, EndReason::kMaxTime);
+  EXPECT_NEAR(r.travel_time_s, 0.5, 1e-9);
+
+  s.velocity_m_s.x() = std::numeric_limits<double>::quiet_NaN();
+  r = SimulateRock(scene, s, ws);
+  EXPECT_EQ(r.end, EndReason::kFailed);
+  EXPECT_FALSE(r.message.empty());
+
+  s.velocity_m_s.x() = 1e300;  // overflows to infinity within a step
+  s.angular_velocity_rad_s = {1e300, 1e300, 0};
+  r = SimulateRock(scene, s, ws);
+  EXPECT_NE(r.end, EndReason::kRest);
+}
+
+TEST(Simulate, RaiseAboveTerrainLiftsOnlyWhatIsBelow) {
+  const Scene scene = FlatScene();
+  RockState s;
+  s.position_m = {50, 0, 0.1};  // half-height 0.25: 0.15 m below ground
+  EXPECT_NEAR(RaiseAboveTerrain(scene, s), 0.15, 1e-12);
+  EXPECT_NEAR(s.position_m.z(), 0.25, 1e-12);
+  EXPECT_EQ(RaiseAboveTerrain(scene, s), 0.0);
+}
+
+TEST(Simulate, SameStartGivesBitIdenticalResults) {
+  const Scene scene = scenes::Ramp40();
+  SimulationWorkspace ws1, ws2;
+  const RockState start = scenes::Ramp40Release(scene, 7, 3);
+  const RockResult a = SimulateRock(scene, start, ws1);
+  SimulateRock(scene, scenes::Ramp40Release(scene, 7, 4), ws2);  // dirty the second workspace
+  const RockResult b = SimulateRock(scene, start, ws2);
+  EXPECT_EQ(a.steps, b.steps);
+  EXPECT_EQ(a.final_state.position_m, b.final_state.position_m);
+  EXPECT_EQ(a.max_kinetic_energy_j, b.max_kinetic_energy_j);
+}
+
+TEST(Options, DefaultsAreValidAndBadValuesAreNamed) {
+  std::string why;
+  EXPECT_TRUE(SolverOptions{}.IsValid(&why)) << why;
+  SolverOptions o;
+  o.dt_s = 0;
+  EXPECT_FALSE(o.IsValid(&why));
+  EXPECT_NE(why.find("dt_s"), std::string::npos) << why;
+  o = SolverOptions{};
+  o.prox_alpha = 2.5;
+  EXPECT_FALSE(o.IsValid(&why));
+  EXPECT_NE(why.find("prox_alpha"), std::string::npos) << why;
+  o = SolverOptions{};
+  o.normal_restitution = std::nan("");
+  EXPECT_FALSE(o.IsValid(&why));
+  EXPECT_NE(why.find("normal_restitution"), std::string::npos) << why;
+}
+
+TEST(Random, StreamsDependOnSeedAndRockOnlyAndOrientationsAreUniform) {
+  RockRandom a(5, 9), b(5, 9), c(5, 10);
+  EXPECT_EQ(a.Uniform(), b.Uniform());
+  EXPECT_NE(RockRandom(5, 9).Uniform(), c.Uniform());
+  // Uniform rotations: the rotated z axis is uniform on the sphere, so its mean is 0 and the
+  // mean of z^2 is 1/3 (standard error ~ 0.3/sqrt(n); tolerance 4 standard errors).
+  const int n = 20000;
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  double zz = 0;
+  for (int k = 0; k < n; ++k) {
+    const Eigen::Vector3d z = RockRandom(1, k).Orientation() * Eigen::Vector3d::UnitZ();
+    mean += z / n;
+    zz += z.z() * z.z() / n;
+  }
+  EXPECT_LT(mean.norm(), 4 * 0.58 / std::sqrt(n));
+  EXPECT_NEAR(zz, 1.0 / 3, 4 * 0.3 / std::sqrt(n));
+}
+
+}  // namespace
+}  // namespace talus

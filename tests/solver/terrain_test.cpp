@@ -1,0 +1,96 @@
+#include "solver/terrain.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+namespace talus {
+namespace {
+
+// 3 x 3 nodes, 2 m spacing, origin (10, 20); heights z = x * y / 100 on the nodes (bilinear
+// functions are reproduced exactly by bilinear interpolation).
+Terrain Saddle() {
+  Heightfield hf;
+  hf.grid = {3, 3, 10.0, 20.0, 2.0, 2.0};
+  for (int j = 0; j < 3; ++j)
+    for (int i = 0; i < 3; ++i) hf.z_m.push_back((10.0 + 2 * i) * (20.0 + 2 * j) / 100);
+  return Terrain(hf, 0);
+}
+
+TEST(Terrain, BilinearHeightAndPatchNormalAreExact) {
+  const Terrain t = Saddle();
+  TerrainSample s;
+  ASSERT_TRUE(t.Sample(11.3, 22.7, &s));
+  EXPECT_NEAR(s.height_m, 11.3 * 22.7 / 100, 1e-13);
+  // Normal of z = x y / 100: (-y/100, -x/100, 1) normalised.
+  const Eigen::Vector3d n = Eigen::Vector3d(-22.7 / 100, -11.3 / 100, 1).normalized();
+  EXPECT_LT((s.normal - n).norm(), 1e-13);
+  ASSERT_TRUE(t.Sample(14.0, 24.0, &s));  // the far corner is inside
+  EXPECT_NEAR(s.height_m, 14.0 * 24.0 / 100, 1e-13);
+}
+
+TEST(Terrain, OutsideAndNodataAreReported) {
+  Terrain t = Saddle();
+  TerrainSample s;
+  EXPECT_FALSE(t.Sample(9.99, 21, &s));
+  EXPECT_FALSE(t.Sample(12, 24.01, &s));
+  EXPECT_FALSE(t.Sample(std::nan(""), 21, &s));
+  Heightfield hf = t.heights();
+  hf.z_m[8] = std::numeric_limits<double>::quiet_NaN();  // node (2, 2)
+  const Terrain holed(hf, 0);
+  EXPECT_TRUE(holed.Sample(11, 21, &s));   // cell (0, 0) has no nodata corner
+  EXPECT_FALSE(holed.Sample(13, 23, &s));  // cell (1, 1) touches node (2, 2)
+  EXPECT_EQ(holed.MaxHeightAround(13, 23, 0.5), std::numeric_limits<double>::infinity());
+}
+
+TEST(Terrain, MaxHeightAroundCoversTheBox) {
+  const Terrain t = Saddle();
+  EXPECT_NEAR(t.MaxHeightAround(11, 21, 0.5), 12.0 * 22.0 / 100, 1e-13);  // cell (0,0)'s corners
+  EXPECT_EQ(t.MaxHeightAround(10.2, 21, 0.5), std::numeric_limits<double>::infinity());  // beyond x0
+}
+
+TEST(Terrain, GroundGridUsesNearestCellAndDefault) {
+  Terrain t = Saddle();
+  EXPECT_EQ(t.GroundAt(11, 21), 0);
+  GroundGrid g;
+  g.grid = {2, 1, 11.0, 21.0, 2.0, 2.0};  // two cells centred at (11, 21) and (13, 21)
+  g.index = {3, GroundGrid::kNoGround};
+  t.SetGroundGrid(g);
+  EXPECT_EQ(t.GroundAt(10.1, 21.9), 3);
+  EXPECT_EQ(t.GroundAt(12.9, 21.0), 0);  // no value: default
+  EXPECT_EQ(t.GroundAt(20, 21), 0);      // outside the ground grid: default
+}
+
+TEST(Terrain, ValidityNamesTheProblem) {
+  std::string why;
+  EXPECT_TRUE(Saddle().IsValid(&why)) << why;
+  Heightfield hf;
+  hf.grid = {3, 3, 0, 0, 1, 1};
+  hf.z_m.assign(8, 0.0);
+  EXPECT_FALSE(Terrain(hf, 0).IsValid(&why));
+  EXPECT_NE(why.find("8 values"), std::string::npos) << why;
+  hf.z_m.assign(9, std::numeric_limits<double>::quiet_NaN());
+  EXPECT_FALSE(Terrain(hf, 0).IsValid(&why));
+  EXPECT_NE(why.find("nodata"), std::string::npos) << why;
+}
+
+TEST(PlaneSpec, BuildsTheRampWithTheKinkOnANode) {
+  PlaneSpec p;  // 40 deg, 200 m + 150 m, 100 m wide, 2 m cells
+  std::string why;
+  EXPECT_TRUE(p.IsValid(&why)) << why;
+  const Terrain t(MakePlaneHeightfield(p), 0);
+  TerrainSample s;
+  ASSERT_TRUE(t.Sample(50.5, 10.3, &s));
+  EXPECT_NEAR(s.height_m, 149.5 * std::tan(40 * M_PI / 180), 1e-9);
+  EXPECT_NEAR(std::acos(s.normal.z()) * 180 / M_PI, 40, 1e-9);
+  ASSERT_TRUE(t.Sample(250, -49, &s));
+  EXPECT_EQ(s.height_m, 0.0);
+  EXPECT_FALSE(t.Sample(351, 0, &s));
+  p.slope_deg = 95;
+  EXPECT_FALSE(p.IsValid(&why));
+  EXPECT_NE(why.find("slope_deg"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace talus
