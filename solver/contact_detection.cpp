@@ -11,16 +11,26 @@ DetectResult DetectContacts(const Scene& scene, const RockState& mid,
   const Terrain& terrain = scene.terrain;
   const Eigen::Vector3d& r = mid.position_m;
   const double radius = rock.bounding_radius_m;
-  if (r.z() - radius > terrain.MaxHeightAround(r.x(), r.y(), radius)) return DetectResult::kOk;
+
+  // Vertical height of a point above the local plane is m . x + offset with m = (-h_x, -h_y, 1).
+  Terrain::LocalPlane plane;
+  const bool local = terrain.PlaneAround(r.x(), r.y(), radius, &plane);
+  const Eigen::Vector3d m(-plane.slope_x, -plane.slope_y, 1.0);
+  const double centre_height = r.z() - plane.at.height_m;  // m . (r - (x, y, h)) as x, y match
+  if (local && centre_height - radius * m.norm() > plane.deviation_m) return DetectResult::kOk;
+  const Eigen::Vector3d m_body = rotation.transpose() * m;
 
   const int vertex_count = static_cast<int>(rock.vertices_m.size());
   for (int k = 0; k < vertex_count; ++k) {
+    if (local && centre_height + m_body.dot(rock.vertices_m[k]) > plane.deviation_m) continue;
     const Eigen::Vector3d arm = rotation * rock.vertices_m[k];
     const Eigen::Vector3d x = r + arm;
+    // The gap (x_z - h) n_z has the sign of x_z - h: the normal is needed only for contacts.
+    double height;
+    if (!terrain.Height(x.x(), x.y(), &height)) return DetectResult::kOutsideDomain;
+    if (x.z() > height) continue;
     TerrainSample sample;
-    if (!terrain.Sample(x.x(), x.y(), &sample)) return DetectResult::kOutsideDomain;
-    const double gap = (x.z() - sample.height_m) * sample.normal.z();
-    if (gap > 0) continue;
+    terrain.Sample(x.x(), x.y(), &sample);
 
     Contact& c = workspace.contacts.emplace_back();
     c.vertex = k;

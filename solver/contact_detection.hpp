@@ -13,7 +13,9 @@ enum class DetectResult { kOk, kOutsideDomain };
 
 // Fills workspace.contacts with the vertices whose gap (height above the terrain times the
 // terrain normal's z) is <= 0, with their contact frame, ground index and friction mu(scar_m).
-// A rock whose bounding sphere is above every terrain node under it costs one test.
+// A rock whose bounding sphere clears the terrain's local plane by more than the terrain departs
+// from that plane costs one test; otherwise only the vertices within that departure of the plane
+// are tested against the terrain itself.
 // Returns kOutsideDomain when a vertex that may touch lies outside the DEM or over nodata.
 DetectResult DetectContacts(const Scene& scene, const RockState& mid,
                             const Eigen::Matrix3d& rotation, StepWorkspace& workspace);

@@ -1,6 +1,6 @@
 #include "solver/kinematics.hpp"
 
-#include <Eigen/LU>
+#include <Eigen/LU>  // fixed-size inverse
 #include <cmath>
 
 namespace talus {
@@ -39,7 +39,7 @@ Eigen::Vector3d FreeRotation(const Eigen::Vector3d& inertia_kg_m2, const Eigen::
     // d/dW_f [dt W_m x Theta W_m] = (dt/2) (skew(W_m) Theta - skew(Theta W_m)).
     Eigen::Matrix3d jacobian = 0.5 * dt_s * (Skew(wm) * theta - Skew(lm));
     jacobian.diagonal() += inertia_kg_m2;
-    const Eigen::Vector3d delta = jacobian.partialPivLu().solve(residual);
+    const Eigen::Vector3d delta = jacobian.inverse() * residual;  // closed-form 3 x 3 inverse
     omega_f -= delta;
     if (delta.norm() <= 1e-15 * scale) break;
   }

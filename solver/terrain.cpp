@@ -21,26 +21,52 @@ bool GridGeometry::IsValid(std::string* why) const {
 }
 
 Terrain::Terrain(Heightfield heights, int default_ground)
-    : heights_(std::move(heights)), default_ground_(default_ground) {}
+    : heights_(std::move(heights)),
+      inv_dx_(1.0 / heights_.grid.dx_m),
+      inv_dy_(1.0 / heights_.grid.dy_m),
+      default_ground_(default_ground) {}
 
 void Terrain::SetGroundGrid(GroundGrid ground) { ground_ = std::move(ground); }
 
-bool Terrain::Sample(double x_m, double y_m, TerrainSample* out) const {
+bool Terrain::Locate(double x_m, double y_m, int* i, int* j, double* u, double* w) const {
   const GridGeometry& g = heights_.grid;
-  const double fx = (x_m - g.x0_m) / g.dx_m;
-  const double fy = (y_m - g.y0_m) / g.dy_m;
+  const double fx = (x_m - g.x0_m) * inv_dx_;
+  const double fy = (y_m - g.y0_m) * inv_dy_;
   if (!(fx >= 0 && fy >= 0 && fx <= g.nx - 1 && fy <= g.ny - 1)) return false;
-  const int i = std::min(static_cast<int>(fx), g.nx - 2);
-  const int j = std::min(static_cast<int>(fy), g.ny - 2);
-  const double u = fx - i;
-  const double w = fy - j;
-  const double* row0 = heights_.z_m.data() + static_cast<std::size_t>(j) * g.nx + i;
-  const double* row1 = row0 + g.nx;
+  *i = std::min(static_cast<int>(fx), g.nx - 2);
+  *j = std::min(static_cast<int>(fy), g.ny - 2);
+  *u = fx - *i;
+  *w = fy - *j;
+  return true;
+}
+
+bool Terrain::Height(double x_m, double y_m, double* height_m) const {
+  int i, j;
+  double u, w;
+  if (!Locate(x_m, y_m, &i, &j, &u, &w)) return false;
+  const int nx = heights_.grid.nx;
+  const double* row0 = heights_.z_m.data() + static_cast<std::size_t>(j) * nx + i;
+  const double* row1 = row0 + nx;
+  const double lower = row0[0] + u * (row0[1] - row0[0]);
+  const double upper = row1[0] + u * (row1[1] - row1[0]);
+  *height_m = lower + w * (upper - lower);
+  return !std::isnan(*height_m);  // a nodata corner
+}
+
+bool Terrain::Sample(double x_m, double y_m, TerrainSample* out) const {
+  int i, j;
+  double u, w;
+  if (!Locate(x_m, y_m, &i, &j, &u, &w)) return false;
+  const int nx = heights_.grid.nx;
+  const double* row0 = heights_.z_m.data() + static_cast<std::size_t>(j) * nx + i;
+  const double* row1 = row0 + nx;
   const double z00 = row0[0], z10 = row0[1], z01 = row1[0], z11 = row1[1];
-  const double h = z00 * (1 - u) * (1 - w) + z10 * u * (1 - w) + z01 * (1 - u) * w + z11 * u * w;
+  const double lower = z00 + u * (z10 - z00);
+  const double upper = z01 + u * (z11 - z01);
+  const double h = lower + w * (upper - lower);
   if (std::isnan(h)) return false;  // a nodata corner
-  const double hx = ((z10 - z00) * (1 - w) + (z11 - z01) * w) / g.dx_m;
-  const double hy = ((z01 - z00) * (1 - u) + (z11 - z10) * u) / g.dy_m;
+  const double hx = ((z10 - z00) * (1 - w) + (z11 - z01) * w) * inv_dx_;
+  const double hy = (upper - lower) * inv_dy_;
   out->height_m = h;
   out->normal = Eigen::Vector3d(-hx, -hy, 1.0) / std::sqrt(hx * hx + hy * hy + 1.0);
   return true;
@@ -56,23 +82,29 @@ int Terrain::GroundAt(double x_m, double y_m) const {
   return index == GroundGrid::kNoGround ? default_ground_ : index;
 }
 
-double Terrain::MaxHeightAround(double x_m, double y_m, double r_m) const {
+bool Terrain::PlaneAround(double x_m, double y_m, double r_m, LocalPlane* out) const {
   const GridGeometry& g = heights_.grid;
-  const double i_lo = std::floor((x_m - r_m - g.x0_m) / g.dx_m);
-  const double i_hi = std::ceil((x_m + r_m - g.x0_m) / g.dx_m);
-  const double j_lo = std::floor((y_m - r_m - g.y0_m) / g.dy_m);
-  const double j_hi = std::ceil((y_m + r_m - g.y0_m) / g.dy_m);
-  if (!(i_lo >= 0 && j_lo >= 0 && i_hi <= g.nx - 1 && j_hi <= g.ny - 1))
-    return std::numeric_limits<double>::infinity();
-  double max_z = -std::numeric_limits<double>::infinity();
+  const double i_lo = std::floor((x_m - r_m - g.x0_m) * inv_dx_);
+  const double i_hi = std::ceil((x_m + r_m - g.x0_m) * inv_dx_);
+  const double j_lo = std::floor((y_m - r_m - g.y0_m) * inv_dy_);
+  const double j_hi = std::ceil((y_m + r_m - g.y0_m) * inv_dy_);
+  if (!(i_lo >= 0 && j_lo >= 0 && i_hi <= g.nx - 1 && j_hi <= g.ny - 1)) return false;
+  if (!Sample(x_m, y_m, &out->at)) return false;
+  const Eigen::Vector3d& n = out->at.normal;
+  out->slope_x = -n.x() / n.z();
+  out->slope_y = -n.y() / n.z();
+  double deviation = 0;
   for (int j = static_cast<int>(j_lo); j <= static_cast<int>(j_hi); ++j) {
     const double* row = heights_.z_m.data() + static_cast<std::size_t>(j) * g.nx;
+    const double dy = g.y0_m + j * g.dy_m - y_m;
     for (int i = static_cast<int>(i_lo); i <= static_cast<int>(i_hi); ++i) {
-      if (std::isnan(row[i])) return std::numeric_limits<double>::infinity();
-      max_z = std::max(max_z, row[i]);
+      const double dx = g.x0_m + i * g.dx_m - x_m;
+      const double d = std::abs(row[i] - (out->at.height_m + out->slope_x * dx + out->slope_y * dy));
+      if (!(d <= deviation)) deviation = d;  // also takes NaN (nodata), which fails below
     }
   }
-  return max_z;
+  out->deviation_m = deviation;
+  return !std::isnan(deviation);
 }
 
 bool Terrain::IsValid(std::string* why) const {

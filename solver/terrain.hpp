@@ -56,13 +56,23 @@ class Terrain {
 
   // False outside the grid or where a corner of the cell is nodata.
   bool Sample(double x_m, double y_m, TerrainSample* out) const;
+  // The height alone (the contact test's fast path); false as for Sample.
+  bool Height(double x_m, double y_m, double* height_m) const;
 
   // Ground index at a horizontal position (the default where the ground grid has none).
   int GroundAt(double x_m, double y_m) const;
 
-  // Highest node of the cells touching the box [x - r, x + r] x [y - r, y + r]; +infinity when
-  // the box reaches beyond the grid (so that callers fall back to exact tests there).
-  double MaxHeightAround(double x_m, double y_m, double r_m) const;
+  // The tangent plane of the terrain at (x, y) and how far the terrain departs from it, vertically,
+  // anywhere in the box [x - r, x + r] x [y - r, y + r]: |h(p) - plane(p)| <= deviation_m there.
+  // (h - plane is the bilinear interpolant of its node values, so the largest node deviation of
+  // the cells covering the box bounds it.) False when the box reaches beyond the grid or nodata.
+  struct LocalPlane {
+    TerrainSample at;          // height and normal at (x, y)
+    double slope_x = 0;        // dh/dx
+    double slope_y = 0;        // dh/dy
+    double deviation_m = 0;
+  };
+  bool PlaneAround(double x_m, double y_m, double r_m, LocalPlane* out) const;
 
   const Heightfield& heights() const { return heights_; }
   int default_ground() const { return default_ground_; }
@@ -73,7 +83,11 @@ class Terrain {
   bool IsValid(std::string* why) const;
 
  private:
+  // Cell (i, j) and local coordinates (u, w) in [0, 1]^2 of a point; false outside the grid.
+  bool Locate(double x_m, double y_m, int* i, int* j, double* u, double* w) const;
+
   Heightfield heights_;
+  double inv_dx_ = 1, inv_dy_ = 1;  // 1 / node spacing, 1/m
   GroundGrid ground_;
   int default_ground_ = 0;
 };

@@ -41,13 +41,21 @@ TEST(Terrain, OutsideAndNodataAreReported) {
   const Terrain holed(hf, 0);
   EXPECT_TRUE(holed.Sample(11, 21, &s));   // cell (0, 0) has no nodata corner
   EXPECT_FALSE(holed.Sample(13, 23, &s));  // cell (1, 1) touches node (2, 2)
-  EXPECT_EQ(holed.MaxHeightAround(13, 23, 0.5), std::numeric_limits<double>::infinity());
+  Terrain::LocalPlane plane;
+  EXPECT_FALSE(holed.PlaneAround(12.5, 22.5, 0.2, &plane));  // cell (1, 1) is in the box
 }
 
-TEST(Terrain, MaxHeightAroundCoversTheBox) {
+TEST(Terrain, LocalPlaneBoundsTheTerrainInTheBox) {
+  // z = x y / 100 departs from its tangent plane at (11, 21) by (x - 11)(y - 21)/100, which is
+  // largest, 0.01 m, at the nodes (10|12, 20|22) of the one cell covering the box.
   const Terrain t = Saddle();
-  EXPECT_NEAR(t.MaxHeightAround(11, 21, 0.5), 12.0 * 22.0 / 100, 1e-13);  // cell (0,0)'s corners
-  EXPECT_EQ(t.MaxHeightAround(10.2, 21, 0.5), std::numeric_limits<double>::infinity());  // beyond x0
+  Terrain::LocalPlane plane;
+  ASSERT_TRUE(t.PlaneAround(11, 21, 0.5, &plane));
+  EXPECT_NEAR(plane.at.height_m, 2.31, 1e-14);
+  EXPECT_NEAR(plane.slope_x, 0.21, 1e-14);
+  EXPECT_NEAR(plane.slope_y, 0.11, 1e-14);
+  EXPECT_NEAR(plane.deviation_m, 0.01, 1e-14);
+  EXPECT_FALSE(t.PlaneAround(10.2, 21, 0.5, &plane));  // the box reaches beyond x0
 }
 
 TEST(Terrain, GroundGridUsesNearestCellAndDefault) {
