@@ -5,6 +5,7 @@
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <map>
@@ -28,7 +29,8 @@ std::string CpuModel() {
 struct Batch {
   double wall_s = 0;
   long steps = 0, contact_steps = 0, iterations = 0, unconverged = 0;
-  double runout_sum_m = 0, time_sum_s = 0;
+  double time_sum_s = 0;
+  std::vector<double> runouts_m, max_speeds_m_s;
   std::map<std::string, int> endings;
 };
 
@@ -44,7 +46,8 @@ Batch RunBatch(const talus::Scene& scene, int rocks, std::uint64_t seed, talus::
     batch.contact_steps += r.contact_steps;
     batch.iterations += r.solver_iterations;
     batch.unconverged += r.unconverged_steps;
-    batch.runout_sum_m += (r.final_state.position_m - start.position_m).head<2>().norm();
+    batch.runouts_m.push_back((r.final_state.position_m - start.position_m).head<2>().norm());
+    batch.max_speeds_m_s.push_back(r.max_speed_m_s);
     batch.time_sum_s += r.travel_time_s;
     ++batch.endings[talus::ToString(r.end)];
   }
@@ -52,10 +55,21 @@ Batch RunBatch(const talus::Scene& scene, int rocks, std::uint64_t seed, talus::
   return batch;
 }
 
-double Median(std::vector<double> v) {
+double Quantile(std::vector<double> v, double q) {
   std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+  const double position = q * (v.size() - 1);
+  const std::size_t lo = static_cast<std::size_t>(position);
+  const std::size_t hi = std::min(lo + 1, v.size() - 1);
+  return v[lo] + (position - lo) * (v[hi] - v[lo]);
+}
+double Median(const std::vector<double>& v) { return Quantile(v, 0.5); }
+
+// Mean and its standard error.
+std::pair<double, double> MeanAndError(const std::vector<double>& v) {
+  double mean = 0, var = 0;
+  for (double x : v) mean += x / v.size();
+  for (double x : v) var += (x - mean) * (x - mean) / (v.size() - 1);
+  return {mean, std::sqrt(var / v.size())};
 }
 
 }  // namespace
@@ -108,8 +122,13 @@ int main(int argc, char** argv) {
   }
   std::printf("\ntrajectories per second (one core, median of %d): %.1f\n", repeats, Median(rates));
   std::printf("steps per second (median): %.3g\n", Median(step_rates));
-  std::printf("mean simulated time per trajectory: %.2f s; mean runout %.1f m\n",
-              last.time_sum_s / rocks, last.runout_sum_m / rocks);
+  const auto [runout, runout_error] = MeanAndError(last.runouts_m);
+  const auto [speed, speed_error] = MeanAndError(last.max_speeds_m_s);
+  std::printf("mean simulated time per trajectory: %.2f s\n", last.time_sum_s / rocks);
+  std::printf("accuracy figures (compare across --dt / --tolerance): runout mean %.1f +- %.1f m, "
+              "median %.1f m, 95th percentile %.1f m; max speed mean %.2f +- %.2f m/s\n",
+              runout, runout_error, Median(last.runouts_m), Quantile(last.runouts_m, 0.95), speed,
+              speed_error);
   std::printf("contact steps: %.1f %% of steps; mean Gauss-Seidel sweeps per contact step: %.2f; "
               "unconverged steps: %ld\n",
               100.0 * last.contact_steps / last.steps,
