@@ -22,8 +22,10 @@ int RunDemo(std::uint64_t seed) {
   SimulationWorkspace workspace;
   const RockResult result = SimulateRock(scene, start, workspace);
   const auto& end = result.final_state.position_m;
-  std::printf("Demo: EOTA221 block (%.0f kg) released 1 m above a 40 deg ramp (medium_hard ground), seed %llu\n",
-              scene.rock.mass_kg, static_cast<unsigned long long>(seed));
+  std::printf(
+      "Demo: EOTA221 block (%.0f kg) released 1 m above a 40 deg ramp (medium_hard ground), seed "
+      "%llu\n",
+      scene.rock.mass_kg, static_cast<unsigned long long>(seed));
   std::printf("  %s\n", result.BriefReport().c_str());
   std::printf("  end position (%.2f, %.2f, %.2f) m, runout %.1f m from release\n", end.x(), end.y(),
               end.z(), (end - start.position_m).head<2>().norm());
@@ -34,7 +36,8 @@ int RunDemo(std::uint64_t seed) {
 
 Runner AddDemoCommand(CLI::App& app) {
   auto seed = std::make_shared<std::uint64_t>(1);
-  CLI::App* demo = app.add_subcommand("demo", "Run one EOTA221 block down the 40 degree benchmark ramp");
+  CLI::App* demo =
+      app.add_subcommand("demo", "Run one EOTA221 block down the 40 degree benchmark ramp");
   demo->add_option("--seed", *seed, "Random seed of the release orientation");
   return [demo, seed]() { return *demo ? RunDemo(*seed) : -1; };
 }

@@ -2,6 +2,8 @@
 // Prints the machine, trajectories per second (median of repeats), steps per second, contact-solver
 // sweeps per contact step and a per-stage time profile.
 
+#include <sys/utsname.h>
+
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
@@ -10,7 +12,6 @@
 #include <fstream>
 #include <map>
 #include <string>
-#include <sys/utsname.h>
 #include <thread>
 #include <vector>
 
@@ -80,9 +81,11 @@ int main(int argc, char** argv) {
   double dt_s = 0.002, tolerance = -1;
   std::uint64_t seed = 1;
   app.add_option("--rocks", rocks, "Trajectories per repeat")->check(CLI::PositiveNumber);
-  app.add_option("--repeats", repeats, "Repeats (the median is reported)")->check(CLI::PositiveNumber);
+  app.add_option("--repeats", repeats, "Repeats (the median is reported)")
+      ->check(CLI::PositiveNumber);
   app.add_option("--dt", dt_s, "Time step, s")->check(CLI::PositiveNumber);
-  app.add_option("--tolerance", tolerance, "Contact solver tolerance, m/s (default: solver default)");
+  app.add_option("--tolerance", tolerance,
+                 "Contact solver tolerance, m/s (default: solver default)");
   app.add_option("--seed", seed, "Seed of the release orientations");
   CLI11_PARSE(app, argc, argv);
 
@@ -106,10 +109,11 @@ int main(int argc, char** argv) {
               "debug"
 #endif
   );
-  std::printf("scene: EOTA221 %.0f kg, %zu hull vertices; 40 deg ramp 200 m + 150 m runout, 2 m cells, "
-              "medium_hard; dt %.4f s, tolerance %.1e m/s\n",
-              scene.rock.mass_kg, scene.rock.vertices_m.size(), scene.options.dt_s,
-              scene.options.tolerance_m_s);
+  std::printf(
+      "scene: EOTA221 %.0f kg, %zu hull vertices; 40 deg ramp 200 m + 150 m runout, 2 m cells, "
+      "medium_hard; dt %.4f s, tolerance %.1e m/s\n",
+      scene.rock.mass_kg, scene.rock.vertices_m.size(), scene.options.dt_s,
+      scene.options.tolerance_m_s);
 
   std::vector<double> rates, step_rates;
   Batch last;
@@ -125,31 +129,37 @@ int main(int argc, char** argv) {
   const auto [runout, runout_error] = MeanAndError(last.runouts_m);
   const auto [speed, speed_error] = MeanAndError(last.max_speeds_m_s);
   std::printf("mean simulated time per trajectory: %.2f s\n", last.time_sum_s / rocks);
-  std::printf("accuracy figures (compare across --dt / --tolerance): runout mean %.1f +- %.1f m, "
-              "median %.1f m, 95th percentile %.1f m; max speed mean %.2f +- %.2f m/s\n",
-              runout, runout_error, Median(last.runouts_m), Quantile(last.runouts_m, 0.95), speed,
-              speed_error);
-  std::printf("contact steps: %.1f %% of steps; mean Gauss-Seidel sweeps per contact step: %.2f; "
-              "unconverged steps: %ld\n",
-              100.0 * last.contact_steps / last.steps,
-              last.contact_steps ? double(last.iterations) / last.contact_steps : 0.0, last.unconverged);
+  std::printf(
+      "accuracy figures (compare across --dt / --tolerance): runout mean %.1f +- %.1f m, "
+      "median %.1f m, 95th percentile %.1f m; max speed mean %.2f +- %.2f m/s\n",
+      runout, runout_error, Median(last.runouts_m), Quantile(last.runouts_m, 0.95), speed,
+      speed_error);
+  std::printf(
+      "contact steps: %.1f %% of steps; mean Gauss-Seidel sweeps per contact step: %.2f; "
+      "unconverged steps: %ld\n",
+      100.0 * last.contact_steps / last.steps,
+      last.contact_steps ? double(last.iterations) / last.contact_steps : 0.0, last.unconverged);
   std::printf("endings:");
   for (const auto& [end, count] : last.endings) std::printf(" %s %d", end.c_str(), count);
-  std::printf("\nreference: RAMMS::ROCKFALL 1000 trajectories in 161.5 s = 6.2 trajectories/s "
-              "(Leine et al. 2021, Table 1)\n");
+  std::printf(
+      "\nreference: RAMMS::ROCKFALL 1000 trajectories in 161.5 s = 6.2 trajectories/s "
+      "(Leine et al. 2021, Table 1)\n");
 
   // Stage profile in a separate run (the clock calls cost time of their own).
   talus::StageTimes times;
   const Batch profiled = RunBatch(scene, std::max(1, rocks / 4), seed, &times);
-  const double total = times.midpoint_s + times.free_rotation_s + times.contacts_s + times.solve_s + times.end_s;
-  std::printf("\nstage profile (%ld steps, %.0f ns/step timed):\n", times.steps, 1e9 * total / times.steps);
+  const double total =
+      times.midpoint_s + times.free_rotation_s + times.contacts_s + times.solve_s + times.end_s;
+  std::printf("\nstage profile (%ld steps, %.0f ns/step timed):\n", times.steps,
+              1e9 * total / times.steps);
   const std::pair<const char*, double> stages[] = {{"midpoint", times.midpoint_s},
                                                    {"free rotation", times.free_rotation_s},
                                                    {"contact detection", times.contacts_s},
                                                    {"contact solve", times.solve_s},
                                                    {"end point + scar", times.end_s}};
   for (const auto& [name, seconds] : stages)
-    std::printf("  %-18s %6.1f %%  %6.0f ns/step\n", name, 100 * seconds / total, 1e9 * seconds / times.steps);
+    std::printf("  %-18s %6.1f %%  %6.0f ns/step\n", name, 100 * seconds / total,
+                1e9 * seconds / times.steps);
   (void)profiled;
   return 0;
 }

@@ -8,15 +8,15 @@ namespace talus {
 
 // One closed vertex contact at the midpoint configuration.
 struct Contact {
-  int vertex = 0;                // hull vertex index
-  int ground = 0;                // ground index at the contact point
-  double mu = 0;                 // friction coefficient mu(s) for this step
-  Eigen::Matrix3d directions;    // world: columns n, t1, t2
-  Eigen::Matrix3d arms;          // body: columns b x (R' d) for d = n, t1, t2 (rotational Jacobian)
+  int vertex = 0;              // hull vertex index
+  int ground = 0;              // ground index at the contact point
+  double mu = 0;               // friction coefficient mu(s) for this step
+  Eigen::Matrix3d directions;  // world: columns n, t1, t2
+  Eigen::Matrix3d arms;        // body: columns b x (R' d) for d = n, t1, t2 (rotational Jacobian)
   Eigen::Matrix3d inv_inertia_arms;  // Theta^-1 arms
-  Eigen::Matrix3d delassus;      // G = W' M^-1 W for this contact (1/kg), and its inverse
+  Eigen::Matrix3d delassus;          // G = W' M^-1 W for this contact (1/kg), and its inverse
   Eigen::Matrix3d delassus_inverse;
-  double r_normal = 0;           // prox step lengths (kg), used when the exact local solve fails
+  double r_normal = 0;  // prox step lengths (kg), used when the exact local solve fails
   double r_tangent = 0;
   Eigen::Vector3d restitution_term = Eigen::Vector3d::Zero();  // eps (.) gamma_B
   Eigen::Vector3d percussion = Eigen::Vector3d::Zero();        // (P_N, P_T1, P_T2), N s

@@ -1,8 +1,8 @@
 #include "solver/contact_solver.hpp"
 
+#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
-#include <Eigen/LU>
 
 namespace talus {
 namespace {
@@ -17,11 +17,14 @@ Eigen::Vector2d ProjectDisk(const Eigen::Vector2d& p, double bound) {
 // velocity of gamma = xi0 + G P, and gamma_N = 0. Newton's method on the angle of d for
 // F = d x gamma_T = 0 (analytic derivative; d is turned without trigonometric calls), started
 // opposite to the tangential velocity that a frictionless impact would leave.
-bool SolveSlip(const Eigen::Matrix3d& g, const Eigen::Vector3d& xi0, double mu, Eigen::Vector3d* p) {
+bool SolveSlip(const Eigen::Matrix3d& g, const Eigen::Vector3d& xi0, double mu,
+               Eigen::Vector3d* p) {
   const double a = g(0, 0);
   const Eigen::Vector2d b = g.block<2, 1>(1, 0);
   const Eigen::Matrix2d c = g.block<2, 2>(1, 1);
-  auto cross = [](const Eigen::Vector2d& u, const Eigen::Vector2d& v) { return u.x() * v.y() - u.y() * v.x(); };
+  auto cross = [](const Eigen::Vector2d& u, const Eigen::Vector2d& v) {
+    return u.x() * v.y() - u.y() * v.x();
+  };
   Eigen::Vector2d d = -(xi0.tail<2>() - (xi0.x() / a) * b);
   if (d.squaredNorm() == 0) return false;
   d.normalize();
@@ -73,7 +76,8 @@ bool SolveLocal(const Contact& c, const Eigen::Vector3d& xi0, Eigen::Vector3d* p
 }
 
 // Fallback: proximal-point iterations on the contact's own 3 x 3 problem.
-Eigen::Vector3d ProxLocal(const Contact& c, const Eigen::Vector3d& xi0, Eigen::Vector3d p, double tolerance) {
+Eigen::Vector3d ProxLocal(const Contact& c, const Eigen::Vector3d& xi0, Eigen::Vector3d p,
+                          double tolerance) {
   for (int iter = 0; iter < 1000; ++iter) {
     const Eigen::Vector3d xi = xi0 + c.delassus * p;
     Eigen::Vector3d next;

@@ -25,7 +25,8 @@ bool GroundParams::IsValid(std::string* why) const {
   return Check(std::isfinite(mu_min) && mu_min >= 0, why, "mu_min", mu_min, "0 <= mu_min") &&
          Check(std::isfinite(mu_max) && mu_max >= mu_min, why, "mu_max", mu_max,
                "mu_min <= mu_max < infinity") &&
-         Check(std::isfinite(beta_1_s) && beta_1_s >= 0, why, "beta", beta_1_s, "beta >= 0 (1/s)") &&
+         Check(std::isfinite(beta_1_s) && beta_1_s >= 0, why, "beta", beta_1_s,
+               "beta >= 0 (1/s)") &&
          Check(std::isfinite(kappa_1_m) && kappa_1_m >= 0, why, "kappa", kappa_1_m,
                "kappa >= 0 (1/m)") &&
          Check(std::isfinite(nu_1_s) && nu_1_s >= 0, why, "nu", nu_1_s, "nu >= 0 (1/s)");

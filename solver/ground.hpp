@@ -40,8 +40,8 @@ class GroundTable {
   // Returns the category's index.
   int Set(const GroundCategory& category);
 
-  int IndexOfCode(int code) const;              // -1 when no category has this code
-  int IndexOfName(std::string_view name) const; // -1 when unknown
+  int IndexOfCode(int code) const;               // -1 when no category has this code
+  int IndexOfName(std::string_view name) const;  // -1 when unknown
 
   int size() const { return static_cast<int>(categories_.size()); }
   const GroundCategory& category(int index) const { return categories_[index]; }

@@ -11,13 +11,16 @@ bool SolverOptions::IsValid(std::string* why) const {
     if (!ok && msg.str().empty()) msg << field << " = " << value << " violates " << bound;
   };
   check(dt_s > 0 && dt_s <= 0.1, "dt_s", dt_s, "0 < dt_s <= 0.1 s");
-  check(max_time_s > 0 && std::isfinite(max_time_s), "max_time_s", max_time_s, "0 < max_time_s < inf");
-  check(gravity_m_s2 >= 0 && std::isfinite(gravity_m_s2), "gravity_m_s2", gravity_m_s2, "gravity >= 0");
-  check(normal_restitution >= 0 && normal_restitution <= 1, "normal_restitution", normal_restitution,
-        "0 <= normal_restitution <= 1");
+  check(max_time_s > 0 && std::isfinite(max_time_s), "max_time_s", max_time_s,
+        "0 < max_time_s < inf");
+  check(gravity_m_s2 >= 0 && std::isfinite(gravity_m_s2), "gravity_m_s2", gravity_m_s2,
+        "gravity >= 0");
+  check(normal_restitution >= 0 && normal_restitution <= 1, "normal_restitution",
+        normal_restitution, "0 <= normal_restitution <= 1");
   check(tangential_restitution >= -1 && tangential_restitution <= 1, "tangential_restitution",
         tangential_restitution, "-1 <= tangential_restitution <= 1");
-  check(tolerance_m_s > 0 && tolerance_m_s < 1, "tolerance_m_s", tolerance_m_s, "0 < tolerance_m_s < 1 m/s");
+  check(tolerance_m_s > 0 && tolerance_m_s < 1, "tolerance_m_s", tolerance_m_s,
+        "0 < tolerance_m_s < 1 m/s");
   check(max_iterations >= 1 && max_iterations <= 100000, "max_iterations", max_iterations,
         "1 <= max_iterations <= 100000");
   check(prox_alpha > 0 && prox_alpha < 2, "prox_alpha", prox_alpha, "0 < prox_alpha < 2");
@@ -25,7 +28,8 @@ bool SolverOptions::IsValid(std::string* why) const {
         "rest_speed_m_s >= 0");
   check(rest_angular_speed_rad_s >= 0 && std::isfinite(rest_angular_speed_rad_s),
         "rest_angular_speed_rad_s", rest_angular_speed_rad_s, "rest_angular_speed_rad_s >= 0");
-  check(rest_hold_s >= 0 && std::isfinite(rest_hold_s), "rest_hold_s", rest_hold_s, "rest_hold_s >= 0");
+  check(rest_hold_s >= 0 && std::isfinite(rest_hold_s), "rest_hold_s", rest_hold_s,
+        "rest_hold_s >= 0");
   if (msg.str().empty()) return true;
   if (why) *why = msg.str();
   return false;

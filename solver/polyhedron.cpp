@@ -8,8 +8,9 @@ namespace talus {
 
 MassProperties ComputeMassProperties(const Polyhedron& poly, double density_kg_m3) {
   // Coordinates are taken relative to the vertex mean so that large (georeferenced) offsets
-  // cost no precision. Each triangle (a, b, c) and that origin span a signed tetrahedron of volume a.(b x c)/6 with
-  // centroid (a + b + c)/4 and second-moment tensor (V/20)(a a' + b b' + c c' + s s'), s = a + b + c.
+  // cost no precision. Each triangle (a, b, c) and that origin span a signed tetrahedron of volume
+  // a.(b x c)/6 with centroid (a + b + c)/4 and second-moment tensor (V/20)(a a' + b b' + c c' + s
+  // s'), s = a + b + c.
   Eigen::Vector3d origin = Eigen::Vector3d::Zero();
   for (const auto& v : poly.vertices_m) origin += v;
   if (!poly.vertices_m.empty()) origin /= static_cast<double>(poly.vertices_m.size());
@@ -24,8 +25,8 @@ MassProperties ComputeMassProperties(const Polyhedron& poly, double density_kg_m
     const Eigen::Vector3d s = a + b + c;
     volume += v;
     first += v * s / 4.0;
-    second += (v / 20.0) * (a * a.transpose() + b * b.transpose() + c * c.transpose() +
-                            s * s.transpose());
+    second += (v / 20.0) *
+              (a * a.transpose() + b * b.transpose() + c * c.transpose() + s * s.transpose());
   }
   MassProperties mp;
   mp.volume_m3 = volume;

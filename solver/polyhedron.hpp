@@ -26,11 +26,12 @@ MassProperties ComputeMassProperties(const Polyhedron& poly, double density_kg_m
 
 // The rock as the solver sees it: a convex polyhedron in its principal frame.
 struct RockShape {
-  std::vector<Eigen::Vector3d> vertices_m;   // hull vertices, principal frame, origin at the centroid
+  std::vector<Eigen::Vector3d>
+      vertices_m;  // hull vertices, principal frame, origin at the centroid
   double mass_kg = 0;
   double volume_m3 = 0;
   Eigen::Vector3d inertia_kg_m2 = Eigen::Vector3d::Ones();  // principal moments, ascending
-  double bounding_radius_m = 0;                              // max |vertex|
+  double bounding_radius_m = 0;                             // max |vertex|
   // x_input = centroid_input_m + principal_to_input * x_principal: how the principal frame sits in
   // the frame the shape was given in (point cloud axes, or a built-in's a, b, c along x, y, z).
   Eigen::Quaterniond principal_to_input = Eigen::Quaterniond::Identity();

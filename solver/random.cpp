@@ -8,7 +8,8 @@ namespace talus {
 RockRandom::RockRandom(std::uint64_t seed, std::uint64_t rock_index) {
   // std::seed_seq and std::mt19937_64 are fully specified by the standard: portable streams.
   std::seed_seq seq{static_cast<std::uint32_t>(seed), static_cast<std::uint32_t>(seed >> 32),
-                    static_cast<std::uint32_t>(rock_index), static_cast<std::uint32_t>(rock_index >> 32)};
+                    static_cast<std::uint32_t>(rock_index),
+                    static_cast<std::uint32_t>(rock_index >> 32)};
   engine_.seed(seq);
 }
 

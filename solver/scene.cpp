@@ -13,13 +13,15 @@ bool Scene::IsValid(std::string* why) const {
   if (!rock.IsValid(&reason)) return fail("rock");
   if (!options.IsValid(&reason)) return fail("solver");
   if (terrain.default_ground() < 0 || terrain.default_ground() >= ground.size()) {
-    reason = "default ground index " + std::to_string(terrain.default_ground()) + " is not in the table";
+    reason =
+        "default ground index " + std::to_string(terrain.default_ground()) + " is not in the table";
     return fail("terrain");
   }
   if (terrain.has_ground_grid()) {
     for (auto index : terrain.ground_grid().index) {
       if (index != GroundGrid::kNoGround && index >= ground.size()) {
-        reason = "ground grid refers to category index " + std::to_string(index) + " not in the table";
+        reason =
+            "ground grid refers to category index " + std::to_string(index) + " not in the table";
         return fail("terrain");
       }
     }

@@ -22,12 +22,15 @@ void AddConvexFace(Polyhedron& poly, std::vector<int> ids, const Eigen::Vector3d
     return std::atan2(d.dot(w), d.dot(u));
   };
   std::sort(ids.begin(), ids.end(), [&](int p, int q) { return angle(p) < angle(q); });
-  for (std::size_t k = 1; k + 1 < ids.size(); ++k) poly.triangles.push_back({ids[0], ids[k], ids[k + 1]});
+  for (std::size_t k = 1; k + 1 < ids.size(); ++k)
+    poly.triangles.push_back({ids[0], ids[k], ids[k + 1]});
 }
 
 }  // namespace
 
-Polyhedron MakeBox(double a_m, double b_m, double c_m) { return MakeBevelledBox(a_m, b_m, c_m, 0.0); }
+Polyhedron MakeBox(double a_m, double b_m, double c_m) {
+  return MakeBevelledBox(a_m, b_m, c_m, 0.0);
+}
 
 Polyhedron MakeOctahedron(double a_m, double b_m, double c_m) {
   Polyhedron poly;
@@ -49,9 +52,9 @@ Polyhedron MakeOctahedron(double a_m, double b_m, double c_m) {
 
 Polyhedron MakeIcosphere(double radius_m, int subdivisions) {
   const double t = (1.0 + std::sqrt(5.0)) / 2.0;
-  std::vector<Eigen::Vector3d> v = {{-1, t, 0}, {1, t, 0},  {-1, -t, 0}, {1, -t, 0},
-                                    {0, -1, t}, {0, 1, t},  {0, -1, -t}, {0, 1, -t},
-                                    {t, 0, -1}, {t, 0, 1},  {-t, 0, -1}, {-t, 0, 1}};
+  std::vector<Eigen::Vector3d> v = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0},
+                                    {0, -1, t}, {0, 1, t}, {0, -1, -t}, {0, 1, -t},
+                                    {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
   std::vector<std::array<int, 3>> f = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
                                        {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
                                        {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
@@ -87,7 +90,8 @@ Polyhedron MakeIcosphere(double radius_m, int subdivisions) {
 
 Polyhedron MakeEllipsoid(double a_m, double b_m, double c_m, int subdivisions) {
   Polyhedron poly = MakeIcosphere(1.0, subdivisions);
-  for (auto& p : poly.vertices_m) p = Eigen::Vector3d(p.x() * a_m / 2, p.y() * b_m / 2, p.z() * c_m / 2);
+  for (auto& p : poly.vertices_m)
+    p = Eigen::Vector3d(p.x() * a_m / 2, p.y() * b_m / 2, p.z() * c_m / 2);
   return poly;
 }
 
@@ -162,7 +166,9 @@ Polyhedron MakeBevelledBox(double a_m, double b_m, double c_m, double bevel_m) {
 }
 
 double BevelForVolume(double a_m, double b_m, double c_m, double volume_m3) {
-  auto volume = [&](double d) { return ComputeMassProperties(MakeBevelledBox(a_m, b_m, c_m, d), 1.0).volume_m3; };
+  auto volume = [&](double d) {
+    return ComputeMassProperties(MakeBevelledBox(a_m, b_m, c_m, d), 1.0).volume_m3;
+  };
   double lo = 0, hi = 0.5 * std::min({a_m, b_m, c_m}) * (1 - 1e-9);
   if (volume_m3 > volume(lo) * (1 + 1e-12) || volume_m3 < volume(hi)) return -1;
   for (int k = 0; k < 100; ++k) {

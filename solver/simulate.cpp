@@ -8,10 +8,14 @@ namespace talus {
 
 const char* ToString(EndReason reason) {
   switch (reason) {
-    case EndReason::kRest: return "rest";
-    case EndReason::kLeftDomain: return "left_domain";
-    case EndReason::kMaxTime: return "max_time";
-    case EndReason::kFailed: return "failed";
+    case EndReason::kRest:
+      return "rest";
+    case EndReason::kLeftDomain:
+      return "left_domain";
+    case EndReason::kMaxTime:
+      return "max_time";
+    case EndReason::kFailed:
+      return "failed";
   }
   return "unknown";
 }
@@ -64,9 +68,10 @@ RockResult SimulateRock(const Scene& scene, const RockState& start, SimulationWo
   // Statistics along the path, the release state included.
   auto record = [&](const TerrainSample& under) {
     result.max_speed_m_s = std::max(result.max_speed_m_s, state.velocity_m_s.norm());
-    result.max_kinetic_energy_j = std::max(result.max_kinetic_energy_j, KineticEnergy(scene.rock, state));
-    result.max_jump_height_m = std::max(
-        result.max_jump_height_m, (state.position_m.z() - under.height_m) * under.normal.z());
+    result.max_kinetic_energy_j =
+        std::max(result.max_kinetic_energy_j, KineticEnergy(scene.rock, state));
+    result.max_jump_height_m = std::max(result.max_jump_height_m,
+                                        (state.position_m.z() - under.height_m) * under.normal.z());
     result.max_angular_speed_rad_s =
         std::max(result.max_angular_speed_rad_s, state.angular_velocity_rad_s.norm());
     result.max_scar_m = std::max(result.max_scar_m, state.scar_m);

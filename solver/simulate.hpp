@@ -16,19 +16,19 @@ const char* ToString(EndReason reason);  // "rest", "left_domain", "max_time", "
 // What happened to one rock: its ending, final state and the extremes along its path.
 struct RockResult {
   EndReason end = EndReason::kMaxTime;
-  std::string message;            // why it failed, for kFailed
+  std::string message;  // why it failed, for kFailed
   RockState final_state;
   double travel_time_s = 0;
-  double path_length_m = 0;       // horizontal path of the centre of mass
+  double path_length_m = 0;  // horizontal path of the centre of mass
   double max_speed_m_s = 0;
   double max_kinetic_energy_j = 0;  // translational + rotational
-  double max_jump_height_m = 0;   // centre of mass above ground, along the terrain normal
+  double max_jump_height_m = 0;     // centre of mass above ground, along the terrain normal
   double max_angular_speed_rad_s = 0;
   double max_scar_m = 0;
   long steps = 0;
-  long contact_steps = 0;         // steps with at least one closed contact
-  long solver_iterations = 0;     // Gauss-Seidel sweeps, summed over steps
-  long unconverged_steps = 0;     // steps whose contact solve hit max_iterations
+  long contact_steps = 0;      // steps with at least one closed contact
+  long solver_iterations = 0;  // Gauss-Seidel sweeps, summed over steps
+  long unconverged_steps = 0;  // steps whose contact solve hit max_iterations
 
   // One line: ending, time, speeds, energy.
   std::string BriefReport() const;
@@ -39,7 +39,8 @@ class StepObserver {
  public:
   virtual ~StepObserver() = default;
   // ground: what the terrain says under the centre of mass.
-  virtual void OnStep(const RockState& state, const StepReport& step, const TerrainSample& ground) = 0;
+  virtual void OnStep(const RockState& state, const StepReport& step,
+                      const TerrainSample& ground) = 0;
 };
 
 // Per-thread scratch space for SimulateRock.

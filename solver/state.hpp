@@ -7,11 +7,11 @@
 namespace talus {
 
 struct RockState {
-  Eigen::Vector3d position_m = Eigen::Vector3d::Zero();      // centre of mass, world
-  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();  // principal frame -> world
-  Eigen::Vector3d velocity_m_s = Eigen::Vector3d::Zero();    // centre of mass, world
+  Eigen::Vector3d position_m = Eigen::Vector3d::Zero();              // centre of mass, world
+  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();   // principal frame -> world
+  Eigen::Vector3d velocity_m_s = Eigen::Vector3d::Zero();            // centre of mass, world
   Eigen::Vector3d angular_velocity_rad_s = Eigen::Vector3d::Zero();  // principal (body) frame
-  double scar_m = 0;       // scar length s >= 0
+  double scar_m = 0;                                                 // scar length s >= 0
   double time_s = 0;
   double rest_timer_s = 0;  // how long the rock has been below the rest thresholds
   int scar_ground = -1;     // ground index of the last loaded contact (its beta decays the scar)

@@ -8,10 +8,10 @@
 namespace talus {
 
 struct StepReport {
-  int contacts = 0;        // closed contacts at the midpoint
-  int iterations = 0;      // Gauss-Seidel sweeps
-  bool converged = true;   // contact solve met its tolerance
-  bool loaded = false;     // a contact carried load: the scar grew
+  int contacts = 0;             // closed contacts at the midpoint
+  int iterations = 0;           // Gauss-Seidel sweeps
+  bool converged = true;        // contact solve met its tolerance
+  bool loaded = false;          // a contact carried load: the scar grew
   bool outside_domain = false;  // a vertex near the ground is outside the DEM or over nodata
 };
 

@@ -99,7 +99,8 @@ bool Terrain::PlaneAround(double x_m, double y_m, double r_m, LocalPlane* out) c
     const double dy = g.y0_m + j * g.dy_m - y_m;
     for (int i = static_cast<int>(i_lo); i <= static_cast<int>(i_hi); ++i) {
       const double dx = g.x0_m + i * g.dx_m - x_m;
-      const double d = std::abs(row[i] - (out->at.height_m + out->slope_x * dx + out->slope_y * dy));
+      const double d =
+          std::abs(row[i] - (out->at.height_m + out->slope_x * dx + out->slope_y * dy));
       if (!(d <= deviation)) deviation = d;  // also takes NaN (nodata), which fails below
     }
   }
@@ -111,8 +112,9 @@ bool Terrain::IsValid(std::string* why) const {
   const GridGeometry& g = heights_.grid;
   if (!g.IsValid(why)) return false;
   if (heights_.z_m.size() != static_cast<std::size_t>(g.nx) * g.ny) {
-    if (why) *why = "heightfield has " + std::to_string(heights_.z_m.size()) + " values for a " +
-                    std::to_string(g.nx) + " x " + std::to_string(g.ny) + " grid";
+    if (why)
+      *why = "heightfield has " + std::to_string(heights_.z_m.size()) + " values for a " +
+             std::to_string(g.nx) + " x " + std::to_string(g.ny) + " grid";
     return false;
   }
   for (double z : heights_.z_m) {
@@ -121,7 +123,8 @@ bool Terrain::IsValid(std::string* why) const {
       return false;
     }
   }
-  if (std::all_of(heights_.z_m.begin(), heights_.z_m.end(), [](double z) { return std::isnan(z); })) {
+  if (std::all_of(heights_.z_m.begin(), heights_.z_m.end(),
+                  [](double z) { return std::isnan(z); })) {
     if (why) *why = "heightfield has no valid height (all nodata)";
     return false;
   }
@@ -159,7 +162,8 @@ bool PlaneSpec::IsValid(std::string* why) const {
 Heightfield MakePlaneHeightfield(const PlaneSpec& spec) {
   Heightfield hf;
   GridGeometry& g = hf.grid;
-  g.nx = static_cast<int>(std::ceil((spec.slope_length_m + spec.runout_m) / spec.cell_m - 1e-9)) + 1;
+  g.nx =
+      static_cast<int>(std::ceil((spec.slope_length_m + spec.runout_m) / spec.cell_m - 1e-9)) + 1;
   g.ny = static_cast<int>(std::ceil(spec.width_m / spec.cell_m - 1e-9)) + 1;
   g.dx_m = g.dy_m = spec.cell_m;
   g.x0_m = 0;

@@ -9,7 +9,8 @@
 
 namespace talus {
 
-// A regular grid of nodes: node (i, j) sits at (x0_m + i dx_m, y0_m + j dy_m), i along x, j along y.
+// A regular grid of nodes: node (i, j) sits at (x0_m + i dx_m, y0_m + j dy_m), i along x, j along
+// y.
 struct GridGeometry {
   int nx = 0;
   int ny = 0;
@@ -67,9 +68,9 @@ class Terrain {
   // (h - plane is the bilinear interpolant of its node values, so the largest node deviation of
   // the cells covering the box bounds it.) False when the box reaches beyond the grid or nodata.
   struct LocalPlane {
-    TerrainSample at;          // height and normal at (x, y)
-    double slope_x = 0;        // dh/dx
-    double slope_y = 0;        // dh/dy
+    TerrainSample at;    // height and normal at (x, y)
+    double slope_x = 0;  // dh/dx
+    double slope_y = 0;  // dh/dy
     double deviation_m = 0;
   };
   bool PlaneAround(double x_m, double y_m, double r_m, LocalPlane* out) const;

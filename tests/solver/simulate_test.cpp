@@ -15,7 +15,8 @@ namespace talus {
 namespace {
 
 Scene FlatScene() {
-  return scenes::Incline(0, MakeRockShape(MakeBox(1, 1, 0.5), 2700), GroundParams{0.5, 0.5, 150, 2, 0});
+  return scenes::Incline(0, MakeRockShape(MakeBox(1, 1, 0.5), 2700),
+                         GroundParams{0.5, 0.5, 150, 2, 0});
 }
 
 TEST(Simulate, FreeFallStatisticsMatchClosedForm) {
@@ -28,7 +29,8 @@ TEST(Simulate, FreeFallStatisticsMatchClosedForm) {
   const RockResult r = SimulateRock(scene, s, ws);
   EXPECT_EQ(r.end, EndReason::kRest);
   EXPECT_NEAR(r.max_jump_height_m, 20.25, 1e-9);
-  EXPECT_NEAR(r.max_kinetic_energy_j, scene.rock.mass_kg * 9.81 * 20, 0.01 * scene.rock.mass_kg * 9.81 * 20);
+  EXPECT_NEAR(r.max_kinetic_energy_j, scene.rock.mass_kg * 9.81 * 20,
+              0.01 * scene.rock.mass_kg * 9.81 * 20);
   EXPECT_NEAR(r.max_speed_m_s, std::sqrt(2 * 9.81 * 20), 0.01 * std::sqrt(2 * 9.81 * 20));
   EXPECT_LT(r.path_length_m, 1e-6);
   EXPECT_EQ(r.unconverged_steps, 0);
@@ -49,7 +51,8 @@ TEST(Simulate, NodataEndsAsLeftDomain) {
   Scene scene = FlatScene();
   Heightfield hf = scene.terrain.heights();
   for (int j = 0; j < hf.grid.ny; ++j)
-    for (int i = 21; i < hf.grid.nx; ++i) hf.z_m[j * hf.grid.nx + i] = std::numeric_limits<double>::quiet_NaN();
+    for (int i = 21; i < hf.grid.nx; ++i)
+      hf.z_m[j * hf.grid.nx + i] = std::numeric_limits<double>::quiet_NaN();
   scene.terrain = Terrain(hf, scene.terrain.default_ground());
   SimulationWorkspace ws;
   RockState s;

@@ -17,7 +17,9 @@ namespace {
 constexpr double kG = 9.81;
 constexpr double kDeg = std::numbers::pi / 180;
 
-GroundParams ConstantFriction(double mu, double nu = 0) { return GroundParams{mu, mu, 150, 2.0, nu}; }
+GroundParams ConstantFriction(double mu, double nu = 0) {
+  return GroundParams{mu, mu, 150, 2.0, nu};
+}
 
 // Places the rock with the shape-frame orientation `q` so that its lowest vertex touches the
 // incline 1e-9 m deep, centre of mass above (x, y).
@@ -45,11 +47,15 @@ RockState Advance(const Scene& scene, RockState s, int steps, StepWorkspace& ws)
   return s;
 }
 
-Eigen::Quaterniond AboutY(double rad) { return Eigen::Quaterniond(Eigen::AngleAxisd(rad, Eigen::Vector3d::UnitY())); }
+Eigen::Quaterniond AboutY(double rad) {
+  return Eigen::Quaterniond(Eigen::AngleAxisd(rad, Eigen::Vector3d::UnitY()));
+}
 
 // A flat box 1 x 1 x 0.2 m lying on an incline of slope theta, sliding or sticking.
-RockState SlideBox(double slope_deg, double mu, double seconds, StepWorkspace& ws, Scene* out = nullptr) {
-  Scene scene = scenes::Incline(slope_deg, MakeRockShape(MakeBox(1, 1, 0.2), 2700), ConstantFriction(mu));
+RockState SlideBox(double slope_deg, double mu, double seconds, StepWorkspace& ws,
+                   Scene* out = nullptr) {
+  Scene scene =
+      scenes::Incline(slope_deg, MakeRockShape(MakeBox(1, 1, 0.2), 2700), ConstantFriction(mu));
   scene.options.tolerance_m_s = 1e-12;
   ws.Reset(scene.rock.vertices_m.size());
   const RockState start = Touching(scene, AboutY(slope_deg * kDeg), 100, 0);
@@ -82,7 +88,8 @@ TEST(Incline, BlockSlidesWithCoulombAcceleration) {
     const RockState start = SlideBox(slope, 0.5, 0.0, ws, &scene);
     const RockState end = Advance(scene, start, 1000, ws);
     const double a = kG * (std::sin(slope * kDeg) - 0.5 * std::cos(slope * kDeg));
-    const Eigen::Vector3d down = Eigen::Vector3d(std::cos(slope * kDeg), 0, -std::sin(slope * kDeg));
+    const Eigen::Vector3d down =
+        Eigen::Vector3d(std::cos(slope * kDeg), 0, -std::sin(slope * kDeg));
     EXPECT_NEAR(end.velocity_m_s.dot(down), a * 2.0, 1e-6 * a * 2.0) << "slope " << slope;
     EXPECT_NEAR((end.position_m - start.position_m).dot(down), a * 2.0, 1e-6 * a * 2.0);
     EXPECT_LT(end.angular_velocity_rad_s.norm(), 1e-9);
@@ -115,7 +122,8 @@ TEST(Incline, FineHullSphereRollsWithFiveSevenths) {
   const Eigen::Quaterniond identity = Eigen::Quaterniond::Identity();
   double previous_error = 1;
   for (int subdivisions : {3, 4, 5}) {
-    const RollResult r = Roll(MakeRockShape(MakeIcosphere(0.5, subdivisions), 2700), identity, 5.0 / 7, 3.0);
+    const RollResult r =
+        Roll(MakeRockShape(MakeIcosphere(0.5, subdivisions), 2700), identity, 5.0 / 7, 3.0);
     const double error = std::abs(r.distance_m / r.expected_m - 1);
     EXPECT_LT(r.distance_m, r.expected_m);  // impacts only take energy out
     EXPECT_LT(1.8 * error, previous_error) << subdivisions << " subdivisions";
@@ -128,8 +136,10 @@ TEST(Incline, DiskRollsWithTwoThirds) {
   // A solid cylinder (disk) rolls with a = 2/3 g sin(theta). 256-gon prism, axis across the slope;
   // measured: the roll-over impacts cost 1.4 % of the distance after 3 s (32-gon: 10.6 %,
   // 128-gon: 2.5 %). Tolerance 2 %.
-  const Eigen::Quaterniond axis_along_y(Eigen::AngleAxisd(std::numbers::pi / 2, Eigen::Vector3d::UnitX()));
-  const RollResult r = Roll(MakeRockShape(MakeCylinder(0.5, 0.3, 256), 2700), axis_along_y, 2.0 / 3, 3.0);
+  const Eigen::Quaterniond axis_along_y(
+      Eigen::AngleAxisd(std::numbers::pi / 2, Eigen::Vector3d::UnitX()));
+  const RollResult r =
+      Roll(MakeRockShape(MakeCylinder(0.5, 0.3, 256), 2700), axis_along_y, 2.0 / 3, 3.0);
   EXPECT_NEAR(r.distance_m, r.expected_m, 0.02 * r.expected_m);
 }
 
@@ -138,7 +148,8 @@ TEST(FlatGround, SlidingSphereEndsRollingAtFiveSevenths) {
   // (friction impulse J: v = v0 - J/m, w r = 5 J/(2 m)). With mu = 0.3 the slip ends at
   // t = 2 v0 / (7 mu g) = 0.49 s; measured at 0.6 s on a 10242-vertex icosphere: -0.86 %
   // (2562 vertices: -1.9 %). Tolerance 1.5 %.
-  const Scene scene = scenes::Incline(0, MakeRockShape(MakeIcosphere(0.5, 5), 2700), ConstantFriction(0.3));
+  const Scene scene =
+      scenes::Incline(0, MakeRockShape(MakeIcosphere(0.5, 5), 2700), ConstantFriction(0.3));
   StepWorkspace ws;
   ws.Reset(scene.rock.vertices_m.size());
   RockState s = Touching(scene, Eigen::Quaterniond::Identity(), 50, 0);
@@ -153,7 +164,8 @@ TEST(FlatGround, SlidingSphereEndsRollingAtFiveSevenths) {
 
 TEST(Impact, PlasticDropDoesNotBounce) {
   // epsilon_N = 0: the normal contact velocity after impact is zero; the block never rises again.
-  const Scene scene = scenes::Incline(0, MakeRockShape(MakeBox(1, 1, 0.5), 2700), ConstantFriction(0.5));
+  const Scene scene =
+      scenes::Incline(0, MakeRockShape(MakeBox(1, 1, 0.5), 2700), ConstantFriction(0.5));
   StepWorkspace ws;
   ws.Reset(scene.rock.vertices_m.size());
   RockState s = Touching(scene, Eigen::Quaterniond::Identity(), 50, 0);
@@ -194,7 +206,8 @@ TEST(Impact, NewtonRestitutionRebounds) {
 }
 
 TEST(Rest, BlockOnFlatGroundStaysAndIsReportedAtRest) {
-  Scene scene = scenes::Incline(0, MakeRockShape(MakeBox(1, 0.8, 0.5), 2700), ConstantFriction(0.5));
+  Scene scene =
+      scenes::Incline(0, MakeRockShape(MakeBox(1, 0.8, 0.5), 2700), ConstantFriction(0.5));
   SimulationWorkspace ws;
   const RockState start = Touching(scene, Eigen::Quaterniond::Identity(), 50, 0);
   const RockResult r = SimulateRock(scene, start, ws);
@@ -250,7 +263,8 @@ TEST(Scar, DecaysExponentiallyInFlight) {
 TEST(Drag, SlowsASlidingBlockAsImplicitViscousDrag) {
   // Flat ground, mu = 0, drag nu: the implicit update gives v_n = v0 / (1 + nu dt)^n, which
   // approaches v0 exp(-nu t); it never reverses or adds energy.
-  const Scene scene = scenes::Incline(0, MakeRockShape(MakeBox(1, 1, 0.2), 2700), ConstantFriction(0.0, 0.8));
+  const Scene scene =
+      scenes::Incline(0, MakeRockShape(MakeBox(1, 1, 0.2), 2700), ConstantFriction(0.0, 0.8));
   StepWorkspace ws;
   ws.Reset(scene.rock.vertices_m.size());
   RockState s = Touching(scene, Eigen::Quaterniond::Identity(), 50, 0);
@@ -267,8 +281,8 @@ namespace {
 
 TEST(Energy, ContactsNeverAddEnergy) {
   // Plastic contacts with Coulomb friction and drag are dissipative. In the midpoint scheme the
-  // percussions do no positive work on the end velocities (P_N gamma_N,E = 0, P_T . gamma_T,E <= 0);
-  // measured against the step's mean velocity they may, at order dt^2, so the mechanical energy
+  // percussions do no positive work on the end velocities (P_N gamma_N,E = 0, P_T . gamma_T,E <=
+  // 0); measured against the step's mean velocity they may, at order dt^2, so the mechanical energy
   // (kinetic + potential) is checked against its running minimum: it may not climb above it by
   // more than 1e-7 of the release energy (measured: 5e-9, about 7 mJ of 1.3 MJ). Ten EOTA221
   // blocks tumble 10 s down the 40 deg ramp.
