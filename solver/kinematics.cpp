@@ -41,7 +41,8 @@ Eigen::Vector3d FreeRotation(const Eigen::Vector3d& inertia_kg_m2, const Eigen::
     jacobian.diagonal() += inertia_kg_m2;
     const Eigen::Vector3d delta = jacobian.inverse() * residual;  // closed-form 3 x 3 inverse
     omega_f -= delta;
-    if (delta.norm() <= 1e-15 * scale) break;
+    // Quadratic convergence: the error left after a step of 1e-9 is round-off.
+    if (delta.norm() <= 1e-9 * scale) break;
   }
   return omega_f;
 }

@@ -51,7 +51,9 @@ TEST(FreeFlight, FollowsTheParabolaAndKeepsEnergy) {
 
 TEST(FreeRotation, CuboidConservesEnergyAndAngularMomentumOver1e5Steps) {
   // Implicit midpoint conserves both quadratic invariants exactly; required: 1e-9 relative over
-  // 1e5 steps at dt = 2 ms (Leine et al. 2021, Sec. 4).
+  // 1e5 steps at dt = 2 ms (Leine et al. 2021, Sec. 4). Measured: 1e-14 for both; the direction
+  // of the world angular momentum, which the orientation update does not conserve exactly, turns
+  // by 9e-7 rad over the 200 s.
   const Scene scene = FlightScene(Cuboid123(), 0.0);
   RockState s;
   s.position_m = {50, 0, 1000};
