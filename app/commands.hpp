@@ -10,5 +10,6 @@ namespace talus::app {
 using Runner = std::function<int()>;
 
 Runner AddDemoCommand(CLI::App& app);
+Runner AddRockCommand(CLI::App& app);
 
 }  // namespace talus::app

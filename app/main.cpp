@@ -13,6 +13,7 @@ int main(int argc, char** argv) {
 
   const std::vector<talus::app::Runner> runners = {
       talus::app::AddDemoCommand(app),
+      talus::app::AddRockCommand(app),
   };
 
   CLI11_PARSE(app, argc, argv);
