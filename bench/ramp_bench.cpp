@@ -79,6 +79,7 @@ int main(int argc, char** argv) {
   CLI::App app{"Ramp benchmark: EOTA221 block trajectories down a 40 degree plane, one core"};
   int rocks = 200, repeats = 5;
   double dt_s = 0.002, tolerance = -1;
+  int max_iterations = -1;
   std::uint64_t seed = 1;
   app.add_option("--rocks", rocks, "Trajectories per repeat")->check(CLI::PositiveNumber);
   app.add_option("--repeats", repeats, "Repeats (the median is reported)")
@@ -86,12 +87,15 @@ int main(int argc, char** argv) {
   app.add_option("--dt", dt_s, "Time step, s")->check(CLI::PositiveNumber);
   app.add_option("--tolerance", tolerance,
                  "Contact solver tolerance, m/s (default: solver default)");
+  app.add_option("--max-iterations", max_iterations,
+                 "Contact solver sweeps at most (default: solver default)");
   app.add_option("--seed", seed, "Seed of the release orientations");
   CLI11_PARSE(app, argc, argv);
 
   talus::Scene scene = talus::scenes::Ramp40();
   scene.options.dt_s = dt_s;
   if (tolerance > 0) scene.options.tolerance_m_s = tolerance;
+  if (max_iterations > 0) scene.options.max_iterations = max_iterations;
   std::string why;
   if (!scene.IsValid(&why)) {
     std::fprintf(stderr, "ramp_bench: %s\n", why.c_str());
@@ -111,9 +115,9 @@ int main(int argc, char** argv) {
   );
   std::printf(
       "scene: EOTA221 %.0f kg, %zu hull vertices; 40 deg ramp 200 m + 150 m runout, 2 m cells, "
-      "medium_hard; dt %.4f s, tolerance %.1e m/s\n",
+      "medium_hard; dt %.4f s, tolerance %.1e m/s, at most %d sweeps\n",
       scene.rock.mass_kg, scene.rock.vertices_m.size(), scene.options.dt_s,
-      scene.options.tolerance_m_s);
+      scene.options.tolerance_m_s, scene.options.max_iterations);
 
   std::vector<double> rates, step_rates;
   Batch last;
