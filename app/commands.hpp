@@ -11,5 +11,6 @@ using Runner = std::function<int()>;
 
 Runner AddDemoCommand(CLI::App& app);
 Runner AddRockCommand(CLI::App& app);
+Runner AddSimulateCommand(CLI::App& app);
 
 }  // namespace talus::app

@@ -14,6 +14,7 @@ int main(int argc, char** argv) {
   const std::vector<talus::app::Runner> runners = {
       talus::app::AddDemoCommand(app),
       talus::app::AddRockCommand(app),
+      talus::app::AddSimulateCommand(app),
   };
 
   CLI11_PARSE(app, argc, argv);

@@ -11,7 +11,7 @@
 namespace talus::pointclouds {
 namespace {
 
-// Standard EOTA blocks of 1 m^3 (ETAG 027 / EAD 340059; ../shared/data/README.md).
+// Standard EOTA blocks of 1 m^3 (ETAG 027 / EAD 340059).
 struct EotaStandard {
   double a_m, b_m, c_m;
 };

@@ -1,5 +1,5 @@
 #pragma once
-// One time step of the Moreau-type midpoint scheme (DESIGN.md section 3).
+// One time step of the Moreau-type midpoint scheme (docs/model.md; Leine et al. 2014, 2021).
 
 #include "solver/contact.hpp"
 #include "solver/scene.hpp"

@@ -1,0 +1,88 @@
+#pragma once
+// Raster statistics of an ensemble on the DEM grid: each rock leaves a footprint (the cells its
+// centre of mass passed, with its largest speed, energy and jump height in each), and footprints
+// are merged in rock order, so that the rasters do not depend on the number of threads.
+
+#include <string>
+#include <vector>
+
+#include "solver/simulate.hpp"
+#include "solver/terrain.hpp"
+
+namespace talus::ensemble {
+
+// Which rasters to accumulate; nothing requested means no raster work at all. Cells are those of
+// `grid`: node (i, j) is the centre of cell (i, j), as for the DEM.
+struct RasterRequest {
+  GridGeometry grid;
+  bool speed = false;        // speed_max, speed_mean, speed_p95 (m/s)
+  bool energy = false;       // energy_max, energy_mean, energy_p95 (J, translational + rotational)
+  bool jump_height = false;  // jump_height_max, _mean, _p95 (m, centre of mass above ground along the normal)
+  bool passages = false;     // rocks that passed the cell
+  bool deposits = false;     // rocks that came to rest in the cell
+  bool reach_probability = false;  // fraction of all rocks that passed the cell
+
+  bool any() const { return speed || energy || jump_height || passages || deposits || reach_probability; }
+  bool needs_passes() const { return speed || energy || jump_height || passages || reach_probability; }
+};
+
+// One rock's footprint: each passed cell once, with the rock's maxima there.
+struct Footprint {
+  std::vector<int> cells;  // j * nx + i
+  std::vector<float> speed_m_s, energy_j, jump_height_m;  // parallel to cells, when requested
+  int deposit_cell = -1;   // cell of the rest position, -1 when the rock did not come to rest there
+};
+
+// Records one rock's footprint from the solver's steps. One per thread, reused across rocks.
+class FootprintRecorder : public StepObserver {
+ public:
+  FootprintRecorder(const RasterRequest& request, const RockShape& rock);
+  void Begin(const RockState& start, const Terrain& terrain);
+  void OnStep(const RockState& state, const StepReport& step, const TerrainSample& ground) override;
+  // Ends the rock: returns its footprint and clears the recorder.
+  Footprint Finish(const RockResult& result);
+
+ private:
+  void Mark(const Eigen::Vector3d& position, float speed, float energy, float jump);
+  int CellOf(double x_m, double y_m) const;
+
+  const RasterRequest& request_;
+  const RockShape& rock_;
+  std::vector<int> slot_;  // per cell: index into footprint_ or -1
+  Footprint footprint_;
+  Eigen::Vector3d previous_ = Eigen::Vector3d::Zero();
+};
+
+// One output raster: values in grid order (row j after row j - 1, j increasing with y).
+struct RasterLayer {
+  std::string name;   // e.g. "speed_p95"; the file is <name>.tif
+  std::string unit;   // e.g. "m/s"
+  std::vector<float> values;
+  bool has_nodata = false;  // statistics are nodata (kNoData) where no rock passed
+  static constexpr float kNoData = -9999.0f;
+};
+
+// Merges footprints; Add must be called in rock order for bit-identical results.
+class RasterAccumulator {
+ public:
+  explicit RasterAccumulator(const RasterRequest& request);
+  void Add(const Footprint& footprint);
+  std::vector<RasterLayer> Finish() const;
+
+ private:
+  struct Stat {
+    std::vector<float> max;
+    std::vector<double> sum;
+    std::vector<std::vector<float>> values;  // every rock's value per cell, for the percentile
+  };
+  void AddStat(Stat& stat, int cell, float value);
+  void FinishStat(const Stat& stat, const std::string& name, const std::string& unit,
+                  std::vector<RasterLayer>& out) const;
+
+  RasterRequest request_;
+  long rocks_ = 0;
+  std::vector<int> passages_, deposits_;
+  Stat speed_, energy_, jump_;
+};
+
+}  // namespace talus::ensemble

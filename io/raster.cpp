@@ -1,0 +1,124 @@
+#include "io/raster.hpp"
+
+#include <gdal_priv.h>
+
+#include <cmath>
+#include <filesystem>
+#include <memory>
+#include <mutex>
+#include <stdexcept>
+
+#include "common/error.hpp"
+#include "io/atomic_file.hpp"
+
+namespace talus::io {
+namespace {
+
+struct DatasetCloser {
+  void operator()(GDALDataset* d) const { GDALClose(d); }
+};
+using Dataset = std::unique_ptr<GDALDataset, DatasetCloser>;
+
+}  // namespace
+
+void RegisterGdal() {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    GDALAllRegister();
+  });
+}
+
+Raster ReadRaster(const std::string& path, const std::string& what) {
+  RegisterGdal();
+  if (!std::filesystem::exists(path)) throw InputError(what + ": file not found: " + path);
+  CPLErrorReset();
+  Dataset dataset(static_cast<GDALDataset*>(GDALOpen(path.c_str(), GA_ReadOnly)));
+  if (!dataset) throw InputError(what + ": GDAL cannot read " + path + ": " + CPLGetLastErrorMsg());
+  if (dataset->GetRasterCount() < 1) throw InputError(what + ": " + path + " has no raster band");
+  double gt[6];
+  if (dataset->GetGeoTransform(gt) != CE_None)
+    throw InputError(what + ": " + path + " has no georeferencing (geotransform)");
+  if (gt[2] != 0 || gt[4] != 0) throw InputError(what + ": " + path + " is rotated; only north-up rasters are supported");
+  if (gt[1] <= 0 || gt[5] >= 0)
+    throw InputError(what + ": " + path + " must be north-up with rows from north to south");
+
+  Raster raster;
+  const int nx = dataset->GetRasterXSize(), ny = dataset->GetRasterYSize();
+  raster.grid.nx = nx;
+  raster.grid.ny = ny;
+  raster.grid.dx_m = gt[1];
+  raster.grid.dy_m = -gt[5];
+  raster.grid.x0_m = gt[0] + 0.5 * gt[1];
+  raster.grid.y0_m = gt[3] + (ny - 0.5) * gt[5];
+  if (const OGRSpatialReference* srs = dataset->GetSpatialRef()) {
+    char* wkt = nullptr;
+    srs->exportToWkt(&wkt);
+    raster.crs_wkt = wkt ? wkt : "";
+    CPLFree(wkt);
+  }
+  GDALRasterBand* band = dataset->GetRasterBand(1);
+  int has_nodata = 0;
+  const double nodata = band->GetNoDataValue(&has_nodata);
+  std::vector<double> rows(static_cast<std::size_t>(nx) * ny);
+  if (band->RasterIO(GF_Read, 0, 0, nx, ny, rows.data(), nx, ny, GDT_Float64, 0, 0) != CE_None)
+    throw InputError(what + ": GDAL cannot read the pixels of " + path + ": " + CPLGetLastErrorMsg());
+  raster.values.resize(rows.size());
+  for (int r = 0; r < ny; ++r) {
+    const int j = ny - 1 - r;  // GDAL row r (from the north) is grid row j (from the south)
+    for (int i = 0; i < nx; ++i) {
+      double v = rows[static_cast<std::size_t>(r) * nx + i];
+      if ((has_nodata && (v == nodata || (std::isnan(nodata) && std::isnan(v)))) || !std::isfinite(v))
+        v = std::nan("");
+      raster.values[static_cast<std::size_t>(j) * nx + i] = v;
+    }
+  }
+  return raster;
+}
+
+bool SameCrs(const std::string& a_wkt, const std::string& b_wkt) {
+  if (a_wkt == b_wkt) return true;
+  OGRSpatialReference a, b;
+  if (a.importFromWkt(a_wkt.c_str()) != OGRERR_NONE || b.importFromWkt(b_wkt.c_str()) != OGRERR_NONE) return false;
+  return a.IsSame(&b);
+}
+
+std::array<double, 6> GeoTransformOf(const GridGeometry& grid) {
+  return {grid.x0_m - 0.5 * grid.dx_m, grid.dx_m, 0.0, grid.y_max_m() + 0.5 * grid.dy_m, 0.0, -grid.dy_m};
+}
+
+void WriteGeoTiff(const std::string& path, const GridGeometry& grid, const std::string& crs_wkt,
+                  const std::vector<float>& values, bool has_nodata, double nodata,
+                  const std::string& description) {
+  RegisterGdal();
+  GDALDriver* driver = GetGDALDriverManager()->GetDriverByName("GTiff");
+  if (!driver) throw std::runtime_error("GDAL has no GTiff driver");
+  AtomicFile file(path);
+  {
+    const char* options[] = {"COMPRESS=DEFLATE", "TILED=YES", nullptr};
+    Dataset dataset(driver->Create(file.temp_path().c_str(), grid.nx, grid.ny, 1, GDT_Float32,
+                                   const_cast<char**>(options)));
+    if (!dataset) throw std::runtime_error("cannot create " + path + ": " + CPLGetLastErrorMsg());
+    std::array<double, 6> gt = GeoTransformOf(grid);
+    dataset->SetGeoTransform(gt.data());
+    if (!crs_wkt.empty()) {
+      OGRSpatialReference srs;
+      srs.importFromWkt(crs_wkt.c_str());
+      dataset->SetSpatialRef(&srs);
+    }
+    GDALRasterBand* band = dataset->GetRasterBand(1);
+    if (has_nodata) band->SetNoDataValue(nodata);
+    band->SetDescription(description.c_str());
+    std::vector<float> rows(values.size());
+    for (int j = 0; j < grid.ny; ++j) {
+      const int r = grid.ny - 1 - j;
+      std::copy_n(values.begin() + static_cast<long>(j) * grid.nx, grid.nx,
+                  rows.begin() + static_cast<long>(r) * grid.nx);
+    }
+    if (band->RasterIO(GF_Write, 0, 0, grid.nx, grid.ny, rows.data(), grid.nx, grid.ny, GDT_Float32, 0, 0) !=
+        CE_None)
+      throw std::runtime_error("cannot write " + path + ": " + CPLGetLastErrorMsg());
+  }  // closing the dataset flushes it
+  file.Commit();
+}
+
+}  // namespace talus::io

@@ -1,0 +1,40 @@
+#pragma once
+// GDAL rasters: reading a DEM or a code raster into the solver's grid convention, and writing
+// GeoTIFFs on a grid with its CRS.
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include "solver/terrain.hpp"
+
+namespace talus::io {
+
+// A single-band raster in the solver's convention: node (i, j) at the centre of cell (i, j), i
+// along x, j along y (GDAL's rows are flipped), values row j after row j - 1, NaN where nodata.
+struct Raster {
+  GridGeometry grid;
+  std::vector<double> values;
+  std::string crs_wkt;  // empty when the file has no CRS
+};
+
+// Reads band 1 of any raster GDAL opens. `what` names the scene key in errors. Throws InputError
+// (file missing or unreadable, rotated or south-up geotransform).
+Raster ReadRaster(const std::string& path, const std::string& what);
+
+// True when two WKT CRS definitions describe the same CRS.
+bool SameCrs(const std::string& a_wkt, const std::string& b_wkt);
+
+// The GDAL geotransform of a grid whose nodes are cell centres (north-up).
+std::array<double, 6> GeoTransformOf(const GridGeometry& grid);
+
+// Writes a one-band Float32 GeoTIFF (deflate-compressed, tiled) on `grid` with `crs_wkt` (may be
+// empty), atomically. `nodata` is set when has_nodata.
+void WriteGeoTiff(const std::string& path, const GridGeometry& grid, const std::string& crs_wkt,
+                  const std::vector<float>& values, bool has_nodata, double nodata,
+                  const std::string& description);
+
+// Makes sure GDAL's drivers are registered (idempotent, thread-safe).
+void RegisterGdal();
+
+}  // namespace talus::io

@@ -1,0 +1,558 @@
+#include "io/scene_file.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <toml++/toml.h>
+
+#include "common/error.hpp"
+#include "io/raster.hpp"
+#include "io/vector.hpp"
+
+namespace talus::io {
+namespace {
+
+namespace fs = std::filesystem;
+using ensemble::ReleaseGeometry;
+
+const std::vector<std::string> kRasterNames = {"speed",    "energy",   "jump_height",
+                                               "passages", "deposits", "reach_probability"};
+
+std::string Fmt(double v) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, "%.10g", v);
+  return buffer;
+}
+
+int EditDistance(const std::string& a, const std::string& b) {
+  std::vector<int> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = static_cast<int>(j);
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    int diagonal = row[0];
+    row[0] = static_cast<int>(i);
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const int up = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diagonal = up;
+    }
+  }
+  return row[b.size()];
+}
+
+// The file being loaded: resolves paths and formats errors as "<file>:<line>: <key>: <reason>".
+class Context {
+ public:
+  explicit Context(std::string file) : file_(std::move(file)), dir_(fs::path(file_).parent_path()) {}
+
+  [[noreturn]] void Fail(const toml::node* node, const std::string& key, const std::string& reason) const {
+    throw InputError(Where(node) + ": " + key + ": " + reason);
+  }
+  std::string Where(const toml::node* node) const {
+    if (node && node->source().begin.line > 0) return file_ + ":" + std::to_string(node->source().begin.line);
+    return file_;
+  }
+  std::string Resolve(const std::string& path) const {
+    const fs::path p(path);
+    return (p.is_absolute() ? p : dir_ / p).lexically_normal().string();
+  }
+  const std::string& file() const { return file_; }
+
+ private:
+  std::string file_;
+  fs::path dir_;
+};
+
+// One table of the scene: typed access to its keys; keys not in `known` are errors.
+class Section {
+ public:
+  Section(const Context& context, const toml::table* table, std::string name, std::vector<std::string> known)
+      : context_(context), table_(table), name_(std::move(name)), known_(std::move(known)) {
+    if (!table_) return;
+    for (const auto& [key, node] : *table_) {
+      const std::string k(key.str());
+      if (std::find(known_.begin(), known_.end(), k) != known_.end()) continue;
+      const std::string hint = ClosestName(k, known_);
+      context_.Fail(&node, Key(k), "unknown key" + (hint.empty() ? "" : " (did you mean '" + hint + "'?)"));
+    }
+  }
+
+  std::string Key(const std::string& key) const { return name_.empty() ? key : name_ + "." + key; }
+  const toml::node* Node(const std::string& key) const { return table_ ? table_->get(key) : nullptr; }
+  bool Has(const std::string& key) const { return Node(key) != nullptr; }
+  [[noreturn]] void Fail(const std::string& key, const std::string& reason) const {
+    context_.Fail(Node(key) ? Node(key) : static_cast<const toml::node*>(table_), Key(key), reason);
+  }
+
+  double Number(const std::string& key, double fallback) const {
+    const toml::node* node = Node(key);
+    if (!node) return fallback;
+    if (auto v = node->value<double>(); v && (node->is_integer() || node->is_floating_point())) return *v;
+    Fail(key, "expected a number");
+  }
+  // A number that must satisfy `ok`, described by `bound` ("must be > 0").
+  template <class Pred>
+  double Checked(const std::string& key, double fallback, Pred ok, const std::string& bound) const {
+    const double v = Number(key, fallback);
+    if (!std::isfinite(v) || !ok(v)) Fail(key, Fmt(v) + " " + bound);
+    return v;
+  }
+  long Integer(const std::string& key, long fallback) const {
+    const toml::node* node = Node(key);
+    if (!node) return fallback;
+    if (!node->is_integer()) Fail(key, "expected an integer");
+    return static_cast<long>(*node->value<std::int64_t>());
+  }
+  bool Bool(const std::string& key, bool fallback) const {
+    const toml::node* node = Node(key);
+    if (!node) return fallback;
+    if (!node->is_boolean()) Fail(key, "expected true or false");
+    return *node->value<bool>();
+  }
+  std::string String(const std::string& key, const std::string& fallback) const {
+    const toml::node* node = Node(key);
+    if (!node) return fallback;
+    if (!node->is_string()) Fail(key, "expected a string");
+    return std::string(*node->value<std::string>());
+  }
+  // A list of exactly n numbers.
+  std::vector<double> Numbers(const std::string& key, std::size_t n) const {
+    return NumbersOf(Node(key), Key(key), n);
+  }
+  std::vector<double> NumbersOf(const toml::node* node, const std::string& key, std::size_t n) const {
+    const toml::array* array = node ? node->as_array() : nullptr;
+    if (!array || array->size() != n) context_.Fail(node, key, "expected a list of " + std::to_string(n) + " numbers");
+    std::vector<double> out;
+    for (const toml::node& item : *array) {
+      const auto v = item.value<double>();
+      if (!v || !(item.is_integer() || item.is_floating_point()) || !std::isfinite(*v))
+        context_.Fail(node, key, "expected a list of " + std::to_string(n) + " finite numbers");
+      out.push_back(*v);
+    }
+    return out;
+  }
+  const toml::table* table() const { return table_; }
+  const Context& context() const { return context_; }
+
+ private:
+  const Context& context_;
+  const toml::table* table_;
+  std::string name_;
+  std::vector<std::string> known_;
+};
+
+const toml::table* SubTable(const Context& context, const toml::table& root, const std::string& key) {
+  const toml::node* node = root.get(key);
+  if (!node) return nullptr;
+  if (!node->is_table()) context.Fail(node, key, "expected a table ([" + key + "])");
+  return node->as_table();
+}
+
+const auto kPositive = [](double v) { return v > 0; };
+
+// [ground.<name>]: user categories, or overrides of built-in ones.
+void LoadGround(const Context& context, const toml::table* ground, GroundTable& table) {
+  if (!ground) return;
+  for (const auto& [key, node] : *ground) {
+    const std::string name(key.str());
+    if (!node.is_table()) context.Fail(&node, "ground." + name, "expected a table ([ground." + name + "])");
+    const Section s(context, node.as_table(), "ground." + name, {"code", "mu_min", "mu_max", "beta", "kappa", "nu"});
+    const int existing = table.IndexOfName(name);
+    GroundCategory category;
+    category.name = name;
+    if (existing >= 0) {
+      category = table.category(existing);
+    } else {
+      for (const char* required : {"code", "mu_min", "mu_max", "beta", "kappa", "nu"})
+        if (!s.Has(required))
+          s.Fail(required, std::string("missing: a new ground category needs code, mu_min, mu_max, beta, kappa and nu") +
+                               (ClosestName(name, {"extra_soft", "soft", "medium_soft", "medium", "medium_hard", "hard",
+                                                   "extra_hard", "snow"}).empty()
+                                    ? ""
+                                    : " (or did you mean the built-in '" +
+                                          ClosestName(name, {"extra_soft", "soft", "medium_soft", "medium",
+                                                             "medium_hard", "hard", "extra_hard", "snow"}) +
+                                          "'?)"));
+    }
+    const long code = s.Integer("code", category.code);
+    if (code < 0 || code > 254) s.Fail("code", std::to_string(code) + " must be in 0..254");
+    category.code = static_cast<int>(code);
+    GroundParams& p = category.params;
+    p.mu_min = s.Number("mu_min", p.mu_min);
+    p.mu_max = s.Number("mu_max", p.mu_max);
+    p.beta_1_s = s.Number("beta", p.beta_1_s);
+    p.kappa_1_m = s.Number("kappa", p.kappa_1_m);
+    p.nu_1_s = s.Number("nu", p.nu_1_s);
+    std::string why;
+    if (!p.IsValid(&why)) context.Fail(&node, "ground." + name, why);
+    const int other = table.IndexOfCode(category.code);
+    if (other >= 0 && table.category(other).name != name)
+      s.Fail("code", std::to_string(code) + " is already the code of '" + table.category(other).name + "'");
+    table.Set(category);
+  }
+  if (table.size() > GroundGrid::kNoGround) context.Fail(ground, "ground", "too many ground categories");
+}
+
+std::string Hex(std::uint64_t v) {
+  char buffer[17];
+  std::snprintf(buffer, sizeof buffer, "%016llx", static_cast<unsigned long long>(v));
+  return buffer;
+}
+
+std::string HashFiles(const std::vector<std::string>& files) {
+  std::uint64_t h = 1469598103934665603ULL;
+  for (const std::string& f : files) {
+    std::ifstream in(f, std::ios::binary);
+    char buffer[65536];
+    while (in.read(buffer, sizeof buffer) || in.gcount() > 0) {
+      for (std::streamsize k = 0; k < in.gcount(); ++k) {
+        h ^= static_cast<unsigned char>(buffer[k]);
+        h *= 1099511628211ULL;
+      }
+    }
+  }
+  return Hex(h);
+}
+
+void LoadTerrain(const Context& context, const Section& s, SceneFile& out) {
+  Scene& scene = out.scene;
+  if (s.Has("dem") == s.Has("plane")) s.Fail(s.Has("dem") ? "plane" : "dem", "give exactly one of 'dem' and 'plane'");
+  Heightfield heights;
+  if (s.Has("plane")) {
+    const toml::node* node = s.Node("plane");
+    if (!node->is_table()) s.Fail("plane", "expected an inline table { slope_deg = ..., ... }");
+    const Section p(context, node->as_table(), "terrain.plane",
+                    {"slope_deg", "slope_length_m", "runout_m", "width_m", "cell_m"});
+    PlaneSpec spec;
+    spec.slope_deg = p.Number("slope_deg", spec.slope_deg);
+    spec.slope_length_m = p.Number("slope_length_m", spec.slope_length_m);
+    spec.runout_m = p.Number("runout_m", spec.runout_m);
+    spec.width_m = p.Number("width_m", spec.width_m);
+    spec.cell_m = p.Number("cell_m", spec.cell_m);
+    std::string why;
+    if (!spec.IsValid(&why)) s.Fail("plane", why);
+    heights = MakePlaneHeightfield(spec);
+    out.terrain_description = "plane " + Fmt(spec.slope_deg) + " deg, " +
+                              std::to_string(heights.grid.nx) + " x " + std::to_string(heights.grid.ny) + " cells of " +
+                              Fmt(spec.cell_m) + " m";
+  } else {
+    const std::string path = context.Resolve(s.String("dem", ""));
+    Raster dem = ReadRaster(path, context.Where(s.Node("dem")) + ": " + s.Key("dem"));
+    out.inputs.push_back(path);
+    out.crs_wkt = dem.crs_wkt;
+    heights.grid = dem.grid;
+    heights.z_m = std::move(dem.values);
+    out.terrain_description = fs::path(path).filename().string() + " (" + std::to_string(heights.grid.nx) + " x " +
+                              std::to_string(heights.grid.ny) + " cells of " + Fmt(heights.grid.dx_m) + " m)";
+  }
+  const std::string default_name = s.String("default_ground", "medium");
+  const int default_index = scene.ground.IndexOfName(default_name);
+  if (default_index < 0) {
+    std::vector<std::string> names;
+    for (int k = 0; k < scene.ground.size(); ++k) names.push_back(scene.ground.category(k).name);
+    const std::string hint = ClosestName(default_name, names);
+    s.Fail("default_ground", "unknown ground category '" + default_name + "'" +
+                                 (hint.empty() ? "" : " (did you mean '" + hint + "'?)"));
+  }
+  scene.terrain = Terrain(std::move(heights), default_index);
+  std::string why;
+  if (!scene.terrain.IsValid(&why)) s.Fail(s.Has("dem") ? "dem" : "plane", why);
+
+  if (s.Has("ground")) {
+    const std::string path = context.Resolve(s.String("ground", ""));
+    const std::string what = context.Where(s.Node("ground")) + ": " + s.Key("ground");
+    const Raster codes = ReadRaster(path, what);
+    out.inputs.push_back(path);
+    if (!codes.crs_wkt.empty() && !out.crs_wkt.empty() && !SameCrs(codes.crs_wkt, out.crs_wkt))
+      throw InputError(what + ": " + path + " is in another CRS than the DEM; reprojecting ground rasters is not "
+                       "supported yet (warp it onto the DEM's CRS first, e.g. with gdalwarp)");
+    GroundGrid grid;
+    grid.grid = codes.grid;
+    grid.index.resize(codes.values.size());
+    for (std::size_t k = 0; k < codes.values.size(); ++k) {
+      const double v = codes.values[k];
+      if (std::isnan(v)) {
+        grid.index[k] = GroundGrid::kNoGround;
+        continue;
+      }
+      const int index = v == std::round(v) ? scene.ground.IndexOfCode(static_cast<int>(v)) : -1;
+      if (index < 0)
+        throw InputError(what + ": " + path + " has the value " + Fmt(v) +
+                         " (cell " + std::to_string(k % static_cast<std::size_t>(codes.grid.nx)) + ", " +
+                         std::to_string(k / static_cast<std::size_t>(codes.grid.nx)) +
+                         " from the south-west), which is not the code of any ground category");
+      grid.index[k] = static_cast<std::uint8_t>(index);
+    }
+    scene.terrain.SetGroundGrid(std::move(grid));
+    if (!scene.terrain.IsValid(&why)) s.Fail("ground", why);
+  }
+}
+
+void LoadRock(const Context& context, const Section& s, SceneFile& out) {
+  RockInput& rock = out.rock;
+  if (!s.Has("shape")) s.Fail("shape", "missing: a point cloud file or a built-in such as { box = [1, 1, 1] }");
+  rock.density_kg_m3 = s.Checked("density_kg_m3", 2700, kPositive, "must be > 0");
+  if (s.Has("volume_m3") && s.Has("mass_kg")) s.Fail("mass_kg", "give volume_m3 or mass_kg, not both");
+  if (s.Has("volume_m3")) rock.volume_m3 = s.Checked("volume_m3", 0, kPositive, "must be > 0");
+  if (s.Has("mass_kg")) rock.mass_kg = s.Checked("mass_kg", 0, kPositive, "must be > 0");
+  const long max_vertices = s.Integer("max_vertices", 0);
+  if (max_vertices != 0 && (max_vertices < 4 || max_vertices > 100000))
+    s.Fail("max_vertices", std::to_string(max_vertices) + " must be 0 (no simplification) or in 4 .. 100000");
+  rock.max_vertices = static_cast<int>(max_vertices);
+  const toml::node* shape = s.Node("shape");
+  if (shape->is_string()) {
+    rock.file = context.Resolve(s.String("shape", ""));
+    rock.description = fs::path(rock.file).filename().string();
+    if (!fs::exists(rock.file)) s.Fail("shape", "file not found: " + rock.file);
+    out.inputs.push_back(rock.file);
+  } else if (shape->is_table()) {
+    const Section b(context, shape->as_table(), "rock.shape", {"box", "ellipsoid", "sphere", "cylinder", "eota", "size_m"});
+    int kinds = 0;
+    for (const char* kind : {"box", "ellipsoid", "sphere", "cylinder", "eota"}) kinds += b.Has(kind);
+    if (kinds != 1)
+      s.Fail("shape", "give exactly one of box or ellipsoid ([a, b, c] in m), sphere (radius in m), cylinder "
+                      "([diameter, height] in m) or eota (\"111\" or \"221\", optionally with size_m = [a, b, c])");
+    auto dims = [&](const std::string& key, std::size_t n, const std::string& builtin) {
+      std::vector<double> d = b.Numbers(key, n);
+      for (double v : d)
+        if (v <= 0) b.Fail(key, "dimensions must be > 0");
+      rock.dimensions_m = d;
+      rock.builtin = builtin;
+      rock.description = key;
+      for (std::size_t k = 0; k < d.size(); ++k) rock.description += (k ? " x " : " ") + Fmt(d[k]);
+      rock.description += " m";
+    };
+    if (b.Has("size_m") && !b.Has("eota")) b.Fail("size_m", "only an eota shape takes a size");
+    if (b.Has("box")) dims("box", 3, "box");
+    if (b.Has("ellipsoid")) dims("ellipsoid", 3, "ellipsoid");
+    if (b.Has("cylinder")) dims("cylinder", 2, "cylinder");
+    if (b.Has("sphere")) {
+      const double radius = b.Checked("sphere", 0, kPositive, "radius must be > 0");
+      rock.builtin = "icosphere";
+      rock.dimensions_m = {2 * radius};
+      rock.description = "sphere of radius " + Fmt(radius) + " m";
+    }
+    if (b.Has("eota")) {
+      const std::string kind = b.String("eota", "");
+      if (kind != "111" && kind != "221") b.Fail("eota", "'" + kind + "': expected \"111\" or \"221\"");
+      rock.builtin = "eota" + kind;
+      rock.description = "EOTA" + kind;
+      if (b.Has("size_m")) {
+        rock.dimensions_m = b.Numbers("size_m", 3);
+        for (double v : rock.dimensions_m)
+          if (v <= 0) b.Fail("size_m", "dimensions must be > 0");
+        rock.description += " " + Fmt(rock.dimensions_m[0]) + " x " + Fmt(rock.dimensions_m[1]) + " x " +
+                            Fmt(rock.dimensions_m[2]) + " m";
+      }
+    }
+  } else {
+    s.Fail("shape", "expected a file name or a built-in such as { box = [1, 1, 1] }");
+  }
+  try {
+    out.scene.rock = BuildRock(rock, &rock.description);
+  } catch (const InputError& e) {
+    throw InputError(context.Where(shape) + ": rock.shape: " + e.what());
+  }
+  std::string why;
+  if (!out.scene.rock.IsValid(&why)) s.Fail("shape", why);
+}
+
+std::vector<Eigen::Vector2d> PointList(const Section& s, const toml::node* node, const std::string& key) {
+  const toml::array* array = node ? node->as_array() : nullptr;
+  if (!array) s.context().Fail(node, key, "expected a list of [x, y] points");
+  std::vector<Eigen::Vector2d> out;
+  for (std::size_t k = 0; k < array->size(); ++k) {
+    const std::vector<double> xy = s.NumbersOf(array->get(k), key + "[" + std::to_string(k) + "]", 2);
+    out.emplace_back(xy[0], xy[1]);
+  }
+  return out;
+}
+
+void LoadRelease(const Context& context, const Section& s, SceneFile& out) {
+  ensemble::ReleaseSpec& r = out.release;
+  // Remember where each release came from, for errors.
+  std::vector<std::string> origin;
+  if (s.Has("points")) {
+    const auto points = PointList(s, s.Node("points"), s.Key("points"));
+    for (std::size_t k = 0; k < points.size(); ++k) {
+      r.releases.push_back({ReleaseGeometry::Kind::kPoint, {{points[k]}}});
+      origin.push_back(s.Key("points") + "[" + std::to_string(k) + "]");
+    }
+  }
+  for (const auto& [key, kind] : {std::pair{std::string("lines"), ReleaseGeometry::Kind::kLine},
+                                  std::pair{std::string("polygons"), ReleaseGeometry::Kind::kPolygon}}) {
+    if (!s.Has(key)) continue;
+    const toml::array* array = s.Node(key)->as_array();
+    if (!array) s.Fail(key, "expected a list of " + key + ", each a list of [x, y] points");
+    for (std::size_t k = 0; k < array->size(); ++k) {
+      const std::string name = s.Key(key) + "[" + std::to_string(k) + "]";
+      r.releases.push_back({kind, {PointList(s, array->get(k), name)}});
+      origin.push_back(name);
+    }
+  }
+  if (s.Has("file")) {
+    const std::string path = context.Resolve(s.String("file", ""));
+    const auto geometries =
+        ReadReleaseGeometries(path, out.crs_wkt, context.Where(s.Node("file")) + ": " + s.Key("file"));
+    out.inputs.push_back(path);
+    for (std::size_t k = 0; k < geometries.size(); ++k) {
+      r.releases.push_back(geometries[k]);
+      origin.push_back(s.Key("file") + " (" + path + ", geometry " + std::to_string(k) + ")");
+    }
+  }
+  if (r.releases.empty()) s.Fail("points", "missing: give points, lines, polygons or a vector file");
+
+  const long rocks = s.Integer("rocks", 1);
+  if (rocks < 1) s.Fail("rocks", std::to_string(rocks) + " must be >= 1");
+  r.rocks_per_release = rocks;
+  r.height_m = s.Checked("height_m", 1.0, [](double v) { return v >= 0; }, "must be >= 0");
+  if (const toml::node* node = s.Node("orientation")) {
+    if (node->is_string()) {
+      if (s.String("orientation", "") != "random")
+        s.Fail("orientation", "expected \"random\" or a unit quaternion [w, x, y, z]");
+    } else {
+      const std::vector<double> q = s.Numbers("orientation", 4);
+      const Eigen::Quaterniond quat(q[0], q[1], q[2], q[3]);
+      if (std::abs(quat.norm() - 1) > 1e-3)
+        s.Fail("orientation", "quaternion [w, x, y, z] has norm " + Fmt(quat.norm()) + ", expected 1");
+      r.orientation = quat.normalized();
+    }
+  }
+  if (s.Has("velocity_m_s")) {
+    const auto v = s.Numbers("velocity_m_s", 3);
+    r.velocity_m_s = Eigen::Vector3d(v[0], v[1], v[2]);
+  }
+  if (s.Has("angular_velocity_rad_s")) {
+    const auto w = s.Numbers("angular_velocity_rad_s", 3);
+    r.angular_velocity_rad_s = Eigen::Vector3d(w[0], w[1], w[2]);
+  }
+  const long seed = s.Integer("seed", 1);
+  if (seed < 0) s.Fail("seed", std::to_string(seed) + " must be >= 0");
+  r.seed = static_cast<std::uint64_t>(seed);
+
+  std::string why;
+  if (!r.IsValid(&why)) context.Fail(s.table(), "release", why);
+  // Every release vertex must lie on valid terrain.
+  const GridGeometry& g = out.scene.terrain.heights().grid;
+  for (std::size_t k = 0; k < r.releases.size(); ++k)
+    for (const auto& ring : r.releases[k].rings)
+      for (const Eigen::Vector2d& v : ring) {
+        TerrainSample sample;
+        if (out.scene.terrain.Sample(v.x(), v.y(), &sample)) continue;
+        throw InputError(context.Where(s.table()) + ": " + origin[k] + ": (" + Fmt(v.x()) + ", " + Fmt(v.y()) +
+                         ") is outside the DEM or on nodata (the DEM covers x " + Fmt(g.x0_m) + " .. " +
+                         Fmt(g.x_max_m()) + ", y " + Fmt(g.y0_m) + " .. " + Fmt(g.y_max_m()) + ")");
+      }
+}
+
+void LoadSolver(const Section& s, SolverOptions& o) {
+  o.dt_s = s.Number("dt_s", o.dt_s);
+  o.max_time_s = s.Number("max_time_s", o.max_time_s);
+  o.gravity_m_s2 = s.Number("gravity_m_s2", o.gravity_m_s2);
+  o.normal_restitution = s.Number("normal_restitution", o.normal_restitution);
+  o.tangential_restitution = s.Number("tangential_restitution", o.tangential_restitution);
+  o.tolerance_m_s = s.Number("tolerance_m_s", o.tolerance_m_s);
+  o.max_iterations = static_cast<int>(s.Integer("max_iterations", o.max_iterations));
+  o.prox_alpha = s.Number("prox_alpha", o.prox_alpha);
+  o.rest_speed_m_s = s.Number("rest_speed_m_s", o.rest_speed_m_s);
+  o.rest_angular_speed_rad_s = s.Number("rest_angular_speed_rad_s", o.rest_angular_speed_rad_s);
+  o.rest_hold_s = s.Number("rest_hold_s", o.rest_hold_s);
+  std::string why;
+  if (!o.IsValid(&why)) s.context().Fail(s.table(), "solver", why);
+}
+
+void LoadOutput(const Section& s, OutputSpec& o) {
+  o.trajectories = s.Bool("trajectories", o.trajectories);
+  o.trajectory_interval_s = s.Checked("trajectory_interval_s", o.trajectory_interval_s, kPositive, "must be > 0");
+  o.quicklook = s.Bool("quicklook", o.quicklook);
+  if (const toml::node* node = s.Node("rasters")) {
+    const toml::array* array = node->as_array();
+    if (!array) s.Fail("rasters", "expected a list of raster names");
+    for (const toml::node& item : *array) {
+      const auto name = item.value<std::string>();
+      if (!name || !item.is_string()) s.Fail("rasters", "expected a list of raster names (strings)");
+      if (std::find(kRasterNames.begin(), kRasterNames.end(), *name) == kRasterNames.end()) {
+        const std::string hint = ClosestName(*name, kRasterNames);
+        s.Fail("rasters", "unknown raster '" + *name + "'" + (hint.empty() ? "" : " (did you mean '" + hint + "'?)") +
+                              "; known: speed, energy, jump_height, passages, deposits, reach_probability");
+      }
+      if (std::find(o.rasters.begin(), o.rasters.end(), *name) == o.rasters.end()) o.rasters.push_back(*name);
+    }
+  }
+}
+
+}  // namespace
+
+std::string ClosestName(const std::string& word, const std::vector<std::string>& candidates) {
+  std::string best;
+  int best_distance = 1 << 30;
+  for (const std::string& c : candidates) {
+    const int d = EditDistance(word, c);
+    if (d < best_distance) {
+      best_distance = d;
+      best = c;
+    }
+  }
+  const int limit = std::max(2, static_cast<int>(word.size()) / 3);
+  return best_distance <= limit ? best : "";
+}
+
+ensemble::RasterRequest OutputSpec::Request(const GridGeometry& grid) const {
+  ensemble::RasterRequest r;
+  r.grid = grid;
+  auto has = [&](const char* name) { return std::find(rasters.begin(), rasters.end(), name) != rasters.end(); };
+  r.speed = has("speed");
+  r.energy = has("energy");
+  r.jump_height = has("jump_height");
+  r.passages = has("passages");
+  r.deposits = has("deposits");
+  r.reach_probability = has("reach_probability");
+  return r;
+}
+
+SceneFile LoadScene(const std::string& path) {
+  const Context context(path);
+  if (!fs::exists(path)) throw InputError(path + ": scene file not found");
+  toml::table root;
+  try {
+    root = toml::parse_file(path);
+  } catch (const toml::parse_error& e) {
+    throw InputError(path + ":" + std::to_string(e.source().begin.line) + ": TOML syntax error: " +
+                     std::string(e.description()));
+  }
+  const Section top(context, &root, "", {"terrain", "ground", "rock", "release", "solver", "output"});
+  for (const char* required : {"terrain", "rock", "release"})
+    if (!root.get(required)) context.Fail(nullptr, required, std::string("missing table [") + required + "]");
+
+  SceneFile out;
+  out.path = path;
+  out.inputs.push_back(path);
+  LoadGround(context, SubTable(context, root, "ground"), out.scene.ground);
+  LoadTerrain(context,
+              Section(context, SubTable(context, root, "terrain"), "terrain", {"dem", "plane", "ground", "default_ground"}),
+              out);
+  LoadRock(context,
+           Section(context, SubTable(context, root, "rock"), "rock", {"shape", "density_kg_m3", "volume_m3", "mass_kg", "max_vertices"}),
+           out);
+  LoadRelease(context,
+              Section(context, SubTable(context, root, "release"), "release",
+                      {"points", "lines", "polygons", "file", "height_m", "rocks", "orientation", "velocity_m_s",
+                       "angular_velocity_rad_s", "seed"}),
+              out);
+  LoadSolver(Section(context, SubTable(context, root, "solver"), "solver",
+                     {"dt_s", "max_time_s", "gravity_m_s2", "normal_restitution", "tangential_restitution",
+                      "tolerance_m_s", "max_iterations", "prox_alpha", "rest_speed_m_s", "rest_angular_speed_rad_s",
+                      "rest_hold_s"}),
+             out.scene.options);
+  LoadOutput(Section(context, SubTable(context, root, "output"), "output",
+                     {"trajectories", "trajectory_interval_s", "rasters", "quicklook"}),
+             out.output);
+  std::string why;
+  if (!out.scene.IsValid(&why)) throw InputError(path + ": " + why);
+  out.inputs_hash = HashFiles(out.inputs);
+  return out;
+}
+
+}  // namespace talus::io

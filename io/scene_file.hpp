@@ -1,0 +1,47 @@
+#pragma once
+// Scene files (TOML, docs/scenes.md): loading and validation. Every error names the file, the
+// line and key, and the reason, and is raised before any simulation starts.
+
+#include <string>
+#include <vector>
+
+#include "ensemble/rasters.hpp"
+#include "ensemble/release.hpp"
+#include "io/rock_input.hpp"
+#include "solver/scene.hpp"
+
+namespace talus::io {
+
+// The [output] table.
+struct OutputSpec {
+  bool trajectories = false;
+  double trajectory_interval_s = 0.01;
+  // Any of "speed", "energy", "jump_height", "passages", "deposits", "reach_probability".
+  std::vector<std::string> rasters;
+  bool quicklook = true;  // quicklook.png: hillshade, reach probability or energy, sample trajectories
+
+  // The raster request on `grid` (nothing when no raster is listed).
+  ensemble::RasterRequest Request(const GridGeometry& grid) const;
+};
+
+// A loaded, validated scene file.
+struct SceneFile {
+  std::string path;        // as given
+  Scene scene;             // IsValid() holds
+  ensemble::ReleaseSpec release;  // IsValid() holds, every release vertex on valid DEM cells
+  OutputSpec output;
+  RockInput rock;
+  std::string crs_wkt;     // the DEM's CRS; empty for the plane or a DEM without CRS
+  std::string terrain_description;  // e.g. "dem.tif (270 x 370 cells of 5 m)"
+  std::vector<std::string> inputs;  // the scene file and every data file it read
+  std::string inputs_hash;          // FNV-1a 64 over the contents of `inputs`, hex
+};
+
+// Loads and validates a scene. Throws talus::InputError with "<file>:<line>: <key>: <reason>".
+SceneFile LoadScene(const std::string& path);
+
+// Names close to `word` among `candidates` for "did you mean" hints (edit distance <= 2, or a third
+// of the word's length); empty when none is close.
+std::string ClosestName(const std::string& word, const std::vector<std::string>& candidates);
+
+}  // namespace talus::io

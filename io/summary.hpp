@@ -1,0 +1,17 @@
+#pragma once
+// summary.json (docs/scenes.md): inputs' hash, version, counts by ending, wall time,
+// trajectories per second, and what the run was.
+
+#include <string>
+#include <vector>
+
+#include "ensemble/runner.hpp"
+#include "io/scene_file.hpp"
+
+namespace talus::io {
+
+// The summary as JSON text; `outputs` lists the files written next to it.
+std::string SummaryJson(const SceneFile& scene, const ensemble::EnsembleReport& report, const std::string& version,
+                        const std::vector<std::string>& outputs);
+
+}  // namespace talus::io

@@ -1,0 +1,33 @@
+#pragma once
+// trajectories.h5 (docs/scenes.md): group /rocks/<rock> per rock with datasets t (n),
+// position (n x 3), quaternion (n x 4, w x y z, the shape as given), velocity (n x 3),
+// angular_velocity (n x 3, world frame), contact (n, 0/1), scar (n); chunked and deflate-compressed,
+// written rock by rock (nothing is kept in memory), complete or absent.
+
+#include <memory>
+#include <string>
+
+#include "ensemble/runner.hpp"
+#include "io/atomic_file.hpp"
+#include "solver/polyhedron.hpp"
+
+namespace talus::io {
+
+class TrajectoryWriter {
+ public:
+  // Creates the file under a temporary name; root attributes mass_kg and principal_inertia_kg_m2.
+  TrajectoryWriter(const std::string& path, const RockShape& rock);
+  ~TrajectoryWriter();
+  TrajectoryWriter(const TrajectoryWriter&) = delete;
+  TrajectoryWriter& operator=(const TrajectoryWriter&) = delete;
+
+  void Write(const ensemble::RockOutcome& rock);
+  void Commit();  // closes and renames into place
+
+ private:
+  struct Impl;
+  AtomicFile file_;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace talus::io

@@ -1,0 +1,111 @@
+#include "ensemble/rasters.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <numeric>
+
+#include "ensemble/runner.hpp"
+#include "fixtures.hpp"
+
+namespace talus::ensemble {
+namespace {
+
+const RasterLayer& Layer(const EnsembleReport& report, const std::string& name) {
+  for (const RasterLayer& l : report.rasters)
+    if (l.name == name) return l;
+  throw std::runtime_error("no raster " + name);
+}
+
+int CellOf(const GridGeometry& g, double x, double y) {
+  return static_cast<int>(std::lround((y - g.y0_m) / g.dy_m) * g.nx + std::lround((x - g.x0_m) / g.dx_m));
+}
+
+// Cubes set down at rest on flat ground stay in their cell: there reach is the share of rocks
+// released there, passages and deposits the count; every other cell is untouched.
+TEST(Rasters, RocksAtRestOnAPlaneGiveTheKnownMaps) {
+  Scene scene = testing::SmallPlane(0, 0, 20, 10);
+  ReleaseSpec release = testing::PointRelease({{5, 0}, {12, 3}}, 3);
+  release.height_m = 0.2;
+  release.orientation = Eigen::Quaterniond::Identity();
+  EnsembleOptions options;
+  options.rasters = {scene.terrain.heights().grid, true, false, false, true, true, true};
+  const EnsembleReport report = RunEnsemble(scene, release, options);
+  ASSERT_EQ(report.count(EndReason::kRest), 6);
+  const GridGeometry& g = scene.terrain.heights().grid;
+  const int a = CellOf(g, 5, 0), b = CellOf(g, 12, 3);
+  const auto& reach = Layer(report, "reach_probability").values;
+  const auto& passages = Layer(report, "passages").values;
+  const auto& deposits = Layer(report, "deposits").values;
+  const auto& speed_max = Layer(report, "speed_max").values;
+  for (int c = 0; c < g.nx * g.ny; ++c) {
+    const bool hit = c == a || c == b;
+    EXPECT_EQ(reach[c], hit ? 0.5f : 0.0f) << c;
+    EXPECT_EQ(passages[c], hit ? 3.0f : 0.0f) << c;
+    EXPECT_EQ(deposits[c], hit ? 3.0f : 0.0f) << c;
+    if (hit) EXPECT_LT(speed_max[c], 0.02f);
+    else EXPECT_EQ(speed_max[c], RasterLayer::kNoData);
+  }
+}
+
+// Balls down a slope: every rock passes its release cell, deposits count the rocks at rest, and the
+// statistics are ordered mean <= p95 <= max wherever a rock passed.
+TEST(Rasters, SlopeRunsAreConsistent) {
+  Scene scene = testing::SmallPlane(35, 15, 15);
+  scene.rock = MakeRockShape(MakeIcosphere(0.2, 1), 2700);  // rolls down
+  scene.options.max_time_s = 6;
+  ReleaseSpec release = testing::PointRelease({{2, 0}}, 6);
+  EnsembleOptions options;
+  options.threads = 2;
+  options.rasters = {scene.terrain.heights().grid, true, true, true, true, true, true};
+  const EnsembleReport report = RunEnsemble(scene, release, options);
+  const GridGeometry& g = scene.terrain.heights().grid;
+  EXPECT_EQ(Layer(report, "passages").values[CellOf(g, 2, 0)], 6.0f);
+  EXPECT_EQ(Layer(report, "reach_probability").values[CellOf(g, 2, 0)], 1.0f);
+  const auto& deposits = Layer(report, "deposits").values;
+  EXPECT_EQ(std::accumulate(deposits.begin(), deposits.end(), 0.0f),
+            static_cast<float>(report.count(EndReason::kRest)));
+  for (const char* q : {"speed", "energy", "jump_height"}) {
+    const auto& mx = Layer(report, std::string(q) + "_max").values;
+    const auto& mean = Layer(report, std::string(q) + "_mean").values;
+    const auto& p95 = Layer(report, std::string(q) + "_p95").values;
+    for (std::size_t c = 0; c < mx.size(); ++c) {
+      if (mx[c] == RasterLayer::kNoData) continue;
+      EXPECT_LE(mean[c], p95[c] * (1 + 1e-6f) + 1e-6f) << q << " " << c;
+      EXPECT_LE(p95[c], mx[c]) << q << " " << c;
+    }
+  }
+  // The path is continuous: every column of cells between the release and the furthest rock
+  // was passed by some rock.
+  const auto& passages = Layer(report, "passages").values;
+  double reach_x = 0;
+  for (int c = 0; c < g.nx * g.ny; ++c)
+    if (passages[c] > 0) reach_x = std::max(reach_x, g.x0_m + (c % g.nx) * g.dx_m);
+  EXPECT_GT(reach_x, 10);
+  for (int i = 2; g.x0_m + i * g.dx_m <= reach_x; ++i) {
+    bool column = false;
+    for (int j = 0; j < g.ny; ++j) column = column || passages[j * g.nx + i] > 0;
+    EXPECT_TRUE(column) << "column " << i;
+  }
+}
+
+TEST(Rasters, P95IsTheNearestRankPercentile) {
+  RasterRequest request;
+  request.grid = {1, 1, 0, 0, 1, 1};
+  request.speed = true;
+  RasterAccumulator acc(request);
+  for (int k = 1; k <= 40; ++k) {
+    Footprint f;
+    f.cells = {0};
+    f.speed_m_s = {static_cast<float>(k)};
+    acc.Add(f);
+  }
+  const auto layers = acc.Finish();
+  ASSERT_EQ(layers.size(), 3u);
+  EXPECT_EQ(layers[0].values[0], 40.0f);  // max
+  EXPECT_EQ(layers[1].values[0], 20.5f);  // mean
+  EXPECT_EQ(layers[2].values[0], 38.0f);  // ceil(0.95 * 40) = 38th value
+}
+
+}  // namespace
+}  // namespace talus::ensemble

@@ -1,0 +1,76 @@
+#include "ensemble/release.hpp"
+
+#include <gtest/gtest.h>
+
+#include "fixtures.hpp"
+
+namespace talus::ensemble {
+namespace {
+
+TEST(Release, StartDependsOnSeedAndRockOnly) {
+  const Scene scene = testing::SmallPlane(30, 20, 10);
+  ReleaseSpec spec = testing::PointRelease({{5, 0}, {6, 1}}, 4);
+  std::string why;
+  ASSERT_TRUE(spec.IsValid(&why)) << why;
+  const RockState a = ReleaseState(scene, spec, 5);
+  const RockState b = ReleaseState(scene, spec, 5);
+  EXPECT_EQ(a.orientation.coeffs(), b.orientation.coeffs());
+  EXPECT_NE(ReleaseState(scene, spec, 6).orientation.coeffs(), a.orientation.coeffs());
+  EXPECT_EQ(spec.ReleaseOf(5), 1);
+  EXPECT_DOUBLE_EQ(a.position_m.x(), 6);
+  TerrainSample ground;
+  ASSERT_TRUE(scene.terrain.Sample(6, 1, &ground));
+  EXPECT_NEAR(a.position_m.z(), ground.height_m + spec.height_m, 1e-12);
+  spec.seed = 2;
+  EXPECT_NE(ReleaseState(scene, spec, 5).orientation.coeffs(), a.orientation.coeffs());
+}
+
+TEST(Release, FixedOrientationRotatesTheShapeAsGiven) {
+  Scene scene = testing::SmallPlane(30, 20, 10);
+  scene.rock = MakeRockShape(MakeBox(0.2, 0.5, 1.0), 2700);  // principal frame differs from the input axes
+  ReleaseSpec spec = testing::PointRelease({{5, 0}}, 1);
+  const Eigen::Quaterniond user(Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 3).normalized()));
+  spec.orientation = user;
+  spec.angular_velocity_rad_s = Eigen::Vector3d(0, 0, 2);
+  const RockState s = ReleaseState(scene, spec, 0);
+  const Eigen::Quaterniond shape = s.orientation * scene.rock.principal_to_input.conjugate();
+  EXPECT_NEAR(std::abs(shape.dot(user)), 1.0, 1e-12);
+  EXPECT_TRUE((s.orientation * s.angular_velocity_rad_s).isApprox(Eigen::Vector3d(0, 0, 2), 1e-12));
+}
+
+TEST(Release, LinesAndPolygonsSampleOnThem) {
+  const Scene scene = testing::SmallPlane(30, 20, 10);
+  ReleaseSpec spec;
+  spec.releases.push_back({ReleaseGeometry::Kind::kLine, {{{2, -3}, {2, 3}, {8, 3}}}});
+  spec.releases.push_back({ReleaseGeometry::Kind::kPolygon, {{{10, -2}, {14, -2}, {14, 2}, {10, 2}},
+                                                             {{11, -1}, {13, -1}, {13, 1}, {11, 1}}}});
+  spec.rocks_per_release = 200;
+  std::string why;
+  ASSERT_TRUE(spec.IsValid(&why)) << why;
+  for (long rock = 0; rock < 200; ++rock) {
+    const Eigen::Vector3d p = ReleaseState(scene, spec, rock).position_m;
+    const bool on_first = std::abs(p.x() - 2) < 1e-12 && std::abs(p.y()) <= 3;
+    const bool on_second = std::abs(p.y() - 3) < 1e-12 && p.x() >= 2 && p.x() <= 8;
+    EXPECT_TRUE(on_first || on_second) << p.transpose();
+  }
+  for (long rock = 200; rock < 400; ++rock) {
+    const Eigen::Vector3d p = ReleaseState(scene, spec, rock).position_m;
+    EXPECT_TRUE(p.x() >= 10 && p.x() <= 14 && std::abs(p.y()) <= 2) << p.transpose();
+    EXPECT_FALSE(std::abs(p.x() - 12) < 1 && std::abs(p.y()) < 1) << "in the hole: " << p.transpose();
+  }
+}
+
+TEST(Release, InvalidSpecsNameTheField) {
+  std::string why;
+  EXPECT_FALSE(ReleaseSpec{}.IsValid(&why));
+  ReleaseSpec spec = testing::PointRelease({{1, 1}}, 0);
+  EXPECT_FALSE(spec.IsValid(&why));
+  EXPECT_NE(why.find("rocks"), std::string::npos) << why;
+  spec.rocks_per_release = 1;
+  spec.releases.push_back({ReleaseGeometry::Kind::kPolygon, {{{0, 0}, {1, 1}, {2, 2}}}});
+  EXPECT_FALSE(spec.IsValid(&why));
+  EXPECT_NE(why.find("positive area"), std::string::npos) << why;
+}
+
+}  // namespace
+}  // namespace talus::ensemble

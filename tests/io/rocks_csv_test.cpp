@@ -1,0 +1,50 @@
+#include "io/rocks_csv.hpp"
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include "test_files.hpp"
+
+namespace talus::io {
+namespace {
+
+TEST(RocksCsvWriter, OneRowPerRockWithTheContractColumns) {
+  const auto dir = testing::FreshDir("csv");
+  const auto path = (dir / "rocks.csv").string();
+  {
+    RocksCsvWriter csv(path, 7);
+    for (long k = 0; k < 3; ++k) {
+      ensemble::RockOutcome rock;
+      rock.rock = k;
+      rock.release = 1;
+      rock.start.position_m = Eigen::Vector3d(0, 0, 10);
+      rock.result.end = EndReason::kRest;
+      rock.result.final_state.position_m = Eigen::Vector3d(3, 4, 1);
+      rock.result.max_speed_m_s = 12.5;
+      csv.Write(rock);
+    }
+    EXPECT_FALSE(std::filesystem::exists(path));  // complete or absent
+    csv.Commit();
+  }
+  std::ifstream in(path);
+  std::string header, row;
+  std::getline(in, header);
+  EXPECT_EQ(header,
+            "rock,release,seed,end,x_end,y_end,z_end,runout_m,path_length_m,travel_time_s,max_speed_m_s,"
+            "max_kinetic_energy_j,max_jump_height_m,max_angular_speed_rad_s,max_scar_m");
+  std::getline(in, row);
+  EXPECT_EQ(row, "0,1,7,rest,3,4,1,5,0,0,12.5,0,0,0,0");
+  int rows = 1;
+  while (std::getline(in, row)) ++rows;
+  EXPECT_EQ(rows, 3);
+}
+
+TEST(RocksCsvWriter, AbandonedWriterLeavesNothing) {
+  const auto dir = testing::FreshDir("abandon");
+  { RocksCsvWriter csv((dir / "rocks.csv").string(), 1); }
+  EXPECT_TRUE(std::filesystem::is_empty(dir));
+}
+
+}  // namespace
+}  // namespace talus::io

@@ -1,0 +1,240 @@
+#include "io/scene_file.hpp"
+
+#include <gtest/gtest.h>
+
+#include "common/error.hpp"
+#include "test_files.hpp"
+
+namespace talus::io {
+namespace {
+
+const char* kPlaneScene = R"([terrain]
+plane = { slope_deg = 35, slope_length_m = 40, runout_m = 20, width_m = 30, cell_m = 1 }
+default_ground = "hard"
+
+[rock]
+shape = { box = [0.5, 0.4, 0.3] }
+density_kg_m3 = 2600
+
+[release]
+points = [[5, 0], [6, 2]]
+lines = [[[3, -5], [3, 5]]]
+polygons = [[[8, -2], [10, -2], [10, 2], [8, 2]]]
+rocks = 7
+height_m = 1.5
+orientation = [1, 0, 0, 0]
+velocity_m_s = [1, 0, 0]
+angular_velocity_rad_s = [0, 0, 1]
+seed = 42
+
+[solver]
+dt_s = 0.004
+max_time_s = 20
+
+[output]
+trajectories = true
+trajectory_interval_s = 0.1
+rasters = ["speed", "reach_probability"]
+)";
+
+std::string Replace(std::string text, const std::string& from, const std::string& to) {
+  const auto at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  return text.replace(at, from.size(), to);
+}
+
+// Loads `text` as scene.toml and returns the error message ("" when it loads).
+std::string ErrorOf(const std::string& text, const std::filesystem::path& dir) {
+  testing::WriteText(dir / "scene.toml", text);
+  try {
+    LoadScene((dir / "scene.toml").string());
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+#define EXPECT_HAS(text, part) EXPECT_NE(std::string(text).find(part), std::string::npos) << (text)
+
+TEST(LoadScene, PlaneSceneWithEveryRelease) {
+  const auto dir = testing::FreshDir("plane");
+  testing::WriteText(dir / "scene.toml", kPlaneScene);
+  const SceneFile s = LoadScene((dir / "scene.toml").string());
+  std::string why;
+  EXPECT_TRUE(s.scene.IsValid(&why)) << why;
+  EXPECT_EQ(s.scene.terrain.default_ground(), s.scene.ground.IndexOfName("hard"));
+  EXPECT_EQ(s.scene.terrain.heights().grid.nx, 61);
+  EXPECT_NEAR(s.scene.rock.mass_kg, 0.5 * 0.4 * 0.3 * 2600, 1e-9);
+  ASSERT_EQ(s.release.releases.size(), 4u);
+  EXPECT_EQ(s.release.releases[2].kind, ensemble::ReleaseGeometry::Kind::kLine);
+  EXPECT_EQ(s.release.releases[3].kind, ensemble::ReleaseGeometry::Kind::kPolygon);
+  EXPECT_EQ(s.release.total_rocks(), 28);
+  EXPECT_EQ(s.release.seed, 42u);
+  EXPECT_DOUBLE_EQ(s.release.height_m, 1.5);
+  ASSERT_TRUE(s.release.orientation.has_value());
+  EXPECT_DOUBLE_EQ(s.release.velocity_m_s.x(), 1);
+  EXPECT_DOUBLE_EQ(s.scene.options.dt_s, 0.004);
+  EXPECT_TRUE(s.output.trajectories);
+  const auto request = s.output.Request(s.scene.terrain.heights().grid);
+  EXPECT_TRUE(request.speed && request.reach_probability);
+  EXPECT_FALSE(request.energy || request.passages || request.deposits || request.jump_height);
+  EXPECT_TRUE(s.crs_wkt.empty());
+  EXPECT_EQ(s.inputs_hash.size(), 16u);
+}
+
+TEST(LoadScene, MinimalSceneUsesDefaults) {
+  const auto dir = testing::FreshDir("minimal");
+  testing::WriteText(dir / "scene.toml",
+                     "[terrain]\nplane = {}\n[rock]\nshape = { eota = \"221\" }\n[release]\npoints = [[10, 0]]\n");
+  const SceneFile s = LoadScene((dir / "scene.toml").string());
+  EXPECT_EQ(s.scene.terrain.default_ground(), s.scene.ground.IndexOfName("medium"));
+  EXPECT_NEAR(s.scene.rock.volume_m3, 1.0, 1e-6);
+  EXPECT_FALSE(s.release.orientation.has_value());
+  EXPECT_FALSE(s.output.trajectories);
+  EXPECT_TRUE(s.output.rasters.empty());
+  EXPECT_FALSE(s.output.Request(s.scene.terrain.heights().grid).any());
+}
+
+TEST(LoadScene, UnknownKeysAreErrorsWithDidYouMean) {
+  const auto dir = testing::FreshDir("unknown");
+  const std::string e1 = ErrorOf(Replace(kPlaneScene, "rocks = 7", "rock = 7"), dir);
+  EXPECT_HAS(e1, "scene.toml:13: release.rock: unknown key (did you mean 'rocks'?)");
+  const std::string e2 = ErrorOf(Replace(kPlaneScene, "[solver]", "[solvr]"), dir);
+  EXPECT_HAS(e2, "solvr: unknown key (did you mean 'solver'?)");
+  const std::string e3 = ErrorOf(Replace(kPlaneScene, "cell_m = 1", "cell = 1"), dir);
+  EXPECT_HAS(e3, "terrain.plane.cell: unknown key (did you mean 'cell_m'?)");
+  const std::string e4 = ErrorOf(Replace(kPlaneScene, "\"speed\",", "\"speeds\","), dir);
+  EXPECT_HAS(e4, "output.rasters: unknown raster 'speeds' (did you mean 'speed'?)");
+  const std::string e5 = ErrorOf(Replace(kPlaneScene, "\"hard\"", "\"hrad\""), dir);
+  EXPECT_HAS(e5, "terrain.default_ground: unknown ground category 'hrad' (did you mean 'hard'?)");
+  const std::string e6 = ErrorOf(Replace(kPlaneScene, "seed = 42", "colour = \"red\""), dir);
+  EXPECT_HAS(e6, "release.colour: unknown key");
+  EXPECT_EQ(e6.find("did you mean"), std::string::npos) << e6;
+}
+
+TEST(LoadScene, NonPhysicalValuesNameKeyAndReason) {
+  const auto dir = testing::FreshDir("values");
+  EXPECT_HAS(ErrorOf(Replace(kPlaneScene, "density_kg_m3 = 2600", "density_kg_m3 = -1"), dir),
+             "rock.density_kg_m3: -1 must be > 0");
+  EXPECT_HAS(ErrorOf(Replace(kPlaneScene, "dt_s = 0.004", "dt_s = -0.1"), dir), "solver: dt_s");
+  EXPECT_HAS(ErrorOf(Replace(kPlaneScene, "slope_deg = 35", "slope_deg = 95"), dir), "slope_deg");
+  EXPECT_HAS(ErrorOf(Replace(kPlaneScene, "rocks = 7", "rocks = 0"), dir), "release.rocks: 0 must be >= 1");
+  EXPECT_HAS(ErrorOf(Replace(kPlaneScene, "orientation = [1, 0, 0, 0]", "orientation = [2, 0, 0, 0]"), dir),
+             "release.orientation: quaternion [w, x, y, z] has norm 2");
+  EXPECT_HAS(ErrorOf(Replace(kPlaneScene, "height_m = 1.5", "height_m = \"high\""), dir),
+             "release.height_m: expected a number");
+  EXPECT_HAS(ErrorOf(Replace(kPlaneScene, "velocity_m_s = [1, 0, 0]", "velocity_m_s = [1, 0]"), dir),
+             "release.velocity_m_s: expected a list of 3 numbers");
+  EXPECT_HAS(ErrorOf(Replace(kPlaneScene, "box = [0.5, 0.4, 0.3]", "box = [0.5, 0, 0.3]"), dir),
+             "rock.shape.box: dimensions must be > 0");
+  EXPECT_HAS(ErrorOf(std::string(kPlaneScene) + "[ground.soft]\nmu_min = 3\n", dir), "ground.soft: mu_max");
+  EXPECT_HAS(ErrorOf("[terrain\nplane = {}\n", dir), "scene.toml:1: TOML syntax error");
+}
+
+TEST(LoadScene, ReleaseOutsideTheDemIsAnError) {
+  const auto dir = testing::FreshDir("outside");
+  const std::string e = ErrorOf(Replace(kPlaneScene, "[6, 2]", "[6, 200]"), dir);
+  EXPECT_HAS(e, "release.points[1]: (6, 200) is outside the DEM or on nodata (the DEM covers x 0 .. 60, y -15 .. 15)");
+  EXPECT_HAS(ErrorOf(Replace(kPlaneScene, "[10, 2], [8, 2]", "[10, 2], [-8, 2]"), dir), "release.polygons[0]");
+}
+
+TEST(LoadScene, MissingPiecesAndFiles) {
+  const auto dir = testing::FreshDir("missing");
+  EXPECT_HAS(ErrorOf("[terrain]\nplane = {}\n[rock]\nshape = { box = [1, 1, 1] }\n", dir), "release: missing table");
+  EXPECT_HAS(ErrorOf(Replace(kPlaneScene, "plane = {", "dem = \"nowhere.tif\"\nplane = {"), dir),
+             "give exactly one of 'dem' and 'plane'");
+  const std::string e = ErrorOf(Replace(kPlaneScene, "plane = { slope_deg = 35, slope_length_m = 40, runout_m = 20, width_m = 30, cell_m = 1 }",
+                                        "dem = \"nowhere.tif\""),
+                                dir);
+  EXPECT_HAS(e, "scene.toml:2: terrain.dem: file not found: ");
+  EXPECT_HAS(e, "nowhere.tif");
+  EXPECT_HAS(ErrorOf(Replace(kPlaneScene, "{ box = [0.5, 0.4, 0.3] }", "\"rock.ply\""), dir),
+             "rock.shape: file not found");
+  EXPECT_HAS(ErrorOf(std::string(kPlaneScene) + "[ground.scree]\ncode = 11\n", dir),
+             "ground.scree.mu_min: missing");
+}
+
+const std::array<double, 6> kGeo = {1000.0, 10.0, 0.0, 2050.0, 0.0, -10.0};  // 10 m cells, north edge y = 2050
+
+// A DEM sloping down to the east, with its ground map on a coarser grid, in a subfolder.
+void WriteDemCase(const std::filesystem::path& dir) {
+  std::filesystem::create_directories(dir / "data");
+  std::vector<std::vector<double>> dem(5, std::vector<double>(6));
+  for (int r = 0; r < 5; ++r)
+    for (int c = 0; c < 6; ++c) dem[r][c] = 100.0 - 5.0 * c;
+  dem[0][5] = -9999;
+  testing::WriteGdalRaster(dir / "data" / "dem.tif", dem, kGeo, 31287, -9999.0);
+  // Ground: 3 x 3 cells of 20 m; codes 6 (hard), 11 (user scree), 255 (nodata -> default).
+  testing::WriteGdalRaster(dir / "data" / "ground.tif", {{6, 6, 11}, {6, 11, 11}, {255, 11, 11}},
+                           {1000.0, 20.0, 0.0, 2050.0, 0.0, -20.0}, 31287, 255.0);
+}
+
+const char* kDemScene = R"([terrain]
+dem = "data/dem.tif"
+ground = "data/ground.tif"
+default_ground = "medium"
+
+[ground.my_scree]
+code = 11
+mu_min = 0.5
+mu_max = 2.0
+beta = 180
+kappa = 3.0
+nu = 0.4
+
+[ground.medium]
+mu_min = 0.36
+
+[rock]
+shape = { sphere = 0.3 }
+
+[release]
+points = [[1015, 2015]]
+)";
+
+TEST(LoadScene, GdalDemGroundRasterAndUserCategories) {
+  const auto dir = testing::FreshDir("dem");
+  WriteDemCase(dir);
+  testing::WriteText(dir / "scene.toml", kDemScene);
+  const SceneFile s = LoadScene((dir / "scene.toml").string());
+  const Terrain& t = s.scene.terrain;
+  EXPECT_EQ(t.heights().grid.nx, 6);
+  EXPECT_DOUBLE_EQ(t.heights().grid.x0_m, 1005);
+  EXPECT_DOUBLE_EQ(t.heights().grid.y0_m, 2005);
+  TerrainSample sample;
+  ASSERT_TRUE(t.Sample(1015, 2015, &sample));
+  EXPECT_NEAR(sample.height_m, 95, 1e-9);
+  EXPECT_FALSE(t.Sample(1055, 2045, &sample));  // the nodata corner
+  const GroundTable& g = s.scene.ground;
+  EXPECT_EQ(t.GroundAt(1005, 2045), g.IndexOfName("hard"));        // north-west ground cell, code 6
+  EXPECT_EQ(t.GroundAt(1055, 2045), g.IndexOfName("my_scree"));    // north-east, code 11
+  EXPECT_EQ(t.GroundAt(1005, 2005), g.IndexOfName("medium"));      // south-west nodata: the default
+  EXPECT_DOUBLE_EQ(g.params(g.IndexOfName("medium")).mu_min, 0.36);  // override keeps the other values
+  EXPECT_DOUBLE_EQ(g.params(g.IndexOfName("medium")).beta_1_s, 150);
+  EXPECT_NE(s.crs_wkt.find("Austria Lambert"), std::string::npos);
+  EXPECT_EQ(s.inputs.size(), 3u);
+}
+
+TEST(LoadScene, GdalDemErrors) {
+  const auto dir = testing::FreshDir("dem_errors");
+  WriteDemCase(dir);
+  EXPECT_HAS(ErrorOf(Replace(kDemScene, "[[1015, 2015]]", "[[1055, 2045]]"), dir), "outside the DEM or on nodata");
+  EXPECT_HAS(ErrorOf(Replace(kDemScene, "code = 11", "code = 12"), dir),
+             "terrain.ground: " + (dir / "data" / "ground.tif").string() + " has the value 11");
+  EXPECT_HAS(ErrorOf(Replace(kDemScene, "code = 11", "code = 6"), dir),
+             "ground.my_scree.code: 6 is already the code of 'hard'");
+  testing::WriteGdalRaster(dir / "data" / "ground_wgs84.tif", {{6}}, {11.0, 0.1, 0.0, 47.0, 0.0, -0.1}, 4326, 255.0);
+  EXPECT_HAS(ErrorOf(Replace(kDemScene, "\"data/ground.tif\"", "\"data/ground_wgs84.tif\""), dir),
+             "is in another CRS than the DEM");
+  EXPECT_HAS(ErrorOf(Replace(kDemScene, "\"data/ground.tif\"", "\"data/grund.tif\""), dir),
+             "scene.toml:3: terrain.ground: file not found");
+}
+
+TEST(ClosestName, OnlySuggestsCloseNames) {
+  EXPECT_EQ(ClosestName("sead", {"seed", "rocks"}), "seed");
+  EXPECT_EQ(ClosestName("trajectory", {"trajectories", "rasters"}), "trajectories");
+  EXPECT_EQ(ClosestName("xyz", {"seed", "rocks"}), "");
+}
+
+}  // namespace
+}  // namespace talus::io
