@@ -12,7 +12,7 @@
 #include "app/commands.hpp"
 #include "common/error.hpp"
 #include "ensemble/runner.hpp"
-#include "io/atomic_file.hpp"
+#include "common/atomic_file.hpp"
 #include "io/quicklook.hpp"
 #include "io/raster.hpp"
 #include "io/rocks_csv.hpp"
@@ -134,7 +134,7 @@ int RunSimulate(const SimulateArgs& args) {
                             sink.paths);
       outputs.push_back("quicklook.png");
     }
-    io::WriteFileAtomically(out("summary.json"), io::SummaryJson(scene, report, kVersion, outputs));
+    WriteFileAtomically(out("summary.json"), io::SummaryJson(scene, report, kVersion, outputs));
     std::printf("%s\n", report.BriefReport().c_str());
     std::printf("Wrote %zu files to %s\n", outputs.size() + 1, args.out.c_str());
     if (report.count(EndReason::kFailed) > 0)

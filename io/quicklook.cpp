@@ -8,7 +8,7 @@
 #include <numbers>
 #include <stdexcept>
 
-#include "io/atomic_file.hpp"
+#include "common/atomic_file.hpp"
 #include "io/raster.hpp"
 
 namespace talus::io {

@@ -9,7 +9,7 @@
 #include <stdexcept>
 
 #include "common/error.hpp"
-#include "io/atomic_file.hpp"
+#include "common/atomic_file.hpp"
 
 namespace talus::io {
 namespace {

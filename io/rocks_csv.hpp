@@ -6,7 +6,7 @@
 #include <string>
 
 #include "ensemble/runner.hpp"
-#include "io/atomic_file.hpp"
+#include "common/atomic_file.hpp"
 
 namespace talus::io {
 

@@ -8,7 +8,7 @@
 #include <string>
 
 #include "ensemble/runner.hpp"
-#include "io/atomic_file.hpp"
+#include "common/atomic_file.hpp"
 #include "solver/polyhedron.hpp"
 
 namespace talus::io {

@@ -20,6 +20,7 @@
 #include <sstream>
 #include <unordered_map>
 
+#include "common/atomic_file.hpp"
 #include "common/error.hpp"
 
 namespace talus::pointclouds {
@@ -370,8 +371,7 @@ PointCloud ReadPointCloud(const std::string& path) {
 
 void WritePolyhedronPly(const Polyhedron& poly, const Eigen::Vector3d& offset_m,
                         const std::string& path) {
-  std::ofstream out(path);
-  if (!out) throw InputError(path + ": cannot open the file for writing");
+  std::ostringstream out;
   out << "ply\nformat ascii 1.0\ncomment Talus convex hull, metres\n"
       << "element vertex " << poly.vertices_m.size() << "\n"
       << "property double x\nproperty double y\nproperty double z\n"
@@ -383,7 +383,11 @@ void WritePolyhedronPly(const Polyhedron& poly, const Eigen::Vector3d& offset_m,
     out << p.x() << " " << p.y() << " " << p.z() << "\n";
   }
   for (const auto& t : poly.triangles) out << "3 " << t[0] << " " << t[1] << " " << t[2] << "\n";
-  if (!out) throw InputError(path + ": writing the file failed");
+  try {
+    WriteFileAtomically(path, out.str());  // complete or absent
+  } catch (const std::exception& e) {
+    throw InputError(path + ": cannot write the file (" + e.what() + ")");
+  }
 }
 
 bool CleanOptions::IsValid(std::string* why) const {

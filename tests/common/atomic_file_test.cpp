@@ -1,14 +1,21 @@
-#include "io/atomic_file.hpp"
+#include "common/atomic_file.hpp"
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <fstream>
 #include <stdexcept>
 
-#include "test_files.hpp"
-
-namespace talus::io {
+namespace talus {
 namespace {
+
+// An empty directory of its own under the system's temporary directory.
+std::filesystem::path FreshDir(const std::string& name) {
+  const auto dir = std::filesystem::temp_directory_path() / ("talus_common_test_" + name);
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir;
+}
 
 int FilesIn(const std::filesystem::path& dir) {
   int n = 0;
@@ -17,7 +24,7 @@ int FilesIn(const std::filesystem::path& dir) {
 }
 
 TEST(AtomicFile, CompleteOrAbsent) {
-  const auto dir = testing::FreshDir("atomic");
+  const auto dir = FreshDir("atomic");
   const auto path = (dir / "out.txt").string();
   {
     AtomicFile file(path);
@@ -35,4 +42,4 @@ TEST(AtomicFile, CompleteOrAbsent) {
 }
 
 }  // namespace
-}  // namespace talus::io
+}  // namespace talus

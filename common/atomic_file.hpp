@@ -4,7 +4,7 @@
 
 #include <string>
 
-namespace talus::io {
+namespace talus {
 
 class AtomicFile {
  public:
@@ -27,4 +27,4 @@ class AtomicFile {
 // Writes `contents` to `path` atomically.
 void WriteFileAtomically(const std::string& path, const std::string& contents);
 
-}  // namespace talus::io
+}  // namespace talus

@@ -1,4 +1,4 @@
-#include "io/atomic_file.hpp"
+#include "common/atomic_file.hpp"
 
 #include <unistd.h>
 
@@ -7,7 +7,7 @@
 #include <stdexcept>
 #include <system_error>
 
-namespace talus::io {
+namespace talus {
 
 AtomicFile::AtomicFile(std::string final_path) : final_path_(std::move(final_path)) {
   const std::filesystem::path p(final_path_);
@@ -43,4 +43,4 @@ void WriteFileAtomically(const std::string& path, const std::string& contents) {
   file.Commit();
 }
 
-}  // namespace talus::io
+}  // namespace talus
