@@ -8,6 +8,7 @@
 #include <iostream>
 #include <memory>
 #include <optional>
+#include <string>
 
 #include "app/commands.hpp"
 #include "common/error.hpp"
@@ -86,9 +87,15 @@ int RunSimulate(const SimulateArgs& args) {
     scene = io::LoadScene(args.scene);
     if (args.rocks > 0) scene.release.rocks_per_release = args.rocks;
     if (args.seed) scene.release.seed = *args.seed;
+    // The scene was valid; only --rocks can break it now (too many rocks in all).
+    if (std::string why; !scene.release.IsValid(&why))
+      throw InputError("--rocks " + std::to_string(args.rocks) + ": " + why);
   } catch (const InputError& e) {
     std::cerr << "talus simulate: " << e.what() << "\n";
     return 2;
+  } catch (const std::exception& e) {  // e.g. out of memory while reading the inputs
+    std::cerr << "talus simulate: cannot load " << args.scene << ": " << e.what() << "\n";
+    return 1;
   }
   std::error_code error;
   fs::create_directories(args.out, error);

@@ -1,5 +1,6 @@
 #include "ensemble/release.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -38,10 +39,14 @@ bool InsidePolygon(const std::vector<std::vector<Eigen::Vector2d>>& rings, const
   return inside;
 }
 
-Eigen::Vector2d PointOnLine(const std::vector<Eigen::Vector2d>& line, double u) {
+double LineLength(const std::vector<Eigen::Vector2d>& line) {
   double total = 0;
   for (std::size_t k = 1; k < line.size(); ++k) total += (line[k] - line[k - 1]).norm();
-  double target = u * total;
+  return total;
+}
+
+Eigen::Vector2d PointOnLine(const std::vector<Eigen::Vector2d>& line, double u) {
+  double target = u * LineLength(line);
   for (std::size_t k = 1; k < line.size(); ++k) {
     const double length = (line[k] - line[k - 1]).norm();
     if (target <= length && length > 0) return line[k - 1] + (target / length) * (line[k] - line[k - 1]);
@@ -74,6 +79,11 @@ bool ReleaseSpec::IsValid(std::string* why) const {
     s << "rocks = " << rocks_per_release << " must be >= 1";
     return Fail(why, s.str());
   }
+  if (rocks_per_release > kMaxTotalRocks / static_cast<long>(releases.size())) {
+    s << "rocks = " << rocks_per_release << " per release x " << releases.size() << " releases is more than "
+      << kMaxTotalRocks << " rocks";
+    return Fail(why, s.str());
+  }
   if (!std::isfinite(height_m) || height_m < 0) {
     s << "height_m = " << height_m << " must be finite and >= 0";
     return Fail(why, s.str());
@@ -96,8 +106,8 @@ bool ReleaseSpec::IsValid(std::string* why) const {
           s << "release " << r << " has a non-finite coordinate";
           return Fail(why, s.str());
         }
-    if (g.kind == ReleaseGeometry::Kind::kLine && g.rings[0].size() < 2) {
-      s << "release " << r << ": a line needs at least 2 points";
+    if (g.kind == ReleaseGeometry::Kind::kLine && (g.rings[0].size() < 2 || LineLength(g.rings[0]) <= 0)) {
+      s << "release " << r << ": a line needs at least 2 points and a positive length";
       return Fail(why, s.str());
     }
     if (g.kind == ReleaseGeometry::Kind::kPolygon &&
@@ -105,8 +115,66 @@ bool ReleaseSpec::IsValid(std::string* why) const {
       s << "release " << r << ": a polygon needs at least 3 points and a positive area";
       return Fail(why, s.str());
     }
+    if (g.kind == ReleaseGeometry::Kind::kPolygon) {
+      // Holes (inner rings) must leave some area to sample from.
+      double holes = 0;
+      for (std::size_t k = 1; k < g.rings.size(); ++k) holes += std::abs(RingArea(g.rings[k]));
+      if (holes >= std::abs(RingArea(g.rings[0]))) {
+        s << "release " << r << ": the polygon's holes cover all of its area";
+        return Fail(why, s.str());
+      }
+    }
   }
   return true;
+}
+
+std::optional<Eigen::Vector2d> PointOffTerrain(const Terrain& terrain, const ReleaseGeometry& release) {
+  const auto off = [&](const Eigen::Vector2d& p) {
+    double height_m;
+    return !terrain.Height(p.x(), p.y(), &height_m);
+  };
+  const GridGeometry& grid = terrain.heights().grid;
+  const bool polygon = release.kind == ReleaseGeometry::Kind::kPolygon;
+  // Vertices first (they bound the walk below), then along the edges.
+  for (const auto& ring : release.rings)
+    for (const Eigen::Vector2d& v : ring)
+      if (off(v)) return v;
+  const double step = 0.25 * std::min(grid.dx_m, grid.dy_m);
+  for (const auto& ring : release.rings) {
+    const std::size_t n = ring.size();
+    const std::size_t edges = n < 2 ? 0 : (polygon ? n : n - 1);
+    for (std::size_t e = 0; e < edges; ++e) {
+      const Eigen::Vector2d& a = ring[e];
+      const Eigen::Vector2d& b = ring[(e + 1) % n];
+      const long pieces = static_cast<long>(std::ceil((b - a).norm() / step));
+      for (long q = 1; q < pieces; ++q) {
+        const Eigen::Vector2d p = a + (double(q) / double(pieces)) * (b - a);
+        if (off(p)) return p;
+      }
+    }
+  }
+  if (!polygon || release.rings.empty() || release.rings[0].empty()) return std::nullopt;
+  // Inside: the cells with a nodata corner whose centre the polygon covers.
+  Eigen::Vector2d lo = release.rings[0][0], hi = lo;
+  for (const Eigen::Vector2d& v : release.rings[0]) {
+    lo = lo.cwiseMin(v);
+    hi = hi.cwiseMax(v);
+  }
+  const auto index = [](double f, int last) { return static_cast<int>(std::clamp(f, 0.0, double(last))); };
+  const int i0 = index(std::floor((lo.x() - grid.x0_m) / grid.dx_m), grid.nx - 2);
+  const int i1 = index(std::ceil((hi.x() - grid.x0_m) / grid.dx_m), grid.nx - 2);
+  const int j0 = index(std::floor((lo.y() - grid.y0_m) / grid.dy_m), grid.ny - 2);
+  const int j1 = index(std::ceil((hi.y() - grid.y0_m) / grid.dy_m), grid.ny - 2);
+  const std::vector<double>& z = terrain.heights().z_m;
+  for (int j = j0; j <= j1; ++j)
+    for (int i = i0; i <= i1; ++i) {
+      const std::size_t k = static_cast<std::size_t>(j) * grid.nx + i;
+      if (!std::isnan(z[k]) && !std::isnan(z[k + 1]) && !std::isnan(z[k + grid.nx]) && !std::isnan(z[k + grid.nx + 1]))
+        continue;
+      const Eigen::Vector2d centre(grid.x0_m + (i + 0.5) * grid.dx_m, grid.y0_m + (j + 0.5) * grid.dy_m);
+      if (InsidePolygon(release.rings, centre)) return centre;
+    }
+  return std::nullopt;
 }
 
 RockState ReleaseState(const Scene& scene, const ReleaseSpec& spec, long rock) {

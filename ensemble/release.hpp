@@ -23,6 +23,8 @@ struct ReleaseGeometry {
 };
 
 struct ReleaseSpec {
+  static constexpr long kMaxTotalRocks = 1'000'000'000;  // rocks in one run, all releases together
+
   std::vector<ReleaseGeometry> releases;
   long rocks_per_release = 1;
   double height_m = 1.0;  // centre of mass above the ground at release (before any raise)
@@ -34,9 +36,16 @@ struct ReleaseSpec {
 
   long total_rocks() const { return rocks_per_release * static_cast<long>(releases.size()); }
   int ReleaseOf(long rock) const { return static_cast<int>(rock / rocks_per_release); }
-  // False, naming the field and value, when a value is out of range or a geometry is degenerate.
+  // False, naming the field and value, when a value is out of range (more than kMaxTotalRocks
+  // rocks in all) or a geometry is degenerate (a line of zero length, a polygon whose holes leave
+  // no area).
   bool IsValid(std::string* why) const;
 };
+
+// A point of `release` where the terrain has no height (outside the DEM or on a nodata cell), or
+// nullopt when rocks can start anywhere on it: its vertices, its lines or rings (checked every
+// quarter cell) and, for a polygon, the centres of the cells without height that it covers.
+std::optional<Eigen::Vector2d> PointOffTerrain(const Terrain& terrain, const ReleaseGeometry& release);
 
 // The start state of rock `rock` (0-based, releases one after another): position on its release
 // with the centre of mass height_m above the ground, orientation, velocities. Not yet raised above

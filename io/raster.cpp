@@ -7,6 +7,7 @@
 #include <memory>
 #include <mutex>
 #include <stdexcept>
+#include <string>
 
 #include "common/error.hpp"
 #include "common/atomic_file.hpp"
@@ -44,6 +45,11 @@ Raster ReadRaster(const std::string& path, const std::string& what) {
 
   Raster raster;
   const int nx = dataset->GetRasterXSize(), ny = dataset->GetRasterYSize();
+  // The same bound as a plane's (solver/terrain.cpp): larger grids do not fit in memory.
+  if (static_cast<double>(nx) * ny > kMaxRasterCells)
+    throw InputError(what + ": " + path + " has " + std::to_string(nx) + " x " + std::to_string(ny) +
+                     " cells, more than " + std::to_string(static_cast<long>(kMaxRasterCells)) +
+                     "; crop or resample it first (e.g. with gdalwarp)");
   raster.grid.nx = nx;
   raster.grid.ny = ny;
   raster.grid.dx_m = gt[1];

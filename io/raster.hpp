@@ -18,8 +18,11 @@ struct Raster {
   std::string crs_wkt;  // empty when the file has no CRS
 };
 
+// The largest raster ReadRaster accepts, in cells.
+inline constexpr double kMaxRasterCells = 4e8;
+
 // Reads band 1 of any raster GDAL opens. `what` names the scene key in errors. Throws InputError
-// (file missing or unreadable, rotated or south-up geotransform).
+// (file missing or unreadable, rotated or south-up geotransform, more than kMaxRasterCells cells).
 Raster ReadRaster(const std::string& path, const std::string& what);
 
 // True when two WKT CRS definitions describe the same CRS.

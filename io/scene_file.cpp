@@ -277,7 +277,8 @@ void LoadTerrain(const Context& context, const Section& s, SceneFile& out) {
         grid.index[k] = GroundGrid::kNoGround;
         continue;
       }
-      const int index = v == std::round(v) ? scene.ground.IndexOfCode(static_cast<int>(v)) : -1;
+      const bool code = v == std::round(v) && v >= 0 && v <= 254;  // and so fits an int
+      const int index = code ? scene.ground.IndexOfCode(static_cast<int>(v)) : -1;
       if (index < 0)
         throw InputError(what + ": " + path + " has the value " + Fmt(v) +
                          " (cell " + std::to_string(k % static_cast<std::size_t>(codes.grid.nx)) + ", " +
@@ -434,17 +435,13 @@ void LoadRelease(const Context& context, const Section& s, SceneFile& out) {
 
   std::string why;
   if (!r.IsValid(&why)) context.Fail(s.table(), "release", why);
-  // Every release vertex must lie on valid terrain.
+  // Every point a rock can start from must lie on valid terrain: vertices, lines, polygon insides.
   const GridGeometry& g = out.scene.terrain.heights().grid;
   for (std::size_t k = 0; k < r.releases.size(); ++k)
-    for (const auto& ring : r.releases[k].rings)
-      for (const Eigen::Vector2d& v : ring) {
-        TerrainSample sample;
-        if (out.scene.terrain.Sample(v.x(), v.y(), &sample)) continue;
-        throw InputError(context.Where(s.table()) + ": " + origin[k] + ": (" + Fmt(v.x()) + ", " + Fmt(v.y()) +
-                         ") is outside the DEM or on nodata (the DEM covers x " + Fmt(g.x0_m) + " .. " +
-                         Fmt(g.x_max_m()) + ", y " + Fmt(g.y0_m) + " .. " + Fmt(g.y_max_m()) + ")");
-      }
+    if (const auto v = ensemble::PointOffTerrain(out.scene.terrain, r.releases[k]))
+      throw InputError(context.Where(s.table()) + ": " + origin[k] + ": (" + Fmt(v->x()) + ", " + Fmt(v->y()) +
+                       ") is outside the DEM or on nodata (the DEM covers x " + Fmt(g.x0_m) + " .. " +
+                       Fmt(g.x_max_m()) + ", y " + Fmt(g.y0_m) + " .. " + Fmt(g.y_max_m()) + ")");
 }
 
 void LoadSolver(const Section& s, SolverOptions& o) {
@@ -454,7 +451,10 @@ void LoadSolver(const Section& s, SolverOptions& o) {
   o.normal_restitution = s.Number("normal_restitution", o.normal_restitution);
   o.tangential_restitution = s.Number("tangential_restitution", o.tangential_restitution);
   o.tolerance_m_s = s.Number("tolerance_m_s", o.tolerance_m_s);
-  o.max_iterations = static_cast<int>(s.Integer("max_iterations", o.max_iterations));
+  const long max_iterations = s.Integer("max_iterations", o.max_iterations);
+  if (max_iterations != static_cast<int>(max_iterations))
+    s.Fail("max_iterations", std::to_string(max_iterations) + " is out of range (1 .. 100000)");
+  o.max_iterations = static_cast<int>(max_iterations);
   o.prox_alpha = s.Number("prox_alpha", o.prox_alpha);
   o.rest_speed_m_s = s.Number("rest_speed_m_s", o.rest_speed_m_s);
   o.rest_angular_speed_rad_s = s.Number("rest_angular_speed_rad_s", o.rest_angular_speed_rad_s);

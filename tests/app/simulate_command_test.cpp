@@ -105,6 +105,21 @@ TEST(SimulateCommand, OverridesRocksAndSeed) {
   EXPECT_EQ(summary["seed"], 9);
 }
 
+// --rocks is checked like the scene's rocks: 2 releases x 2^63 - 1 rocks used to overflow to a
+// "successful" run of no rock.
+TEST(SimulateCommand, TooManyRocksOnTheCommandLineIsAnError) {
+  const fs::path dir = FreshDir("too_many");
+  std::ofstream(dir / "scene.toml") << kScene;
+  std::string log;
+  EXPECT_EQ(RunCommand(std::string(TALUS_BINARY) + " simulate " + (dir / "scene.toml").string() + " --out " +
+                           (dir / "out").string() + " --rocks 9223372036854775807",
+                       &log),
+            2)
+      << log;
+  EXPECT_NE(log.find("--rocks 9223372036854775807: "), std::string::npos) << log;
+  EXPECT_FALSE(fs::exists(dir / "out" / "rocks.csv"));
+}
+
 TEST(SimulateCommand, BadSceneFailsBeforeAnyWorkNamingFileLineAndKey) {
   const fs::path dir = FreshDir("bad");
   std::string scene = kScene;

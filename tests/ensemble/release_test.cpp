@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <limits>
+
 #include "fixtures.hpp"
 
 namespace talus::ensemble {
@@ -70,6 +73,59 @@ TEST(Release, InvalidSpecsNameTheField) {
   spec.releases.push_back({ReleaseGeometry::Kind::kPolygon, {{{0, 0}, {1, 1}, {2, 2}}}});
   EXPECT_FALSE(spec.IsValid(&why));
   EXPECT_NE(why.find("positive area"), std::string::npos) << why;
+}
+
+// Specs that would silently misplace rocks are invalid: a line of zero length (every rock at one
+// point), holes that cover the whole polygon (the sampler finds no inside point), and more rocks
+// than a run can hold (rocks x releases overflowed to a run of no rock at all).
+TEST(Release, DegenerateGeometriesAndTooManyRocksAreInvalid) {
+  std::string why;
+  ReleaseSpec line;
+  line.releases.push_back({ReleaseGeometry::Kind::kLine, {{{3, 0}, {3, 0}}}});
+  EXPECT_FALSE(line.IsValid(&why));
+  EXPECT_NE(why.find("positive length"), std::string::npos) << why;
+
+  ReleaseSpec holed;
+  const std::vector<Eigen::Vector2d> square = {{3, -1}, {5, -1}, {5, 1}, {3, 1}};
+  holed.releases.push_back({ReleaseGeometry::Kind::kPolygon, {square, square}});
+  EXPECT_FALSE(holed.IsValid(&why));
+  EXPECT_NE(why.find("holes cover"), std::string::npos) << why;
+
+  ReleaseSpec many = testing::PointRelease({{1, 1}, {2, 2}}, std::numeric_limits<long>::max());
+  EXPECT_FALSE(many.IsValid(&why));
+  EXPECT_NE(why.find("more than"), std::string::npos) << why;
+  many.rocks_per_release = ReleaseSpec::kMaxTotalRocks / 2;
+  EXPECT_TRUE(many.IsValid(&why)) << why;
+}
+
+// Rocks start anywhere on a line or inside a polygon, so a nodata cell there is found even when
+// every vertex is on valid terrain.
+TEST(Release, PointOffTerrainFindsNodataAlongLinesAndInsidePolygons) {
+  Scene scene = testing::SmallPlane(30, 20, 10);  // x 0 .. 30, y -10 .. 10, 1 m cells
+  Heightfield heights = scene.terrain.heights();
+  const GridGeometry& g = heights.grid;
+  const int i = 10, j = 5;  // the node at (10, -5)
+  heights.z_m[static_cast<std::size_t>(j) * g.nx + i] = std::nan("");
+  const Terrain terrain(heights, 0);
+  // Cells touching the nodata node: x in [9, 11], y in [-6, -4].
+  const ReleaseGeometry point{ReleaseGeometry::Kind::kPoint, {{{5, 0}}}};
+  EXPECT_FALSE(PointOffTerrain(terrain, point));
+  const ReleaseGeometry crossing{ReleaseGeometry::Kind::kLine, {{{5, -5}, {15, -5}}}};
+  const auto on_line = PointOffTerrain(terrain, crossing);
+  ASSERT_TRUE(on_line);
+  EXPECT_TRUE(on_line->x() >= 9 && on_line->x() <= 11) << on_line->transpose();
+  const ReleaseGeometry beside{ReleaseGeometry::Kind::kLine, {{{5, -2}, {15, -2}}}};
+  EXPECT_FALSE(PointOffTerrain(terrain, beside));
+  const ReleaseGeometry around{ReleaseGeometry::Kind::kPolygon, {{{7, -8}, {13, -8}, {13, -2}, {7, -2}}}};
+  const auto inside = PointOffTerrain(terrain, around);
+  ASSERT_TRUE(inside);
+  EXPECT_TRUE(std::abs(inside->x() - 10) < 1 && std::abs(inside->y() + 5) < 1) << inside->transpose();  // a cell centre
+  // A hole around the nodata cells makes the polygon fine again.
+  const ReleaseGeometry holed{ReleaseGeometry::Kind::kPolygon,
+                              {{{7, -8}, {13, -8}, {13, -2}, {7, -2}}, {{8, -7}, {12, -7}, {12, -3}, {8, -3}}}};
+  EXPECT_FALSE(PointOffTerrain(terrain, holed));
+  const ReleaseGeometry elsewhere{ReleaseGeometry::Kind::kPolygon, {{{15, -8}, {20, -8}, {20, -2}, {15, -2}}}};
+  EXPECT_FALSE(PointOffTerrain(terrain, elsewhere));
 }
 
 }  // namespace

@@ -62,6 +62,30 @@ TEST(ReadRaster, BadFilesAreInputErrors) {
   }
 }
 
+// A raster too large for memory (here a 200000 x 200000 VRT over a tiny file) is an input error
+// that names the key, not an allocation failure that aborts the program.
+TEST(ReadRaster, HugeRasterIsAnInputError) {
+  const auto dir = testing::FreshDir("huge");
+  testing::WriteGdalRaster(dir / "small.tif", {{1, 2}, {3, 4}}, kGeo, 0, std::nullopt);
+  testing::WriteText(dir / "huge.vrt",
+                     R"(<VRTDataset rasterXSize="200000" rasterYSize="200000">
+  <GeoTransform>600000, 5, 0, 250000, 0, -5</GeoTransform>
+  <VRTRasterBand dataType="Float32" band="1">
+    <SimpleSource>
+      <SourceFilename relativeToVRT="1">small.tif</SourceFilename>
+      <SourceBand>1</SourceBand>
+    </SimpleSource>
+  </VRTRasterBand>
+</VRTDataset>)");
+  try {
+    ReadRaster((dir / "huge.vrt").string(), "scene.toml:2: terrain.dem");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("scene.toml:2: terrain.dem: "), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("200000 x 200000 cells"), std::string::npos) << e.what();
+  }
+}
+
 TEST(WriteGeoTiff, RoundTripsGridCrsAndValues) {
   const auto dir = testing::FreshDir("write");
   const GridGeometry grid{4, 3, 10.5, 20.5, 1.0, 1.0};

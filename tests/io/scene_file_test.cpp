@@ -230,6 +230,39 @@ TEST(LoadScene, GdalDemErrors) {
              "scene.toml:3: terrain.ground: file not found");
 }
 
+// Rocks start anywhere along a line or inside a polygon: nodata there is an error before any rock
+// runs, even when every vertex is on valid terrain (it used to start such rocks at z = height_m
+// and count them as having left the domain).
+TEST(LoadScene, ReleaseOverNodataBetweenVerticesIsAnError) {
+  const auto dir = testing::FreshDir("nodata_inside");
+  std::filesystem::create_directories(dir / "data");
+  std::vector<std::vector<double>> dem(7, std::vector<double>(7, 500.0));
+  dem[3][3] = -9999;  // the node at (1035, 2015): cells x 1025 .. 1045, y 2005 .. 2025 have no height
+  testing::WriteGdalRaster(dir / "data" / "dem.tif", dem, kGeo, 31287, -9999.0);
+  const std::string scene = "[terrain]\ndem = \"data/dem.tif\"\n[rock]\nshape = { sphere = 0.3 }\n[release]\n";
+  const std::string line = ErrorOf(scene + "lines = [[[1015, 2015], [1055, 2015]]]\n", dir);
+  EXPECT_HAS(line, "release.lines[0]: (");
+  EXPECT_HAS(line, "is outside the DEM or on nodata");
+  const std::string polygon =
+      ErrorOf(scene + "polygons = [[[1015, 1995], [1055, 1995], [1055, 2035], [1015, 2035]]]\n", dir);
+  EXPECT_HAS(polygon, "release.polygons[0]: (1030, 2010) is outside the DEM or on nodata");  // a cell centre
+  EXPECT_EQ(ErrorOf(scene + "lines = [[[1015, 2035], [1055, 2035]]]\n", dir), "");
+}
+
+TEST(LoadScene, OutOfRangeIntegersAreErrors) {
+  const auto dir = testing::FreshDir("integers");
+  // 2^32 + 1 used to wrap to max_iterations = 1.
+  EXPECT_HAS(ErrorOf(Replace(kPlaneScene, "max_time_s = 20", "max_time_s = 20\nmax_iterations = 4294967297"), dir),
+             "solver.max_iterations: 4294967297 is out of range");
+  EXPECT_HAS(ErrorOf(Replace(kPlaneScene, "rocks = 7", "rocks = 9223372036854775807"), dir), "is more than");
+  // A ground value far outside any code (converting it to int was undefined behaviour).
+  WriteDemCase(dir);
+  testing::WriteGdalRaster(dir / "data" / "ground_huge.tif", {{6, 6, 11}, {6, 11, 11}, {255, 11, 1e20}},
+                           {1000.0, 20.0, 0.0, 2050.0, 0.0, -20.0}, 31287, 255.0);
+  EXPECT_HAS(ErrorOf(Replace(kDemScene, "\"data/ground.tif\"", "\"data/ground_huge.tif\""), dir),
+             "has the value 1e+20");
+}
+
 TEST(ClosestName, OnlySuggestsCloseNames) {
   EXPECT_EQ(ClosestName("sead", {"seed", "rocks"}), "seed");
   EXPECT_EQ(ClosestName("trajectory", {"trajectories", "rasters"}), "trajectories");
