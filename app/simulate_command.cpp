@@ -106,7 +106,7 @@ int RunSimulate(const SimulateArgs& args) {
   const auto out = [&](const std::string& name) { return (fs::path(args.out) / name).string(); };
 
   std::printf("Scene %s: %s; rock %s (%.1f kg, %zu hull vertices); %zu releases x %ld rocks, seed %llu\n",
-              args.scene.c_str(), scene.terrain_description.c_str(), scene.rock.description.c_str(),
+              args.scene.c_str(), scene.terrain_description.c_str(), scene.rock_description.c_str(),
               scene.scene.rock.mass_kg, scene.scene.rock.vertices_m.size(), scene.release.releases.size(),
               scene.release.rocks_per_release, static_cast<unsigned long long>(scene.release.seed));
   try {

@@ -292,7 +292,7 @@ void LoadTerrain(const Context& context, const Section& s, SceneFile& out) {
 }
 
 void LoadRock(const Context& context, const Section& s, SceneFile& out) {
-  RockInput& rock = out.rock;
+  pointclouds::RockSpec& rock = out.rock;
   if (!s.Has("shape")) s.Fail("shape", "missing: a point cloud file or a built-in such as { box = [1, 1, 1] }");
   rock.density_kg_m3 = s.Checked("density_kg_m3", 2700, kPositive, "must be > 0");
   if (s.Has("volume_m3") && s.Has("mass_kg")) s.Fail("mass_kg", "give volume_m3 or mass_kg, not both");
@@ -305,7 +305,6 @@ void LoadRock(const Context& context, const Section& s, SceneFile& out) {
   const toml::node* shape = s.Node("shape");
   if (shape->is_string()) {
     rock.file = context.Resolve(s.String("shape", ""));
-    rock.description = fs::path(rock.file).filename().string();
     if (!fs::exists(rock.file)) s.Fail("shape", "file not found: " + rock.file);
     out.inputs.push_back(rock.file);
   } else if (shape->is_table()) {
@@ -321,9 +320,6 @@ void LoadRock(const Context& context, const Section& s, SceneFile& out) {
         if (v <= 0) b.Fail(key, "dimensions must be > 0");
       rock.dimensions_m = d;
       rock.builtin = builtin;
-      rock.description = key;
-      for (std::size_t k = 0; k < d.size(); ++k) rock.description += (k ? " x " : " ") + Fmt(d[k]);
-      rock.description += " m";
     };
     if (b.Has("size_m") && !b.Has("eota")) b.Fail("size_m", "only an eota shape takes a size");
     if (b.Has("box")) dims("box", 3, "box");
@@ -333,26 +329,24 @@ void LoadRock(const Context& context, const Section& s, SceneFile& out) {
       const double radius = b.Checked("sphere", 0, kPositive, "radius must be > 0");
       rock.builtin = "icosphere";
       rock.dimensions_m = {2 * radius};
-      rock.description = "sphere of radius " + Fmt(radius) + " m";
     }
     if (b.Has("eota")) {
       const std::string kind = b.String("eota", "");
       if (kind != "111" && kind != "221") b.Fail("eota", "'" + kind + "': expected \"111\" or \"221\"");
       rock.builtin = "eota" + kind;
-      rock.description = "EOTA" + kind;
       if (b.Has("size_m")) {
         rock.dimensions_m = b.Numbers("size_m", 3);
         for (double v : rock.dimensions_m)
           if (v <= 0) b.Fail("size_m", "dimensions must be > 0");
-        rock.description += " " + Fmt(rock.dimensions_m[0]) + " x " + Fmt(rock.dimensions_m[1]) + " x " +
-                            Fmt(rock.dimensions_m[2]) + " m";
       }
     }
   } else {
     s.Fail("shape", "expected a file name or a built-in such as { box = [1, 1, 1] }");
   }
   try {
-    out.scene.rock = BuildRock(rock, &rock.description);
+    pointclouds::RockReport report;
+    out.scene.rock = pointclouds::MakeRock(rock, &report);
+    out.rock_description = report.source;
   } catch (const InputError& e) {
     throw InputError(context.Where(shape) + ": rock.shape: " + e.what());
   }

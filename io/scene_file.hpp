@@ -7,7 +7,7 @@
 
 #include "ensemble/rasters.hpp"
 #include "ensemble/release.hpp"
-#include "io/rock_input.hpp"
+#include "pointclouds/rock_source.hpp"
 #include "solver/scene.hpp"
 
 namespace talus::io {
@@ -30,7 +30,8 @@ struct SceneFile {
   Scene scene;             // IsValid() holds
   ensemble::ReleaseSpec release;  // IsValid() holds, every release vertex on valid DEM cells
   OutputSpec output;
-  RockInput rock;
+  pointclouds::RockSpec rock;   // the [rock] table
+  std::string rock_description;  // e.g. "eota221 0.93 x 0.93 x 0.47 m, bevel 0.12 m"
   std::string crs_wkt;     // the DEM's CRS; empty for the plane or a DEM without CRS
   std::string terrain_description;  // e.g. "dem.tif (270 x 370 cells of 5 m)"
   std::vector<std::string> inputs;  // the scene file and every data file it read

@@ -12,7 +12,7 @@ std::string SummaryJson(const SceneFile& scene, const ensemble::EnsembleReport& 
   j["inputs"] = scene.inputs;
   j["inputs_hash_fnv1a64"] = scene.inputs_hash;
   j["terrain"] = scene.terrain_description;
-  j["rock"] = {{"shape", scene.rock.description},
+  j["rock"] = {{"shape", scene.rock_description},
                {"mass_kg", scene.scene.rock.mass_kg},
                {"volume_m3", scene.scene.rock.volume_m3},
                {"hull_vertices", scene.scene.rock.vertices_m.size()}};

@@ -269,5 +269,23 @@ TEST(ClosestName, OnlySuggestsCloseNames) {
   EXPECT_EQ(ClosestName("xyz", {"seed", "rocks"}), "");
 }
 
+// Point cloud files go through the pointclouds module: the hull of the points is the rock.
+TEST(LoadScene, PointCloudFileIsTheRocksHull) {
+  const auto dir = testing::FreshDir("cloud");
+  std::string xyz;
+  for (int k = 0; k < 8; ++k)
+    xyz += std::to_string(k & 1 ? 0.5 : -0.5) + " " + std::to_string(k & 2 ? 0.25 : -0.25) + " " +
+           std::to_string(k & 4 ? 0.1 : -0.1) + "\n";
+  xyz += "0 0 0\n0.1 0.1 0\n";  // inside the hull
+  testing::WriteText(dir / "block.xyz", xyz);
+  testing::WriteText(dir / "scene.toml",
+                     "[terrain]\nplane = {}\n[rock]\nshape = \"block.xyz\"\ndensity_kg_m3 = 2000\n"
+                     "[release]\npoints = [[10, 0]]\n");
+  const SceneFile s = LoadScene((dir / "scene.toml").string());
+  EXPECT_NEAR(s.scene.rock.mass_kg, 1.0 * 0.5 * 0.2 * 2000, 1e-6);
+  EXPECT_EQ(s.scene.rock.vertices_m.size(), 8u);
+  EXPECT_EQ(s.inputs.size(), 2u);  // the scene and the point cloud
+}
+
 }  // namespace
 }  // namespace talus::io
