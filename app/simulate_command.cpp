@@ -80,6 +80,16 @@ class ProgressBar {
   std::chrono::steady_clock::time_point start_;
 };
 
+// Every file name talus simulate may write into its output directory.
+std::vector<std::string> TalusOutputNames() {
+  std::vector<std::string> names = {"rocks.csv", "trajectories.h5", "summary.json", "quicklook.png",
+                                    "passages.tif", "deposits.tif", "reach_probability.tif"};
+  for (const char* quantity : {"speed", "energy", "jump_height"})
+    for (const char* statistic : {"max", "mean", "p95"})
+      names.push_back(std::string(quantity) + "_" + statistic + ".tif");
+  return names;
+}
+
 int RunSimulate(const SimulateArgs& args) {
   namespace fs = std::filesystem;
   io::SceneFile scene;
@@ -104,6 +114,10 @@ int RunSimulate(const SimulateArgs& args) {
     return 2;
   }
   const auto out = [&](const std::string& name) { return (fs::path(args.out) / name).string(); };
+  // An earlier run's outputs that this run would not replace must not pass for this run's.
+  int stale = 0;
+  for (const std::string& name : TalusOutputNames()) stale += fs::remove(out(name), error) ? 1 : 0;
+  if (stale > 0) std::printf("Removed %d outputs of an earlier run from %s\n", stale, args.out.c_str());
 
   std::printf("Scene %s: %s; rock %s (%.1f kg, %zu hull vertices); %zu releases x %ld rocks, seed %llu\n",
               args.scene.c_str(), scene.terrain_description.c_str(), scene.rock_description.c_str(),

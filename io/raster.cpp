@@ -123,7 +123,10 @@ void WriteGeoTiff(const std::string& path, const GridGeometry& grid, const std::
     if (band->RasterIO(GF_Write, 0, 0, grid.nx, grid.ny, rows.data(), grid.nx, grid.ny, GDT_Float32, 0, 0) !=
         CE_None)
       throw std::runtime_error("cannot write " + path + ": " + CPLGetLastErrorMsg());
-  }  // closing the dataset flushes it
+    CPLErrorReset();
+  }  // closing the dataset flushes it; a failure there is reported through CPLGetLastErrorType
+  if (CPLGetLastErrorType() >= CE_Failure)
+    throw std::runtime_error("cannot write " + path + ": " + CPLGetLastErrorMsg());
   file.Commit();
 }
 

@@ -134,4 +134,29 @@ TEST(SimulateCommand, BadSceneFailsBeforeAnyWorkNamingFileLineAndKey) {
   EXPECT_FALSE(fs::exists(dir / "out"));
 }
 
+TEST(SimulateCommand, ARunRemovesOutputsOfAnEarlierRunThatItDoesNotWrite) {
+  const fs::path dir = FreshDir("stale");
+  std::ofstream(dir / "all.toml") << kScene;
+  std::string lean = kScene;
+  lean.replace(lean.find("trajectories = true"), 19, "trajectories = false");
+  lean.replace(lean.find("rasters = ["), lean.find("]\n", lean.find("rasters = [")) - lean.find("rasters = [") + 1,
+               "rasters = []\nquicklook = false");
+  std::ofstream(dir / "lean.toml") << lean;
+  const std::string out = (dir / "out").string();
+  std::string log;
+  ASSERT_EQ(RunCommand(std::string(TALUS_BINARY) + " simulate " + (dir / "all.toml").string() + " --out " + out, &log), 0)
+      << log;
+  ASSERT_TRUE(fs::exists(dir / "out" / "trajectories.h5"));
+  ASSERT_TRUE(fs::exists(dir / "out" / "speed_p95.tif"));
+  std::ofstream(dir / "out" / "notes.txt") << "the user's own file";
+  ASSERT_EQ(RunCommand(std::string(TALUS_BINARY) + " simulate " + (dir / "lean.toml").string() + " --out " + out, &log), 0)
+      << log;
+  EXPECT_FALSE(fs::exists(dir / "out" / "trajectories.h5"));
+  EXPECT_FALSE(fs::exists(dir / "out" / "speed_p95.tif"));
+  EXPECT_FALSE(fs::exists(dir / "out" / "quicklook.png"));
+  EXPECT_TRUE(fs::exists(dir / "out" / "rocks.csv"));
+  EXPECT_TRUE(fs::exists(dir / "out" / "summary.json"));
+  EXPECT_TRUE(fs::exists(dir / "out" / "notes.txt"));
+}
+
 }  // namespace
