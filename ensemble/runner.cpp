@@ -161,7 +161,6 @@ EnsembleReport RunEnsemble(const Scene& scene, const ReleaseSpec& release, const
 
   std::vector<std::thread> pool;
   pool.reserve(static_cast<std::size_t>(threads));
-  for (int k = 0; k < threads; ++k) pool.emplace_back(work);
   auto stop = [&]() {
     {
       std::lock_guard lock(mutex);
@@ -170,6 +169,12 @@ EnsembleReport RunEnsemble(const Scene& scene, const ReleaseSpec& release, const
     worker_cv.notify_all();
     for (std::thread& t : pool) t.join();
   };
+  try {
+    for (int k = 0; k < threads; ++k) pool.emplace_back(work);
+  } catch (...) {  // a thread could not start: stop and join the ones that did
+    stop();
+    throw;
+  }
 
   EnsembleReport report;
   report.threads = threads;
