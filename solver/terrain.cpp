@@ -28,44 +28,38 @@ Terrain::Terrain(Heightfield heights, int default_ground)
 
 void Terrain::SetGroundGrid(GroundGrid ground) { ground_ = std::move(ground); }
 
-bool Terrain::Locate(double x_m, double y_m, int* i, int* j, double* u, double* w) const {
+bool Terrain::Locate(double x_m, double y_m, Cell* cell) const {
   const GridGeometry& g = heights_.grid;
   const double fx = (x_m - g.x0_m) * inv_dx_;
   const double fy = (y_m - g.y0_m) * inv_dy_;
   if (!(fx >= 0 && fy >= 0 && fx <= g.nx - 1 && fy <= g.ny - 1)) return false;
-  *i = std::min(static_cast<int>(fx), g.nx - 2);
-  *j = std::min(static_cast<int>(fy), g.ny - 2);
-  *u = fx - *i;
-  *w = fy - *j;
+  const int i = std::min(static_cast<int>(fx), g.nx - 2);
+  const int j = std::min(static_cast<int>(fy), g.ny - 2);
+  cell->row0 = heights_.z_m.data() + static_cast<std::size_t>(j) * g.nx + i;
+  cell->row1 = cell->row0 + g.nx;
+  cell->u = fx - i;
+  cell->w = fy - j;
   return true;
 }
 
 bool Terrain::Height(double x_m, double y_m, double* height_m) const {
-  int i, j;
-  double u, w;
-  if (!Locate(x_m, y_m, &i, &j, &u, &w)) return false;
-  const int nx = heights_.grid.nx;
-  const double* row0 = heights_.z_m.data() + static_cast<std::size_t>(j) * nx + i;
-  const double* row1 = row0 + nx;
-  const double lower = row0[0] + u * (row0[1] - row0[0]);
-  const double upper = row1[0] + u * (row1[1] - row1[0]);
-  *height_m = lower + w * (upper - lower);
+  Cell c;
+  if (!Locate(x_m, y_m, &c)) return false;
+  const double lower = c.row0[0] + c.u * (c.row0[1] - c.row0[0]);
+  const double upper = c.row1[0] + c.u * (c.row1[1] - c.row1[0]);
+  *height_m = lower + c.w * (upper - lower);
   return !std::isnan(*height_m);  // a nodata corner
 }
 
 bool Terrain::Sample(double x_m, double y_m, TerrainSample* out) const {
-  int i, j;
-  double u, w;
-  if (!Locate(x_m, y_m, &i, &j, &u, &w)) return false;
-  const int nx = heights_.grid.nx;
-  const double* row0 = heights_.z_m.data() + static_cast<std::size_t>(j) * nx + i;
-  const double* row1 = row0 + nx;
-  const double z00 = row0[0], z10 = row0[1], z01 = row1[0], z11 = row1[1];
-  const double lower = z00 + u * (z10 - z00);
-  const double upper = z01 + u * (z11 - z01);
-  const double h = lower + w * (upper - lower);
+  Cell c;
+  if (!Locate(x_m, y_m, &c)) return false;
+  const double z00 = c.row0[0], z10 = c.row0[1], z01 = c.row1[0], z11 = c.row1[1];
+  const double lower = z00 + c.u * (z10 - z00);
+  const double upper = z01 + c.u * (z11 - z01);
+  const double h = lower + c.w * (upper - lower);
   if (std::isnan(h)) return false;  // a nodata corner
-  const double hx = ((z10 - z00) * (1 - w) + (z11 - z01) * w) * inv_dx_;
+  const double hx = ((z10 - z00) * (1 - c.w) + (z11 - z01) * c.w) * inv_dx_;
   const double hy = (upper - lower) * inv_dy_;
   out->height_m = h;
   out->normal = Eigen::Vector3d(-hx, -hy, 1.0) / std::sqrt(hx * hx + hy * hy + 1.0);

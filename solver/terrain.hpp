@@ -84,8 +84,15 @@ class Terrain {
   bool IsValid(std::string* why) const;
 
  private:
-  // Cell (i, j) and local coordinates (u, w) in [0, 1]^2 of a point; false outside the grid.
-  bool Locate(double x_m, double y_m, int* i, int* j, double* u, double* w) const;
+  // The cell holding a point: its lower and upper rows of node heights (corners [0] and [1] of
+  // each) and the point's local coordinates (u, w) in [0, 1]^2.
+  struct Cell {
+    const double* row0;
+    const double* row1;
+    double u, w;
+  };
+  // False outside the grid.
+  bool Locate(double x_m, double y_m, Cell* cell) const;
 
   Heightfield heights_;
   double inv_dx_ = 1, inv_dy_ = 1;  // 1 / node spacing, 1/m
