@@ -10,6 +10,10 @@ int main(int argc, char** argv) {
   CLI::App app{"Talus: rockfall simulation with non-smooth contact mechanics"};
   app.set_version_flag("--version", std::string("talus ") + talus::kVersion);
   app.require_subcommand(1);
+  // Usage errors are one line on stderr, like every other failure.
+  app.failure_message([](const CLI::App*, const CLI::Error& e) {
+    return std::string(e.what()) + " (see --help)\n";
+  });
 
   const std::vector<talus::app::Runner> runners = {
       talus::app::AddDemoCommand(app),

@@ -73,10 +73,15 @@ bool ParseCount(std::string_view token, long long* value) {
   return ec == std::errc() && end == token.data() + token.size() && *value >= 0;
 }
 
+// Fields separated by blanks, commas or semicolons; on a line with a semicolon, commas are not
+// separators (they may be decimal commas, "1,5;2,5;3,5", which must not read as 1, 5, 2).
 std::vector<std::string_view> SplitFields(std::string_view line) {
   std::vector<std::string_view> fields;
   std::size_t i = 0;
-  auto separator = [](char c) { return c == ' ' || c == '\t' || c == ',' || c == ';'; };
+  const bool semicolons = line.find(';') != std::string_view::npos;
+  auto separator = [semicolons](char c) {
+    return c == ' ' || c == '\t' || c == ';' || (c == ',' && !semicolons);
+  };
   while (i < line.size()) {
     while (i < line.size() && separator(line[i])) ++i;
     const std::size_t start = i;
@@ -180,30 +185,94 @@ double FieldValue(const std::uint8_t* at, std::uint8_t datatype) {
   }
 }
 
-// What is missing from the header of a PCD or PLY file ("" when it looks complete). PCL's PCD
-// reader can crash on files that are not PCD at all, so they never reach it.
-std::string MissingHeader(const std::string& path, bool pcd) {
+// Bytes of one binary PLY scalar type (0 for a type it does not know).
+std::size_t PlyTypeSize(const std::string& type) {
+  if (type == "char" || type == "uchar" || type == "int8" || type == "uint8") return 1;
+  if (type == "short" || type == "ushort" || type == "int16" || type == "uint16") return 2;
+  if (type == "int" || type == "uint" || type == "int32" || type == "uint32" || type == "float" ||
+      type == "float32")
+    return 4;
+  if (type == "double" || type == "float64") return 8;
+  return 0;
+}
+
+// What is wrong with the header of a PCD or PLY file ("" when it looks complete). PCL's PCD
+// reader can crash on files that are not PCD at all, so they never reach it; and PCL allocates
+// the points a header announces before reading them, so a count that the rest of the file
+// cannot hold (binary: bytes per point; ASCII: at least one byte per value) is refused first.
+std::string HeaderProblem(const std::string& path, bool pcd) {
   std::ifstream in(path, std::ios::binary);
   std::string line;
-  if (!pcd)
-    return std::getline(in, line) && line.starts_with("ply") ? "" : "it does not start with 'ply'";
-  std::vector<std::string> missing = {"FIELDS", "SIZE", "TYPE", "WIDTH", "POINTS", "DATA"};
-  for (int n = 0; n < 64 && std::getline(in, line); ++n) {
-    std::istringstream words(line);
-    std::string keyword;
-    words >> keyword;
-    std::erase(missing, keyword);
-    if (keyword == "DATA") break;
+  unsigned long long points = 0, point_bytes = 0, values = 0;
+  bool binary = false, check = false;
+  if (!pcd) {
+    if (!std::getline(in, line) || !line.starts_with("ply")) return "it does not start with 'ply'";
+    bool in_vertex = false;
+    for (int n = 0; n < 1000 && std::getline(in, line); ++n) {
+      std::istringstream words(line);
+      std::string keyword, a, b;
+      words >> keyword >> a >> b;
+      if (keyword == "end_header") break;
+      if (keyword == "format") binary = a != "ascii";
+      if (keyword == "element") {
+        in_vertex = a == "vertex";
+        if (in_vertex) check = static_cast<bool>(std::istringstream(b) >> points);
+      }
+      if (keyword == "property" && in_vertex) {
+        const std::size_t size = PlyTypeSize(a);
+        if (size == 0) check = false;  // a list or an unknown type: no fixed size
+        point_bytes += size;
+        ++values;
+      }
+    }
+  } else {
+    std::vector<std::string> missing = {"FIELDS", "SIZE", "TYPE", "WIDTH", "POINTS", "DATA"};
+    std::vector<unsigned long long> sizes, counts;
+    for (int n = 0; n < 64 && std::getline(in, line); ++n) {
+      std::istringstream words(line);
+      std::string keyword;
+      words >> keyword;
+      std::erase(missing, keyword);
+      unsigned long long number = 0;
+      if (keyword == "SIZE")
+        while (words >> number) sizes.push_back(number);
+      if (keyword == "COUNT")
+        while (words >> number) counts.push_back(number);
+      if (keyword == "POINTS") check = static_cast<bool>(words >> points);
+      if (keyword == "DATA") {
+        std::string kind;
+        words >> kind;
+        binary = kind == "binary";
+        if (kind != "ascii" && kind != "binary") check = false;  // binary_compressed
+        break;
+      }
+    }
+    if (!missing.empty()) return "no " + missing.front() + " line in its header";
+    if (counts.empty()) counts.assign(sizes.size(), 1);
+    if (counts.size() != sizes.size()) check = false;
+    for (std::size_t k = 0; k < sizes.size() && k < counts.size(); ++k) {
+      point_bytes += sizes[k] * counts[k];
+      values += counts[k];
+    }
   }
-  return missing.empty() ? "" : "no " + missing.front() + " line in its header";
+  const std::streamoff header = in ? static_cast<std::streamoff>(in.tellg()) : -1;
+  std::error_code ec;
+  const auto file_bytes = std::filesystem::file_size(path, ec);
+  if (!check || header < 0 || ec) return "";
+  const unsigned long long data_bytes = file_bytes - static_cast<unsigned long long>(header);
+  const unsigned long long per_point = binary ? point_bytes : values;
+  if (per_point > 0 && points > data_bytes / per_point)
+    return "its header announces " + std::to_string(points) + " points, more than the " +
+           std::to_string(data_bytes) + " bytes after it can hold";
+  return "";
 }
 
 // PCD and PLY through PCL, into a PCLPointCloud2 so that double-precision fields stay double.
 PointCloud ReadPclPoints(const std::string& path, bool pcd) {
   const char* format = pcd ? "PCD" : "PLY";
-  const std::string missing = MissingHeader(path, pcd);
-  if (!missing.empty())
-    throw InputError(path + ": not a readable " + format + " file (" + missing + ")");
+  const std::string problem = HeaderProblem(path, pcd);
+  if (!problem.empty())
+    throw InputError(path + ": not a readable " + format + " file (" + problem + ")");
   pcl::PCLPointCloud2 blob;
   int status = -1;
   try {
@@ -397,8 +466,9 @@ bool CleanOptions::IsValid(std::string* why) const {
         << " violates 0 <= outlier_neighbours <= 1000";
   else if (!(outlier_std_ratio > 0) || !std::isfinite(outlier_std_ratio))
     msg << "outlier_std_ratio = " << outlier_std_ratio << " violates 0 < outlier_std_ratio < inf";
-  else if (!(voxel_m >= 0) || !std::isfinite(voxel_m))
-    msg << "voxel_m = " << voxel_m << " violates 0 <= voxel_m < inf m";
+  else if (!(voxel_m == 0 || voxel_m >= kMinVoxel_m) || !std::isfinite(voxel_m))
+    msg << "voxel_m = " << voxel_m << " violates voxel_m = 0 (off) or " << kMinVoxel_m
+        << " <= voxel_m < inf m";
   if (msg.str().empty()) return true;
   if (why) *why = msg.str();
   return false;

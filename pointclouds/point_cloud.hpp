@@ -25,9 +25,11 @@ struct PointCloud {
 
 // Reads a point cloud; the format follows the extension (case-insensitive):
 //   .pcd, .ply  PCL readers; the x, y, z fields of any numeric type, kept in double precision.
-//   .xyz, .txt, .csv  one point per line, x y z first, separated by blanks, commas or semicolons;
-//               further columns (intensity, colour, normals) are ignored, as are blank lines,
-//               comment lines (#, //) and one header line of column names before the first point.
+//   .xyz, .txt, .csv  one point per line, x y z first, separated by blanks, commas or semicolons
+//               (on a line with a semicolon, commas do not separate: a decimal comma is an error,
+//               not an extra coordinate); further columns (intensity, colour, normals) are
+//               ignored, as are blank lines, comment lines (#, //) and one header line of column
+//               names before the first point.
 //   .pts  RAMMS-style point list: x y z per line as above; a line holding a single integer is a
 //         point count (Leica PTS) and must match the number of points that follow it.
 // Throws InputError naming the file (and line) for a missing or unreadable file, an unknown
@@ -49,8 +51,10 @@ struct CleanOptions {
   int outlier_neighbours = 0;
   double outlier_std_ratio = 2.0;
   // Voxel downsampling: > 0 keeps, in each cube of this edge, the point nearest its centre
-  // (points stay measured points, so the hull never grows). 0: off.
+  // (points stay measured points, so the hull never grows). 0: off; else >= kMinVoxel_m, so that
+  // voxel indices stay within 64-bit integers.
   double voxel_m = 0;
+  static constexpr double kMinVoxel_m = 1e-6;
 
   // False, with the field, value and violated bound in *why, when an option is out of range.
   bool IsValid(std::string* why) const;

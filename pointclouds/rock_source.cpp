@@ -131,7 +131,7 @@ RockShape MakeRockFromPoints(PointCloud cloud, const RockSpec& spec, RockReport*
   r.points_read = cloud.points_m.size();
   r.clean = CleanPointCloud(spec.clean, &cloud);
   r.points_used = cloud.points_m.size();
-  if (r.points_used < 4 && r.points_read >= 4) {
+  if (r.points_used < 4 && r.points_used < r.points_read) {
     std::ostringstream msg;
     msg << source << ": only " << r.points_used << " of " << r.points_read << " points are usable ("
         << r.clean.non_finite << " non-finite, " << r.clean.duplicates << " duplicates, "

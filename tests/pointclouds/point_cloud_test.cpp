@@ -49,6 +49,10 @@ TEST(CleanOptions, DefaultsAreValid) {
   bad.voxel_m = -0.1;
   EXPECT_FALSE(bad.IsValid(&why));
   EXPECT_NE(why.find("voxel_m"), std::string::npos) << why;
+  // So small that the voxel indices of a metre-sized rock overflow 64-bit integers.
+  bad.voxel_m = 1e-30;
+  EXPECT_FALSE(bad.IsValid(&why));
+  EXPECT_NE(why.find("voxel_m = 1e-30"), std::string::npos) << why;
 }
 
 TEST(ReadPointCloud, TextFormatsWithHeadersCommentsAndExtraColumns) {
@@ -65,6 +69,37 @@ TEST(ReadPointCloud, TextFormatsWithHeadersCommentsAndExtraColumns) {
                                     "2 3 4\n0.125 0.25 0.5 1 2 3 4\n");
   for (const auto& path : {xyz, csv, txt, pts}) ExpectPoints(ReadPointCloud(path), kPoints);
   EXPECT_EQ(ReadPointCloud(xyz).source_lines.front(), 3);
+}
+
+TEST(ReadPointCloud, DecimalCommasAreAnErrorNotExtraCoordinates) {
+  // "1,5;2,5;3,5" is the point (1.5, 2.5, 3.5) in a European CSV; splitting it at the commas
+  // as well would read (1, 5, 2).
+  TempDir dir;
+  const std::string path = dir.Write("eu.csv", "x;y;z\n1,5;2,5;3,5\n0;0;0\n");
+  const std::string why = ReadError(path);
+  EXPECT_NE(why.find(path + ":2: expected a point"), std::string::npos) << why;
+  // Semicolons alone, and commas alone, still separate.
+  ExpectPoints(ReadPointCloud(dir.Write("semi.csv", "1.5; 2.5; 3.5\n")), {{1.5, 2.5, 3.5}});
+  ExpectPoints(ReadPointCloud(dir.Write("comma.csv", "1.5, 2.5, 3.5, 7\n")), {{1.5, 2.5, 3.5}});
+}
+
+TEST(ReadPointCloud, HeaderCountsTheFileCannotHoldAreRefused) {
+  // PCL allocates the points a header announces before it reads them: a 100-byte file claiming
+  // 10^9 points took 12 GB and half a minute. 10^7 here, so that the test stays cheap either way.
+  TempDir dir;
+  const std::string pcd =
+      dir.Write("huge.pcd",
+                "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 10000000\n"
+                "HEIGHT 1\nPOINTS 10000000\nDATA binary\n0123456789ab");
+  const std::string ply = dir.Write("huge.ply",
+                                    "ply\nformat ascii 1.0\nelement vertex 10000000\nproperty "
+                                    "float x\nproperty float y\nproperty float z\nend_header\n"
+                                    "0 0 0\n");
+  for (const auto& path : {pcd, ply}) {
+    const std::string why = ReadError(path);
+    EXPECT_NE(why.find(path + ": not a readable"), std::string::npos) << why;
+    EXPECT_NE(why.find("announces 10000000 points"), std::string::npos) << why;
+  }
 }
 
 TEST(ReadPointCloud, PtsCountMustMatch) {

@@ -272,6 +272,18 @@ TEST(MakeRock, ScalesToVolumeOrMassAboutTheCentroid) {
   spec.volume_m3.reset();
   spec.mass_kg = 1000;
   EXPECT_NEAR(MakeRock(spec).volume_m3, 1000 / 2700.0, 1e-14);
+
+  // A scan away from the origin: scaling about the origin instead would move the centroid.
+  const Eigen::Vector3d at(5, -3, 2);
+  std::vector<Eigen::Vector3d> corners;
+  for (const auto& c : testing::BoxCorners(1, 2, 3)) corners.push_back(c + at);
+  RockSpec file = FileSpec("", 2700);
+  file.volume_m3 = 48.0;
+  RockReport moved;
+  const RockShape far = MakeRockFromPoints(Cloud(corners), file, &moved);
+  EXPECT_NEAR(moved.scale, 2, 1e-14);
+  EXPECT_NEAR(far.volume_m3, 48, 1e-12);
+  EXPECT_LT((moved.centroid_m - at).norm(), 1e-12);
 }
 
 TEST(MakeRock, BuiltInEota221MatchesTheChantSuraBlock) {
@@ -317,6 +329,9 @@ TEST(MakeRock, BadInputSaysWhatIsWrong) {
       {dir.Write("line.csv", "0,0,0\n1,1,1\n2,2,2\n3,3,3\n"), "collinear"},
       {dir.Write("nan.xyz", "nan 0 0\n0 nan 0\n0 0 nan\n1 2 3\n4 5 6\n"),
        "only 2 of 5 points are usable (3 non-finite"},
+      // Fewer than 4 points in the file, some of them dropped: say so, not "1 point".
+      {dir.Write("few.xyz", "nan 0 0\n1 2 3\n1 2 3\n"),
+       "only 1 of 3 points are usable (1 non-finite, 1 duplicates"},
       {dir.Write("empty.ply", ""), "empty"},
       {dir.Write("junk.pcd", "not a point cloud\n"), "not a readable PCD file"},
       {dir.Write("rock.las", "LASF"), "unknown point cloud format '.las'"},
