@@ -11,9 +11,9 @@
 #include <string>
 
 #include "app/commands.hpp"
+#include "common/atomic_file.hpp"
 #include "common/error.hpp"
 #include "ensemble/runner.hpp"
-#include "common/atomic_file.hpp"
 #include "io/quicklook.hpp"
 #include "io/raster.hpp"
 #include "io/rocks_csv.hpp"
@@ -44,7 +44,8 @@ class FileSink : public ensemble::RockSink {
     if (trajectories_) trajectories_->Write(rock);
     if (rock.rock < sample_) {
       std::vector<Eigen::Vector2d>& path = paths.emplace_back();
-      for (const ensemble::TrajectorySample& s : rock.trajectory) path.push_back(s.position_m.head<2>());
+      for (const ensemble::TrajectorySample& s : rock.trajectory)
+        path.push_back(s.position_m.head<2>());
     }
   }
   std::vector<std::vector<Eigen::Vector2d>> paths;
@@ -60,10 +61,12 @@ constexpr long kQuickLookPaths = 20;  // rocks drawn on the quick-look
 // "rocks done / total, rate, time left" on a terminal; nothing otherwise.
 class ProgressBar {
  public:
-  ProgressBar() : enabled_(::isatty(STDERR_FILENO) != 0), start_(std::chrono::steady_clock::now()) {}
+  ProgressBar()
+      : enabled_(::isatty(STDERR_FILENO) != 0), start_(std::chrono::steady_clock::now()) {}
   void operator()(long done, long total) {
     if (!enabled_ || total <= 0) return;
-    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+    const double elapsed =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
     const double rate = elapsed > 0 ? double(done) / elapsed : 0.0;
     const double left = rate > 0 ? double(total - done) / rate : 0.0;
     constexpr int kWidth = 30;
@@ -82,8 +85,9 @@ class ProgressBar {
 
 // Every file name talus simulate may write into its output directory.
 std::vector<std::string> TalusOutputNames() {
-  std::vector<std::string> names = {"rocks.csv", "trajectories.h5", "summary.json", "quicklook.png",
-                                    "passages.tif", "deposits.tif", "reach_probability.tif"};
+  std::vector<std::string> names = {
+      "rocks.csv",    "trajectories.h5", "summary.json",         "quicklook.png",
+      "passages.tif", "deposits.tif",    "reach_probability.tif"};
   for (const char* quantity : {"speed", "energy", "jump_height"})
     for (const char* statistic : {"max", "mean", "p95"})
       names.push_back(std::string(quantity) + "_" + statistic + ".tif");
@@ -117,12 +121,14 @@ int RunSimulate(const SimulateArgs& args) {
   // An earlier run's outputs that this run would not replace must not pass for this run's.
   int stale = 0;
   for (const std::string& name : TalusOutputNames()) stale += fs::remove(out(name), error) ? 1 : 0;
-  if (stale > 0) std::printf("Removed %d outputs of an earlier run from %s\n", stale, args.out.c_str());
+  if (stale > 0)
+    std::printf("Removed %d outputs of an earlier run from %s\n", stale, args.out.c_str());
 
-  std::printf("Scene %s: %s; rock %s (%.1f kg, %zu hull vertices); %zu releases x %ld rocks, seed %llu\n",
-              args.scene.c_str(), scene.terrain_description.c_str(), scene.rock_description.c_str(),
-              scene.scene.rock.mass_kg, scene.scene.rock.vertices_m.size(), scene.release.releases.size(),
-              scene.release.rocks_per_release, static_cast<unsigned long long>(scene.release.seed));
+  std::printf(
+      "Scene %s: %s; rock %s (%.1f kg, %zu hull vertices); %zu releases x %ld rocks, seed %llu\n",
+      args.scene.c_str(), scene.terrain_description.c_str(), scene.rock_description.c_str(),
+      scene.scene.rock.mass_kg, scene.scene.rock.vertices_m.size(), scene.release.releases.size(),
+      scene.release.rocks_per_release, static_cast<unsigned long long>(scene.release.seed));
   try {
     ensemble::EnsembleOptions options;
     options.threads = args.threads;
@@ -138,11 +144,13 @@ int RunSimulate(const SimulateArgs& args) {
     io::RocksCsvWriter csv(out("rocks.csv"), scene.release.seed);
     std::unique_ptr<io::TrajectoryWriter> trajectories;
     if (scene.output.trajectories) {
-      trajectories = std::make_unique<io::TrajectoryWriter>(out("trajectories.h5"), scene.scene.rock);
+      trajectories =
+          std::make_unique<io::TrajectoryWriter>(out("trajectories.h5"), scene.scene.rock);
       outputs.push_back("trajectories.h5");
     }
     FileSink sink(csv, trajectories.get(), options.sample_trajectories);
-    const ensemble::EnsembleReport report = ensemble::RunEnsemble(scene.scene, scene.release, options, &sink);
+    const ensemble::EnsembleReport report =
+        ensemble::RunEnsemble(scene.scene, scene.release, options, &sink);
     csv.Commit();
     if (trajectories) trajectories->Commit();
     for (const ensemble::RasterLayer& layer : report.rasters) {
@@ -151,15 +159,16 @@ int RunSimulate(const SimulateArgs& args) {
       outputs.push_back(layer.name + ".tif");
     }
     if (scene.output.quicklook) {
-      io::WriteQuickLookPng(out("quicklook.png"), scene.scene.terrain.heights(), io::QuickLookLayer(report.rasters),
-                            sink.paths);
+      io::WriteQuickLookPng(out("quicklook.png"), scene.scene.terrain.heights(),
+                            io::QuickLookLayer(report.rasters), sink.paths);
       outputs.push_back("quicklook.png");
     }
     WriteFileAtomically(out("summary.json"), io::SummaryJson(scene, report, kVersion, outputs));
     std::printf("%s\n", report.BriefReport().c_str());
     std::printf("Wrote %zu files to %s\n", outputs.size() + 1, args.out.c_str());
     if (report.count(EndReason::kFailed) > 0)
-      std::fprintf(stderr, "talus simulate: %ld rocks failed numerically (end = failed in rocks.csv)\n",
+      std::fprintf(stderr,
+                   "talus simulate: %ld rocks failed numerically (end = failed in rocks.csv)\n",
                    report.count(EndReason::kFailed));
     return 0;
   } catch (const std::exception& e) {
@@ -172,13 +181,17 @@ int RunSimulate(const SimulateArgs& args) {
 
 Runner AddSimulateCommand(CLI::App& app) {
   auto args = std::make_shared<SimulateArgs>();
-  CLI::App* cmd = app.add_subcommand("simulate", "Run a scene's rocks and write rocks.csv, rasters, trajectories");
+  CLI::App* cmd = app.add_subcommand(
+      "simulate", "Run a scene's rocks and write rocks.csv, rasters, trajectories");
   cmd->add_option("scene", args->scene, "Scene file (TOML)")->required();
   cmd->add_option("--out", args->out, "Output directory")->required();
-  cmd->add_option("--rocks", args->rocks, "Rocks per release (overrides the scene)")->check(CLI::PositiveNumber);
-  cmd->add_option("--threads", args->threads, "Worker threads (default: all cores)")->check(CLI::NonNegativeNumber);
+  cmd->add_option("--rocks", args->rocks, "Rocks per release (overrides the scene)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--threads", args->threads, "Worker threads (default: all cores)")
+      ->check(CLI::NonNegativeNumber);
   cmd->add_option_function<std::uint64_t>(
-      "--seed", [args](const std::uint64_t& seed) { args->seed = seed; }, "Random seed (overrides the scene)");
+      "--seed", [args](const std::uint64_t& seed) { args->seed = seed; },
+      "Random seed (overrides the scene)");
   return [cmd, args]() { return *cmd ? RunSimulate(*args) : -1; };
 }
 

@@ -28,7 +28,9 @@ AtomicFile::~AtomicFile() {
 void AtomicFile::Commit() {
   std::error_code error;
   std::filesystem::rename(temp_path_, final_path_, error);
-  if (error) throw std::runtime_error("cannot rename " + temp_path_ + " to " + final_path_ + ": " + error.message());
+  if (error)
+    throw std::runtime_error("cannot rename " + temp_path_ + " to " + final_path_ + ": " +
+                             error.message());
   committed_ = true;
 }
 

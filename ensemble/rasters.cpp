@@ -6,7 +6,8 @@
 namespace talus::ensemble {
 
 FootprintRecorder::FootprintRecorder(const RasterRequest& request, const RockShape& rock)
-    : request_(request), rock_(rock),
+    : request_(request),
+      rock_(rock),
       slot_(static_cast<std::size_t>(request.grid.nx) * request.grid.ny, -1) {}
 
 int FootprintRecorder::CellOf(double x_m, double y_m) const {
@@ -17,7 +18,8 @@ int FootprintRecorder::CellOf(double x_m, double y_m) const {
   return static_cast<int>(j * g.nx + i);
 }
 
-void FootprintRecorder::Mark(const Eigen::Vector3d& position, float speed, float energy, float jump) {
+void FootprintRecorder::Mark(const Eigen::Vector3d& position, float speed, float energy,
+                             float jump) {
   const int cell = CellOf(position.x(), position.y());
   if (cell < 0) return;
   int& slot = slot_[static_cast<std::size_t>(cell)];
@@ -32,25 +34,29 @@ void FootprintRecorder::Mark(const Eigen::Vector3d& position, float speed, float
   const auto k = static_cast<std::size_t>(slot);
   if (request_.speed) footprint_.speed_m_s[k] = std::max(footprint_.speed_m_s[k], speed);
   if (request_.energy) footprint_.energy_j[k] = std::max(footprint_.energy_j[k], energy);
-  if (request_.jump_height) footprint_.jump_height_m[k] = std::max(footprint_.jump_height_m[k], jump);
+  if (request_.jump_height)
+    footprint_.jump_height_m[k] = std::max(footprint_.jump_height_m[k], jump);
 }
 
 void FootprintRecorder::Begin(const RockState& start, const Terrain& terrain) {
   previous_ = start.position_m;
   if (!request_.needs_passes()) return;
   TerrainSample ground;
-  const float jump = terrain.Sample(start.position_m.x(), start.position_m.y(), &ground)
-                         ? static_cast<float>((start.position_m.z() - ground.height_m) * ground.normal.z())
-                         : 0.0f;
+  const float jump =
+      terrain.Sample(start.position_m.x(), start.position_m.y(), &ground)
+          ? static_cast<float>((start.position_m.z() - ground.height_m) * ground.normal.z())
+          : 0.0f;
   Mark(start.position_m, static_cast<float>(start.velocity_m_s.norm()),
        static_cast<float>(KineticEnergy(rock_, start)), jump);
 }
 
-void FootprintRecorder::OnStep(const RockState& state, const StepReport&, const TerrainSample& ground) {
+void FootprintRecorder::OnStep(const RockState& state, const StepReport&,
+                               const TerrainSample& ground) {
   if (!request_.needs_passes()) return;
   const auto speed = static_cast<float>(state.velocity_m_s.norm());
   const auto energy = request_.energy ? static_cast<float>(KineticEnergy(rock_, state)) : 0.0f;
-  const auto jump = static_cast<float>((state.position_m.z() - ground.height_m) * ground.normal.z());
+  const auto jump =
+      static_cast<float>((state.position_m.z() - ground.height_m) * ground.normal.z());
   // A step longer than half a cell marks the cells in between too.
   const double half_cell = 0.5 * std::min(request_.grid.dx_m, request_.grid.dy_m);
   const double moved = (state.position_m - previous_).head<2>().norm();
@@ -74,8 +80,9 @@ RasterAccumulator::RasterAccumulator(const RasterRequest& request) : request_(re
   const auto cells = static_cast<std::size_t>(request.grid.nx) * request.grid.ny;
   if (request.passages || request.reach_probability) passages_.assign(cells, 0);
   if (request.deposits) deposits_.assign(cells, 0);
-  for (auto [wanted, stat] : {std::pair{request.speed, &speed_}, std::pair{request.energy, &energy_},
-                              std::pair{request.jump_height, &jump_}}) {
+  for (auto [wanted, stat] :
+       {std::pair{request.speed, &speed_}, std::pair{request.energy, &energy_},
+        std::pair{request.jump_height, &jump_}}) {
     if (!wanted) continue;
     stat->max.assign(cells, 0.0f);
     stat->sum.assign(cells, 0.0);
@@ -99,11 +106,12 @@ void RasterAccumulator::Add(const Footprint& footprint) {
     if (request_.energy) AddStat(energy_, cell, footprint.energy_j[k]);
     if (request_.jump_height) AddStat(jump_, cell, footprint.jump_height_m[k]);
   }
-  if (!deposits_.empty() && footprint.deposit_cell >= 0) ++deposits_[static_cast<std::size_t>(footprint.deposit_cell)];
+  if (!deposits_.empty() && footprint.deposit_cell >= 0)
+    ++deposits_[static_cast<std::size_t>(footprint.deposit_cell)];
 }
 
-void RasterAccumulator::FinishStat(const Stat& stat, const std::string& name, const std::string& unit,
-                                   std::vector<RasterLayer>& out) const {
+void RasterAccumulator::FinishStat(const Stat& stat, const std::string& name,
+                                   const std::string& unit, std::vector<RasterLayer>& out) const {
   const std::size_t cells = stat.max.size();
   RasterLayer max{name + "_max", unit, std::vector<float>(cells, RasterLayer::kNoData), true};
   RasterLayer mean{name + "_mean", unit, std::vector<float>(cells, RasterLayer::kNoData), true};

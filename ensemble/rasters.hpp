@@ -15,22 +15,27 @@ namespace talus::ensemble {
 // `grid`: node (i, j) is the centre of cell (i, j), as for the DEM.
 struct RasterRequest {
   GridGeometry grid;
-  bool speed = false;        // speed_max, speed_mean, speed_p95 (m/s)
-  bool energy = false;       // energy_max, energy_mean, energy_p95 (J, translational + rotational)
-  bool jump_height = false;  // jump_height_max, _mean, _p95 (m, centre of mass above ground along the normal)
-  bool passages = false;     // rocks that passed the cell
-  bool deposits = false;     // rocks that came to rest in the cell
+  bool speed = false;   // speed_max, speed_mean, speed_p95 (m/s)
+  bool energy = false;  // energy_max, energy_mean, energy_p95 (J, translational + rotational)
+  bool jump_height =
+      false;  // jump_height_max, _mean, _p95 (m, centre of mass above ground along the normal)
+  bool passages = false;           // rocks that passed the cell
+  bool deposits = false;           // rocks that came to rest in the cell
   bool reach_probability = false;  // fraction of all rocks that passed the cell
 
-  bool any() const { return speed || energy || jump_height || passages || deposits || reach_probability; }
-  bool needs_passes() const { return speed || energy || jump_height || passages || reach_probability; }
+  bool any() const {
+    return speed || energy || jump_height || passages || deposits || reach_probability;
+  }
+  bool needs_passes() const {
+    return speed || energy || jump_height || passages || reach_probability;
+  }
 };
 
 // One rock's footprint: each passed cell once, with the rock's maxima there.
 struct Footprint {
-  std::vector<int> cells;  // j * nx + i
+  std::vector<int> cells;                                 // j * nx + i
   std::vector<float> speed_m_s, energy_j, jump_height_m;  // parallel to cells, when requested
-  int deposit_cell = -1;   // cell of the rest position, -1 when the rock did not come to rest there
+  int deposit_cell = -1;  // cell of the rest position, -1 when the rock did not come to rest there
 };
 
 // Records one rock's footprint from the solver's steps. One per thread, reused across rocks.
@@ -55,8 +60,8 @@ class FootprintRecorder : public StepObserver {
 
 // One output raster: values in grid order (row j after row j - 1, j increasing with y).
 struct RasterLayer {
-  std::string name;   // e.g. "speed_p95"; the file is <name>.tif
-  std::string unit;   // e.g. "m/s"
+  std::string name;  // e.g. "speed_p95"; the file is <name>.tif
+  std::string unit;  // e.g. "m/s"
   std::vector<float> values;
   bool has_nodata = false;  // statistics are nodata (kNoData) where no rock passed
   static constexpr float kNoData = -9999.0f;

@@ -25,7 +25,8 @@ double RingArea(const std::vector<Eigen::Vector2d>& ring) {
 }
 
 // Even-odd rule over all rings, so that inner rings are holes.
-bool InsidePolygon(const std::vector<std::vector<Eigen::Vector2d>>& rings, const Eigen::Vector2d& p) {
+bool InsidePolygon(const std::vector<std::vector<Eigen::Vector2d>>& rings,
+                   const Eigen::Vector2d& p) {
   bool inside = false;
   for (const auto& ring : rings) {
     for (std::size_t k = 0, l = ring.size() - 1; k < ring.size(); l = k++) {
@@ -49,13 +50,15 @@ Eigen::Vector2d PointOnLine(const std::vector<Eigen::Vector2d>& line, double u) 
   double target = u * LineLength(line);
   for (std::size_t k = 1; k < line.size(); ++k) {
     const double length = (line[k] - line[k - 1]).norm();
-    if (target <= length && length > 0) return line[k - 1] + (target / length) * (line[k] - line[k - 1]);
+    if (target <= length && length > 0)
+      return line[k - 1] + (target / length) * (line[k] - line[k - 1]);
     target -= length;
   }
   return line.back();
 }
 
-Eigen::Vector2d PointInPolygon(const std::vector<std::vector<Eigen::Vector2d>>& rings, RockRandom& random) {
+Eigen::Vector2d PointInPolygon(const std::vector<std::vector<Eigen::Vector2d>>& rings,
+                               RockRandom& random) {
   Eigen::Vector2d lo = rings[0][0], hi = rings[0][0];
   for (const Eigen::Vector2d& v : rings[0]) {
     lo = lo.cwiseMin(v);
@@ -80,8 +83,8 @@ bool ReleaseSpec::IsValid(std::string* why) const {
     return Fail(why, s.str());
   }
   if (rocks_per_release > kMaxTotalRocks / static_cast<long>(releases.size())) {
-    s << "rocks = " << rocks_per_release << " per release x " << releases.size() << " releases is more than "
-      << kMaxTotalRocks << " rocks";
+    s << "rocks = " << rocks_per_release << " per release x " << releases.size()
+      << " releases is more than " << kMaxTotalRocks << " rocks";
     return Fail(why, s.str());
   }
   if (!std::isfinite(height_m) || height_m < 0) {
@@ -89,8 +92,10 @@ bool ReleaseSpec::IsValid(std::string* why) const {
     return Fail(why, s.str());
   }
   if (!velocity_m_s.allFinite()) return Fail(why, "velocity_m_s must be finite");
-  if (!angular_velocity_rad_s.allFinite()) return Fail(why, "angular_velocity_rad_s must be finite");
-  if (orientation && (!orientation->coeffs().allFinite() || std::abs(orientation->norm() - 1) > 1e-6)) {
+  if (!angular_velocity_rad_s.allFinite())
+    return Fail(why, "angular_velocity_rad_s must be finite");
+  if (orientation &&
+      (!orientation->coeffs().allFinite() || std::abs(orientation->norm() - 1) > 1e-6)) {
     s << "orientation must be a unit quaternion [w, x, y, z] (norm " << orientation->norm() << ")";
     return Fail(why, s.str());
   }
@@ -106,7 +111,8 @@ bool ReleaseSpec::IsValid(std::string* why) const {
           s << "release " << r << " has a non-finite coordinate";
           return Fail(why, s.str());
         }
-    if (g.kind == ReleaseGeometry::Kind::kLine && (g.rings[0].size() < 2 || LineLength(g.rings[0]) <= 0)) {
+    if (g.kind == ReleaseGeometry::Kind::kLine &&
+        (g.rings[0].size() < 2 || LineLength(g.rings[0]) <= 0)) {
       s << "release " << r << ": a line needs at least 2 points and a positive length";
       return Fail(why, s.str());
     }
@@ -128,7 +134,8 @@ bool ReleaseSpec::IsValid(std::string* why) const {
   return true;
 }
 
-std::optional<Eigen::Vector2d> PointOffTerrain(const Terrain& terrain, const ReleaseGeometry& release) {
+std::optional<Eigen::Vector2d> PointOffTerrain(const Terrain& terrain,
+                                               const ReleaseGeometry& release) {
   const auto off = [&](const Eigen::Vector2d& p) {
     double height_m;
     return !terrain.Height(p.x(), p.y(), &height_m);
@@ -160,7 +167,9 @@ std::optional<Eigen::Vector2d> PointOffTerrain(const Terrain& terrain, const Rel
     lo = lo.cwiseMin(v);
     hi = hi.cwiseMax(v);
   }
-  const auto index = [](double f, int last) { return static_cast<int>(std::clamp(f, 0.0, double(last))); };
+  const auto index = [](double f, int last) {
+    return static_cast<int>(std::clamp(f, 0.0, double(last)));
+  };
   const int i0 = index(std::floor((lo.x() - grid.x0_m) / grid.dx_m), grid.nx - 2);
   const int i1 = index(std::ceil((hi.x() - grid.x0_m) / grid.dx_m), grid.nx - 2);
   const int j0 = index(std::floor((lo.y() - grid.y0_m) / grid.dy_m), grid.ny - 2);
@@ -169,9 +178,11 @@ std::optional<Eigen::Vector2d> PointOffTerrain(const Terrain& terrain, const Rel
   for (int j = j0; j <= j1; ++j)
     for (int i = i0; i <= i1; ++i) {
       const std::size_t k = static_cast<std::size_t>(j) * grid.nx + i;
-      if (!std::isnan(z[k]) && !std::isnan(z[k + 1]) && !std::isnan(z[k + grid.nx]) && !std::isnan(z[k + grid.nx + 1]))
+      if (!std::isnan(z[k]) && !std::isnan(z[k + 1]) && !std::isnan(z[k + grid.nx]) &&
+          !std::isnan(z[k + grid.nx + 1]))
         continue;
-      const Eigen::Vector2d centre(grid.x0_m + (i + 0.5) * grid.dx_m, grid.y0_m + (j + 0.5) * grid.dy_m);
+      const Eigen::Vector2d centre(grid.x0_m + (i + 0.5) * grid.dx_m,
+                                   grid.y0_m + (j + 0.5) * grid.dy_m);
       if (InsidePolygon(release.rings, centre)) return centre;
     }
   return std::nullopt;

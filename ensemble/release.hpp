@@ -30,7 +30,7 @@ struct ReleaseSpec {
   double height_m = 1.0;  // centre of mass above the ground at release (before any raise)
   // Fixed orientation of the shape as given (w, x, y, z), or nullopt for uniform on SO(3).
   std::optional<Eigen::Quaterniond> orientation;
-  Eigen::Vector3d velocity_m_s = Eigen::Vector3d::Zero();          // world frame
+  Eigen::Vector3d velocity_m_s = Eigen::Vector3d::Zero();            // world frame
   Eigen::Vector3d angular_velocity_rad_s = Eigen::Vector3d::Zero();  // world frame
   std::uint64_t seed = 1;
 
@@ -45,7 +45,8 @@ struct ReleaseSpec {
 // A point of `release` where the terrain has no height (outside the DEM or on a nodata cell), or
 // nullopt when rocks can start anywhere on it: its vertices, its lines or rings (checked every
 // quarter cell) and, for a polygon, the centres of the cells without height that it covers.
-std::optional<Eigen::Vector2d> PointOffTerrain(const Terrain& terrain, const ReleaseGeometry& release);
+std::optional<Eigen::Vector2d> PointOffTerrain(const Terrain& terrain,
+                                               const ReleaseGeometry& release);
 
 // The start state of rock `rock` (0-based, releases one after another): position on its release
 // with the centre of mass height_m above the ground, orientation, velocities. Not yet raised above

@@ -17,7 +17,8 @@ using Clock = std::chrono::steady_clock;
 // Samples the trajectory at the requested interval.
 class TrajectoryRecorder {
  public:
-  TrajectoryRecorder(const RockShape& rock, double interval_s) : rock_(rock), interval_s_(interval_s) {}
+  TrajectoryRecorder(const RockShape& rock, double interval_s)
+      : rock_(rock), interval_s_(interval_s) {}
   void Begin(const RockState& start, std::vector<TrajectorySample>* out) {
     out_ = out;
     Record(start, false);
@@ -65,14 +66,17 @@ class TrajectoryRecorder {
 class Recorders : public StepObserver {
  public:
   Recorders(const Scene& scene, const EnsembleOptions& options)
-      : scene_(scene), options_(options), footprint_(options.rasters, scene.rock),
+      : scene_(scene),
+        options_(options),
+        footprint_(options.rasters, scene.rock),
         trajectory_(scene.rock, options.trajectory_interval_s) {}
   void Begin(RockOutcome& outcome) {
     record_ = options_.trajectories || outcome.rock < options_.sample_trajectories;
     if (options_.rasters.any()) footprint_.Begin(outcome.start, scene_.terrain);
     if (record_) trajectory_.Begin(outcome.start, &outcome.trajectory);
   }
-  void OnStep(const RockState& state, const StepReport& step, const TerrainSample& ground) override {
+  void OnStep(const RockState& state, const StepReport& step,
+              const TerrainSample& ground) override {
     if (options_.rasters.any()) footprint_.OnStep(state, step, ground);
     if (record_) trajectory_.OnStep(state, step, scene_.options.dt_s);
   }
@@ -99,19 +103,21 @@ struct Finished {
 
 std::string EnsembleReport::BriefReport() const {
   char line[320];
-  std::snprintf(line, sizeof line,
-                "%ld rocks in %.2f s on %d threads (%.1f trajectories/s): %ld rest, %ld left the domain, "
-                "%ld max time, %ld failed; %ld raised at release",
-                rocks, wall_time_s, threads, trajectories_per_s(), count(EndReason::kRest),
-                count(EndReason::kLeftDomain), count(EndReason::kMaxTime), count(EndReason::kFailed), raised);
+  std::snprintf(
+      line, sizeof line,
+      "%ld rocks in %.2f s on %d threads (%.1f trajectories/s): %ld rest, %ld left the domain, "
+      "%ld max time, %ld failed; %ld raised at release",
+      rocks, wall_time_s, threads, trajectories_per_s(), count(EndReason::kRest),
+      count(EndReason::kLeftDomain), count(EndReason::kMaxTime), count(EndReason::kFailed), raised);
   return line;
 }
 
-EnsembleReport RunEnsemble(const Scene& scene, const ReleaseSpec& release, const EnsembleOptions& options,
-                           RockSink* sink) {
+EnsembleReport RunEnsemble(const Scene& scene, const ReleaseSpec& release,
+                           const EnsembleOptions& options, RockSink* sink) {
   const auto t0 = Clock::now();
   const long total = release.total_rocks();
-  int threads = options.threads > 0 ? options.threads : static_cast<int>(std::thread::hardware_concurrency());
+  int threads =
+      options.threads > 0 ? options.threads : static_cast<int>(std::thread::hardware_concurrency());
   threads = static_cast<int>(std::clamp<long>(threads, 1, std::max<long>(total, 1)));
   // Finished rocks wait in a ring of `window` slots until every earlier rock is done.
   const long window = 8L * threads + 16;
@@ -131,7 +137,9 @@ EnsembleReport RunEnsemble(const Scene& scene, const ReleaseSpec& release, const
         long rock;
         {
           std::unique_lock lock(mutex);
-          worker_cv.wait(lock, [&] { return abort || next_claim >= total || next_claim < next_merge + window; });
+          worker_cv.wait(lock, [&] {
+            return abort || next_claim >= total || next_claim < next_merge + window;
+          });
           if (abort || next_claim >= total) return;
           rock = next_claim++;
         }
@@ -142,7 +150,8 @@ EnsembleReport RunEnsemble(const Scene& scene, const ReleaseSpec& release, const
         out.start = ReleaseState(scene, release, rock);
         out.lift_m = RaiseAboveTerrain(scene, out.start);
         recorders.Begin(out);
-        out.result = SimulateRock(scene, out.start, workspace, recorders.needed() ? &recorders : nullptr);
+        out.result =
+            SimulateRock(scene, out.start, workspace, recorders.needed() ? &recorders : nullptr);
         done.footprint = recorders.End(out.result);
         {
           std::lock_guard lock(mutex);

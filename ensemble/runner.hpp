@@ -20,21 +20,22 @@ namespace talus::ensemble {
 // One trajectory sample, in the user's conventions (docs/scenes.md).
 struct TrajectorySample {
   double t_s = 0;
-  Eigen::Vector3d position_m;              // centre of mass, world
-  Eigen::Quaterniond orientation;          // rotation of the shape as given (not the principal frame)
-  Eigen::Vector3d velocity_m_s;            // world
+  Eigen::Vector3d position_m;      // centre of mass, world
+  Eigen::Quaterniond orientation;  // rotation of the shape as given (not the principal frame)
+  Eigen::Vector3d velocity_m_s;    // world
   Eigen::Vector3d angular_velocity_rad_s;  // world frame
   bool contact = false;                    // at least one closed contact in the step
   double scar_m = 0;
 };
 
 struct EnsembleOptions {
-  int threads = 0;  // worker threads; 0: all cores
+  int threads = 0;                      // worker threads; 0: all cores
   bool trajectories = false;            // record every rock's trajectory
   long sample_trajectories = 0;         // record also the trajectories of rocks 0 .. n - 1
   double trajectory_interval_s = 0.01;  // samples at t = 0, every interval, and the end
   RasterRequest rasters;                // nothing requested: no raster work
-  // Called on the calling thread with (rocks done, rocks in total), at most every 0.2 s and at the end.
+  // Called on the calling thread with (rocks done, rocks in total), at most every 0.2 s and at the
+  // end.
   std::function<void(long, long)> progress;
 };
 
@@ -72,7 +73,7 @@ struct EnsembleReport {
 
 // Runs rocks 0 .. release.total_rocks() - 1. Requires scene.IsValid() and release.IsValid().
 // An exception thrown by the sink stops the workers and is rethrown.
-EnsembleReport RunEnsemble(const Scene& scene, const ReleaseSpec& release, const EnsembleOptions& options,
-                           RockSink* sink = nullptr);
+EnsembleReport RunEnsemble(const Scene& scene, const ReleaseSpec& release,
+                           const EnsembleOptions& options, RockSink* sink = nullptr);
 
 }  // namespace talus::ensemble

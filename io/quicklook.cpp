@@ -23,7 +23,8 @@ Rgb Ramp(double t) {
   const double s = t * 3;
   const int k = std::min(2, static_cast<int>(s));
   const double f = s - k;
-  return {stops[k][0] + f * (stops[k + 1][0] - stops[k][0]), stops[k][1] + f * (stops[k + 1][1] - stops[k][1]),
+  return {stops[k][0] + f * (stops[k + 1][0] - stops[k][0]),
+          stops[k][1] + f * (stops[k + 1][1] - stops[k][1]),
           stops[k][2] + f * (stops[k + 1][2] - stops[k][2])};
 }
 
@@ -36,7 +37,8 @@ const ensemble::RasterLayer* QuickLookLayer(const std::vector<ensemble::RasterLa
   return nullptr;
 }
 
-void WriteQuickLookPng(const std::string& path, const Heightfield& dem, const ensemble::RasterLayer* layer,
+void WriteQuickLookPng(const std::string& path, const Heightfield& dem,
+                       const ensemble::RasterLayer* layer,
                        const std::vector<std::vector<Eigen::Vector2d>>& paths) {
   const GridGeometry& g = dem.grid;
   const int scale = std::max(1, 900 / std::max(g.nx, g.ny));  // pixels per cell
@@ -56,8 +58,8 @@ void WriteQuickLookPng(const std::string& path, const Heightfield& dem, const en
   }
   // Hillshade: sun from the north-west, 45 degrees up.
   const double azimuth = 315 * std::numbers::pi / 180, altitude = 45 * std::numbers::pi / 180;
-  const Eigen::Vector3d sun(std::sin(azimuth) * std::cos(altitude), std::cos(azimuth) * std::cos(altitude),
-                            std::sin(altitude));
+  const Eigen::Vector3d sun(std::sin(azimuth) * std::cos(altitude),
+                            std::cos(azimuth) * std::cos(altitude), std::sin(altitude));
   for (int j = 0; j < g.ny; ++j)
     for (int i = 0; i < g.nx; ++i) {
       const double here = z(i, j);
@@ -71,7 +73,8 @@ void WriteQuickLookPng(const std::string& path, const Heightfield& dem, const en
         const double grey = 60 + 180 * shade;
         colour = {grey, grey, grey};
         const std::size_t c = static_cast<std::size_t>(j) * g.nx + i;
-        if (layer && layer->values[c] != ensemble::RasterLayer::kNoData && layer->values[c] > 0 && top > 0) {
+        if (layer && layer->values[c] != ensemble::RasterLayer::kNoData && layer->values[c] > 0 &&
+            top > 0) {
           const double v = layer->values[c];
           const double t = log_scale ? std::log1p(v) / std::log1p(top) : v / top;
           const Rgb ramp = Ramp(t);
@@ -80,7 +83,8 @@ void WriteQuickLookPng(const std::string& path, const Heightfield& dem, const en
       }
       for (int dy = 0; dy < scale; ++dy)
         for (int dx = 0; dx < scale; ++dx)
-          image[static_cast<std::size_t>((g.ny - 1 - j) * scale + dy) * w + i * scale + dx] = colour;
+          image[static_cast<std::size_t>((g.ny - 1 - j) * scale + dy) * w + i * scale + dx] =
+              colour;
     }
   // Paths: translucent blue lines (one dot per half pixel, blended once per dot).
   auto pixel = [&](const Eigen::Vector2d& p) {
@@ -109,13 +113,15 @@ void WriteQuickLookPng(const std::string& path, const Heightfield& dem, const en
   for (int k = 0; k < 3; ++k) {
     for (std::size_t p = 0; p < image.size(); ++p)
       band[p] = static_cast<unsigned char>(std::lround(std::clamp(image[p][k], 0.0, 255.0)));
-    if (canvas->GetRasterBand(k + 1)->RasterIO(GF_Write, 0, 0, w, h, band.data(), w, h, GDT_Byte, 0, 0) != CE_None) {
+    if (canvas->GetRasterBand(k + 1)->RasterIO(GF_Write, 0, 0, w, h, band.data(), w, h, GDT_Byte, 0,
+                                               0) != CE_None) {
       GDALClose(canvas);
       throw std::runtime_error("cannot draw " + path);
     }
   }
   AtomicFile file(path);
-  GDALDataset* written = png->CreateCopy(file.temp_path().c_str(), canvas, FALSE, nullptr, nullptr, nullptr);
+  GDALDataset* written =
+      png->CreateCopy(file.temp_path().c_str(), canvas, FALSE, nullptr, nullptr, nullptr);
   GDALClose(canvas);
   if (!written) throw std::runtime_error("cannot write " + path + ": " + CPLGetLastErrorMsg());
   GDALClose(written);

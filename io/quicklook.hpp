@@ -18,7 +18,8 @@ namespace talus::io {
 const ensemble::RasterLayer* QuickLookLayer(const std::vector<ensemble::RasterLayer>& layers);
 
 // Writes the PNG atomically (GDAL's PNG driver). paths: horizontal positions, map coordinates.
-void WriteQuickLookPng(const std::string& path, const Heightfield& dem, const ensemble::RasterLayer* layer,
+void WriteQuickLookPng(const std::string& path, const Heightfield& dem,
+                       const ensemble::RasterLayer* layer,
                        const std::vector<std::vector<Eigen::Vector2d>>& paths);
 
 }  // namespace talus::io

@@ -9,8 +9,8 @@
 #include <stdexcept>
 #include <string>
 
-#include "common/error.hpp"
 #include "common/atomic_file.hpp"
+#include "common/error.hpp"
 
 namespace talus::io {
 namespace {
@@ -24,9 +24,7 @@ using Dataset = std::unique_ptr<GDALDataset, DatasetCloser>;
 
 void RegisterGdal() {
   static std::once_flag once;
-  std::call_once(once, [] {
-    GDALAllRegister();
-  });
+  std::call_once(once, [] { GDALAllRegister(); });
 }
 
 Raster ReadRaster(const std::string& path, const std::string& what) {
@@ -39,7 +37,8 @@ Raster ReadRaster(const std::string& path, const std::string& what) {
   double gt[6];
   if (dataset->GetGeoTransform(gt) != CE_None)
     throw InputError(what + ": " + path + " has no georeferencing (geotransform)");
-  if (gt[2] != 0 || gt[4] != 0) throw InputError(what + ": " + path + " is rotated; only north-up rasters are supported");
+  if (gt[2] != 0 || gt[4] != 0)
+    throw InputError(what + ": " + path + " is rotated; only north-up rasters are supported");
   if (gt[1] <= 0 || gt[5] >= 0)
     throw InputError(what + ": " + path + " must be north-up with rows from north to south");
 
@@ -47,8 +46,9 @@ Raster ReadRaster(const std::string& path, const std::string& what) {
   const int nx = dataset->GetRasterXSize(), ny = dataset->GetRasterYSize();
   // The same bound as a plane's (solver/terrain.cpp): larger grids do not fit in memory.
   if (static_cast<double>(nx) * ny > kMaxRasterCells)
-    throw InputError(what + ": " + path + " has " + std::to_string(nx) + " x " + std::to_string(ny) +
-                     " cells, more than " + std::to_string(static_cast<long>(kMaxRasterCells)) +
+    throw InputError(what + ": " + path + " has " + std::to_string(nx) + " x " +
+                     std::to_string(ny) + " cells, more than " +
+                     std::to_string(static_cast<long>(kMaxRasterCells)) +
                      "; crop or resample it first (e.g. with gdalwarp)");
   raster.grid.nx = nx;
   raster.grid.ny = ny;
@@ -67,13 +67,15 @@ Raster ReadRaster(const std::string& path, const std::string& what) {
   const double nodata = band->GetNoDataValue(&has_nodata);
   std::vector<double> rows(static_cast<std::size_t>(nx) * ny);
   if (band->RasterIO(GF_Read, 0, 0, nx, ny, rows.data(), nx, ny, GDT_Float64, 0, 0) != CE_None)
-    throw InputError(what + ": GDAL cannot read the pixels of " + path + ": " + CPLGetLastErrorMsg());
+    throw InputError(what + ": GDAL cannot read the pixels of " + path + ": " +
+                     CPLGetLastErrorMsg());
   raster.values.resize(rows.size());
   for (int r = 0; r < ny; ++r) {
     const int j = ny - 1 - r;  // GDAL row r (from the north) is grid row j (from the south)
     for (int i = 0; i < nx; ++i) {
       double v = rows[static_cast<std::size_t>(r) * nx + i];
-      if ((has_nodata && (v == nodata || (std::isnan(nodata) && std::isnan(v)))) || !std::isfinite(v))
+      if ((has_nodata && (v == nodata || (std::isnan(nodata) && std::isnan(v)))) ||
+          !std::isfinite(v))
         v = std::nan("");
       raster.values[static_cast<std::size_t>(j) * nx + i] = v;
     }
@@ -84,12 +86,15 @@ Raster ReadRaster(const std::string& path, const std::string& what) {
 bool SameCrs(const std::string& a_wkt, const std::string& b_wkt) {
   if (a_wkt == b_wkt) return true;
   OGRSpatialReference a, b;
-  if (a.importFromWkt(a_wkt.c_str()) != OGRERR_NONE || b.importFromWkt(b_wkt.c_str()) != OGRERR_NONE) return false;
+  if (a.importFromWkt(a_wkt.c_str()) != OGRERR_NONE ||
+      b.importFromWkt(b_wkt.c_str()) != OGRERR_NONE)
+    return false;
   return a.IsSame(&b);
 }
 
 std::array<double, 6> GeoTransformOf(const GridGeometry& grid) {
-  return {grid.x0_m - 0.5 * grid.dx_m, grid.dx_m, 0.0, grid.y_max_m() + 0.5 * grid.dy_m, 0.0, -grid.dy_m};
+  return {grid.x0_m - 0.5 * grid.dx_m,      grid.dx_m, 0.0,
+          grid.y_max_m() + 0.5 * grid.dy_m, 0.0,       -grid.dy_m};
 }
 
 void WriteGeoTiff(const std::string& path, const GridGeometry& grid, const std::string& crs_wkt,
@@ -120,8 +125,8 @@ void WriteGeoTiff(const std::string& path, const GridGeometry& grid, const std::
       std::copy_n(values.begin() + static_cast<long>(j) * grid.nx, grid.nx,
                   rows.begin() + static_cast<long>(r) * grid.nx);
     }
-    if (band->RasterIO(GF_Write, 0, 0, grid.nx, grid.ny, rows.data(), grid.nx, grid.ny, GDT_Float32, 0, 0) !=
-        CE_None)
+    if (band->RasterIO(GF_Write, 0, 0, grid.nx, grid.ny, rows.data(), grid.nx, grid.ny, GDT_Float32,
+                       0, 0) != CE_None)
       throw std::runtime_error("cannot write " + path + ": " + CPLGetLastErrorMsg());
     CPLErrorReset();
   }  // closing the dataset flushes it; a failure there is reported through CPLGetLastErrorType

@@ -5,8 +5,8 @@
 #include <cstdio>
 #include <string>
 
-#include "ensemble/runner.hpp"
 #include "common/atomic_file.hpp"
+#include "ensemble/runner.hpp"
 
 namespace talus::io {
 

@@ -1,12 +1,13 @@
 #include "io/scene_file.hpp"
 
+#include <toml++/toml.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
-#include <toml++/toml.h>
 
 #include "common/error.hpp"
 #include "io/raster.hpp"
@@ -45,13 +46,16 @@ int EditDistance(const std::string& a, const std::string& b) {
 // The file being loaded: resolves paths and formats errors as "<file>:<line>: <key>: <reason>".
 class Context {
  public:
-  explicit Context(std::string file) : file_(std::move(file)), dir_(fs::path(file_).parent_path()) {}
+  explicit Context(std::string file)
+      : file_(std::move(file)), dir_(fs::path(file_).parent_path()) {}
 
-  [[noreturn]] void Fail(const toml::node* node, const std::string& key, const std::string& reason) const {
+  [[noreturn]] void Fail(const toml::node* node, const std::string& key,
+                         const std::string& reason) const {
     throw InputError(Where(node) + ": " + key + ": " + reason);
   }
   std::string Where(const toml::node* node) const {
-    if (node && node->source().begin.line > 0) return file_ + ":" + std::to_string(node->source().begin.line);
+    if (node && node->source().begin.line > 0)
+      return file_ + ":" + std::to_string(node->source().begin.line);
     return file_;
   }
   std::string Resolve(const std::string& path) const {
@@ -68,19 +72,23 @@ class Context {
 // One table of the scene: typed access to its keys; keys not in `known` are errors.
 class Section {
  public:
-  Section(const Context& context, const toml::table* table, std::string name, std::vector<std::string> known)
+  Section(const Context& context, const toml::table* table, std::string name,
+          std::vector<std::string> known)
       : context_(context), table_(table), name_(std::move(name)), known_(std::move(known)) {
     if (!table_) return;
     for (const auto& [key, node] : *table_) {
       const std::string k(key.str());
       if (std::find(known_.begin(), known_.end(), k) != known_.end()) continue;
       const std::string hint = ClosestName(k, known_);
-      context_.Fail(&node, Key(k), "unknown key" + (hint.empty() ? "" : " (did you mean '" + hint + "'?)"));
+      context_.Fail(&node, Key(k),
+                    "unknown key" + (hint.empty() ? "" : " (did you mean '" + hint + "'?)"));
     }
   }
 
   std::string Key(const std::string& key) const { return name_.empty() ? key : name_ + "." + key; }
-  const toml::node* Node(const std::string& key) const { return table_ ? table_->get(key) : nullptr; }
+  const toml::node* Node(const std::string& key) const {
+    return table_ ? table_->get(key) : nullptr;
+  }
   bool Has(const std::string& key) const { return Node(key) != nullptr; }
   [[noreturn]] void Fail(const std::string& key, const std::string& reason) const {
     context_.Fail(Node(key) ? Node(key) : static_cast<const toml::node*>(table_), Key(key), reason);
@@ -89,7 +97,8 @@ class Section {
   double Number(const std::string& key, double fallback) const {
     const toml::node* node = Node(key);
     if (!node) return fallback;
-    if (auto v = node->value<double>(); v && (node->is_integer() || node->is_floating_point())) return *v;
+    if (auto v = node->value<double>(); v && (node->is_integer() || node->is_floating_point()))
+      return *v;
     Fail(key, "expected a number");
   }
   // A number that must satisfy `ok`, described by `bound` ("must be > 0").
@@ -121,9 +130,11 @@ class Section {
   std::vector<double> Numbers(const std::string& key, std::size_t n) const {
     return NumbersOf(Node(key), Key(key), n);
   }
-  std::vector<double> NumbersOf(const toml::node* node, const std::string& key, std::size_t n) const {
+  std::vector<double> NumbersOf(const toml::node* node, const std::string& key,
+                                std::size_t n) const {
     const toml::array* array = node ? node->as_array() : nullptr;
-    if (!array || array->size() != n) context_.Fail(node, key, "expected a list of " + std::to_string(n) + " numbers");
+    if (!array || array->size() != n)
+      context_.Fail(node, key, "expected a list of " + std::to_string(n) + " numbers");
     std::vector<double> out;
     for (const toml::node& item : *array) {
       const auto v = item.value<double>();
@@ -143,7 +154,8 @@ class Section {
   std::vector<std::string> known_;
 };
 
-const toml::table* SubTable(const Context& context, const toml::table& root, const std::string& key) {
+const toml::table* SubTable(const Context& context, const toml::table& root,
+                            const std::string& key) {
   const toml::node* node = root.get(key);
   if (!node) return nullptr;
   if (!node->is_table()) context.Fail(node, key, "expected a table ([" + key + "])");
@@ -157,8 +169,10 @@ void LoadGround(const Context& context, const toml::table* ground, GroundTable& 
   if (!ground) return;
   for (const auto& [key, node] : *ground) {
     const std::string name(key.str());
-    if (!node.is_table()) context.Fail(&node, "ground." + name, "expected a table ([ground." + name + "])");
-    const Section s(context, node.as_table(), "ground." + name, {"code", "mu_min", "mu_max", "beta", "kappa", "nu"});
+    if (!node.is_table())
+      context.Fail(&node, "ground." + name, "expected a table ([ground." + name + "])");
+    const Section s(context, node.as_table(), "ground." + name,
+                    {"code", "mu_min", "mu_max", "beta", "kappa", "nu"});
     const int existing = table.IndexOfName(name);
     GroundCategory category;
     category.name = name;
@@ -167,14 +181,18 @@ void LoadGround(const Context& context, const toml::table* ground, GroundTable& 
     } else {
       for (const char* required : {"code", "mu_min", "mu_max", "beta", "kappa", "nu"})
         if (!s.Has(required))
-          s.Fail(required, std::string("missing: a new ground category needs code, mu_min, mu_max, beta, kappa and nu") +
-                               (ClosestName(name, {"extra_soft", "soft", "medium_soft", "medium", "medium_hard", "hard",
-                                                   "extra_hard", "snow"}).empty()
-                                    ? ""
-                                    : " (or did you mean the built-in '" +
-                                          ClosestName(name, {"extra_soft", "soft", "medium_soft", "medium",
-                                                             "medium_hard", "hard", "extra_hard", "snow"}) +
-                                          "'?)"));
+          s.Fail(
+              required,
+              std::string(
+                  "missing: a new ground category needs code, mu_min, mu_max, beta, kappa and nu") +
+                  (ClosestName(name, {"extra_soft", "soft", "medium_soft", "medium", "medium_hard",
+                                      "hard", "extra_hard", "snow"})
+                           .empty()
+                       ? ""
+                       : " (or did you mean the built-in '" +
+                             ClosestName(name, {"extra_soft", "soft", "medium_soft", "medium",
+                                                "medium_hard", "hard", "extra_hard", "snow"}) +
+                             "'?)"));
     }
     const long code = s.Integer("code", category.code);
     if (code < 0 || code > 254) s.Fail("code", std::to_string(code) + " must be in 0..254");
@@ -189,10 +207,12 @@ void LoadGround(const Context& context, const toml::table* ground, GroundTable& 
     if (!p.IsValid(&why)) context.Fail(&node, "ground." + name, why);
     const int other = table.IndexOfCode(category.code);
     if (other >= 0 && table.category(other).name != name)
-      s.Fail("code", std::to_string(code) + " is already the code of '" + table.category(other).name + "'");
+      s.Fail("code",
+             std::to_string(code) + " is already the code of '" + table.category(other).name + "'");
     table.Set(category);
   }
-  if (table.size() > GroundGrid::kNoGround) context.Fail(ground, "ground", "too many ground categories");
+  if (table.size() > GroundGrid::kNoGround)
+    context.Fail(ground, "ground", "too many ground categories");
 }
 
 std::string Hex(std::uint64_t v) {
@@ -218,7 +238,8 @@ std::string HashFiles(const std::vector<std::string>& files) {
 
 void LoadTerrain(const Context& context, const Section& s, SceneFile& out) {
   Scene& scene = out.scene;
-  if (s.Has("dem") == s.Has("plane")) s.Fail(s.Has("dem") ? "plane" : "dem", "give exactly one of 'dem' and 'plane'");
+  if (s.Has("dem") == s.Has("plane"))
+    s.Fail(s.Has("dem") ? "plane" : "dem", "give exactly one of 'dem' and 'plane'");
   Heightfield heights;
   if (s.Has("plane")) {
     const toml::node* node = s.Node("plane");
@@ -234,9 +255,9 @@ void LoadTerrain(const Context& context, const Section& s, SceneFile& out) {
     std::string why;
     if (!spec.IsValid(&why)) s.Fail("plane", why);
     heights = MakePlaneHeightfield(spec);
-    out.terrain_description = "plane " + Fmt(spec.slope_deg) + " deg, " +
-                              std::to_string(heights.grid.nx) + " x " + std::to_string(heights.grid.ny) + " cells of " +
-                              Fmt(spec.cell_m) + " m";
+    out.terrain_description =
+        "plane " + Fmt(spec.slope_deg) + " deg, " + std::to_string(heights.grid.nx) + " x " +
+        std::to_string(heights.grid.ny) + " cells of " + Fmt(spec.cell_m) + " m";
   } else {
     const std::string path = context.Resolve(s.String("dem", ""));
     Raster dem = ReadRaster(path, context.Where(s.Node("dem")) + ": " + s.Key("dem"));
@@ -244,8 +265,9 @@ void LoadTerrain(const Context& context, const Section& s, SceneFile& out) {
     out.crs_wkt = dem.crs_wkt;
     heights.grid = dem.grid;
     heights.z_m = std::move(dem.values);
-    out.terrain_description = fs::path(path).filename().string() + " (" + std::to_string(heights.grid.nx) + " x " +
-                              std::to_string(heights.grid.ny) + " cells of " + Fmt(heights.grid.dx_m) + " m)";
+    out.terrain_description =
+        fs::path(path).filename().string() + " (" + std::to_string(heights.grid.nx) + " x " +
+        std::to_string(heights.grid.ny) + " cells of " + Fmt(heights.grid.dx_m) + " m)";
   }
   const std::string default_name = s.String("default_ground", "medium");
   const int default_index = scene.ground.IndexOfName(default_name);
@@ -266,7 +288,8 @@ void LoadTerrain(const Context& context, const Section& s, SceneFile& out) {
     const Raster codes = ReadRaster(path, what);
     out.inputs.push_back(path);
     if (!codes.crs_wkt.empty() && !out.crs_wkt.empty() && !SameCrs(codes.crs_wkt, out.crs_wkt))
-      throw InputError(what + ": " + path + " is in another CRS than the DEM; reprojecting ground rasters is not "
+      throw InputError(what + ": " + path +
+                       " is in another CRS than the DEM; reprojecting ground rasters is not "
                        "supported yet (warp it onto the DEM's CRS first, e.g. with gdalwarp)");
     GroundGrid grid;
     grid.grid = codes.grid;
@@ -280,8 +303,8 @@ void LoadTerrain(const Context& context, const Section& s, SceneFile& out) {
       const bool code = v == std::round(v) && v >= 0 && v <= 254;  // and so fits an int
       const int index = code ? scene.ground.IndexOfCode(static_cast<int>(v)) : -1;
       if (index < 0)
-        throw InputError(what + ": " + path + " has the value " + Fmt(v) +
-                         " (cell " + std::to_string(k % static_cast<std::size_t>(codes.grid.nx)) + ", " +
+        throw InputError(what + ": " + path + " has the value " + Fmt(v) + " (cell " +
+                         std::to_string(k % static_cast<std::size_t>(codes.grid.nx)) + ", " +
                          std::to_string(k / static_cast<std::size_t>(codes.grid.nx)) +
                          " from the south-west), which is not the code of any ground category");
       grid.index[k] = static_cast<std::uint8_t>(index);
@@ -293,14 +316,17 @@ void LoadTerrain(const Context& context, const Section& s, SceneFile& out) {
 
 void LoadRock(const Context& context, const Section& s, SceneFile& out) {
   pointclouds::RockSpec& rock = out.rock;
-  if (!s.Has("shape")) s.Fail("shape", "missing: a point cloud file or a built-in such as { box = [1, 1, 1] }");
+  if (!s.Has("shape"))
+    s.Fail("shape", "missing: a point cloud file or a built-in such as { box = [1, 1, 1] }");
   rock.density_kg_m3 = s.Checked("density_kg_m3", 2700, kPositive, "must be > 0");
-  if (s.Has("volume_m3") && s.Has("mass_kg")) s.Fail("mass_kg", "give volume_m3 or mass_kg, not both");
+  if (s.Has("volume_m3") && s.Has("mass_kg"))
+    s.Fail("mass_kg", "give volume_m3 or mass_kg, not both");
   if (s.Has("volume_m3")) rock.volume_m3 = s.Checked("volume_m3", 0, kPositive, "must be > 0");
   if (s.Has("mass_kg")) rock.mass_kg = s.Checked("mass_kg", 0, kPositive, "must be > 0");
   const long max_vertices = s.Integer("max_vertices", 0);
   if (max_vertices != 0 && (max_vertices < 4 || max_vertices > 100000))
-    s.Fail("max_vertices", std::to_string(max_vertices) + " must be 0 (no simplification) or in 4 .. 100000");
+    s.Fail("max_vertices",
+           std::to_string(max_vertices) + " must be 0 (no simplification) or in 4 .. 100000");
   rock.max_vertices = static_cast<int>(max_vertices);
   const toml::node* shape = s.Node("shape");
   if (shape->is_string()) {
@@ -308,12 +334,17 @@ void LoadRock(const Context& context, const Section& s, SceneFile& out) {
     if (!fs::exists(rock.file)) s.Fail("shape", "file not found: " + rock.file);
     out.inputs.push_back(rock.file);
   } else if (shape->is_table()) {
-    const Section b(context, shape->as_table(), "rock.shape", {"box", "ellipsoid", "sphere", "cylinder", "eota", "size_m"});
+    const Section b(context, shape->as_table(), "rock.shape",
+                    {"box", "ellipsoid", "sphere", "cylinder", "eota", "size_m"});
     int kinds = 0;
-    for (const char* kind : {"box", "ellipsoid", "sphere", "cylinder", "eota"}) kinds += b.Has(kind);
+    for (const char* kind : {"box", "ellipsoid", "sphere", "cylinder", "eota"})
+      kinds += b.Has(kind);
     if (kinds != 1)
-      s.Fail("shape", "give exactly one of box or ellipsoid ([a, b, c] in m), sphere (radius in m), cylinder "
-                      "([diameter, height] in m) or eota (\"111\" or \"221\", optionally with size_m = [a, b, c])");
+      s.Fail(
+          "shape",
+          "give exactly one of box or ellipsoid ([a, b, c] in m), sphere (radius in m), cylinder "
+          "([diameter, height] in m) or eota (\"111\" or \"221\", optionally with size_m = [a, b, "
+          "c])");
     auto dims = [&](const std::string& key, std::size_t n, const std::string& builtin) {
       std::vector<double> d = b.Numbers(key, n);
       for (double v : d)
@@ -332,7 +363,8 @@ void LoadRock(const Context& context, const Section& s, SceneFile& out) {
     }
     if (b.Has("eota")) {
       const std::string kind = b.String("eota", "");
-      if (kind != "111" && kind != "221") b.Fail("eota", "'" + kind + "': expected \"111\" or \"221\"");
+      if (kind != "111" && kind != "221")
+        b.Fail("eota", "'" + kind + "': expected \"111\" or \"221\"");
       rock.builtin = "eota" + kind;
       if (b.Has("size_m")) {
         rock.dimensions_m = b.Numbers("size_m", 3);
@@ -354,12 +386,14 @@ void LoadRock(const Context& context, const Section& s, SceneFile& out) {
   if (!out.scene.rock.IsValid(&why)) s.Fail("shape", why);
 }
 
-std::vector<Eigen::Vector2d> PointList(const Section& s, const toml::node* node, const std::string& key) {
+std::vector<Eigen::Vector2d> PointList(const Section& s, const toml::node* node,
+                                       const std::string& key) {
   const toml::array* array = node ? node->as_array() : nullptr;
   if (!array) s.context().Fail(node, key, "expected a list of [x, y] points");
   std::vector<Eigen::Vector2d> out;
   for (std::size_t k = 0; k < array->size(); ++k) {
-    const std::vector<double> xy = s.NumbersOf(array->get(k), key + "[" + std::to_string(k) + "]", 2);
+    const std::vector<double> xy =
+        s.NumbersOf(array->get(k), key + "[" + std::to_string(k) + "]", 2);
     out.emplace_back(xy[0], xy[1]);
   }
   return out;
@@ -376,8 +410,9 @@ void LoadRelease(const Context& context, const Section& s, SceneFile& out) {
       origin.push_back(s.Key("points") + "[" + std::to_string(k) + "]");
     }
   }
-  for (const auto& [key, kind] : {std::pair{std::string("lines"), ReleaseGeometry::Kind::kLine},
-                                  std::pair{std::string("polygons"), ReleaseGeometry::Kind::kPolygon}}) {
+  for (const auto& [key, kind] :
+       {std::pair{std::string("lines"), ReleaseGeometry::Kind::kLine},
+        std::pair{std::string("polygons"), ReleaseGeometry::Kind::kPolygon}}) {
     if (!s.Has(key)) continue;
     const toml::array* array = s.Node(key)->as_array();
     if (!array) s.Fail(key, "expected a list of " + key + ", each a list of [x, y] points");
@@ -389,20 +424,22 @@ void LoadRelease(const Context& context, const Section& s, SceneFile& out) {
   }
   if (s.Has("file")) {
     const std::string path = context.Resolve(s.String("file", ""));
-    const auto geometries =
-        ReadReleaseGeometries(path, out.crs_wkt, context.Where(s.Node("file")) + ": " + s.Key("file"));
+    const auto geometries = ReadReleaseGeometries(
+        path, out.crs_wkt, context.Where(s.Node("file")) + ": " + s.Key("file"));
     out.inputs.push_back(path);
     for (std::size_t k = 0; k < geometries.size(); ++k) {
       r.releases.push_back(geometries[k]);
       origin.push_back(s.Key("file") + " (" + path + ", geometry " + std::to_string(k) + ")");
     }
   }
-  if (r.releases.empty()) s.Fail("points", "missing: give points, lines, polygons or a vector file");
+  if (r.releases.empty())
+    s.Fail("points", "missing: give points, lines, polygons or a vector file");
 
   const long rocks = s.Integer("rocks", 1);
   if (rocks < 1) s.Fail("rocks", std::to_string(rocks) + " must be >= 1");
   r.rocks_per_release = rocks;
-  r.height_m = s.Checked("height_m", 1.0, [](double v) { return v >= 0; }, "must be >= 0");
+  r.height_m = s.Checked(
+      "height_m", 1.0, [](double v) { return v >= 0; }, "must be >= 0");
   if (const toml::node* node = s.Node("orientation")) {
     if (node->is_string()) {
       if (s.String("orientation", "") != "random")
@@ -411,7 +448,8 @@ void LoadRelease(const Context& context, const Section& s, SceneFile& out) {
       const std::vector<double> q = s.Numbers("orientation", 4);
       const Eigen::Quaterniond quat(q[0], q[1], q[2], q[3]);
       if (std::abs(quat.norm() - 1) > 1e-3)
-        s.Fail("orientation", "quaternion [w, x, y, z] has norm " + Fmt(quat.norm()) + ", expected 1");
+        s.Fail("orientation",
+               "quaternion [w, x, y, z] has norm " + Fmt(quat.norm()) + ", expected 1");
       r.orientation = quat.normalized();
     }
   }
@@ -433,9 +471,10 @@ void LoadRelease(const Context& context, const Section& s, SceneFile& out) {
   const GridGeometry& g = out.scene.terrain.heights().grid;
   for (std::size_t k = 0; k < r.releases.size(); ++k)
     if (const auto v = ensemble::PointOffTerrain(out.scene.terrain, r.releases[k]))
-      throw InputError(context.Where(s.table()) + ": " + origin[k] + ": (" + Fmt(v->x()) + ", " + Fmt(v->y()) +
-                       ") is outside the DEM or on nodata (the DEM covers x " + Fmt(g.x0_m) + " .. " +
-                       Fmt(g.x_max_m()) + ", y " + Fmt(g.y0_m) + " .. " + Fmt(g.y_max_m()) + ")");
+      throw InputError(context.Where(s.table()) + ": " + origin[k] + ": (" + Fmt(v->x()) + ", " +
+                       Fmt(v->y()) + ") is outside the DEM or on nodata (the DEM covers x " +
+                       Fmt(g.x0_m) + " .. " + Fmt(g.x_max_m()) + ", y " + Fmt(g.y0_m) + " .. " +
+                       Fmt(g.y_max_m()) + ")");
 }
 
 void LoadSolver(const Section& s, SolverOptions& o) {
@@ -459,20 +498,25 @@ void LoadSolver(const Section& s, SolverOptions& o) {
 
 void LoadOutput(const Section& s, OutputSpec& o) {
   o.trajectories = s.Bool("trajectories", o.trajectories);
-  o.trajectory_interval_s = s.Checked("trajectory_interval_s", o.trajectory_interval_s, kPositive, "must be > 0");
+  o.trajectory_interval_s =
+      s.Checked("trajectory_interval_s", o.trajectory_interval_s, kPositive, "must be > 0");
   o.quicklook = s.Bool("quicklook", o.quicklook);
   if (const toml::node* node = s.Node("rasters")) {
     const toml::array* array = node->as_array();
     if (!array) s.Fail("rasters", "expected a list of raster names");
     for (const toml::node& item : *array) {
       const auto name = item.value<std::string>();
-      if (!name || !item.is_string()) s.Fail("rasters", "expected a list of raster names (strings)");
+      if (!name || !item.is_string())
+        s.Fail("rasters", "expected a list of raster names (strings)");
       if (std::find(kRasterNames.begin(), kRasterNames.end(), *name) == kRasterNames.end()) {
         const std::string hint = ClosestName(*name, kRasterNames);
-        s.Fail("rasters", "unknown raster '" + *name + "'" + (hint.empty() ? "" : " (did you mean '" + hint + "'?)") +
-                              "; known: speed, energy, jump_height, passages, deposits, reach_probability");
+        s.Fail("rasters",
+               "unknown raster '" + *name + "'" +
+                   (hint.empty() ? "" : " (did you mean '" + hint + "'?)") +
+                   "; known: speed, energy, jump_height, passages, deposits, reach_probability");
       }
-      if (std::find(o.rasters.begin(), o.rasters.end(), *name) == o.rasters.end()) o.rasters.push_back(*name);
+      if (std::find(o.rasters.begin(), o.rasters.end(), *name) == o.rasters.end())
+        o.rasters.push_back(*name);
     }
   }
 }
@@ -496,7 +540,9 @@ std::string ClosestName(const std::string& word, const std::vector<std::string>&
 ensemble::RasterRequest OutputSpec::Request(const GridGeometry& grid) const {
   ensemble::RasterRequest r;
   r.grid = grid;
-  auto has = [&](const char* name) { return std::find(rasters.begin(), rasters.end(), name) != rasters.end(); };
+  auto has = [&](const char* name) {
+    return std::find(rasters.begin(), rasters.end(), name) != rasters.end();
+  };
   r.speed = has("speed");
   r.energy = has("energy");
   r.jump_height = has("jump_height");
@@ -513,32 +559,36 @@ SceneFile LoadScene(const std::string& path) {
   try {
     root = toml::parse_file(path);
   } catch (const toml::parse_error& e) {
-    throw InputError(path + ":" + std::to_string(e.source().begin.line) + ": TOML syntax error: " +
-                     std::string(e.description()));
+    throw InputError(path + ":" + std::to_string(e.source().begin.line) +
+                     ": TOML syntax error: " + std::string(e.description()));
   }
-  const Section top(context, &root, "", {"terrain", "ground", "rock", "release", "solver", "output"});
+  const Section top(context, &root, "",
+                    {"terrain", "ground", "rock", "release", "solver", "output"});
   for (const char* required : {"terrain", "rock", "release"})
-    if (!root.get(required)) context.Fail(nullptr, required, std::string("missing table [") + required + "]");
+    if (!root.get(required))
+      context.Fail(nullptr, required, std::string("missing table [") + required + "]");
 
   SceneFile out;
   out.path = path;
   out.inputs.push_back(path);
   LoadGround(context, SubTable(context, root, "ground"), out.scene.ground);
   LoadTerrain(context,
-              Section(context, SubTable(context, root, "terrain"), "terrain", {"dem", "plane", "ground", "default_ground"}),
+              Section(context, SubTable(context, root, "terrain"), "terrain",
+                      {"dem", "plane", "ground", "default_ground"}),
               out);
   LoadRock(context,
-           Section(context, SubTable(context, root, "rock"), "rock", {"shape", "density_kg_m3", "volume_m3", "mass_kg", "max_vertices"}),
+           Section(context, SubTable(context, root, "rock"), "rock",
+                   {"shape", "density_kg_m3", "volume_m3", "mass_kg", "max_vertices"}),
            out);
   LoadRelease(context,
               Section(context, SubTable(context, root, "release"), "release",
-                      {"points", "lines", "polygons", "file", "height_m", "rocks", "orientation", "velocity_m_s",
-                       "angular_velocity_rad_s", "seed"}),
+                      {"points", "lines", "polygons", "file", "height_m", "rocks", "orientation",
+                       "velocity_m_s", "angular_velocity_rad_s", "seed"}),
               out);
   LoadSolver(Section(context, SubTable(context, root, "solver"), "solver",
-                     {"dt_s", "max_time_s", "gravity_m_s2", "normal_restitution", "tangential_restitution",
-                      "tolerance_m_s", "max_iterations", "prox_alpha", "rest_speed_m_s", "rest_angular_speed_rad_s",
-                      "rest_hold_s"}),
+                     {"dt_s", "max_time_s", "gravity_m_s2", "normal_restitution",
+                      "tangential_restitution", "tolerance_m_s", "max_iterations", "prox_alpha",
+                      "rest_speed_m_s", "rest_angular_speed_rad_s", "rest_hold_s"}),
              out.scene.options);
   LoadOutput(Section(context, SubTable(context, root, "output"), "output",
                      {"trajectories", "trajectory_interval_s", "rasters", "quicklook"}),

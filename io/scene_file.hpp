@@ -18,7 +18,8 @@ struct OutputSpec {
   double trajectory_interval_s = 0.01;
   // Any of "speed", "energy", "jump_height", "passages", "deposits", "reach_probability".
   std::vector<std::string> rasters;
-  bool quicklook = true;  // quicklook.png: hillshade, reach probability or energy, sample trajectories
+  bool quicklook =
+      true;  // quicklook.png: hillshade, reach probability or energy, sample trajectories
 
   // The raster request on `grid` (nothing when no raster is listed).
   ensemble::RasterRequest Request(const GridGeometry& grid) const;
@@ -26,13 +27,13 @@ struct OutputSpec {
 
 // A loaded, validated scene file.
 struct SceneFile {
-  std::string path;        // as given
-  Scene scene;             // IsValid() holds
+  std::string path;               // as given
+  Scene scene;                    // IsValid() holds
   ensemble::ReleaseSpec release;  // IsValid() holds, every release vertex on valid DEM cells
   OutputSpec output;
-  pointclouds::RockSpec rock;   // the [rock] table
-  std::string rock_description;  // e.g. "eota221 0.93 x 0.93 x 0.47 m, bevel 0.12 m"
-  std::string crs_wkt;     // the DEM's CRS; empty for the plane or a DEM without CRS
+  pointclouds::RockSpec rock;       // the [rock] table
+  std::string rock_description;     // e.g. "eota221 0.93 x 0.93 x 0.47 m, bevel 0.12 m"
+  std::string crs_wkt;              // the DEM's CRS; empty for the plane or a DEM without CRS
   std::string terrain_description;  // e.g. "dem.tif (270 x 370 cells of 5 m)"
   std::vector<std::string> inputs;  // the scene file and every data file it read
   std::string inputs_hash;          // FNV-1a 64 over the contents of `inputs`, hex

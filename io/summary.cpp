@@ -4,8 +4,8 @@
 
 namespace talus::io {
 
-std::string SummaryJson(const SceneFile& scene, const ensemble::EnsembleReport& report, const std::string& version,
-                        const std::vector<std::string>& outputs) {
+std::string SummaryJson(const SceneFile& scene, const ensemble::EnsembleReport& report,
+                        const std::string& version, const std::vector<std::string>& outputs) {
   nlohmann::ordered_json j;
   j["talus_version"] = version;
   j["scene"] = scene.path;

@@ -11,7 +11,7 @@
 namespace talus::io {
 
 // The summary as JSON text; `outputs` lists the files written next to it.
-std::string SummaryJson(const SceneFile& scene, const ensemble::EnsembleReport& report, const std::string& version,
-                        const std::vector<std::string>& outputs);
+std::string SummaryJson(const SceneFile& scene, const ensemble::EnsembleReport& report,
+                        const std::string& version, const std::vector<std::string>& outputs);
 
 }  // namespace talus::io

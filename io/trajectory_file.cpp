@@ -25,8 +25,8 @@ void Attribute(H5::H5Object& object, const char* name, const std::vector<double>
 }
 
 template <class T>
-void Dataset(H5::Group& group, const char* name, const H5::PredType& type, const std::vector<T>& data, hsize_t rows,
-             hsize_t columns) {
+void Dataset(H5::Group& group, const char* name, const H5::PredType& type,
+             const std::vector<T>& data, hsize_t rows, hsize_t columns) {
   const hsize_t dims[2] = {rows, columns};
   const int rank = columns == 1 ? 1 : 2;
   H5::DataSpace space(rank, dims);
@@ -68,10 +68,11 @@ void TrajectoryWriter::Write(const ensemble::RockOutcome& rock) {
   for (const ensemble::TrajectorySample& s : samples) {
     t.push_back(s.t_s);
     position.insert(position.end(), {s.position_m.x(), s.position_m.y(), s.position_m.z()});
-    quaternion.insert(quaternion.end(), {s.orientation.w(), s.orientation.x(), s.orientation.y(), s.orientation.z()});
+    quaternion.insert(quaternion.end(),
+                      {s.orientation.w(), s.orientation.x(), s.orientation.y(), s.orientation.z()});
     velocity.insert(velocity.end(), {s.velocity_m_s.x(), s.velocity_m_s.y(), s.velocity_m_s.z()});
-    angular.insert(angular.end(),
-                   {s.angular_velocity_rad_s.x(), s.angular_velocity_rad_s.y(), s.angular_velocity_rad_s.z()});
+    angular.insert(angular.end(), {s.angular_velocity_rad_s.x(), s.angular_velocity_rad_s.y(),
+                                   s.angular_velocity_rad_s.z()});
     contact.push_back(s.contact ? 1 : 0);
     scar.push_back(s.scar_m);
   }
@@ -88,8 +89,8 @@ void TrajectoryWriter::Write(const ensemble::RockOutcome& rock) {
     Dataset(group, "contact", H5::PredType::NATIVE_UINT8, contact, n, 1);
     Dataset(group, "scar", d, scar, n, 1);
   } catch (const H5::Exception& e) {
-    throw std::runtime_error("cannot write rock " + std::to_string(rock.rock) + " to " + file_.temp_path() + ": " +
-                             e.getDetailMsg());
+    throw std::runtime_error("cannot write rock " + std::to_string(rock.rock) + " to " +
+                             file_.temp_path() + ": " + e.getDetailMsg());
   }
 }
 

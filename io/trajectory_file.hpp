@@ -1,14 +1,14 @@
 #pragma once
 // trajectories.h5 (docs/scenes.md): group /rocks/<rock> per rock with datasets t (n),
 // position (n x 3), quaternion (n x 4, w x y z, the shape as given), velocity (n x 3),
-// angular_velocity (n x 3, world frame), contact (n, 0/1), scar (n); chunked and deflate-compressed,
-// written rock by rock (nothing is kept in memory), complete or absent.
+// angular_velocity (n x 3, world frame), contact (n, 0/1), scar (n); chunked and
+// deflate-compressed, written rock by rock (nothing is kept in memory), complete or absent.
 
 #include <memory>
 #include <string>
 
-#include "ensemble/runner.hpp"
 #include "common/atomic_file.hpp"
+#include "ensemble/runner.hpp"
 #include "solver/polyhedron.hpp"
 
 namespace talus::io {

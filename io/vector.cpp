@@ -22,7 +22,8 @@ std::vector<Eigen::Vector2d> Ring(const OGRSimpleCurve& curve) {
   return ring;
 }
 
-void Collect(const OGRGeometry& geometry, const std::string& where, std::vector<ReleaseGeometry>& out) {
+void Collect(const OGRGeometry& geometry, const std::string& where,
+             std::vector<ReleaseGeometry>& out) {
   switch (wkbFlatten(geometry.getGeometryType())) {
     case wkbPoint: {
       const auto& p = *geometry.toPoint();
@@ -41,7 +42,8 @@ void Collect(const OGRGeometry& geometry, const std::string& where, std::vector<
       const auto& polygon = *geometry.toPolygon();
       ReleaseGeometry g{ReleaseGeometry::Kind::kPolygon, {}};
       if (polygon.getExteriorRing()) g.rings.push_back(Ring(*polygon.getExteriorRing()));
-      for (int k = 0; k < polygon.getNumInteriorRings(); ++k) g.rings.push_back(Ring(*polygon.getInteriorRing(k)));
+      for (int k = 0; k < polygon.getNumInteriorRings(); ++k)
+        g.rings.push_back(Ring(*polygon.getInteriorRing(k)));
       out.push_back(std::move(g));
       return;
     }
@@ -59,12 +61,13 @@ void Collect(const OGRGeometry& geometry, const std::string& where, std::vector<
 
 }  // namespace
 
-std::vector<ReleaseGeometry> ReadReleaseGeometries(const std::string& path, const std::string& target_crs_wkt,
+std::vector<ReleaseGeometry> ReadReleaseGeometries(const std::string& path,
+                                                   const std::string& target_crs_wkt,
                                                    const std::string& what) {
   RegisterGdal();
   if (!std::filesystem::exists(path)) throw InputError(what + ": file not found: " + path);
-  std::unique_ptr<GDALDataset> dataset(
-      GDALDataset::Open(path.c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY, nullptr, nullptr, nullptr));
+  std::unique_ptr<GDALDataset> dataset(GDALDataset::Open(
+      path.c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY, nullptr, nullptr, nullptr));
   if (!dataset) throw InputError(what + ": GDAL/OGR cannot read " + path + " as a vector file");
   OGRSpatialReference target;
   if (!target_crs_wkt.empty()) {
@@ -79,24 +82,28 @@ std::vector<ReleaseGeometry> ReadReleaseGeometries(const std::string& path, cons
       // GDAL reports WGS 84 for every GeoJSON file without a "crs" member (RFC 7946); a scene
       // without a CRS (the plane, a DEM without one) takes such coordinates as they are.
       const char* code = source->GetAuthorityCode(nullptr);
-      const bool geojson_default = std::string(dataset->GetDriver()->GetDescription()) == "GeoJSON" && code &&
-                                   std::string(code) == "4326";
+      const bool geojson_default =
+          std::string(dataset->GetDriver()->GetDescription()) == "GeoJSON" && code &&
+          std::string(code) == "4326";
       if (!geojson_default)
-        throw InputError(what + ": " + path + " has a CRS but the DEM has none, so the release cannot be placed");
+        throw InputError(what + ": " + path +
+                         " has a CRS but the DEM has none, so the release cannot be placed");
     } else if (source && !source->IsSame(&target)) {
       OGRSpatialReference s(*source);
       s.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
       transform.reset(OGRCreateCoordinateTransformation(&s, &target));
-      if (!transform) throw InputError(what + ": no transformation from the CRS of " + path + " to the DEM's");
+      if (!transform)
+        throw InputError(what + ": no transformation from the CRS of " + path + " to the DEM's");
     }
     for (auto& feature : *layer) {
       const OGRGeometry* geometry = feature->GetGeometryRef();
       if (!geometry) continue;
       std::unique_ptr<OGRGeometry> copy(geometry->clone());
       if (transform && copy->transform(transform.get()) != OGRERR_NONE)
-        throw InputError(what + ": cannot transform feature " + std::to_string(feature->GetFID()) + " of " + path +
-                         " to the DEM's CRS");
-      Collect(*copy, what + " (" + path + ", feature " + std::to_string(feature->GetFID()) + ")", out);
+        throw InputError(what + ": cannot transform feature " + std::to_string(feature->GetFID()) +
+                         " of " + path + " to the DEM's CRS");
+      Collect(*copy, what + " (" + path + ", feature " + std::to_string(feature->GetFID()) + ")",
+              out);
     }
   }
   if (out.empty()) throw InputError(what + ": " + path + " has no point, line or polygon");

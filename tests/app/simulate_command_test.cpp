@@ -1,10 +1,9 @@
 // End to end through the talus program: `talus simulate` on a tiny scene.
 
 #include <gtest/gtest.h>
-
-#include <array>
 #include <sys/wait.h>
 
+#include <array>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -28,7 +27,8 @@ int RunCommand(const std::string& command, std::string* output) {
   std::FILE* pipe = ::popen((command + " 2>&1").c_str(), "r");
   std::array<char, 4096> buffer;
   output->clear();
-  while (std::size_t n = std::fread(buffer.data(), 1, buffer.size(), pipe)) output->append(buffer.data(), n);
+  while (std::size_t n = std::fread(buffer.data(), 1, buffer.size(), pipe))
+    output->append(buffer.data(), n);
   const int status = ::pclose(pipe);
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
@@ -63,9 +63,9 @@ TEST(SimulateCommand, WritesEveryOutputIdenticallyForOneAndTwoThreads) {
   std::string log;
   for (const char* threads : {"1", "2"}) {
     const std::string out = (dir / (std::string("out") + threads)).string();
-    ASSERT_EQ(RunCommand(std::string(TALUS_BINARY) + " simulate " + (dir / "scene.toml").string() + " --out " + out +
-                      " --threads " + threads,
-                  &log),
+    ASSERT_EQ(RunCommand(std::string(TALUS_BINARY) + " simulate " + (dir / "scene.toml").string() +
+                             " --out " + out + " --threads " + threads,
+                         &log),
               0)
         << log;
   }
@@ -95,9 +95,9 @@ TEST(SimulateCommand, OverridesRocksAndSeed) {
   const fs::path dir = FreshDir("overrides");
   std::ofstream(dir / "scene.toml") << kScene;
   std::string log;
-  ASSERT_EQ(RunCommand(std::string(TALUS_BINARY) + " simulate " + (dir / "scene.toml").string() + " --out " +
-                    (dir / "out").string() + " --rocks 1 --seed 9",
-                &log),
+  ASSERT_EQ(RunCommand(std::string(TALUS_BINARY) + " simulate " + (dir / "scene.toml").string() +
+                           " --out " + (dir / "out").string() + " --rocks 1 --seed 9",
+                       &log),
             0)
       << log;
   const auto summary = nlohmann::json::parse(Slurp(dir / "out" / "summary.json"));
@@ -111,8 +111,8 @@ TEST(SimulateCommand, TooManyRocksOnTheCommandLineIsAnError) {
   const fs::path dir = FreshDir("too_many");
   std::ofstream(dir / "scene.toml") << kScene;
   std::string log;
-  EXPECT_EQ(RunCommand(std::string(TALUS_BINARY) + " simulate " + (dir / "scene.toml").string() + " --out " +
-                           (dir / "out").string() + " --rocks 9223372036854775807",
+  EXPECT_EQ(RunCommand(std::string(TALUS_BINARY) + " simulate " + (dir / "scene.toml").string() +
+                           " --out " + (dir / "out").string() + " --rocks 9223372036854775807",
                        &log),
             2)
       << log;
@@ -126,11 +126,13 @@ TEST(SimulateCommand, BadSceneFailsBeforeAnyWorkNamingFileLineAndKey) {
   scene.replace(scene.find("rocks = 3"), 9, "rock = 3");
   std::ofstream(dir / "scene.toml") << scene;
   std::string log;
-  EXPECT_EQ(RunCommand(std::string(TALUS_BINARY) + " simulate " + (dir / "scene.toml").string() + " --out " +
-                    (dir / "out").string(),
-                &log),
+  EXPECT_EQ(RunCommand(std::string(TALUS_BINARY) + " simulate " + (dir / "scene.toml").string() +
+                           " --out " + (dir / "out").string(),
+                       &log),
             2);
-  EXPECT_NE(log.find("scene.toml:9: release.rock: unknown key (did you mean 'rocks'?)"), std::string::npos) << log;
+  EXPECT_NE(log.find("scene.toml:9: release.rock: unknown key (did you mean 'rocks'?)"),
+            std::string::npos)
+      << log;
   EXPECT_FALSE(fs::exists(dir / "out"));
 }
 
@@ -139,17 +141,24 @@ TEST(SimulateCommand, ARunRemovesOutputsOfAnEarlierRunThatItDoesNotWrite) {
   std::ofstream(dir / "all.toml") << kScene;
   std::string lean = kScene;
   lean.replace(lean.find("trajectories = true"), 19, "trajectories = false");
-  lean.replace(lean.find("rasters = ["), lean.find("]\n", lean.find("rasters = [")) - lean.find("rasters = [") + 1,
+  lean.replace(lean.find("rasters = ["),
+               lean.find("]\n", lean.find("rasters = [")) - lean.find("rasters = [") + 1,
                "rasters = []\nquicklook = false");
   std::ofstream(dir / "lean.toml") << lean;
   const std::string out = (dir / "out").string();
   std::string log;
-  ASSERT_EQ(RunCommand(std::string(TALUS_BINARY) + " simulate " + (dir / "all.toml").string() + " --out " + out, &log), 0)
+  ASSERT_EQ(RunCommand(std::string(TALUS_BINARY) + " simulate " + (dir / "all.toml").string() +
+                           " --out " + out,
+                       &log),
+            0)
       << log;
   ASSERT_TRUE(fs::exists(dir / "out" / "trajectories.h5"));
   ASSERT_TRUE(fs::exists(dir / "out" / "speed_p95.tif"));
   std::ofstream(dir / "out" / "notes.txt") << "the user's own file";
-  ASSERT_EQ(RunCommand(std::string(TALUS_BINARY) + " simulate " + (dir / "lean.toml").string() + " --out " + out, &log), 0)
+  ASSERT_EQ(RunCommand(std::string(TALUS_BINARY) + " simulate " + (dir / "lean.toml").string() +
+                           " --out " + out,
+                       &log),
+            0)
       << log;
   EXPECT_FALSE(fs::exists(dir / "out" / "trajectories.h5"));
   EXPECT_FALSE(fs::exists(dir / "out" / "speed_p95.tif"));

@@ -38,7 +38,8 @@ TEST(AtomicFile, CompleteOrAbsent) {
   std::getline(in, line);
   EXPECT_EQ(line, "whole");
   EXPECT_EQ(FilesIn(dir), 1);
-  EXPECT_THROW(WriteFileAtomically((dir / "no_such_dir" / "x.txt").string(), "x"), std::runtime_error);
+  EXPECT_THROW(WriteFileAtomically((dir / "no_such_dir" / "x.txt").string(), "x"),
+               std::runtime_error);
 }
 
 }  // namespace

@@ -18,7 +18,8 @@ const RasterLayer& Layer(const EnsembleReport& report, const std::string& name) 
 }
 
 int CellOf(const GridGeometry& g, double x, double y) {
-  return static_cast<int>(std::lround((y - g.y0_m) / g.dy_m) * g.nx + std::lround((x - g.x0_m) / g.dx_m));
+  return static_cast<int>(std::lround((y - g.y0_m) / g.dy_m) * g.nx +
+                          std::lround((x - g.x0_m) / g.dx_m));
 }
 
 // Cubes set down at rest on flat ground stay in their cell: there reach is the share of rocks
@@ -43,8 +44,10 @@ TEST(Rasters, RocksAtRestOnAPlaneGiveTheKnownMaps) {
     EXPECT_EQ(reach[c], hit ? 0.5f : 0.0f) << c;
     EXPECT_EQ(passages[c], hit ? 3.0f : 0.0f) << c;
     EXPECT_EQ(deposits[c], hit ? 3.0f : 0.0f) << c;
-    if (hit) EXPECT_LT(speed_max[c], 0.02f);
-    else EXPECT_EQ(speed_max[c], RasterLayer::kNoData);
+    if (hit)
+      EXPECT_LT(speed_max[c], 0.02f);
+    else
+      EXPECT_EQ(speed_max[c], RasterLayer::kNoData);
   }
 }
 

@@ -30,7 +30,8 @@ TEST(Release, StartDependsOnSeedAndRockOnly) {
 
 TEST(Release, FixedOrientationRotatesTheShapeAsGiven) {
   Scene scene = testing::SmallPlane(30, 20, 10);
-  scene.rock = MakeRockShape(MakeBox(0.2, 0.5, 1.0), 2700);  // principal frame differs from the input axes
+  scene.rock =
+      MakeRockShape(MakeBox(0.2, 0.5, 1.0), 2700);  // principal frame differs from the input axes
   ReleaseSpec spec = testing::PointRelease({{5, 0}}, 1);
   const Eigen::Quaterniond user(Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 3).normalized()));
   spec.orientation = user;
@@ -45,8 +46,9 @@ TEST(Release, LinesAndPolygonsSampleOnThem) {
   const Scene scene = testing::SmallPlane(30, 20, 10);
   ReleaseSpec spec;
   spec.releases.push_back({ReleaseGeometry::Kind::kLine, {{{2, -3}, {2, 3}, {8, 3}}}});
-  spec.releases.push_back({ReleaseGeometry::Kind::kPolygon, {{{10, -2}, {14, -2}, {14, 2}, {10, 2}},
-                                                             {{11, -1}, {13, -1}, {13, 1}, {11, 1}}}});
+  spec.releases.push_back(
+      {ReleaseGeometry::Kind::kPolygon,
+       {{{10, -2}, {14, -2}, {14, 2}, {10, 2}}, {{11, -1}, {13, -1}, {13, 1}, {11, 1}}}});
   spec.rocks_per_release = 200;
   std::string why;
   ASSERT_TRUE(spec.IsValid(&why)) << why;
@@ -59,7 +61,8 @@ TEST(Release, LinesAndPolygonsSampleOnThem) {
   for (long rock = 200; rock < 400; ++rock) {
     const Eigen::Vector3d p = ReleaseState(scene, spec, rock).position_m;
     EXPECT_TRUE(p.x() >= 10 && p.x() <= 14 && std::abs(p.y()) <= 2) << p.transpose();
-    EXPECT_FALSE(std::abs(p.x() - 12) < 1 && std::abs(p.y()) < 1) << "in the hole: " << p.transpose();
+    EXPECT_FALSE(std::abs(p.x() - 12) < 1 && std::abs(p.y()) < 1)
+        << "in the hole: " << p.transpose();
   }
 }
 
@@ -116,15 +119,19 @@ TEST(Release, PointOffTerrainFindsNodataAlongLinesAndInsidePolygons) {
   EXPECT_TRUE(on_line->x() >= 9 && on_line->x() <= 11) << on_line->transpose();
   const ReleaseGeometry beside{ReleaseGeometry::Kind::kLine, {{{5, -2}, {15, -2}}}};
   EXPECT_FALSE(PointOffTerrain(terrain, beside));
-  const ReleaseGeometry around{ReleaseGeometry::Kind::kPolygon, {{{7, -8}, {13, -8}, {13, -2}, {7, -2}}}};
+  const ReleaseGeometry around{ReleaseGeometry::Kind::kPolygon,
+                               {{{7, -8}, {13, -8}, {13, -2}, {7, -2}}}};
   const auto inside = PointOffTerrain(terrain, around);
   ASSERT_TRUE(inside);
-  EXPECT_TRUE(std::abs(inside->x() - 10) < 1 && std::abs(inside->y() + 5) < 1) << inside->transpose();  // a cell centre
+  EXPECT_TRUE(std::abs(inside->x() - 10) < 1 && std::abs(inside->y() + 5) < 1)
+      << inside->transpose();  // a cell centre
   // A hole around the nodata cells makes the polygon fine again.
-  const ReleaseGeometry holed{ReleaseGeometry::Kind::kPolygon,
-                              {{{7, -8}, {13, -8}, {13, -2}, {7, -2}}, {{8, -7}, {12, -7}, {12, -3}, {8, -3}}}};
+  const ReleaseGeometry holed{
+      ReleaseGeometry::Kind::kPolygon,
+      {{{7, -8}, {13, -8}, {13, -2}, {7, -2}}, {{8, -7}, {12, -7}, {12, -3}, {8, -3}}}};
   EXPECT_FALSE(PointOffTerrain(terrain, holed));
-  const ReleaseGeometry elsewhere{ReleaseGeometry::Kind::kPolygon, {{{15, -8}, {20, -8}, {20, -2}, {15, -2}}}};
+  const ReleaseGeometry elsewhere{ReleaseGeometry::Kind::kPolygon,
+                                  {{{15, -8}, {20, -8}, {20, -2}, {15, -2}}}};
   EXPECT_FALSE(PointOffTerrain(terrain, elsewhere));
 }
 

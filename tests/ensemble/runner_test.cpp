@@ -56,7 +56,8 @@ TEST(RunEnsemble, BitIdenticalForAnyThreadCount) {
       const auto& a = reports[0].rasters[l].values;
       const auto& b = reports[k].rasters[l].values;
       ASSERT_EQ(a.size(), b.size());
-      EXPECT_EQ(std::memcmp(a.data(), b.data(), a.size() * sizeof(float)), 0) << reports[0].rasters[l].name;
+      EXPECT_EQ(std::memcmp(a.data(), b.data(), a.size() * sizeof(float)), 0)
+          << reports[0].rasters[l].name;
     }
   }
   EXPECT_EQ(reports[0].rocks, 10);
@@ -86,11 +87,13 @@ TEST(RunEnsemble, TrajectoriesUseTheShapeAsGivenAndTheWorldFrame) {
   // mix-up would be off by order one): check it at the next sample (0.1 s,
   // before the 3 m drop hits the ground).
   const auto momentum = [&](const TrajectorySample& s) {
-    const Eigen::Matrix3d to_world = (s.orientation * scene.rock.principal_to_input).toRotationMatrix();
+    const Eigen::Matrix3d to_world =
+        (s.orientation * scene.rock.principal_to_input).toRotationMatrix();
     const Eigen::Vector3d body = to_world.transpose() * s.angular_velocity_rad_s;
     return Eigen::Vector3d(to_world * scene.rock.inertia_kg_m2.cwiseProduct(body));
   };
-  EXPECT_TRUE(momentum(t[1]).isApprox(momentum(t[0]), 1e-5)) << momentum(t[0]).transpose() << " vs " << momentum(t[1]).transpose();
+  EXPECT_TRUE(momentum(t[1]).isApprox(momentum(t[0]), 1e-5))
+      << momentum(t[0]).transpose() << " vs " << momentum(t[1]).transpose();
   EXPECT_NEAR(t[1].t_s, 0.1, 1e-9);
   EXPECT_NEAR(t[2].t_s - t[1].t_s, 0.1, 1e-9);
 }

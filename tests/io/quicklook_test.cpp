@@ -22,7 +22,8 @@ TEST(QuickLook, PicksTheLayerInOrderOfPreference) {
 TEST(QuickLook, WritesAnRgbPngNorthUp) {
   const auto dir = testing::FreshDir("png");
   const Heightfield dem = MakePlaneHeightfield({30, 20, 10, 20, 1});
-  ensemble::RasterLayer reach{"reach_probability", "1", std::vector<float>(dem.z_m.size(), 0.0f), false};
+  ensemble::RasterLayer reach{"reach_probability", "1", std::vector<float>(dem.z_m.size(), 0.0f),
+                              false};
   reach.values[0] = 1.0f;  // south-west corner cell
   const auto path = (dir / "quicklook.png").string();
   WriteQuickLookPng(path, dem, &reach, {{{2, 0}, {25, 5}}});
@@ -35,8 +36,10 @@ TEST(QuickLook, WritesAnRgbPngNorthUp) {
   // The south-west cell is at the bottom left, in the ramp's dark red (red well above blue).
   unsigned char red = 0, blue = 0;
   const int y = png->GetRasterYSize() - 1;
-  EXPECT_EQ(png->GetRasterBand(1)->RasterIO(GF_Read, 0, y, 1, 1, &red, 1, 1, GDT_Byte, 0, 0), CE_None);
-  EXPECT_EQ(png->GetRasterBand(3)->RasterIO(GF_Read, 0, y, 1, 1, &blue, 1, 1, GDT_Byte, 0, 0), CE_None);
+  EXPECT_EQ(png->GetRasterBand(1)->RasterIO(GF_Read, 0, y, 1, 1, &red, 1, 1, GDT_Byte, 0, 0),
+            CE_None);
+  EXPECT_EQ(png->GetRasterBand(3)->RasterIO(GF_Read, 0, y, 1, 1, &blue, 1, 1, GDT_Byte, 0, 0),
+            CE_None);
   EXPECT_GT(red, blue + 40);
   GDALClose(png);
 }

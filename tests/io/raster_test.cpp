@@ -21,20 +21,21 @@ TEST(ReadRaster, FlipsRowsToCellCentredNodesAndMapsNodata) {
   const Raster r = ReadRaster((dir / "dem.tif").string(), "terrain.dem");
   EXPECT_EQ(r.grid.nx, 3);
   EXPECT_EQ(r.grid.ny, 2);
-  EXPECT_DOUBLE_EQ(r.grid.x0_m, 600002.5);   // centre of the western column
-  EXPECT_DOUBLE_EQ(r.grid.y0_m, 249992.5);   // centre of the southern row
-  EXPECT_DOUBLE_EQ(r.values[0], 4);          // south-west
+  EXPECT_DOUBLE_EQ(r.grid.x0_m, 600002.5);  // centre of the western column
+  EXPECT_DOUBLE_EQ(r.grid.y0_m, 249992.5);  // centre of the southern row
+  EXPECT_DOUBLE_EQ(r.values[0], 4);         // south-west
   EXPECT_TRUE(std::isnan(r.values[1]));
-  EXPECT_DOUBLE_EQ(r.values[3], 1);          // north-west
+  EXPECT_DOUBLE_EQ(r.values[3], 1);  // north-west
   EXPECT_NE(r.crs_wkt.find("Austria Lambert"), std::string::npos) << r.crs_wkt;
   EXPECT_EQ(GeoTransformOf(r.grid), kGeo);
 }
 
 TEST(ReadRaster, ReadsEsriAsciiGrids) {
   const auto dir = testing::FreshDir("asc");
-  testing::WriteText(dir / "dem.asc",
-                     "ncols 3\nnrows 2\nxllcorner 100\nyllcorner 200\ncellsize 2\nNODATA_value -9999\n"
-                     "1 2 3\n4 5 -9999\n");
+  testing::WriteText(
+      dir / "dem.asc",
+      "ncols 3\nnrows 2\nxllcorner 100\nyllcorner 200\ncellsize 2\nNODATA_value -9999\n"
+      "1 2 3\n4 5 -9999\n");
   const Raster r = ReadRaster((dir / "dem.asc").string(), "terrain.dem");
   EXPECT_DOUBLE_EQ(r.grid.x0_m, 101);
   EXPECT_DOUBLE_EQ(r.grid.y0_m, 201);
@@ -49,11 +50,14 @@ TEST(ReadRaster, BadFilesAreInputErrors) {
     ReadRaster((dir / "missing.tif").string(), "scene.toml:3: terrain.dem");
     FAIL();
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("scene.toml:3: terrain.dem: file not found"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("scene.toml:3: terrain.dem: file not found"),
+              std::string::npos)
+        << e.what();
   }
   testing::WriteText(dir / "junk.tif", "not a raster");
   EXPECT_THROW(ReadRaster((dir / "junk.tif").string(), "terrain.dem"), InputError);
-  testing::WriteGdalRaster(dir / "rotated.tif", {{1, 2}, {3, 4}}, {0, 1, 0.1, 10, 0, -1}, 0, std::nullopt);
+  testing::WriteGdalRaster(dir / "rotated.tif", {{1, 2}, {3, 4}}, {0, 1, 0.1, 10, 0, -1}, 0,
+                           std::nullopt);
   try {
     ReadRaster((dir / "rotated.tif").string(), "terrain.dem");
     FAIL();
@@ -81,7 +85,8 @@ TEST(ReadRaster, HugeRasterIsAnInputError) {
     ReadRaster((dir / "huge.vrt").string(), "scene.toml:2: terrain.dem");
     FAIL();
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("scene.toml:2: terrain.dem: "), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("scene.toml:2: terrain.dem: "), std::string::npos)
+        << e.what();
     EXPECT_NE(std::string(e.what()).find("200000 x 200000 cells"), std::string::npos) << e.what();
   }
 }
@@ -92,7 +97,8 @@ TEST(WriteGeoTiff, RoundTripsGridCrsAndValues) {
   std::vector<float> values(12);
   for (int k = 0; k < 12; ++k) values[k] = static_cast<float>(k);
   values[5] = -9999.0f;
-  WriteGeoTiff((dir / "out.tif").string(), grid, testing::Wkt(31287), values, true, -9999.0, "test");
+  WriteGeoTiff((dir / "out.tif").string(), grid, testing::Wkt(31287), values, true, -9999.0,
+               "test");
   const Raster r = ReadRaster((dir / "out.tif").string(), "out");
   EXPECT_DOUBLE_EQ(r.grid.x0_m, grid.x0_m);
   EXPECT_DOUBLE_EQ(r.grid.y0_m, grid.y0_m);
@@ -102,7 +108,8 @@ TEST(WriteGeoTiff, RoundTripsGridCrsAndValues) {
   EXPECT_NE(r.crs_wkt.find("Austria Lambert"), std::string::npos);
   // Complete or absent: no temporary file is left behind.
   int files = 0;
-  for (const auto& entry : std::filesystem::directory_iterator(dir)) files += entry.is_regular_file();
+  for (const auto& entry : std::filesystem::directory_iterator(dir))
+    files += entry.is_regular_file();
   EXPECT_EQ(files, 1);
 }
 
@@ -111,22 +118,26 @@ TEST(WriteGeoTiff, RoundTripsGridCrsAndValues) {
 // and CRS.
 TEST(WriteGeoTiff, OutputCellLinesUpWithTheDemCell) {
   const auto dir = testing::FreshDir("align");
-  std::vector<std::vector<double>> rows(7, std::vector<double>(9, 1000.0));  // flat, 9 x 7 cells of 5 m
+  std::vector<std::vector<double>> rows(
+      7, std::vector<double>(9, 1000.0));  // flat, 9 x 7 cells of 5 m
   testing::WriteGdalRaster(dir / "dem.tif", rows, kGeo, 31287, -9999.0);
   // Release in GDAL column 6, row 2: x in [600030, 600035), y in (249985, 249990].
   const double x = 600031.0, y = 249986.5;
-  testing::WriteText(dir / "scene.toml",
-                     "[terrain]\ndem = \"dem.tif\"\n[rock]\nshape = { box = [0.4, 0.4, 0.4] }\n"
-                     "[release]\npoints = [[600031.0, 249986.5]]\nheight_m = 0.2\norientation = [1, 0, 0, 0]\n"
-                     "rocks = 2\n[solver]\nmax_time_s = 5\n[output]\nrasters = [\"deposits\"]\n");
+  testing::WriteText(
+      dir / "scene.toml",
+      "[terrain]\ndem = \"dem.tif\"\n[rock]\nshape = { box = [0.4, 0.4, 0.4] }\n"
+      "[release]\npoints = [[600031.0, 249986.5]]\nheight_m = 0.2\norientation = [1, 0, 0, 0]\n"
+      "rocks = 2\n[solver]\nmax_time_s = 5\n[output]\nrasters = [\"deposits\"]\n");
   const SceneFile scene = LoadScene((dir / "scene.toml").string());
   ensemble::EnsembleOptions options;
   options.rasters = scene.output.Request(scene.scene.terrain.heights().grid);
-  const ensemble::EnsembleReport report = ensemble::RunEnsemble(scene.scene, scene.release, options);
+  const ensemble::EnsembleReport report =
+      ensemble::RunEnsemble(scene.scene, scene.release, options);
   ASSERT_EQ(report.count(EndReason::kRest), 2);
   ASSERT_EQ(report.rasters.size(), 1u);
   const auto out = (dir / "deposits.tif").string();
-  WriteGeoTiff(out, scene.scene.terrain.heights().grid, scene.crs_wkt, report.rasters[0].values, false, 0, "deposits");
+  WriteGeoTiff(out, scene.scene.terrain.heights().grid, scene.crs_wkt, report.rasters[0].values,
+               false, 0, "deposits");
 
   RegisterGdal();
   GDALDataset* d = static_cast<GDALDataset*>(GDALOpen(out.c_str(), GA_ReadOnly));
@@ -139,14 +150,17 @@ TEST(WriteGeoTiff, OutputCellLinesUpWithTheDemCell) {
   EXPECT_STREQ(d->GetSpatialRef()->GetAuthorityCode(nullptr), "31287");
   GDALClose(dem);
   std::vector<float> pixels(63);
-  ASSERT_EQ(d->GetRasterBand(1)->RasterIO(GF_Read, 0, 0, 9, 7, pixels.data(), 9, 7, GDT_Float32, 0, 0), CE_None);
+  ASSERT_EQ(
+      d->GetRasterBand(1)->RasterIO(GF_Read, 0, 0, 9, 7, pixels.data(), 9, 7, GDT_Float32, 0, 0),
+      CE_None);
   GDALClose(d);
   const int column = static_cast<int>((x - kGeo[0]) / kGeo[1]);
   const int row = static_cast<int>((y - kGeo[3]) / kGeo[5]);
   ASSERT_EQ(column, 6);
   ASSERT_EQ(row, 2);
   for (int r = 0; r < 7; ++r)
-    for (int c = 0; c < 9; ++c) EXPECT_EQ(pixels[r * 9 + c], (r == row && c == column) ? 2.0f : 0.0f) << r << "," << c;
+    for (int c = 0; c < 9; ++c)
+      EXPECT_EQ(pixels[r * 9 + c], (r == row && c == column) ? 2.0f : 0.0f) << r << "," << c;
 }
 
 }  // namespace

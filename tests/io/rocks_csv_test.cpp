@@ -30,9 +30,10 @@ TEST(RocksCsvWriter, OneRowPerRockWithTheContractColumns) {
   std::ifstream in(path);
   std::string header, row;
   std::getline(in, header);
-  EXPECT_EQ(header,
-            "rock,release,seed,end,x_end,y_end,z_end,runout_m,path_length_m,travel_time_s,max_speed_m_s,"
-            "max_kinetic_energy_j,max_jump_height_m,max_angular_speed_rad_s,max_scar_m");
+  EXPECT_EQ(
+      header,
+      "rock,release,seed,end,x_end,y_end,z_end,runout_m,path_length_m,travel_time_s,max_speed_m_s,"
+      "max_kinetic_energy_j,max_jump_height_m,max_angular_speed_rad_s,max_scar_m");
   std::getline(in, row);
   EXPECT_EQ(row, "0,1,7,rest,3,4,1,5,0,0,12.5,0,0,0,0");
   int rows = 1;

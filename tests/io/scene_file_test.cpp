@@ -84,8 +84,9 @@ TEST(LoadScene, PlaneSceneWithEveryRelease) {
 
 TEST(LoadScene, MinimalSceneUsesDefaults) {
   const auto dir = testing::FreshDir("minimal");
-  testing::WriteText(dir / "scene.toml",
-                     "[terrain]\nplane = {}\n[rock]\nshape = { eota = \"221\" }\n[release]\npoints = [[10, 0]]\n");
+  testing::WriteText(
+      dir / "scene.toml",
+      "[terrain]\nplane = {}\n[rock]\nshape = { eota = \"221\" }\n[release]\npoints = [[10, 0]]\n");
   const SceneFile s = LoadScene((dir / "scene.toml").string());
   EXPECT_EQ(s.scene.terrain.default_ground(), s.scene.ground.IndexOfName("medium"));
   EXPECT_NEAR(s.scene.rock.volume_m3, 1.0, 1e-6);
@@ -118,32 +119,43 @@ TEST(LoadScene, NonPhysicalValuesNameKeyAndReason) {
              "rock.density_kg_m3: -1 must be > 0");
   EXPECT_HAS(ErrorOf(Replace(kPlaneScene, "dt_s = 0.004", "dt_s = -0.1"), dir), "solver: dt_s");
   EXPECT_HAS(ErrorOf(Replace(kPlaneScene, "slope_deg = 35", "slope_deg = 95"), dir), "slope_deg");
-  EXPECT_HAS(ErrorOf(Replace(kPlaneScene, "rocks = 7", "rocks = 0"), dir), "release.rocks: 0 must be >= 1");
-  EXPECT_HAS(ErrorOf(Replace(kPlaneScene, "orientation = [1, 0, 0, 0]", "orientation = [2, 0, 0, 0]"), dir),
-             "release.orientation: quaternion [w, x, y, z] has norm 2");
+  EXPECT_HAS(ErrorOf(Replace(kPlaneScene, "rocks = 7", "rocks = 0"), dir),
+             "release.rocks: 0 must be >= 1");
+  EXPECT_HAS(
+      ErrorOf(Replace(kPlaneScene, "orientation = [1, 0, 0, 0]", "orientation = [2, 0, 0, 0]"),
+              dir),
+      "release.orientation: quaternion [w, x, y, z] has norm 2");
   EXPECT_HAS(ErrorOf(Replace(kPlaneScene, "height_m = 1.5", "height_m = \"high\""), dir),
              "release.height_m: expected a number");
-  EXPECT_HAS(ErrorOf(Replace(kPlaneScene, "velocity_m_s = [1, 0, 0]", "velocity_m_s = [1, 0]"), dir),
-             "release.velocity_m_s: expected a list of 3 numbers");
+  EXPECT_HAS(
+      ErrorOf(Replace(kPlaneScene, "velocity_m_s = [1, 0, 0]", "velocity_m_s = [1, 0]"), dir),
+      "release.velocity_m_s: expected a list of 3 numbers");
   EXPECT_HAS(ErrorOf(Replace(kPlaneScene, "box = [0.5, 0.4, 0.3]", "box = [0.5, 0, 0.3]"), dir),
              "rock.shape.box: dimensions must be > 0");
-  EXPECT_HAS(ErrorOf(std::string(kPlaneScene) + "[ground.soft]\nmu_min = 3\n", dir), "ground.soft: mu_max");
+  EXPECT_HAS(ErrorOf(std::string(kPlaneScene) + "[ground.soft]\nmu_min = 3\n", dir),
+             "ground.soft: mu_max");
   EXPECT_HAS(ErrorOf("[terrain\nplane = {}\n", dir), "scene.toml:1: TOML syntax error");
 }
 
 TEST(LoadScene, ReleaseOutsideTheDemIsAnError) {
   const auto dir = testing::FreshDir("outside");
   const std::string e = ErrorOf(Replace(kPlaneScene, "[6, 2]", "[6, 200]"), dir);
-  EXPECT_HAS(e, "release.points[1]: (6, 200) is outside the DEM or on nodata (the DEM covers x 0 .. 60, y -15 .. 15)");
-  EXPECT_HAS(ErrorOf(Replace(kPlaneScene, "[10, 2], [8, 2]", "[10, 2], [-8, 2]"), dir), "release.polygons[0]");
+  EXPECT_HAS(e,
+             "release.points[1]: (6, 200) is outside the DEM or on nodata (the DEM covers x 0 .. "
+             "60, y -15 .. 15)");
+  EXPECT_HAS(ErrorOf(Replace(kPlaneScene, "[10, 2], [8, 2]", "[10, 2], [-8, 2]"), dir),
+             "release.polygons[0]");
 }
 
 TEST(LoadScene, MissingPiecesAndFiles) {
   const auto dir = testing::FreshDir("missing");
-  EXPECT_HAS(ErrorOf("[terrain]\nplane = {}\n[rock]\nshape = { box = [1, 1, 1] }\n", dir), "release: missing table");
+  EXPECT_HAS(ErrorOf("[terrain]\nplane = {}\n[rock]\nshape = { box = [1, 1, 1] }\n", dir),
+             "release: missing table");
   EXPECT_HAS(ErrorOf(Replace(kPlaneScene, "plane = {", "dem = \"nowhere.tif\"\nplane = {"), dir),
              "give exactly one of 'dem' and 'plane'");
-  const std::string e = ErrorOf(Replace(kPlaneScene, "plane = { slope_deg = 35, slope_length_m = 40, runout_m = 20, width_m = 30, cell_m = 1 }",
+  const std::string e = ErrorOf(Replace(kPlaneScene,
+                                        "plane = { slope_deg = 35, slope_length_m = 40, runout_m = "
+                                        "20, width_m = 30, cell_m = 1 }",
                                         "dem = \"nowhere.tif\""),
                                 dir);
   EXPECT_HAS(e, "scene.toml:2: terrain.dem: file not found: ");
@@ -154,7 +166,8 @@ TEST(LoadScene, MissingPiecesAndFiles) {
              "ground.scree.mu_min: missing");
 }
 
-const std::array<double, 6> kGeo = {1000.0, 10.0, 0.0, 2050.0, 0.0, -10.0};  // 10 m cells, north edge y = 2050
+const std::array<double, 6> kGeo = {1000.0, 10.0, 0.0,
+                                    2050.0, 0.0,  -10.0};  // 10 m cells, north edge y = 2050
 
 // A DEM sloping down to the east, with its ground map on a coarser grid, in a subfolder.
 void WriteDemCase(const std::filesystem::path& dir) {
@@ -206,10 +219,11 @@ TEST(LoadScene, GdalDemGroundRasterAndUserCategories) {
   EXPECT_NEAR(sample.height_m, 95, 1e-9);
   EXPECT_FALSE(t.Sample(1055, 2045, &sample));  // the nodata corner
   const GroundTable& g = s.scene.ground;
-  EXPECT_EQ(t.GroundAt(1005, 2045), g.IndexOfName("hard"));        // north-west ground cell, code 6
-  EXPECT_EQ(t.GroundAt(1055, 2045), g.IndexOfName("my_scree"));    // north-east, code 11
-  EXPECT_EQ(t.GroundAt(1005, 2005), g.IndexOfName("medium"));      // south-west nodata: the default
-  EXPECT_DOUBLE_EQ(g.params(g.IndexOfName("medium")).mu_min, 0.36);  // override keeps the other values
+  EXPECT_EQ(t.GroundAt(1005, 2045), g.IndexOfName("hard"));      // north-west ground cell, code 6
+  EXPECT_EQ(t.GroundAt(1055, 2045), g.IndexOfName("my_scree"));  // north-east, code 11
+  EXPECT_EQ(t.GroundAt(1005, 2005), g.IndexOfName("medium"));    // south-west nodata: the default
+  EXPECT_DOUBLE_EQ(g.params(g.IndexOfName("medium")).mu_min,
+                   0.36);  // override keeps the other values
   EXPECT_DOUBLE_EQ(g.params(g.IndexOfName("medium")).beta_1_s, 150);
   EXPECT_NE(s.crs_wkt.find("Austria Lambert"), std::string::npos);
   EXPECT_EQ(s.inputs.size(), 3u);
@@ -218,12 +232,14 @@ TEST(LoadScene, GdalDemGroundRasterAndUserCategories) {
 TEST(LoadScene, GdalDemErrors) {
   const auto dir = testing::FreshDir("dem_errors");
   WriteDemCase(dir);
-  EXPECT_HAS(ErrorOf(Replace(kDemScene, "[[1015, 2015]]", "[[1055, 2045]]"), dir), "outside the DEM or on nodata");
+  EXPECT_HAS(ErrorOf(Replace(kDemScene, "[[1015, 2015]]", "[[1055, 2045]]"), dir),
+             "outside the DEM or on nodata");
   EXPECT_HAS(ErrorOf(Replace(kDemScene, "code = 11", "code = 12"), dir),
              "terrain.ground: " + (dir / "data" / "ground.tif").string() + " has the value 11");
   EXPECT_HAS(ErrorOf(Replace(kDemScene, "code = 11", "code = 6"), dir),
              "ground.my_scree.code: 6 is already the code of 'hard'");
-  testing::WriteGdalRaster(dir / "data" / "ground_wgs84.tif", {{6}}, {11.0, 0.1, 0.0, 47.0, 0.0, -0.1}, 4326, 255.0);
+  testing::WriteGdalRaster(dir / "data" / "ground_wgs84.tif", {{6}},
+                           {11.0, 0.1, 0.0, 47.0, 0.0, -0.1}, 4326, 255.0);
   EXPECT_HAS(ErrorOf(Replace(kDemScene, "\"data/ground.tif\"", "\"data/ground_wgs84.tif\""), dir),
              "is in another CRS than the DEM");
   EXPECT_HAS(ErrorOf(Replace(kDemScene, "\"data/ground.tif\"", "\"data/grund.tif\""), dir),
@@ -237,27 +253,34 @@ TEST(LoadScene, ReleaseOverNodataBetweenVerticesIsAnError) {
   const auto dir = testing::FreshDir("nodata_inside");
   std::filesystem::create_directories(dir / "data");
   std::vector<std::vector<double>> dem(7, std::vector<double>(7, 500.0));
-  dem[3][3] = -9999;  // the node at (1035, 2015): cells x 1025 .. 1045, y 2005 .. 2025 have no height
+  dem[3][3] =
+      -9999;  // the node at (1035, 2015): cells x 1025 .. 1045, y 2005 .. 2025 have no height
   testing::WriteGdalRaster(dir / "data" / "dem.tif", dem, kGeo, 31287, -9999.0);
-  const std::string scene = "[terrain]\ndem = \"data/dem.tif\"\n[rock]\nshape = { sphere = 0.3 }\n[release]\n";
+  const std::string scene =
+      "[terrain]\ndem = \"data/dem.tif\"\n[rock]\nshape = { sphere = 0.3 }\n[release]\n";
   const std::string line = ErrorOf(scene + "lines = [[[1015, 2015], [1055, 2015]]]\n", dir);
   EXPECT_HAS(line, "release.lines[0]: (");
   EXPECT_HAS(line, "is outside the DEM or on nodata");
-  const std::string polygon =
-      ErrorOf(scene + "polygons = [[[1015, 1995], [1055, 1995], [1055, 2035], [1015, 2035]]]\n", dir);
-  EXPECT_HAS(polygon, "release.polygons[0]: (1030, 2010) is outside the DEM or on nodata");  // a cell centre
+  const std::string polygon = ErrorOf(
+      scene + "polygons = [[[1015, 1995], [1055, 1995], [1055, 2035], [1015, 2035]]]\n", dir);
+  EXPECT_HAS(polygon,
+             "release.polygons[0]: (1030, 2010) is outside the DEM or on nodata");  // a cell centre
   EXPECT_EQ(ErrorOf(scene + "lines = [[[1015, 2035], [1055, 2035]]]\n", dir), "");
 }
 
 TEST(LoadScene, OutOfRangeIntegersAreErrors) {
   const auto dir = testing::FreshDir("integers");
   // 2^32 + 1 used to wrap to max_iterations = 1.
-  EXPECT_HAS(ErrorOf(Replace(kPlaneScene, "max_time_s = 20", "max_time_s = 20\nmax_iterations = 4294967297"), dir),
+  EXPECT_HAS(ErrorOf(Replace(kPlaneScene, "max_time_s = 20",
+                             "max_time_s = 20\nmax_iterations = 4294967297"),
+                     dir),
              "solver.max_iterations: 4294967297 is out of range");
-  EXPECT_HAS(ErrorOf(Replace(kPlaneScene, "rocks = 7", "rocks = 9223372036854775807"), dir), "is more than");
+  EXPECT_HAS(ErrorOf(Replace(kPlaneScene, "rocks = 7", "rocks = 9223372036854775807"), dir),
+             "is more than");
   // A ground value far outside any code (converting it to int was undefined behaviour).
   WriteDemCase(dir);
-  testing::WriteGdalRaster(dir / "data" / "ground_huge.tif", {{6, 6, 11}, {6, 11, 11}, {255, 11, 1e20}},
+  testing::WriteGdalRaster(dir / "data" / "ground_huge.tif",
+                           {{6, 6, 11}, {6, 11, 11}, {255, 11, 1e20}},
                            {1000.0, 20.0, 0.0, 2050.0, 0.0, -20.0}, 31287, 255.0);
   EXPECT_HAS(ErrorOf(Replace(kDemScene, "\"data/ground.tif\"", "\"data/ground_huge.tif\""), dir),
              "has the value 1e+20");

@@ -1,6 +1,7 @@
 #include "io/summary.hpp"
 
 #include <gtest/gtest.h>
+
 #include <nlohmann/json.hpp>
 
 #include "test_files.hpp"
@@ -11,7 +12,8 @@ namespace {
 TEST(SummaryJson, CarriesHashVersionCountsAndRate) {
   const auto dir = testing::FreshDir("summary");
   testing::WriteText(dir / "scene.toml",
-                     "[terrain]\nplane = {}\n[rock]\nshape = { box = [1, 1, 1] }\n[release]\npoints = [[10, 0]]\n");
+                     "[terrain]\nplane = {}\n[rock]\nshape = { box = [1, 1, 1] "
+                     "}\n[release]\npoints = [[10, 0]]\n");
   const SceneFile scene = LoadScene((dir / "scene.toml").string());
   ensemble::EnsembleReport report;
   report.rocks = 10;

@@ -3,8 +3,8 @@
 // with GDAL directly (north-up, rows from the north, as any GIS writes them).
 
 #include <gdal_priv.h>
-#include <ogr_spatialref.h>
 #include <gtest/gtest.h>
+#include <ogr_spatialref.h>
 
 #include <filesystem>
 #include <fstream>
@@ -17,8 +17,9 @@ namespace talus::io::testing {
 
 inline std::filesystem::path FreshDir(const std::string& name) {
   const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "talus_io_tests" /
-                                    (std::string(info->test_suite_name()) + "." + info->name() + "." + name);
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / "talus_io_tests" /
+      (std::string(info->test_suite_name()) + "." + info->name() + "." + name);
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir;
@@ -39,7 +40,8 @@ inline std::string Wkt(int epsg) {
 }
 
 // rows: GDAL order (row 0 is the northern edge). gt: GDAL geotransform. epsg 0: no CRS.
-inline void WriteGdalRaster(const std::filesystem::path& path, const std::vector<std::vector<double>>& rows,
+inline void WriteGdalRaster(const std::filesystem::path& path,
+                            const std::vector<std::vector<double>>& rows,
                             const std::array<double, 6>& gt, int epsg, std::optional<double> nodata,
                             const char* driver_name = "GTiff") {
   RegisterGdal();
@@ -56,7 +58,9 @@ inline void WriteGdalRaster(const std::filesystem::path& path, const std::vector
   if (nodata) d->GetRasterBand(1)->SetNoDataValue(*nodata);
   std::vector<double> flat;
   for (const auto& r : rows) flat.insert(flat.end(), r.begin(), r.end());
-  EXPECT_EQ(d->GetRasterBand(1)->RasterIO(GF_Write, 0, 0, nx, ny, flat.data(), nx, ny, GDT_Float64, 0, 0), CE_None);
+  EXPECT_EQ(
+      d->GetRasterBand(1)->RasterIO(GF_Write, 0, 0, nx, ny, flat.data(), nx, ny, GDT_Float64, 0, 0),
+      CE_None);
   GDALDriver* out = GetGDALDriverManager()->GetDriverByName(driver_name);
   GDALDataset* copy = out->CreateCopy(path.c_str(), d, FALSE, nullptr, nullptr, nullptr);
   ASSERT_NE(copy, nullptr);

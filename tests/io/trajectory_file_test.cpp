@@ -63,7 +63,8 @@ TEST(TrajectoryWriter, GroupsPerRockChunkedAndCompressed) {
 TEST(TrajectoryWriter, AbandonedWriterLeavesNothing) {
   const auto dir = testing::FreshDir("abandon");
   {
-    TrajectoryWriter writer((dir / "trajectories.h5").string(), MakeRockShape(MakeBox(1, 1, 1), 2000));
+    TrajectoryWriter writer((dir / "trajectories.h5").string(),
+                            MakeRockShape(MakeBox(1, 1, 1), 2000));
     writer.Write(Rock(0, 5));
   }
   EXPECT_TRUE(std::filesystem::is_empty(dir));

@@ -35,9 +35,11 @@ TEST(ReadReleaseGeometries, SceneReleaseFileIsRelativeToTheScene) {
   const auto dir = testing::FreshDir("scene");
   std::filesystem::create_directories(dir / "gis");
   testing::WriteText(dir / "gis" / "release.geojson", kGeoJson);
-  testing::WriteText(dir / "scene.toml",
-                     "[terrain]\nplane = { slope_deg = 30, slope_length_m = 20, runout_m = 10, width_m = 20 }\n"
-                     "[rock]\nshape = { box = [1, 1, 1] }\n[release]\nfile = \"gis/release.geojson\"\nrocks = 3\n");
+  testing::WriteText(
+      dir / "scene.toml",
+      "[terrain]\nplane = { slope_deg = 30, slope_length_m = 20, runout_m = 10, width_m = 20 }\n"
+      "[rock]\nshape = { box = [1, 1, 1] }\n[release]\nfile = \"gis/release.geojson\"\nrocks = "
+      "3\n");
   const SceneFile s = LoadScene((dir / "scene.toml").string());
   EXPECT_EQ(s.release.releases.size(), 4u);
   EXPECT_EQ(s.release.total_rocks(), 12);
@@ -45,17 +47,20 @@ TEST(ReadReleaseGeometries, SceneReleaseFileIsRelativeToTheScene) {
 
 TEST(ReadReleaseGeometries, BadFiles) {
   const auto dir = testing::FreshDir("bad");
-  EXPECT_THROW(ReadReleaseGeometries((dir / "none.geojson").string(), "", "release.file"), InputError);
+  EXPECT_THROW(ReadReleaseGeometries((dir / "none.geojson").string(), "", "release.file"),
+               InputError);
   testing::WriteText(dir / "empty.geojson", R"({"type": "FeatureCollection", "features": []})");
   try {
     ReadReleaseGeometries((dir / "empty.geojson").string(), "", "release.file");
     FAIL();
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("has no point, line or polygon"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("has no point, line or polygon"), std::string::npos)
+        << e.what();
   }
   // A release in a CRS while the DEM has none cannot be placed.
-  testing::WriteText(dir / "crs.geojson",
-                     R"({"type": "FeatureCollection", "crs": {"type": "name", "properties": {"name": "urn:ogc:def:crs:EPSG::31287"}},
+  testing::WriteText(
+      dir / "crs.geojson",
+      R"({"type": "FeatureCollection", "crs": {"type": "name", "properties": {"name": "urn:ogc:def:crs:EPSG::31287"}},
  "features": [{"type": "Feature", "properties": {}, "geometry": {"type": "Point", "coordinates": [5, 1]}}]})");
   try {
     ReadReleaseGeometries((dir / "crs.geojson").string(), "", "release.file");
@@ -68,12 +73,15 @@ TEST(ReadReleaseGeometries, BadFiles) {
 TEST(ReadReleaseGeometries, ReprojectsToTheDemCrs) {
   const auto dir = testing::FreshDir("reproject");
   // A point given in WGS 84 lon/lat; the DEM is in MGI / Austria Lambert (EPSG:31287).
-  testing::WriteText(dir / "wgs84.geojson",
-                     R"({"type": "FeatureCollection", "features": [{"type": "Feature", "properties": {},
+  testing::WriteText(
+      dir / "wgs84.geojson",
+      R"({"type": "FeatureCollection", "features": [{"type": "Feature", "properties": {},
  "geometry": {"type": "Point", "coordinates": [11.4, 47.3]}}]})");
-  const auto g = ReadReleaseGeometries((dir / "wgs84.geojson").string(), testing::Wkt(31287), "release.file");
+  const auto g =
+      ReadReleaseGeometries((dir / "wgs84.geojson").string(), testing::Wkt(31287), "release.file");
   ASSERT_EQ(g.size(), 1u);
-  // Innsbruck area in Austria Lambert: x about 250 km, y about 370 km (false origin 400 km, 400 km).
+  // Innsbruck area in Austria Lambert: x about 250 km, y about 370 km (false origin 400 km, 400
+  // km).
   EXPECT_GT(g[0].rings[0][0].x(), 200000);
   EXPECT_LT(g[0].rings[0][0].x(), 300000);
   EXPECT_GT(g[0].rings[0][0].y(), 330000);

@@ -60,8 +60,8 @@ TEST(MakeBuiltinShape, DimensionsAlongXyz) {
 }
 
 TEST(MakeBuiltinShape, EotaStandardBlocksAreOneCubicMetre) {
-  // EOTA test blocks (ETAG 027 / EAD 340059): EOTA111 bounding box 1.122 m, EOTA221 1.414 x 1.414 x 0.707 m,
-  // each for 1 m^3; the bevel is chosen so that the volume matches.
+  // EOTA test blocks (ETAG 027 / EAD 340059): EOTA111 bounding box 1.122 m, EOTA221 1.414 x 1.414 x
+  // 0.707 m, each for 1 m^3; the bevel is chosen so that the volume matches.
   const Polyhedron e111 = MakeBuiltinShape(Spec("eota111", {}));
   EXPECT_NEAR(Volume(e111), 1.0, 1e-9);
   EXPECT_NEAR((Extent(e111) - Eigen::Vector3d::Constant(1.122)).norm(), 0, 1e-12);
