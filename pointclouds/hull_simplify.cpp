@@ -48,12 +48,7 @@ Eigen::Vector3d PrincipalMoments(const Polyhedron& poly) {
 Polyhedron SimplifyHull(const Polyhedron& hull, int max_vertices, SimplifyReport* report) {
   assert(max_vertices >= 4);
   // Candidates: the vertices that the triangles use.
-  std::vector<char> used(hull.vertices_m.size(), 0);
-  for (const auto& t : hull.triangles)
-    for (int k : t) used[k] = 1;
-  std::vector<Eigen::Vector3d> candidates;
-  for (std::size_t i = 0; i < used.size(); ++i)
-    if (used[i]) candidates.push_back(hull.vertices_m[i]);
+  const std::vector<Eigen::Vector3d> candidates = UsedVertices(hull);
 
   Polyhedron result = hull;
   std::vector<char> chosen(candidates.size(), 1);

@@ -145,12 +145,7 @@ ShapeClass ClassifyZingg(double b_over_a, double c_over_b) {
 
 ShapeDescriptors DescribeShape(const Polyhedron& hull) {
   ShapeDescriptors s;
-  std::vector<char> used(hull.vertices_m.size(), 0);
-  for (const auto& t : hull.triangles)
-    for (int k : t) used[k] = 1;
-  std::vector<Eigen::Vector3d> v;
-  for (std::size_t i = 0; i < used.size(); ++i)
-    if (used[i]) v.push_back(hull.vertices_m[i]);
+  const std::vector<Eigen::Vector3d> v = UsedVertices(hull);
   if (v.size() < 4) return s;
 
   // Surface area, and the smallest width over the face normals.

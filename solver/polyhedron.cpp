@@ -6,6 +6,16 @@
 
 namespace talus {
 
+std::vector<Eigen::Vector3d> UsedVertices(const Polyhedron& poly) {
+  std::vector<char> used(poly.vertices_m.size(), 0);
+  for (const auto& t : poly.triangles)
+    for (int k : t) used[k] = 1;
+  std::vector<Eigen::Vector3d> vertices;
+  for (std::size_t i = 0; i < used.size(); ++i)
+    if (used[i]) vertices.push_back(poly.vertices_m[i]);
+  return vertices;
+}
+
 MassProperties ComputeMassProperties(const Polyhedron& poly, double density_kg_m3) {
   // Coordinates are taken relative to the vertex mean so that large (georeferenced) offsets
   // cost no precision. Each triangle (a, b, c) and that origin span a signed tetrahedron of volume
@@ -52,12 +62,8 @@ RockShape MakeRockShape(const Polyhedron& hull, double density_kg_m3) {
   rock.principal_to_input = Eigen::Quaterniond(axes).normalized();
   rock.centroid_input_m = mp.centroid_m;
 
-  std::vector<char> used(hull.vertices_m.size(), 0);
-  for (const auto& t : hull.triangles)
-    for (int k : t) used[k] = 1;
-  for (std::size_t i = 0; i < hull.vertices_m.size(); ++i) {
-    if (!used[i]) continue;
-    const Eigen::Vector3d local = axes.transpose() * (hull.vertices_m[i] - mp.centroid_m);
+  for (const Eigen::Vector3d& vertex : UsedVertices(hull)) {
+    const Eigen::Vector3d local = axes.transpose() * (vertex - mp.centroid_m);
     rock.vertices_m.push_back(local);
     rock.bounding_radius_m = std::max(rock.bounding_radius_m, local.norm());
   }

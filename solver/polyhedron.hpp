@@ -15,6 +15,9 @@ struct Polyhedron {
   std::vector<std::array<int, 3>> triangles;
 };
 
+// The vertices that at least one triangle uses, in index order.
+std::vector<Eigen::Vector3d> UsedVertices(const Polyhedron& poly);
+
 // Mass properties of a homogeneous solid polyhedron, by exact integration over the tetrahedra
 // that its triangles span with the origin (divergence theorem).
 struct MassProperties {
