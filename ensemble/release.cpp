@@ -201,7 +201,7 @@ RockState ReleaseState(const Scene& scene, const ReleaseSpec& spec, long rock) {
   state.position_m = Eigen::Vector3d(xy.x(), xy.y(), z + spec.height_m);
   // The user's orientation rotates the shape as given; the state holds principal -> world.
   const Eigen::Quaterniond user = spec.orientation ? *spec.orientation : random.Orientation();
-  state.orientation = (user * scene.rock.principal_to_input).normalized();
+  state.orientation = scene.rock.PrincipalOrientation(user);
   state.velocity_m_s = spec.velocity_m_s;
   state.angular_velocity_rad_s = state.orientation.conjugate() * spec.angular_velocity_rad_s;
   return state;

@@ -46,7 +46,7 @@ class TrajectoryRecorder {
     TrajectorySample sample;
     sample.t_s = s.time_s;
     sample.position_m = s.position_m;
-    sample.orientation = (s.orientation * rock_.principal_to_input.conjugate()).normalized();
+    sample.orientation = rock_.ShapeOrientation(s.orientation);
     sample.velocity_m_s = s.velocity_m_s;
     sample.angular_velocity_rad_s = s.orientation * s.angular_velocity_rad_s;
     sample.contact = contact;

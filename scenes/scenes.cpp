@@ -1,7 +1,5 @@
 #include "scenes/scenes.hpp"
 
-#include <cmath>
-
 #include "solver/random.hpp"
 #include "solver/shapes.hpp"
 #include "solver/simulate.hpp"
@@ -51,11 +49,6 @@ Scene Incline(double slope_deg, const RockShape& rock, const GroundParams& groun
   scene.terrain = Terrain(MakePlaneHeightfield(plane), test);
   scene.rock = rock;
   return scene;
-}
-
-Eigen::Vector3d InclineNormal(double slope_deg) {
-  const double theta = slope_deg * M_PI / 180.0;
-  return Eigen::Vector3d(std::sin(theta), 0.0, std::cos(theta));
 }
 
 }  // namespace talus::scenes

@@ -25,7 +25,4 @@ RockState Ramp40Release(const Scene& ramp, std::uint64_t seed, std::uint64_t roc
 Scene Incline(double slope_deg, const RockShape& rock, const GroundParams& ground,
               double length_m = 200, double cell_m = 5);
 
-// The upward unit normal of Incline(slope_deg).
-Eigen::Vector3d InclineNormal(double slope_deg);
-
 }  // namespace talus::scenes
