@@ -28,7 +28,7 @@ int RunDemo(std::uint64_t seed) {
       scene.rock.mass_kg, static_cast<unsigned long long>(seed));
   std::printf("  %s\n", result.BriefReport().c_str());
   std::printf("  end position (%.2f, %.2f, %.2f) m, runout %.1f m from release\n", end.x(), end.y(),
-              end.z(), (end - start.position_m).head<2>().norm());
+              end.z(), result.runout_m);
   return result.end == EndReason::kFailed ? 1 : 0;
 }
 

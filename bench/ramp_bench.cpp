@@ -47,7 +47,7 @@ Batch RunBatch(const talus::Scene& scene, int rocks, std::uint64_t seed, talus::
     batch.contact_steps += r.contact_steps;
     batch.iterations += r.solver_iterations;
     batch.unconverged += r.unconverged_steps;
-    batch.runouts_m.push_back((r.final_state.position_m - start.position_m).head<2>().norm());
+    batch.runouts_m.push_back(r.runout_m);
     batch.max_speeds_m_s.push_back(r.max_speed_m_s);
     batch.time_sum_s += r.travel_time_s;
     ++batch.endings[talus::ToString(r.end)];

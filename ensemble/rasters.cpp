@@ -5,9 +5,9 @@
 
 namespace talus::ensemble {
 
-FootprintRecorder::FootprintRecorder(const RasterRequest& request, const RockShape& rock)
+FootprintRecorder::FootprintRecorder(const RasterRequest& request, const Terrain& terrain)
     : request_(request),
-      rock_(rock),
+      terrain_(terrain),
       slot_(static_cast<std::size_t>(request.grid.nx) * request.grid.ny, -1) {}
 
 int FootprintRecorder::CellOf(double x_m, double y_m) const {
@@ -38,23 +38,25 @@ void FootprintRecorder::Mark(const Eigen::Vector3d& position, float speed, float
     footprint_.jump_height_m[k] = std::max(footprint_.jump_height_m[k], jump);
 }
 
-void FootprintRecorder::Begin(const RockState& start, const Terrain& terrain) {
+void FootprintRecorder::Begin(const RockOutcome& outcome) {
+  const RockState& start = outcome.start;
+  rock_ = outcome.shape.get();
   previous_ = start.position_m;
   if (!request_.needs_passes()) return;
   TerrainSample ground;
   const float jump =
-      terrain.Sample(start.position_m.x(), start.position_m.y(), &ground)
+      terrain_.Sample(start.position_m.x(), start.position_m.y(), &ground)
           ? static_cast<float>((start.position_m.z() - ground.height_m) * ground.normal.z())
           : 0.0f;
   Mark(start.position_m, static_cast<float>(start.velocity_m_s.norm()),
-       static_cast<float>(KineticEnergy(rock_, start)), jump);
+       static_cast<float>(KineticEnergy(*rock_, start)), jump);
 }
 
 void FootprintRecorder::OnStep(const RockState& state, const StepReport&,
                                const TerrainSample& ground) {
   if (!request_.needs_passes()) return;
   const auto speed = static_cast<float>(state.velocity_m_s.norm());
-  const auto energy = request_.energy ? static_cast<float>(KineticEnergy(rock_, state)) : 0.0f;
+  const auto energy = request_.energy ? static_cast<float>(KineticEnergy(*rock_, state)) : 0.0f;
   const auto jump =
       static_cast<float>((state.position_m.z() - ground.height_m) * ground.normal.z());
   // A step longer than half a cell marks the cells in between too.
@@ -67,13 +69,14 @@ void FootprintRecorder::OnStep(const RockState& state, const StepReport&,
   previous_ = state.position_m;
 }
 
-Footprint FootprintRecorder::Finish(const RockResult& result) {
+void FootprintRecorder::Finish(RockOutcome& outcome) {
   for (int cell : footprint_.cells) slot_[static_cast<std::size_t>(cell)] = -1;
-  Footprint out = std::move(footprint_);
+  outcome.footprint = std::move(footprint_);
   footprint_ = Footprint{};
+  const RockResult& result = outcome.result;
   if (result.end == EndReason::kRest)
-    out.deposit_cell = CellOf(result.final_state.position_m.x(), result.final_state.position_m.y());
-  return out;
+    outcome.footprint.deposit_cell =
+        CellOf(result.final_state.position_m.x(), result.final_state.position_m.y());
 }
 
 RasterAccumulator::RasterAccumulator(const RasterRequest& request) : request_(request) {

@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include "ensemble/outcome.hpp"
+#include "ensemble/recorders.hpp"
 #include "solver/simulate.hpp"
 #include "solver/terrain.hpp"
 
@@ -31,28 +33,22 @@ struct RasterRequest {
   }
 };
 
-// One rock's footprint: each passed cell once, with the rock's maxima there.
-struct Footprint {
-  std::vector<int> cells;                                 // j * nx + i
-  std::vector<float> speed_m_s, energy_j, jump_height_m;  // parallel to cells, when requested
-  int deposit_cell = -1;  // cell of the rest position, -1 when the rock did not come to rest there
-};
-
-// Records one rock's footprint from the solver's steps. One per thread, reused across rocks.
-class FootprintRecorder : public StepObserver {
+// Records one rock's footprint (outcome.footprint) from the solver's steps. One per thread,
+// reused across rocks.
+class FootprintRecorder : public RockRecorder {
  public:
-  FootprintRecorder(const RasterRequest& request, const RockShape& rock);
-  void Begin(const RockState& start, const Terrain& terrain);
+  FootprintRecorder(const RasterRequest& request, const Terrain& terrain);
+  void Begin(const RockOutcome& outcome) override;
   void OnStep(const RockState& state, const StepReport& step, const TerrainSample& ground) override;
-  // Ends the rock: returns its footprint and clears the recorder.
-  Footprint Finish(const RockResult& result);
+  void Finish(RockOutcome& outcome) override;
 
  private:
   void Mark(const Eigen::Vector3d& position, float speed, float energy, float jump);
   int CellOf(double x_m, double y_m) const;
 
   const RasterRequest& request_;
-  const RockShape& rock_;
+  const Terrain& terrain_;
+  const RockShape* rock_ = nullptr;
   std::vector<int> slot_;  // per cell: index into footprint_ or -1
   Footprint footprint_;
   Eigen::Vector3d previous_ = Eigen::Vector3d::Zero();

@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "solver/random.hpp"
+#include "solver/simulate.hpp"
 
 namespace talus::ensemble {
 namespace {
@@ -75,15 +76,53 @@ Eigen::Vector2d PointInPolygon(const std::vector<std::vector<Eigen::Vector2d>>& 
 
 }  // namespace
 
+std::string ReleaseSpec::ReleaseName(int release) const {
+  return runs.empty() ? std::to_string(release) : runs[static_cast<std::size_t>(release)].id;
+}
+
 bool ReleaseSpec::IsValid(std::string* why) const {
   std::ostringstream s;
-  if (releases.empty()) return Fail(why, "no release point, line or polygon");
+  if (releases.empty() && runs.empty()) return Fail(why, "no release point, line, polygon or run");
+  if (!releases.empty() && !runs.empty())
+    return Fail(why, "release geometries and runs cannot be combined");
+  for (std::size_t b = 0; b < blocks.size(); ++b) {
+    std::string shape_why;
+    if (!blocks[b].shape) {
+      s << "block " << blocks[b].id << " has no shape";
+      return Fail(why, s.str());
+    }
+    if (!blocks[b].shape->IsValid(&shape_why)) {
+      s << "block " << blocks[b].id << ": " << shape_why;
+      return Fail(why, s.str());
+    }
+  }
+  for (std::size_t r = 0; r < runs.size(); ++r) {
+    const ReleaseRun& run = runs[r];
+    const auto bad = [&](const std::string& what) {
+      s << "run " << run.id << ": " << what;
+      return Fail(why, s.str());
+    };
+    if (run.id.empty()) return bad("empty id");
+    for (std::size_t q = 0; q < r; ++q)
+      if (runs[q].id == run.id) return bad("the id appears twice");
+    if (!run.xy_m.allFinite() || (run.z_m && !std::isfinite(*run.z_m)))
+      return bad("non-finite position");
+    if (run.height_m && (!std::isfinite(*run.height_m) || *run.height_m < 0))
+      return bad("height must be finite and >= 0");
+    if (!run.velocity_m_s.allFinite() || !run.angular_velocity_rad_s.allFinite())
+      return bad("non-finite velocity");
+    if (run.block < -1 || run.block >= static_cast<int>(blocks.size()))
+      return bad("unknown block index " + std::to_string(run.block));
+    if (run.orientation &&
+        (!run.orientation->coeffs().allFinite() || std::abs(run.orientation->norm() - 1) > 1e-6))
+      return bad("orientation must be a unit quaternion [w, x, y, z]");
+  }
   if (rocks_per_release < 1) {
     s << "rocks = " << rocks_per_release << " must be >= 1";
     return Fail(why, s.str());
   }
-  if (rocks_per_release > kMaxTotalRocks / static_cast<long>(releases.size())) {
-    s << "rocks = " << rocks_per_release << " per release x " << releases.size()
+  if (rocks_per_release > kMaxTotalRocks / release_count()) {
+    s << "rocks = " << rocks_per_release << " per release x " << release_count()
       << " releases is more than " << kMaxTotalRocks << " rocks";
     return Fail(why, s.str());
   }
@@ -188,23 +227,59 @@ std::optional<Eigen::Vector2d> PointOffTerrain(const Terrain& terrain,
   return std::nullopt;
 }
 
-RockState ReleaseState(const Scene& scene, const ReleaseSpec& spec, long rock) {
-  RockRandom random(spec.seed, static_cast<std::uint64_t>(rock));
-  const ReleaseGeometry& g = spec.releases[static_cast<std::size_t>(spec.ReleaseOf(rock))];
-  Eigen::Vector2d xy = g.rings[0][0];
-  if (g.kind == ReleaseGeometry::Kind::kLine) xy = PointOnLine(g.rings[0], random.Uniform());
-  if (g.kind == ReleaseGeometry::Kind::kPolygon) xy = PointInPolygon(g.rings, random);
+std::uint64_t RockShapeSeed(std::uint64_t seed, long rock) {
+  // SplitMix64 (Steele, Lea, Flood 2014) over a combination of the two.
+  std::uint64_t z =
+      seed * 0x9E3779B97F4A7C15ULL + static_cast<std::uint64_t>(rock) + 0x632BE59BD9B4E019ULL;
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
+  return z ^ (z >> 31);
+}
 
-  RockState state;
+ReleasedRock Release(const Scene& scene, const ReleaseSpec& spec, long rock) {
+  RockRandom random(spec.seed, static_cast<std::uint64_t>(rock));
+  const int release = spec.ReleaseOf(rock);
+  const ReleaseRun* run =
+      spec.runs.empty() ? nullptr : &spec.runs[static_cast<std::size_t>(release)];
+
+  // Shape: the rock's own, its run's block, or the scene's rock (not owned).
+  const int block = run ? run->block : -1;
+  ReleasedRock out;
+  if (spec.shape_per_rock) {
+    out.shape = std::make_shared<const RockShape>(
+        spec.shape_per_rock(block, RockShapeSeed(spec.seed, rock)));
+  } else if (block >= 0) {
+    out.shape = spec.blocks[static_cast<std::size_t>(block)].shape;
+  } else {
+    out.shape = std::shared_ptr<const RockShape>(std::shared_ptr<const RockShape>(), &scene.rock);
+  }
+
+  // Position: on the release geometry, or the run's.
+  Eigen::Vector2d xy;
+  if (run) {
+    xy = run->xy_m;
+  } else {
+    const ReleaseGeometry& g = spec.releases[static_cast<std::size_t>(release)];
+    xy = g.rings[0][0];
+    if (g.kind == ReleaseGeometry::Kind::kLine) xy = PointOnLine(g.rings[0], random.Uniform());
+    if (g.kind == ReleaseGeometry::Kind::kPolygon) xy = PointInPolygon(g.rings, random);
+  }
+  RockState& state = out.start;
   TerrainSample ground;
   const double z = scene.terrain.Sample(xy.x(), xy.y(), &ground) ? ground.height_m : 0.0;
-  state.position_m = Eigen::Vector3d(xy.x(), xy.y(), z + spec.height_m);
+  const double height = run && run->height_m ? *run->height_m : spec.height_m;
+  state.position_m = Eigen::Vector3d(xy.x(), xy.y(), run && run->z_m ? *run->z_m : z + height);
+
   // The user's orientation rotates the shape as given; the state holds principal -> world.
-  const Eigen::Quaterniond user = spec.orientation ? *spec.orientation : random.Orientation();
-  state.orientation = scene.rock.PrincipalOrientation(user);
-  state.velocity_m_s = spec.velocity_m_s;
-  state.angular_velocity_rad_s = state.orientation.conjugate() * spec.angular_velocity_rad_s;
-  return state;
+  const std::optional<Eigen::Quaterniond>& fixed = run ? run->orientation : spec.orientation;
+  const Eigen::Quaterniond user = fixed ? *fixed : random.Orientation();
+  state.orientation = out.shape->PrincipalOrientation(user);
+  const Eigen::Vector3d& v = run ? run->velocity_m_s : spec.velocity_m_s;
+  const Eigen::Vector3d& w = run ? run->angular_velocity_rad_s : spec.angular_velocity_rad_s;
+  state.velocity_m_s = v;
+  state.angular_velocity_rad_s = state.orientation.conjugate() * w;
+  out.lift_m = RaiseAboveTerrain(scene, *out.shape, state);
+  return out;
 }
 
 }  // namespace talus::ensemble

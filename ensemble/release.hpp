@@ -5,6 +5,8 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <cstdint>
+#include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -22,20 +24,54 @@ struct ReleaseGeometry {
   std::vector<std::vector<Eigen::Vector2d>> rings;  // point: one ring of one vertex; line: one ring
 };
 
+// One run of an experiment campaign or a documented event: a release state of its own, with its
+// own block. Positions in map coordinates (m), velocities in the world frame.
+struct ReleaseRun {
+  std::string id;  // e.g. the trajectory_id of a run table; unique within a spec
+  Eigen::Vector2d xy_m = Eigen::Vector2d::Zero();
+  std::optional<double> z_m;       // centre of mass height; else height_m above the ground
+  std::optional<double> height_m;  // centre of mass above the ground; else ReleaseSpec::height_m
+  Eigen::Vector3d velocity_m_s = Eigen::Vector3d::Zero();
+  Eigen::Vector3d angular_velocity_rad_s = Eigen::Vector3d::Zero();
+  int block = -1;  // index into ReleaseSpec::blocks; -1: the scene's rock
+  // Measured orientation of the shape as given (w, x, y, z); nullopt: uniform on SO(3) per rock.
+  std::optional<Eigen::Quaterniond> orientation;
+};
+
+// A named rock shape that runs refer to (e.g. the blocks of an experiment campaign).
+struct Block {
+  std::string id;
+  std::shared_ptr<const RockShape> shape;
+};
+
 struct ReleaseSpec {
   static constexpr long kMaxTotalRocks = 1'000'000'000;  // rocks in one run, all releases together
 
+  // Where rocks start: either geometries (points, lines, polygons) or runs, never both.
   std::vector<ReleaseGeometry> releases;
-  long rocks_per_release = 1;
-  double height_m = 1.0;  // centre of mass above the ground at release (before any raise)
+  std::vector<ReleaseRun> runs;
+  std::vector<Block> blocks;  // shapes the runs name
+  // When set, every rock gets a shape of its own: shape_per_rock(block, shape seed) with the
+  // block of its run (-1: the scene's rock) and a seed that depends on (seed, rock) only. It is
+  // called from worker threads and must be thread-safe; a bad shape is an exception.
+  std::function<RockShape(int block, std::uint64_t shape_seed)> shape_per_rock;
+  long rocks_per_release = 1;  // per release geometry or per run
+  double height_m = 1.0;       // centre of mass above the ground at release (before any raise)
   // Fixed orientation of the shape as given (w, x, y, z), or nullopt for uniform on SO(3).
   std::optional<Eigen::Quaterniond> orientation;
   Eigen::Vector3d velocity_m_s = Eigen::Vector3d::Zero();            // world frame
   Eigen::Vector3d angular_velocity_rad_s = Eigen::Vector3d::Zero();  // world frame
   std::uint64_t seed = 1;
 
-  long total_rocks() const { return rocks_per_release * static_cast<long>(releases.size()); }
+  // Number of release geometries or runs.
+  long release_count() const {
+    return static_cast<long>(runs.empty() ? releases.size() : runs.size());
+  }
+  long total_rocks() const { return rocks_per_release * release_count(); }
+  // Index of the release geometry or run of a rock: rocks of one release are consecutive.
   int ReleaseOf(long rock) const { return static_cast<int>(rock / rocks_per_release); }
+  // The run id of a rock's release: the run's id, or the release's index for geometries.
+  std::string ReleaseName(int release) const;
   // False, naming the field and value, when a value is out of range (more than kMaxTotalRocks
   // rocks in all) or a geometry is degenerate (a line of zero length, a polygon whose holes leave
   // no area).
@@ -48,9 +84,22 @@ struct ReleaseSpec {
 std::optional<Eigen::Vector2d> PointOffTerrain(const Terrain& terrain,
                                                const ReleaseGeometry& release);
 
-// The start state of rock `rock` (0-based, releases one after another): position on its release
-// with the centre of mass height_m above the ground, orientation, velocities. Not yet raised above
-// the terrain (see RaiseAboveTerrain). Depends on (spec.seed, rock) only.
-RockState ReleaseState(const Scene& scene, const ReleaseSpec& spec, long rock);
+// A rock ready to run: its shape and start state.
+struct ReleasedRock {
+  std::shared_ptr<const RockShape> shape;  // the scene's rock, a block's, or the rock's own
+  RockState start;                         // raised so that no vertex is below ground
+  double lift_m = 0;                       // how far it was raised (m, >= 0)
+};
+
+// The one way to release rock `rock` (0-based, releases one after another): its shape, position
+// on its release (or its run's position) with the centre of mass height_m above the ground (or at
+// the run's z_m), orientation (fixed, or uniform on SO(3)), velocities; then raised until no
+// vertex is below the terrain. Depends on (spec.seed, rock) only. `scene` must outlive the result
+// when the rock uses the scene's shape.
+ReleasedRock Release(const Scene& scene, const ReleaseSpec& spec, long rock);
+
+// The seed of rock `rock`'s own shape (see ReleaseSpec::shape_per_rock): SplitMix64 mixing of
+// (seed, rock), independent of the rock's orientation stream.
+std::uint64_t RockShapeSeed(std::uint64_t seed, long rock);
 
 }  // namespace talus::ensemble

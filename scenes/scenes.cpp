@@ -1,6 +1,5 @@
 #include "scenes/scenes.hpp"
 
-#include "solver/random.hpp"
 #include "solver/shapes.hpp"
 #include "solver/simulate.hpp"
 
@@ -21,15 +20,18 @@ Scene Ramp40() {
   return scene;
 }
 
+ensemble::ReleaseSpec Ramp40ReleaseSpec(std::uint64_t seed, long rocks) {
+  ensemble::ReleaseSpec spec;
+  spec.releases.push_back({ensemble::ReleaseGeometry::Kind::kPoint, {{{10.0, 0.0}}}});
+  spec.rocks_per_release = rocks;
+  spec.height_m = 1.0;
+  spec.seed = seed;
+  return spec;
+}
+
 RockState Ramp40Release(const Scene& ramp, std::uint64_t seed, std::uint64_t rock_index) {
-  RockRandom random(seed, rock_index);
-  RockState state;
-  TerrainSample ground;
-  ramp.terrain.Sample(10.0, 0.0, &ground);
-  state.position_m = Eigen::Vector3d(10.0, 0.0, ground.height_m + 1.0);
-  state.orientation = random.Orientation();
-  RaiseAboveTerrain(ramp, state);
-  return state;
+  const long rock = static_cast<long>(rock_index);
+  return ensemble::Release(ramp, Ramp40ReleaseSpec(seed, rock + 1), rock).start;
 }
 
 }  // namespace talus::scenes

@@ -3,6 +3,7 @@
 
 #include <cstdint>
 
+#include "ensemble/release.hpp"
 #include "solver/scene.hpp"
 #include "solver/state.hpp"
 
@@ -16,8 +17,12 @@ RockShape Eota221();
 // 2 m cells, ground "medium_hard" everywhere, default solver options, EOTA221 block.
 Scene Ramp40();
 
-// Release state of rock `rock_index` on Ramp40: centre of mass 1 m above the ground at x = 10 m,
-// y = 0, at rest, orientation uniform on SO(3) from (seed, rock_index).
+// The release of the Ramp40 rocks: centre of mass 1 m above the ground at x = 10 m, y = 0, at
+// rest, orientation of the shape uniform on SO(3) from (seed, rock) -- the release a scene file
+// with that point gives (cases/ramp40), so the same-numbered rock starts the same everywhere.
+ensemble::ReleaseSpec Ramp40ReleaseSpec(std::uint64_t seed, long rocks);
+
+// Release state of rock `rock_index` of Ramp40ReleaseSpec.
 RockState Ramp40Release(const Scene& ramp, std::uint64_t seed, std::uint64_t rock_index);
 
 // A test incline: a plane falling along +x at slope_deg (0: flat), x in [0, length_m],

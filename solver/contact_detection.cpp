@@ -4,10 +4,9 @@
 
 namespace talus {
 
-DetectResult DetectContacts(const Scene& scene, const RockState& mid,
+DetectResult DetectContacts(const Scene& scene, const RockShape& rock, const RockState& mid,
                             const Eigen::Matrix3d& rotation, StepWorkspace& workspace) {
   workspace.contacts.clear();
-  const RockShape& rock = scene.rock;
   const Terrain& terrain = scene.terrain;
   const Eigen::Vector3d& r = mid.position_m;
   const double radius = rock.bounding_radius_m;

@@ -17,7 +17,7 @@ enum class DetectResult { kOk, kOutsideDomain };
 // from that plane costs one test; otherwise only the vertices within that departure of the plane
 // are tested against the terrain itself.
 // Returns kOutsideDomain when a vertex that may touch lies outside the DEM or over nodata.
-DetectResult DetectContacts(const Scene& scene, const RockState& mid,
+DetectResult DetectContacts(const Scene& scene, const RockShape& rock, const RockState& mid,
                             const Eigen::Matrix3d& rotation, StepWorkspace& workspace);
 
 }  // namespace talus

@@ -92,12 +92,12 @@ Eigen::Vector3d ProxLocal(const Contact& c, const Eigen::Vector3d& xi0, Eigen::V
 
 }  // namespace
 
-ContactSolveReport SolveContacts(const Scene& scene, const Eigen::Matrix3d& rotation,
-                                 double mass_eff_kg, const Eigen::Vector3d& v_begin,
-                                 const Eigen::Vector3d& omega_begin, Eigen::Vector3d& velocity_m_s,
-                                 Eigen::Vector3d& omega_rad_s, StepWorkspace& workspace) {
+ContactSolveReport SolveContacts(const Scene& scene, const RockShape& rock,
+                                 const Eigen::Matrix3d& rotation, double mass_eff_kg,
+                                 const Eigen::Vector3d& v_begin, const Eigen::Vector3d& omega_begin,
+                                 Eigen::Vector3d& velocity_m_s, Eigen::Vector3d& omega_rad_s,
+                                 StepWorkspace& workspace) {
   ContactSolveReport report;
-  const RockShape& rock = scene.rock;
   const SolverOptions& opt = scene.options;
   const Eigen::Vector3d inv_inertia = rock.inertia_kg_m2.cwiseInverse();
   const Eigen::Vector3d restitution(opt.normal_restitution, opt.tangential_restitution,

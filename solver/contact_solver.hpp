@@ -22,9 +22,10 @@ struct ContactSolveReport {
 // xi = gamma_E + eps gamma_B: Signorini/Newton in the normal direction, Coulomb disk in the tangent
 // plane; the iteration stops when no contact changes the velocity of any body point by more
 // than the tolerance.
-ContactSolveReport SolveContacts(const Scene& scene, const Eigen::Matrix3d& rotation,
-                                 double mass_eff_kg, const Eigen::Vector3d& v_begin,
-                                 const Eigen::Vector3d& omega_begin, Eigen::Vector3d& velocity_m_s,
-                                 Eigen::Vector3d& omega_rad_s, StepWorkspace& workspace);
+ContactSolveReport SolveContacts(const Scene& scene, const RockShape& rock,
+                                 const Eigen::Matrix3d& rotation, double mass_eff_kg,
+                                 const Eigen::Vector3d& v_begin, const Eigen::Vector3d& omega_begin,
+                                 Eigen::Vector3d& velocity_m_s, Eigen::Vector3d& omega_rad_s,
+                                 StepWorkspace& workspace);
 
 }  // namespace talus

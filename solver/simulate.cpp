@@ -45,16 +45,17 @@ bool IsFinite(const RockState& s) {
 }
 }  // namespace
 
-RockResult SimulateRock(const Scene& scene, const RockState& start, SimulationWorkspace& workspace,
-                        StepObserver* observer) {
+RockResult SimulateRock(const Scene& scene, const RockShape& rock, const RockState& start,
+                        SimulationWorkspace& workspace, StepObserver* observer) {
   const SolverOptions& opt = scene.options;
   RockResult result;
   RockState state = start;
-  workspace.step.Reset(scene.rock.vertices_m.size());
+  workspace.step.Reset(rock.vertices_m.size());
   auto finish = [&](EndReason end) {
     result.end = end;
     result.final_state = state;
     result.travel_time_s = state.time_s - start.time_s;
+    result.runout_m = (state.position_m - start.position_m).head<2>().norm();
     return result;
   };
   if (!IsFinite(state)) {
@@ -69,7 +70,7 @@ RockResult SimulateRock(const Scene& scene, const RockState& start, SimulationWo
   auto record = [&](const TerrainSample& under) {
     result.max_speed_m_s = std::max(result.max_speed_m_s, state.velocity_m_s.norm());
     result.max_kinetic_energy_j =
-        std::max(result.max_kinetic_energy_j, KineticEnergy(scene.rock, state));
+        std::max(result.max_kinetic_energy_j, KineticEnergy(rock, state));
     result.max_jump_height_m = std::max(result.max_jump_height_m,
                                         (state.position_m.z() - under.height_m) * under.normal.z());
     result.max_angular_speed_rad_s =
@@ -81,7 +82,7 @@ RockResult SimulateRock(const Scene& scene, const RockState& start, SimulationWo
   const double end_time = start.time_s + opt.max_time_s;
   while (true) {
     const Eigen::Vector3d previous = state.position_m;
-    const StepReport step = Step(scene, state, workspace.step, workspace.stage_times);
+    const StepReport step = Step(scene, rock, state, workspace.step, workspace.stage_times);
     if (step.outside_domain) return finish(EndReason::kLeftDomain);
     ++result.steps;
     if (!IsFinite(state)) {
@@ -109,10 +110,10 @@ RockResult SimulateRock(const Scene& scene, const RockState& start, SimulationWo
   }
 }
 
-double RaiseAboveTerrain(const Scene& scene, RockState& state) {
+double RaiseAboveTerrain(const Scene& scene, const RockShape& rock, RockState& state) {
   const Eigen::Matrix3d rotation = state.orientation.toRotationMatrix();
   double lift = 0;
-  for (const Eigen::Vector3d& b : scene.rock.vertices_m) {
+  for (const Eigen::Vector3d& b : rock.vertices_m) {
     const Eigen::Vector3d x = state.position_m + rotation * b;
     TerrainSample sample;
     if (!scene.terrain.Sample(x.x(), x.y(), &sample)) continue;

@@ -19,6 +19,7 @@ struct RockResult {
   std::string message;  // why it failed, for kFailed
   RockState final_state;
   double travel_time_s = 0;
+  double runout_m = 0;       // horizontal distance of the centre of mass from start to end
   double path_length_m = 0;  // horizontal path of the centre of mass
   double max_speed_m_s = 0;
   double max_kinetic_energy_j = 0;  // translational + rotational
@@ -49,16 +50,24 @@ struct SimulationWorkspace {
   StageTimes* stage_times = nullptr;  // set to profile the step's stages
 };
 
-// Runs the rock from `start` until rest, leaving the domain, max_time or a non-finite state.
-// Requires scene.IsValid(). Never throws for numerical trouble: that is reported as kFailed.
-RockResult SimulateRock(const Scene& scene, const RockState& start, SimulationWorkspace& workspace,
-                        StepObserver* observer = nullptr);
+// Runs the rock of shape `rock` from `start` until rest, leaving the domain, max_time or a
+// non-finite state. Requires scene.IsValid() and rock.IsValid(). Never throws for numerical
+// trouble: that is reported as kFailed. The overload without a shape runs scene.rock.
+RockResult SimulateRock(const Scene& scene, const RockShape& rock, const RockState& start,
+                        SimulationWorkspace& workspace, StepObserver* observer = nullptr);
+inline RockResult SimulateRock(const Scene& scene, const RockState& start,
+                               SimulationWorkspace& workspace, StepObserver* observer = nullptr) {
+  return SimulateRock(scene, scene.rock, start, workspace, observer);
+}
 
 // Kinetic energy (translational + rotational), J.
 double KineticEnergy(const RockShape& rock, const RockState& state);
 
 // Raises the rock along z until no hull vertex is below the terrain; returns the lift (m, >= 0).
 // Vertices outside the DEM are ignored.
-double RaiseAboveTerrain(const Scene& scene, RockState& state);
+double RaiseAboveTerrain(const Scene& scene, const RockShape& rock, RockState& state);
+inline double RaiseAboveTerrain(const Scene& scene, RockState& state) {
+  return RaiseAboveTerrain(scene, scene.rock, state);
+}
 
 }  // namespace talus

@@ -44,7 +44,8 @@ void UpdateScar(const Scene& scene, const StepReport& report, const StepWorkspac
 
 }  // namespace
 
-StepReport Step(const Scene& scene, RockState& state, StepWorkspace& workspace, StageTimes* times) {
+StepReport Step(const Scene& scene, const RockShape& rock, RockState& state,
+                StepWorkspace& workspace, StageTimes* times) {
   const SolverOptions& opt = scene.options;
   const double dt = opt.dt_s;
   const RockState begin = state;
@@ -56,12 +57,12 @@ StepReport Step(const Scene& scene, RockState& state, StepWorkspace& workspace, 
   clock.Lap(&StageTimes::midpoint_s);
 
   // 2. Free rotation by the implicit midpoint rule.
-  Eigen::Vector3d omega = FreeRotation(scene.rock.inertia_kg_m2, begin.angular_velocity_rad_s, dt);
+  Eigen::Vector3d omega = FreeRotation(rock.inertia_kg_m2, begin.angular_velocity_rad_s, dt);
   clock.Lap(&StageTimes::free_rotation_s);
 
   // 3. Contact set at the midpoint.
   const Eigen::Matrix3d rotation = state.orientation.toRotationMatrix();
-  if (DetectContacts(scene, state, rotation, workspace) == DetectResult::kOutsideDomain) {
+  if (DetectContacts(scene, rock, state, rotation, workspace) == DetectResult::kOutsideDomain) {
     state = begin;
     report.outside_domain = true;
     return report;
@@ -70,7 +71,7 @@ StepReport Step(const Scene& scene, RockState& state, StepWorkspace& workspace, 
   clock.Lap(&StageTimes::contacts_s);
 
   // 4. Velocity update: gravity and, in contact, implicit drag m (1 + nu dt) v_E, then percussions.
-  const double mass = scene.rock.mass_kg;
+  const double mass = rock.mass_kg;
   Eigen::Vector3d velocity = begin.velocity_m_s;
   velocity.z() -= dt * opt.gravity_m_s2;
   if (workspace.contacts.empty()) {
@@ -82,7 +83,7 @@ StepReport Step(const Scene& scene, RockState& state, StepWorkspace& workspace, 
     const double drag_factor = 1.0 + nu * dt;
     velocity /= drag_factor;
     const ContactSolveReport solve =
-        SolveContacts(scene, rotation, mass * drag_factor, begin.velocity_m_s,
+        SolveContacts(scene, rock, rotation, mass * drag_factor, begin.velocity_m_s,
                       begin.angular_velocity_rad_s, velocity, omega, workspace);
     report.iterations = solve.iterations;
     report.converged = solve.converged;

@@ -23,7 +23,13 @@ struct StageTimes {
 
 // Advances state by one step of scene.options.dt_s. When outside_domain is reported the state is
 // left at the step's beginning.
-StepReport Step(const Scene& scene, RockState& state, StepWorkspace& workspace,
-                StageTimes* times = nullptr);
+// `rock` is the shape of this rock (a scene may carry many); the overload without it uses
+// scene.rock.
+StepReport Step(const Scene& scene, const RockShape& rock, RockState& state,
+                StepWorkspace& workspace, StageTimes* times = nullptr);
+inline StepReport Step(const Scene& scene, RockState& state, StepWorkspace& workspace,
+                       StageTimes* times = nullptr) {
+  return Step(scene, scene.rock, state, workspace, times);
+}
 
 }  // namespace talus

@@ -15,17 +15,17 @@ TEST(Release, StartDependsOnSeedAndRockOnly) {
   ReleaseSpec spec = testing::PointRelease({{5, 0}, {6, 1}}, 4);
   std::string why;
   ASSERT_TRUE(spec.IsValid(&why)) << why;
-  const RockState a = ReleaseState(scene, spec, 5);
-  const RockState b = ReleaseState(scene, spec, 5);
+  const RockState a = Release(scene, spec, 5).start;
+  const RockState b = Release(scene, spec, 5).start;
   EXPECT_EQ(a.orientation.coeffs(), b.orientation.coeffs());
-  EXPECT_NE(ReleaseState(scene, spec, 6).orientation.coeffs(), a.orientation.coeffs());
+  EXPECT_NE(Release(scene, spec, 6).start.orientation.coeffs(), a.orientation.coeffs());
   EXPECT_EQ(spec.ReleaseOf(5), 1);
   EXPECT_DOUBLE_EQ(a.position_m.x(), 6);
   TerrainSample ground;
   ASSERT_TRUE(scene.terrain.Sample(6, 1, &ground));
   EXPECT_NEAR(a.position_m.z(), ground.height_m + spec.height_m, 1e-12);
   spec.seed = 2;
-  EXPECT_NE(ReleaseState(scene, spec, 5).orientation.coeffs(), a.orientation.coeffs());
+  EXPECT_NE(Release(scene, spec, 5).start.orientation.coeffs(), a.orientation.coeffs());
 }
 
 TEST(Release, FixedOrientationRotatesTheShapeAsGiven) {
@@ -36,7 +36,7 @@ TEST(Release, FixedOrientationRotatesTheShapeAsGiven) {
   const Eigen::Quaterniond user(Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 3).normalized()));
   spec.orientation = user;
   spec.angular_velocity_rad_s = Eigen::Vector3d(0, 0, 2);
-  const RockState s = ReleaseState(scene, spec, 0);
+  const RockState s = Release(scene, spec, 0).start;
   const Eigen::Quaterniond shape = s.orientation * scene.rock.principal_to_input.conjugate();
   EXPECT_NEAR(std::abs(shape.dot(user)), 1.0, 1e-12);
   EXPECT_TRUE((s.orientation * s.angular_velocity_rad_s).isApprox(Eigen::Vector3d(0, 0, 2), 1e-12));
@@ -53,13 +53,13 @@ TEST(Release, LinesAndPolygonsSampleOnThem) {
   std::string why;
   ASSERT_TRUE(spec.IsValid(&why)) << why;
   for (long rock = 0; rock < 200; ++rock) {
-    const Eigen::Vector3d p = ReleaseState(scene, spec, rock).position_m;
+    const Eigen::Vector3d p = Release(scene, spec, rock).start.position_m;
     const bool on_first = std::abs(p.x() - 2) < 1e-12 && std::abs(p.y()) <= 3;
     const bool on_second = std::abs(p.y() - 3) < 1e-12 && p.x() >= 2 && p.x() <= 8;
     EXPECT_TRUE(on_first || on_second) << p.transpose();
   }
   for (long rock = 200; rock < 400; ++rock) {
-    const Eigen::Vector3d p = ReleaseState(scene, spec, rock).position_m;
+    const Eigen::Vector3d p = Release(scene, spec, rock).start.position_m;
     EXPECT_TRUE(p.x() >= 10 && p.x() <= 14 && std::abs(p.y()) <= 2) << p.transpose();
     EXPECT_FALSE(std::abs(p.x() - 12) < 1 && std::abs(p.y()) < 1)
         << "in the hole: " << p.transpose();
