@@ -1,0 +1,153 @@
+#include "common/csv_table.hpp"
+
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+#include "common/error.hpp"
+
+namespace talus {
+namespace {
+
+std::string Trim(const std::string& s) {
+  const auto begin = s.find_first_not_of(" \t\r");
+  if (begin == std::string::npos) return "";
+  const auto end = s.find_last_not_of(" \t\r");
+  return s.substr(begin, end - begin + 1);
+}
+
+}  // namespace
+
+CsvTable CsvTable::Read(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path + ": cannot open (" + std::strerror(errno) + ")");
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) throw InputError(path + ": read error");
+  return Parse(text.str(), path);
+}
+
+CsvTable CsvTable::Parse(const std::string& text, const std::string& path) {
+  CsvTable table;
+  table.path_ = path;
+  std::size_t pos = text.compare(0, 3, "\xEF\xBB\xBF") == 0 ? 3 : 0;
+  int line = 1;
+  // Splits one record (which may span lines inside quotes) into fields.
+  auto record = [&](std::vector<std::string>& fields, int& first_line) {
+    fields.clear();
+    first_line = line;
+    std::string field;
+    bool quoted = false, was_quoted = false;
+    while (pos < text.size()) {
+      const char c = text[pos++];
+      if (quoted) {
+        if (c == '"') {
+          if (pos < text.size() && text[pos] == '"') {
+            field += '"';
+            ++pos;
+          } else {
+            quoted = false;
+          }
+        } else {
+          if (c == '\n') ++line;
+          field += c;
+        }
+      } else if (c == '"' && Trim(field).empty()) {
+        quoted = was_quoted = true;
+        field.clear();
+      } else if (c == ',') {
+        fields.push_back(was_quoted ? field : Trim(field));
+        field.clear();
+        was_quoted = false;
+      } else if (c == '\n') {
+        ++line;
+        break;
+      } else {
+        field += c;
+      }
+    }
+    if (quoted) throw InputError(path + ":" + std::to_string(first_line) + ": unclosed quote");
+    fields.push_back(was_quoted ? field : Trim(field));
+  };
+
+  std::vector<std::string> fields;
+  int first = 0;
+  while (pos < text.size()) {
+    record(fields, first);
+    const bool blank = fields.size() == 1 && fields[0].empty();
+    if (blank || (!fields.empty() && !fields[0].empty() && fields[0][0] == '#')) continue;
+    if (table.header_.empty()) {
+      table.header_ = fields;
+      for (std::size_t k = 0; k < fields.size(); ++k) {
+        if (fields[k].empty())
+          throw InputError(path + ":" + std::to_string(first) + ": header column " +
+                           std::to_string(k + 1) + " has no name");
+        for (std::size_t q = 0; q < k; ++q)
+          if (fields[q] == fields[k])
+            throw InputError(path + ":" + std::to_string(first) + ": header names column '" +
+                             fields[k] + "' twice");
+      }
+      continue;
+    }
+    if (fields.size() != table.header_.size())
+      throw InputError(path + ":" + std::to_string(first) + ": " + std::to_string(fields.size()) +
+                       " fields, but the header has " + std::to_string(table.header_.size()));
+    table.cells_.push_back(fields);
+    table.lines_.push_back(first);
+  }
+  if (table.header_.empty()) throw InputError(path + ": empty file (no header line)");
+  return table;
+}
+
+int CsvTable::Column(const std::string& name) const {
+  for (std::size_t k = 0; k < header_.size(); ++k)
+    if (header_[k] == name) return static_cast<int>(k);
+  return -1;
+}
+
+void CsvTable::Require(const std::vector<std::string>& columns) const {
+  for (const std::string& c : columns) {
+    if (Has(c)) continue;
+    std::string have;
+    for (const std::string& h : header_) have += (have.empty() ? "" : ", ") + h;
+    throw InputError(path_ + ": missing column '" + c + "' (the header has: " + have + ")");
+  }
+}
+
+std::string CsvTable::Where(int row, const std::string& column) const {
+  return path_ + ":" + std::to_string(line(row)) + ": column '" + column + "'";
+}
+
+std::string CsvTable::Text(int row, const std::string& column) const {
+  const int c = Column(column);
+  if (c < 0) Require({column});
+  return cells_[static_cast<std::size_t>(row)][static_cast<std::size_t>(c)];
+}
+
+bool CsvTable::Empty(int row, const std::string& column) const {
+  if (!Has(column)) return true;
+  const std::string t = Text(row, column);
+  return t.empty() || t == "NA" || t == "NaN" || t == "nan" || t == "NAN";
+}
+
+double CsvTable::Number(int row, const std::string& column) const {
+  const std::string t = Text(row, column);
+  double v = 0;
+  const char* begin = t.data();
+  const char* end = t.data() + t.size();
+  if (!t.empty() && *begin == '+') ++begin;
+  const auto [ptr, ec] = std::from_chars(begin, end, v);
+  if (t.empty() || ec != std::errc() || ptr != end || !std::isfinite(v))
+    throw InputError(Where(row, column) + ": '" + t + "' is not a finite number");
+  return v;
+}
+
+std::optional<double> CsvTable::OptionalNumber(int row, const std::string& column) const {
+  if (Empty(row, column)) return std::nullopt;
+  return Number(row, column);
+}
+
+}  // namespace talus

@@ -1,0 +1,51 @@
+#pragma once
+// Tables of named columns from CSV files (run tables, observation tables). Columns are read by
+// name, extra columns are ignored, and every error names the file, the line and the column.
+// RFC 4180 quoting ("a, b" and "" inside quotes); a UTF-8 byte-order mark is skipped; blank lines
+// and lines starting with '#' are skipped.
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace talus {
+
+class CsvTable {
+ public:
+  // Reads the whole file. Throws InputError "<path>: <reason>" when it cannot be read, has no
+  // header, a header names a column twice, or a row has more or fewer fields than the header.
+  static CsvTable Read(const std::string& path);
+  // The same from text already in memory; `path` names it in errors.
+  static CsvTable Parse(const std::string& text, const std::string& path);
+
+  const std::string& path() const { return path_; }
+  int rows() const { return static_cast<int>(cells_.size()); }
+  int line(int row) const { return lines_[static_cast<std::size_t>(row)]; }  // 1-based line
+  bool Has(const std::string& column) const { return Column(column) >= 0; }
+  const std::vector<std::string>& columns() const { return header_; }
+
+  // Throws naming the first of `columns` the header lacks, and the columns it has.
+  void Require(const std::vector<std::string>& columns) const;
+
+  // The cell as text (trimmed of surrounding blanks); throws when the column is absent.
+  std::string Text(int row, const std::string& column) const;
+  // True when the column is absent or the cell is empty (or NA / NaN / nan, as CSV writers put it).
+  bool Empty(int row, const std::string& column) const;
+  // A finite number; throws "<path>:<line>: column '<c>': '<text>' is not a finite number".
+  double Number(int row, const std::string& column) const;
+  // nullopt when Empty, else as Number.
+  std::optional<double> OptionalNumber(int row, const std::string& column) const;
+
+  // "<path>:<line>: column '<column>'" for messages of the caller's own checks.
+  std::string Where(int row, const std::string& column) const;
+
+ private:
+  int Column(const std::string& name) const;
+
+  std::string path_;
+  std::vector<std::string> header_;
+  std::vector<std::vector<std::string>> cells_;
+  std::vector<int> lines_;
+};
+
+}  // namespace talus
