@@ -29,15 +29,24 @@ void AddShapeOptions(CLI::App* verb, RockArgs& args) {
   verb->add_option("file", spec.file, "Point cloud: .pcd, .ply, .xyz, .txt, .csv or .pts (metres)");
   verb->add_option("--builtin", spec.builtin,
                    "Built-in shape instead of a file: box, ellipsoid, icosphere, "
-                   "cylinder, disk, eota111, eota221");
+                   "cylinder, disk, rock, eota111, eota221");
   verb->add_option("--dimensions", spec.dimensions_m,
                    "Built-in dimensions in m (box a b c, cylinder diameter "
                    "height, ...)")
       ->expected(1, 3);
+  verb->add_option("--points", spec.points, "Built-in rock: random points on the ellipsoid")
+      ->capture_default_str();
+  verb->add_option("--roughness", spec.roughness,
+                   "Built-in rock: radial perturbation of the points (0 .. 0.5)")
+      ->capture_default_str();
+  verb->add_option("--shape-seed", spec.shape_seed, "Built-in rock: seed of the points")
+      ->capture_default_str();
   verb->add_option("--density", spec.density_kg_m3, "Density in kg/m^3")->capture_default_str();
   args.volume =
       verb->add_option("--volume", args.volume_m3, "Scale the rock to this volume in m^3");
-  args.mass = verb->add_option("--mass", args.mass_kg, "Scale the rock to this mass in kg")
+  args.mass = verb->add_option("--mass", args.mass_kg,
+                               "Mass in kg: sets the density of a built-in of given dimensions, "
+                               "else scales the rock")
                   ->excludes(args.volume);
   verb->add_option("--max-vertices", spec.max_vertices,
                    "Simplify the hull to at most K vertices (0: off)")

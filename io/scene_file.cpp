@@ -335,16 +335,17 @@ void LoadRock(const Context& context, const Section& s, SceneFile& out) {
     out.inputs.push_back(rock.file);
   } else if (shape->is_table()) {
     const Section b(context, shape->as_table(), "rock.shape",
-                    {"box", "ellipsoid", "sphere", "cylinder", "eota", "size_m"});
+                    {"box", "ellipsoid", "sphere", "cylinder", "rock", "eota", "size_m", "points",
+                     "roughness", "shape_seed"});
     int kinds = 0;
-    for (const char* kind : {"box", "ellipsoid", "sphere", "cylinder", "eota"})
+    for (const char* kind : {"box", "ellipsoid", "sphere", "cylinder", "rock", "eota"})
       kinds += b.Has(kind);
     if (kinds != 1)
       s.Fail(
           "shape",
-          "give exactly one of box or ellipsoid ([a, b, c] in m), sphere (radius in m), cylinder "
-          "([diameter, height] in m) or eota (\"111\" or \"221\", optionally with size_m = [a, b, "
-          "c])");
+          "give exactly one of box, ellipsoid or rock ([a, b, c] in m), sphere (radius in m), "
+          "cylinder ([diameter, height] in m) or eota (\"111\" or \"221\", optionally with size_m "
+          "= [a, b, c])");
     auto dims = [&](const std::string& key, std::size_t n, const std::string& builtin) {
       std::vector<double> d = b.Numbers(key, n);
       for (double v : d)
@@ -356,6 +357,22 @@ void LoadRock(const Context& context, const Section& s, SceneFile& out) {
     if (b.Has("box")) dims("box", 3, "box");
     if (b.Has("ellipsoid")) dims("ellipsoid", 3, "ellipsoid");
     if (b.Has("cylinder")) dims("cylinder", 2, "cylinder");
+    for (const char* knob : {"points", "roughness", "shape_seed"})
+      if (b.Has(knob) && !b.Has("rock"))
+        b.Fail(knob, "only a rock shape takes " + std::string(knob));
+    if (b.Has("rock")) {
+      dims("rock", 3, "rock");
+      const long points = b.Integer("points", rock.points);
+      if (points < 4 || points > 1000000)
+        b.Fail("points", std::to_string(points) + " must be in 4 .. 1000000");
+      rock.points = static_cast<int>(points);
+      rock.roughness = b.Checked(
+          "roughness", rock.roughness, [](double v) { return v >= 0 && v <= 0.5; },
+          "must be in 0 .. 0.5");
+      const long seed = b.Integer("shape_seed", 0);
+      if (seed < 0) b.Fail("shape_seed", std::to_string(seed) + " must be >= 0");
+      rock.shape_seed = static_cast<std::uint64_t>(seed);
+    }
     if (b.Has("sphere")) {
       const double radius = b.Checked("sphere", 0, kPositive, "radius must be > 0");
       rock.builtin = "icosphere";
@@ -375,6 +392,14 @@ void LoadRock(const Context& context, const Section& s, SceneFile& out) {
   } else {
     s.Fail("shape", "expected a file name or a built-in such as { box = [1, 1, 1] }");
   }
+  if (pointclouds::DimensionsFixSize(rock) && s.Has("volume_m3"))
+    s.Fail("volume_m3",
+           "the dimensions of the shape fix its volume; give mass_kg (which sets the "
+           "density) or neither");
+  if (pointclouds::DimensionsFixSize(rock) && s.Has("mass_kg") && s.Has("density_kg_m3"))
+    s.Fail("mass_kg",
+           "the dimensions of the shape and mass_kg fix the density (mass / volume); "
+           "give density_kg_m3 or mass_kg, not both");
   try {
     pointclouds::RockReport report;
     out.scene.rock = pointclouds::MakeRock(rock, &report);

@@ -20,6 +20,9 @@ BuiltinSpec ToBuiltinSpec(const RockSpec& spec) {
   builtin.dimensions_m = spec.dimensions_m;
   builtin.subdivisions = spec.subdivisions;
   builtin.segments = spec.segments;
+  builtin.points = spec.points;
+  builtin.roughness = spec.roughness;
+  builtin.shape_seed = spec.shape_seed;
   if (spec.volume_m3) builtin.volume_m3 = spec.volume_m3;
   if (spec.mass_kg) builtin.volume_m3 = *spec.mass_kg / spec.density_kg_m3;
   return builtin;
@@ -34,27 +37,34 @@ RockShape FinishRock(Polyhedron hull, const Eigen::Vector3d& offset_m, const Roc
     hull = SimplifyHull(hull, spec.max_vertices, &simplify);
     r.simplify = simplify;
   }
-  // Scaling about the centroid keeps the centroid where the shape put it.
+  // Dimensions that fix the size keep it: the mass sets the density. Otherwise scale about the
+  // centroid, which keeps the centroid where the shape put it.
+  double density_kg_m3 = spec.density_kg_m3;
   std::optional<double> target_m3 = spec.volume_m3;
-  if (spec.mass_kg) target_m3 = *spec.mass_kg / spec.density_kg_m3;
+  if (spec.mass_kg && DimensionsFixSize(spec)) {
+    density_kg_m3 = *spec.mass_kg / ComputeMassProperties(hull, 1.0).volume_m3;
+    r.density_from_mass = true;
+  } else if (spec.mass_kg) {
+    target_m3 = *spec.mass_kg / spec.density_kg_m3;
+  }
   if (target_m3) {
-    const MassProperties mp = ComputeMassProperties(hull, spec.density_kg_m3);
+    const MassProperties mp = ComputeMassProperties(hull, density_kg_m3);
     r.scale = std::cbrt(*target_m3 / mp.volume_m3);
     for (auto& v : hull.vertices_m) v = mp.centroid_m + r.scale * (v - mp.centroid_m);
   }
 
-  RockShape rock = MakeRockShape(hull, spec.density_kg_m3);
+  RockShape rock = MakeRockShape(hull, density_kg_m3);
   rock.centroid_input_m += offset_m;
   std::string why;
   if (!rock.IsValid(&why)) throw InputError(r.source + ": " + why);
 
-  const MassProperties mp = ComputeMassProperties(hull, spec.density_kg_m3);
+  const MassProperties mp = ComputeMassProperties(hull, density_kg_m3);
   r.recentred_by_m = offset_m;
   r.hull_vertices = static_cast<int>(rock.vertices_m.size());
   r.hull_faces = static_cast<int>(hull.triangles.size());
   r.volume_m3 = rock.volume_m3;
   r.mass_kg = rock.mass_kg;
-  r.density_kg_m3 = spec.density_kg_m3;
+  r.density_kg_m3 = density_kg_m3;
   r.centroid_m = rock.centroid_input_m;
   r.inertia_kg_m2 = mp.inertia_kg_m2;
   r.principal_moments_kg_m2 = rock.inertia_kg_m2;
@@ -88,6 +98,10 @@ bool RockSpec::IsValid(std::string* why) const {
     msg << "density_kg_m3 = " << density_kg_m3 << " violates 0 < density_kg_m3 < inf";
   else if (volume_m3 && mass_kg)
     msg << "give volume_m3 or mass_kg to scale the rock, not both";
+  else if (volume_m3 && DimensionsFixSize(*this))
+    msg << "volume_m3 = " << *volume_m3 << " contradicts the dimensions of the " << builtin
+        << ", which fix its volume; give the dimensions or volume_m3, not both (mass_kg with "
+           "the dimensions sets the density)";
   else if (volume_m3 && (!(*volume_m3 > 0) || !std::isfinite(*volume_m3)))
     msg << "volume_m3 = " << *volume_m3 << " violates 0 < volume_m3 < inf";
   else if (mass_kg && (!(*mass_kg > 0) || !std::isfinite(*mass_kg)))
@@ -102,6 +116,20 @@ bool RockSpec::IsValid(std::string* why) const {
   if (msg.str().empty()) return true;
   if (why) *why = msg.str();
   return false;
+}
+
+bool DimensionsFixSize(const RockSpec& spec) {
+  if (!spec.file.empty() || spec.dimensions_m.empty()) return false;
+  for (const char* name : {"box", "ellipsoid", "icosphere", "cylinder", "disk", "rock"})
+    if (spec.builtin == name) return true;
+  return false;
+}
+
+std::uint64_t ShapeSeed(std::uint64_t base, std::uint64_t index) {
+  std::uint64_t z = base + (index + 1) * 0x9e3779b97f4a7c15ULL;
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+  return z ^ (z >> 31);
 }
 
 RockShape MakeRock(const RockSpec& spec, RockReport* report) {
@@ -162,8 +190,10 @@ std::string RockReport::FullReport() const {
                   scale);
     out << line;
   }
-  std::snprintf(line, sizeof line, "  volume %.6g m^3, density %.6g kg/m^3, mass %.6g kg\n",
-                volume_m3, density_kg_m3, mass_kg);
+  std::snprintf(line, sizeof line, "  volume %.6g m^3, density %.6g kg/m^3%s, mass %.6g kg\n",
+                volume_m3, density_kg_m3,
+                density_from_mass ? " (the mass over the volume of the given dimensions)" : "",
+                mass_kg);
   out << line;
   out << "  centroid " << Vec(centroid_m, "%.6f") << " m (input frame)\n";
   out << "  principal moments " << Vec(principal_moments_kg_m2) << " kg m^2 (ascending)\n";
@@ -202,6 +232,7 @@ std::string RockReport::ToJson() const {
   j["points_read"] = points_read;
   j["points_used"] = points_used;
   j["scale"] = scale;
+  j["density_from_mass"] = density_from_mass;
   j["recentred_by_m"] = Array(recentred_by_m);
   j["cleaning"] = {{"non_finite", clean.non_finite},
                    {"duplicates", clean.duplicates},

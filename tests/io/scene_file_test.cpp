@@ -292,6 +292,41 @@ TEST(ClosestName, OnlySuggestsCloseNames) {
   EXPECT_EQ(ClosestName("xyz", {"seed", "rocks"}), "");
 }
 
+// The built-in rock: { rock = [a, b, c] } with its knobs; given dimensions and a mass, the
+// dimensions stay and the density follows (mass / volume, to rounding: 1e-12 relative).
+TEST(LoadScene, BuiltInRockWithItsKnobs) {
+  const auto dir = testing::FreshDir("rock");
+  const std::string shape =
+      "{ rock = [0.46, 0.30, 0.20], points = 24, roughness = 0.3, "
+      "shape_seed = 9 }";
+  const std::string scene = Replace(Replace(kPlaneScene, "{ box = [0.5, 0.4, 0.3] }", shape),
+                                    "density_kg_m3 = 2600", "mass_kg = 40");
+  testing::WriteText(dir / "scene.toml", scene);
+  const SceneFile s = LoadScene((dir / "scene.toml").string());
+  EXPECT_EQ(s.rock.builtin, "rock");
+  EXPECT_EQ(s.rock.points, 24);
+  EXPECT_DOUBLE_EQ(s.rock.roughness, 0.3);
+  EXPECT_EQ(s.rock.shape_seed, 9u);
+  EXPECT_EQ(s.rock_description, "rock 0.46 x 0.3 x 0.2 m, 24 points, roughness 0.3, seed 9");
+  EXPECT_LE(s.scene.rock.vertices_m.size(), 24u);
+  EXPECT_NEAR(s.scene.rock.mass_kg, 40, 40e-12);
+
+  EXPECT_HAS(ErrorOf(Replace(scene, "points = 24", "points = 3"), dir),
+             "scene.toml:6: rock.shape.points: 3 must be in 4 .. 1000000");
+  EXPECT_HAS(ErrorOf(Replace(scene, "roughness = 0.3", "roughness = 0.7"), dir),
+             "scene.toml:6: rock.shape.roughness: 0.7 must be in 0 .. 0.5");
+  EXPECT_HAS(ErrorOf(Replace(scene, "shape_seed = 9", "shape_seed = -9"), dir),
+             "rock.shape.shape_seed: -9 must be >= 0");
+  EXPECT_HAS(ErrorOf(Replace(scene, "shape_seed = 9", "shape_seed = 1.5"), dir),
+             "rock.shape.shape_seed: expected an integer");
+  EXPECT_HAS(ErrorOf(Replace(scene, "rock = [0.46, 0.30, 0.20]", "box = [0.46, 0.30, 0.20]"), dir),
+             "rock.shape.points: only a rock shape takes points");
+  EXPECT_HAS(ErrorOf(Replace(scene, "mass_kg = 40", "mass_kg = 40\ndensity_kg_m3 = 2600"), dir),
+             "rock.mass_kg: the dimensions of the shape and mass_kg fix the density");
+  EXPECT_HAS(ErrorOf(Replace(scene, "mass_kg = 40", "volume_m3 = 0.1"), dir),
+             "scene.toml:7: rock.volume_m3: the dimensions of the shape fix its volume");
+}
+
 // Point cloud files go through the pointclouds module: the hull of the points is the rock.
 TEST(LoadScene, PointCloudFileIsTheRocksHull) {
   const auto dir = testing::FreshDir("cloud");

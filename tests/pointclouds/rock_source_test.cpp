@@ -254,16 +254,17 @@ TEST(MakeRock, InvariantUnderRotationAndGeoreferencedTranslation) {
   EXPECT_GT(b.recentred_by_m.norm(), 1e6);
 }
 
+// Built-ins without dimensions and point clouds scale to volume_m3 or mass_kg / density_kg_m3.
+// (This test used a box of 1 x 2 x 3 m; dimensions now fix the size, see the next test.)
 TEST(MakeRock, ScalesToVolumeOrMassAboutTheCentroid) {
   RockSpec spec;
-  spec.builtin = "box";
-  spec.dimensions_m = {1, 2, 3};
+  spec.builtin = "icosphere";  // no diameter: 1 m, scaled
   RockReport plain, scaled;
   const RockShape one = MakeRock(spec, &plain);
-  spec.volume_m3 = 48.0;  // 8 times: linear factor 2, moments 2^5
+  spec.volume_m3 = 8 * one.volume_m3;  // linear factor 2, moments 2^5
   const RockShape big = MakeRock(spec, &scaled);
   EXPECT_NEAR(scaled.scale, 2, 1e-15);
-  EXPECT_NEAR(big.volume_m3, 48, 1e-12);
+  EXPECT_NEAR(big.volume_m3, 8 * one.volume_m3, 1e-14);
   EXPECT_LT(((big.inertia_kg_m2 - 32 * one.inertia_kg_m2).array() / big.inertia_kg_m2.array())
                 .abs()
                 .maxCoeff(),
@@ -272,6 +273,7 @@ TEST(MakeRock, ScalesToVolumeOrMassAboutTheCentroid) {
   spec.volume_m3.reset();
   spec.mass_kg = 1000;
   EXPECT_NEAR(MakeRock(spec).volume_m3, 1000 / 2700.0, 1e-14);
+  EXPECT_FALSE(plain.density_from_mass);
 
   // A scan away from the origin: scaling about the origin instead would move the centroid.
   const Eigen::Vector3d at(5, -3, 2);
@@ -284,6 +286,123 @@ TEST(MakeRock, ScalesToVolumeOrMassAboutTheCentroid) {
   EXPECT_NEAR(moved.scale, 2, 1e-14);
   EXPECT_NEAR(far.volume_m3, 48, 1e-12);
   EXPECT_LT((moved.centroid_m - at).norm(), 1e-12);
+  // The same scan given a mass: scaled to mass_kg / density_kg_m3, the density kept.
+  file.volume_m3.reset();
+  file.mass_kg = 2700 * 48.0;
+  const RockShape heavy = MakeRockFromPoints(Cloud(corners), file, &moved);
+  EXPECT_NEAR(moved.scale, 2, 1e-14);
+  EXPECT_NEAR(heavy.mass_kg, 2700 * 48.0, 1e-9);
+  EXPECT_EQ(moved.density_kg_m3, 2700);
+  EXPECT_FALSE(moved.density_from_mass);
+}
+
+// A block of given dimensions and mass keeps its dimensions; the density follows. Box: the
+// volume is abc exactly up to rounding in the mass-property sums (1e-16), so density and mass
+// hold to 1e-12 relative; the extents are untouched (no scaling at all: exact).
+TEST(MakeRock, DimensionsAndMassSetTheDensity) {
+  RockSpec spec;
+  spec.builtin = "box";
+  spec.dimensions_m = {0.46, 0.30, 0.20};
+  spec.mass_kg = 40;
+  ASSERT_TRUE(DimensionsFixSize(spec));
+  RockReport r;
+  const RockShape box = MakeRock(spec, &r);
+  const double density = 40 / (0.46 * 0.30 * 0.20);
+  EXPECT_LT(RelativeError(r.density_kg_m3, density), 1e-12);
+  EXPECT_LT(RelativeError(box.mass_kg, 40), 1e-12);
+  EXPECT_LT(RelativeError(r.mass_kg, 40), 1e-12);
+  EXPECT_EQ(r.scale, 1);
+  EXPECT_TRUE(r.density_from_mass);
+  EXPECT_LT((r.shape.dimensions_m - Eigen::Vector3d(0.46, 0.30, 0.20)).norm(), 1e-12);
+  EXPECT_NE(r.FullReport().find("(the mass over the volume of the given dimensions)"),
+            std::string::npos)
+      << r.FullReport();
+  EXPECT_EQ(nlohmann::json::parse(r.ToJson())["density_from_mass"], true);
+
+  // Every built-in whose dimensions fix its size: the extents stay, the mass is met.
+  for (const auto& [name, dims] :
+       std::vector<std::pair<std::string, std::vector<double>>>{{"ellipsoid", {0.46, 0.30, 0.20}},
+                                                                {"rock", {0.46, 0.30, 0.20}},
+                                                                {"icosphere", {0.4}},
+                                                                {"cylinder", {0.4, 0.2}},
+                                                                {"disk", {0.6, 0.1}}}) {
+    RockSpec other = spec;
+    other.builtin = name;
+    other.dimensions_m = dims;
+    RockSpec without_mass = other;
+    without_mass.mass_kg.reset();
+    RockReport a, b;
+    MakeRock(without_mass, &a);
+    const RockShape rock = MakeRock(other, &b);
+    EXPECT_LT(RelativeError(rock.mass_kg, 40), 1e-12) << name;
+    EXPECT_TRUE(b.shape.dimensions_m == a.shape.dimensions_m) << name;  // the same hull
+    EXPECT_LT(RelativeError(b.density_kg_m3, 40 / a.volume_m3), 1e-12) << name;
+  }
+
+  // Dimensions and a volume contradict each other (unless the volume were exactly theirs).
+  spec.mass_kg.reset();
+  spec.volume_m3 = 0.1;
+  EXPECT_FALSE(DimensionsFixSize(FileSpec("rock.ply")));
+  std::string why;
+  EXPECT_FALSE(spec.IsValid(&why));
+  EXPECT_NE(why.find("volume_m3 = 0.1 contradicts the dimensions of the box"), std::string::npos)
+      << why;
+  EXPECT_NE(RockError(spec).find("contradicts"), std::string::npos);
+  // Built-ins without dimensions still scale; EOTA blocks of given size take the bevel instead.
+  spec.dimensions_m.clear();
+  spec.builtin = "icosphere";
+  EXPECT_FALSE(DimensionsFixSize(spec));
+  EXPECT_TRUE(spec.IsValid(&why)) << why;
+  spec.builtin = "eota221";
+  spec.dimensions_m = {0.93, 0.93, 0.47};
+  EXPECT_FALSE(DimensionsFixSize(spec));
+}
+
+TEST(MakeRock, BuiltInRockTakesItsKnobs) {
+  RockSpec spec;
+  spec.builtin = "rock";
+  spec.dimensions_m = {0.46, 0.30, 0.20};
+  spec.shape_seed = 7;
+  RockReport r;
+  const RockShape seven = MakeRock(spec, &r);
+  EXPECT_EQ(r.source, "rock 0.46 x 0.3 x 0.2 m, 32 points, roughness 0.15, seed 7");
+  EXPECT_LE(r.hull_vertices, 32);
+  // The bounding box in the input frame (not the principal-frame dimensions of the descriptors).
+  Eigen::Vector3d lo = r.hull.vertices_m[0], hi = lo;
+  for (const auto& v : r.hull.vertices_m) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
+  EXPECT_LT((hi - lo - Eigen::Vector3d(0.46, 0.30, 0.20)).norm(), 1e-12);
+  spec.points = 12;
+  spec.roughness = 0.4;
+  MakeRock(spec, &r);
+  EXPECT_EQ(r.source, "rock 0.46 x 0.3 x 0.2 m, 12 points, roughness 0.4, seed 7");
+  EXPECT_LE(r.hull_vertices, 12);
+  spec.points = 3;
+  std::string why;
+  EXPECT_FALSE(spec.IsValid(&why));
+  EXPECT_NE(why.find("points = 3"), std::string::npos) << why;
+  // Rocks k = 0, 1 of a run with base seed 7 get different shapes.
+  spec.points = 32;
+  spec.roughness = 0.15;
+  spec.shape_seed = ShapeSeed(7, 0);
+  const double v0 = MakeRock(spec).volume_m3;
+  spec.shape_seed = ShapeSeed(7, 1);
+  EXPECT_NE(MakeRock(spec).volume_m3, v0);
+  EXPECT_NE(v0, seven.volume_m3);
+}
+
+// ShapeSeed is SplitMix64 (Steele, Lea & Flood 2014; Vigna's splitmix64.c): seeded with 0, its
+// first outputs are e220a8397b1dcdaf, 6e789e6aa1b965f4, 06c45d188009454f (the published reference
+// sequence). Exact integer arithmetic: compared exactly.
+TEST(ShapeSeed, IsSplitMix64) {
+  EXPECT_EQ(ShapeSeed(0, 0), 0xe220a8397b1dcdafULL);
+  EXPECT_EQ(ShapeSeed(0, 1), 0x6e789e6aa1b965f4ULL);
+  EXPECT_EQ(ShapeSeed(0, 2), 0x06c45d188009454fULL);
+  // Distinct over many rocks and bases (a bijection of base + (index + 1) * gamma).
+  std::vector<std::uint64_t> seeds;
+  for (std::uint64_t base : {0ULL, 1ULL, 42ULL})
+    for (std::uint64_t k = 0; k < 1000; ++k) seeds.push_back(ShapeSeed(base, k));
+  std::sort(seeds.begin(), seeds.end());
+  EXPECT_EQ(std::adjacent_find(seeds.begin(), seeds.end()), seeds.end());
 }
 
 TEST(MakeRock, BuiltInEota221MatchesTheChantSuraBlock) {
