@@ -6,9 +6,11 @@
 
 namespace talus {
 
-// One closed vertex contact at the midpoint configuration.
+// One vertex contact of the step: closed at the midpoint configuration (gap_m = 0), or open there
+// and predicted to close before the next midpoint (gap_m > 0, see DetectContacts).
 struct Contact {
   int vertex = 0;              // hull vertex index
+  double gap_m = 0;            // open contact's gap along n at the midpoint; 0 for a closed one
   int ground = 0;              // ground index at the contact point
   double mu = 0;               // friction coefficient mu(s) for this step
   Eigen::Matrix3d directions;  // world: columns n, t1, t2
@@ -18,8 +20,10 @@ struct Contact {
   Eigen::Matrix3d delassus_inverse;
   double r_normal = 0;  // prox step lengths (kg), used when the exact local solve fails
   double r_tangent = 0;
-  Eigen::Vector3d restitution_term = Eigen::Vector3d::Zero();  // eps (.) gamma_B
-  Eigen::Vector3d percussion = Eigen::Vector3d::Zero();        // (P_N, P_T1, P_T2), N s
+  // Added to the end contact velocity in the laws: xi = gamma_E + eps (.) gamma_B + (gap_m/dt, 0,
+  // 0).
+  Eigen::Vector3d velocity_bias = Eigen::Vector3d::Zero();
+  Eigen::Vector3d percussion = Eigen::Vector3d::Zero();  // (P_N, P_T1, P_T2), N s
 };
 
 // Scratch space reused across steps; one per thread. Reset() before each new rock.

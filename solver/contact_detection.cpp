@@ -1,46 +1,86 @@
 #include "solver/contact_detection.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace talus {
+namespace {
+
+// Friction, ground and contact frame (n, t1, t2) of a contact at the terrain point (x, y).
+void SetFrame(const Scene& scene, const RockState& mid, const Eigen::Vector3d& x,
+              const Eigen::Vector3d& n, Contact& c) {
+  c.ground = scene.terrain.GroundAt(x.x(), x.y());
+  c.mu = scene.ground.params(c.ground).Friction(mid.scar_m);
+  // Tangent basis: e_y x n never vanishes for an upward normal.
+  const Eigen::Vector3d t1 = Eigen::Vector3d(n.z(), 0.0, -n.x()).normalized();
+  c.directions.col(0) = n;
+  c.directions.col(1) = t1;
+  c.directions.col(2) = n.cross(t1);
+}
+
+}  // namespace
 
 DetectResult DetectContacts(const Scene& scene, const RockShape& rock, const RockState& mid,
-                            const Eigen::Matrix3d& rotation, StepWorkspace& workspace) {
+                            const Eigen::Matrix3d& rotation, const Eigen::Vector3d& velocity_m_s,
+                            const Eigen::Vector3d& omega_rad_s, double horizon_s,
+                            double allowed_depth_m, StepWorkspace& workspace) {
   workspace.contacts.clear();
   const Terrain& terrain = scene.terrain;
   const Eigen::Vector3d& r = mid.position_m;
   const double radius = rock.bounding_radius_m;
 
   // Vertical height of a point above the local plane is m . x + offset with m = (-h_x, -h_y, 1).
+  // Over the horizon it changes at the rate m . (v + w x arm) = m . v + b . (m_body x W): the
+  // prediction is linear in time, as the solver's contact velocities are.
   Terrain::LocalPlane plane;
   const bool local = terrain.PlaneAround(r.x(), r.y(), radius, &plane);
   const Eigen::Vector3d m(-plane.slope_x, -plane.slope_y, 1.0);
   const double centre_height = r.z() - plane.at.height_m;  // m . (r - (x, y, h)) as x, y match
-  if (local && centre_height - radius * m.norm() > plane.deviation_m) return DetectResult::kOk;
+  const double centre_rate = m.dot(velocity_m_s);
+  const double lowest_rate = centre_rate - radius * m.norm() * omega_rad_s.norm();
+  if (local && centre_height - radius * m.norm() + horizon_s * std::min(0.0, lowest_rate) >
+                   plane.deviation_m)
+    return DetectResult::kOk;
   const Eigen::Vector3d m_body = rotation.transpose() * m;
+  const Eigen::Vector3d rate_lever = m_body.cross(omega_rad_s);
 
   const int vertex_count = static_cast<int>(rock.vertices_m.size());
   for (int k = 0; k < vertex_count; ++k) {
-    if (local && centre_height + m_body.dot(rock.vertices_m[k]) > plane.deviation_m) continue;
-    const Eigen::Vector3d arm = rotation * rock.vertices_m[k];
+    const Eigen::Vector3d& b = rock.vertices_m[k];
+    if (local &&
+        centre_height + m_body.dot(b) + horizon_s * std::min(0.0, centre_rate + b.dot(rate_lever)) >
+            plane.deviation_m)
+      continue;
+    const Eigen::Vector3d arm = rotation * b;
     const Eigen::Vector3d x = r + arm;
     // The gap (x_z - h) n_z has the sign of x_z - h: the normal is needed only for contacts.
     double height;
     if (!terrain.Height(x.x(), x.y(), &height)) return DetectResult::kOutsideDomain;
-    if (x.z() > height) continue;
-    TerrainSample sample;
-    terrain.Sample(x.x(), x.y(), &sample);
-
+    if (x.z() <= height) {
+      // Closed at the midpoint.
+      TerrainSample sample;
+      terrain.Sample(x.x(), x.y(), &sample);
+      Contact& c = workspace.contacts.emplace_back();
+      c.vertex = k;
+      c.gap_m = 0;
+      SetFrame(scene, mid, x, sample.normal, c);
+      continue;
+    }
+    if (horizon_s == 0) continue;
+    // Open: predicted to close when the vertex, moving for the horizon with its predicted
+    // velocity, would end deeper than allowed_depth_m. The contact takes the terrain's tangent
+    // plane at that end point (so that a vertex heading past a concave kink meets the face it
+    // will hit); its gap is the midpoint vertex's distance to that plane plus the allowed depth.
+    const Eigen::Vector3d x_end = x + horizon_s * (velocity_m_s + rotation * omega_rad_s.cross(b));
+    TerrainSample end;
+    if (!terrain.Sample(x_end.x(), x_end.y(), &end)) continue;  // leaving: the next step says so
+    const Eigen::Vector3d& n = end.normal;
+    if ((x_end.z() - end.height_m) * n.z() >= -allowed_depth_m) continue;
+    const Eigen::Vector3d on_plane(x_end.x(), x_end.y(), end.height_m);
     Contact& c = workspace.contacts.emplace_back();
     c.vertex = k;
-    c.ground = terrain.GroundAt(x.x(), x.y());
-    c.mu = scene.ground.params(c.ground).Friction(mid.scar_m);
-    const Eigen::Vector3d& n = sample.normal;
-    // Tangent basis: e_y x n never vanishes for an upward normal.
-    const Eigen::Vector3d t1 = Eigen::Vector3d(n.z(), 0.0, -n.x()).normalized();
-    c.directions.col(0) = n;
-    c.directions.col(1) = t1;
-    c.directions.col(2) = n.cross(t1);
+    c.gap_m = std::max(0.0, n.dot(x - on_plane) + allowed_depth_m);  // never a push out
+    SetFrame(scene, mid, x_end, n, c);
   }
   return DetectResult::kOk;
 }

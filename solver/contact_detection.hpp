@@ -1,5 +1,6 @@
 #pragma once
-// Contact detection stage: which hull vertices touch the terrain at the midpoint.
+// Contact detection stage: which hull vertices touch the terrain at the midpoint, or will touch it
+// before the next midpoint.
 
 #include <Eigen/Core>
 
@@ -11,13 +12,23 @@ namespace talus {
 
 enum class DetectResult { kOk, kOutsideDomain };
 
-// Fills workspace.contacts with the vertices whose gap (height above the terrain times the
-// terrain normal's z) is <= 0, with their contact frame, ground index and friction mu(scar_m).
-// A rock whose bounding sphere clears the terrain's local plane by more than the terrain departs
-// from that plane costs one test; otherwise only the vertices within that departure of the plane
-// are tested against the terrain itself.
+// Fills workspace.contacts with the vertices in contact, with their contact frame, ground index and
+// friction mu(scar_m):
+// - closed: gap (height above the terrain times the terrain normal's z) <= 0 at the midpoint
+//   `mid`; gap_m = 0, frame of the terrain under the vertex;
+// - predicted (only when horizon_s > 0): open at the midpoint, but deeper than allowed_depth_m
+//   below the terrain after moving for horizon_s with its predicted velocity (from the centre of
+//   mass's world velocity and the body angular velocity given); frame of the terrain at that end
+//   point, gap_m = the midpoint vertex's distance to the terrain's tangent plane there plus
+//   allowed_depth_m (>= 0), so that the solver's law gap_m + horizon gamma_N,E >= 0 lets the
+//   vertex sink no deeper than allowed_depth_m by the next midpoint.
+// A rock whose bounding sphere clears the terrain's local plane, over the horizon, by more than
+// the terrain departs from that plane costs one test; otherwise only the vertices within that
+// departure of the plane are tested against the terrain itself.
 // Returns kOutsideDomain when a vertex that may touch lies outside the DEM or over nodata.
 DetectResult DetectContacts(const Scene& scene, const RockShape& rock, const RockState& mid,
-                            const Eigen::Matrix3d& rotation, StepWorkspace& workspace);
+                            const Eigen::Matrix3d& rotation, const Eigen::Vector3d& velocity_m_s,
+                            const Eigen::Vector3d& omega_rad_s, double horizon_s,
+                            double allowed_depth_m, StepWorkspace& workspace);
 
 }  // namespace talus

@@ -104,6 +104,7 @@ ContactSolveReport SolveContacts(const Scene& scene, const RockShape& rock,
                                     opt.tangential_restitution);
   const bool with_restitution = opt.normal_restitution != 0 || opt.tangential_restitution != 0;
   const double inv_mass = 1.0 / mass_eff_kg;
+  const double inv_dt = 1.0 / opt.dt_s;
 
   // Per-contact Jacobians, step lengths and warm start.
   for (Contact& c : workspace.contacts) {
@@ -120,11 +121,12 @@ ContactSolveReport SolveContacts(const Scene& scene, const RockShape& rock,
     const double mean = 0.5 * (g(1, 1) + g(2, 2));
     const double half_diff = 0.5 * (g(1, 1) - g(2, 2));
     c.r_tangent = opt.prox_alpha / (mean + std::sqrt(half_diff * half_diff + g(1, 2) * g(1, 2)));
-    c.restitution_term =
+    c.velocity_bias =
         with_restitution
             ? Eigen::Vector3d(restitution.cwiseProduct(c.directions.transpose() * v_begin +
                                                        c.arms.transpose() * omega_begin))
             : Eigen::Vector3d::Zero();
+    c.velocity_bias.x() += c.gap_m * inv_dt;
     c.percussion.setZero();
     if (workspace.last_closed[c.vertex]) {
       // Previous step's percussion, re-expressed in this frame and made admissible.
@@ -144,7 +146,7 @@ ContactSolveReport SolveContacts(const Scene& scene, const RockShape& rock,
     double max_change = 0;
     for (Contact& c : workspace.contacts) {
       const Eigen::Vector3d xi = c.directions.transpose() * velocity_m_s +
-                                 c.arms.transpose() * omega_rad_s + c.restitution_term;
+                                 c.arms.transpose() * omega_rad_s + c.velocity_bias;
       const Eigen::Vector3d xi0 = xi - c.delassus * c.percussion;
       Eigen::Vector3d p;
       if (!SolveLocal(c, xi0, &p)) p = ProxLocal(c, xi0, c.percussion, 1e-3 * opt.tolerance_m_s);

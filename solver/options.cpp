@@ -24,6 +24,8 @@ bool SolverOptions::IsValid(std::string* why) const {
   check(max_iterations >= 1 && max_iterations <= 100000, "max_iterations", max_iterations,
         "1 <= max_iterations <= 100000");
   check(prox_alpha > 0 && prox_alpha < 2, "prox_alpha", prox_alpha, "0 < prox_alpha < 2");
+  check(penetration_tolerance > 0 && penetration_tolerance <= 0.5, "penetration_tolerance",
+        penetration_tolerance, "0 < penetration_tolerance <= 0.5");
   check(rest_speed_m_s >= 0 && std::isfinite(rest_speed_m_s), "rest_speed_m_s", rest_speed_m_s,
         "rest_speed_m_s >= 0");
   check(rest_angular_speed_rad_s >= 0 && std::isfinite(rest_angular_speed_rad_s),

@@ -16,6 +16,10 @@ struct SolverOptions {
   double tolerance_m_s = 1e-7;
   int max_iterations = 200;
   double prox_alpha = 1.0;  // step length r = alpha / diag(W' M^-1 W), in (0, 2)
+  // Contact prediction (plastic normal law only): a vertex that would sink deeper than this
+  // fraction of the rock's thickness by the next midpoint joins the contact set early and is
+  // stopped at that depth. In (0, 0.5].
+  double penetration_tolerance = 0.01;
   // Rest: speed and angular speed below these thresholds, in contact, for rest_hold_s.
   double rest_speed_m_s = 0.02;
   double rest_angular_speed_rad_s = 0.05;

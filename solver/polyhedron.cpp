@@ -67,6 +67,12 @@ RockShape MakeRockShape(const Polyhedron& hull, double density_kg_m3) {
     rock.vertices_m.push_back(local);
     rock.bounding_radius_m = std::max(rock.bounding_radius_m, local.norm());
   }
+  Eigen::Vector3d lo = Eigen::Vector3d::Zero(), hi = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d& b : rock.vertices_m) {
+    lo = lo.cwiseMin(b);
+    hi = hi.cwiseMax(b);
+  }
+  rock.thickness_m = (hi - lo).minCoeff();
   return rock;
 }
 
@@ -83,6 +89,8 @@ bool RockShape::IsValid(std::string* why) const {
         << ") kg m^2 violate the triangle inequality";
   else if (!(bounding_radius_m > 0) || !std::isfinite(bounding_radius_m))
     msg << "rock bounding radius " << bounding_radius_m << " m must be positive";
+  else if (!(thickness_m > 0) || !(thickness_m <= 2 * bounding_radius_m))
+    msg << "rock thickness " << thickness_m << " m must be in (0, 2 bounding radius]";
   if (msg.str().empty()) return true;
   if (why) *why = msg.str();
   return false;

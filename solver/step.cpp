@@ -60,20 +60,24 @@ StepReport Step(const Scene& scene, const RockShape& rock, RockState& state,
   Eigen::Vector3d omega = FreeRotation(rock.inertia_kg_m2, begin.angular_velocity_rad_s, dt);
   clock.Lap(&StageTimes::free_rotation_s);
 
-  // 3. Contact set at the midpoint.
+  // 3. Contact set at the midpoint: closed contacts and, with a plastic normal law, the vertices
+  // that the free motion (gravity, no contacts) would carry deeper than the penetration tolerance
+  // below the terrain by the next midpoint.
+  Eigen::Vector3d velocity = begin.velocity_m_s;
+  velocity.z() -= dt * opt.gravity_m_s2;
+  const double horizon = opt.normal_restitution == 0 ? dt : 0.0;
+  const double allowed_depth = opt.penetration_tolerance * rock.thickness_m;
   const Eigen::Matrix3d rotation = state.orientation.toRotationMatrix();
-  if (DetectContacts(scene, rock, state, rotation, workspace) == DetectResult::kOutsideDomain) {
+  if (DetectContacts(scene, rock, state, rotation, velocity, omega, horizon, allowed_depth,
+                     workspace) == DetectResult::kOutsideDomain) {
     state = begin;
     report.outside_domain = true;
     return report;
   }
-  report.contacts = static_cast<int>(workspace.contacts.size());
   clock.Lap(&StageTimes::contacts_s);
 
   // 4. Velocity update: gravity and, in contact, implicit drag m (1 + nu dt) v_E, then percussions.
   const double mass = rock.mass_kg;
-  Eigen::Vector3d velocity = begin.velocity_m_s;
-  velocity.z() -= dt * opt.gravity_m_s2;
   if (workspace.contacts.empty()) {
     workspace.ForgetPercussions();
   } else {
@@ -85,6 +89,8 @@ StepReport Step(const Scene& scene, const RockShape& rock, RockState& state,
     const ContactSolveReport solve =
         SolveContacts(scene, rock, rotation, mass * drag_factor, begin.velocity_m_s,
                       begin.angular_velocity_rad_s, velocity, omega, workspace);
+    for (const Contact& c : workspace.contacts)
+      report.contacts += c.gap_m == 0 || c.percussion.x() > 0;
     report.iterations = solve.iterations;
     report.converged = solve.converged;
     report.loaded = solve.loaded;

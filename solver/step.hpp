@@ -8,7 +8,7 @@
 namespace talus {
 
 struct StepReport {
-  int contacts = 0;             // closed contacts at the midpoint
+  int contacts = 0;             // contacts closed at the midpoint or carrying load
   int iterations = 0;           // Gauss-Seidel sweeps
   bool converged = true;        // contact solve met its tolerance
   bool loaded = false;          // a contact carried load: the scar grew

@@ -115,6 +115,10 @@ TEST(Options, DefaultsAreValidAndBadValuesAreNamed) {
   EXPECT_FALSE(o.IsValid(&why));
   EXPECT_NE(why.find("prox_alpha"), std::string::npos) << why;
   o = SolverOptions{};
+  o.penetration_tolerance = 0;
+  EXPECT_FALSE(o.IsValid(&why));
+  EXPECT_NE(why.find("penetration_tolerance"), std::string::npos) << why;
+  o = SolverOptions{};
   o.normal_restitution = std::nan("");
   EXPECT_FALSE(o.IsValid(&why));
   EXPECT_NE(why.find("normal_restitution"), std::string::npos) << why;
@@ -162,21 +166,25 @@ void ExpectStableAndDissipative(const Scene& scene, RockState s, const char* wha
     running_min = std::min(running_min, e);
     worst_rise = std::max(worst_rise, (e - running_min) / std::abs(e0));
   }
-  EXPECT_GT(contact_steps, 30) << what;  // measured: 37 (the 94 t block jumps) to 19206 (snow)
+  // Measured: 18 (the 94 t block jumps; 37 before contact prediction, when late-found vertices
+  // stayed closed below the surface for longer) to 19786 (pebble).
+  EXPECT_GT(contact_steps, 10) << what;
   EXPECT_LT(worst_rise, 1e-7) << what;
 }
 
 TEST(Extremes, SmallFastHugeSpinningAndSteepStayStableAndDissipative) {
   const GroundParams hard{0.55, 2.0, 185, 3.0, 0.4}, snow{0.10, 0.35, 150, 2.0, 0.7};
   {  // a 5 cm pebble (0.3 kg) down 60 degrees at dt = 2 ms
-    const Scene scene = scenes::Incline(60, MakeRockShape(MakeBox(0.05, 0.04, 0.03), 2700), hard, 200, 2);
+    const Scene scene =
+        scenes::Incline(60, MakeRockShape(MakeBox(0.05, 0.04, 0.03), 2700), hard, 200, 2);
     RockState s;
     s.orientation = RockRandom(3, 0).Orientation();
     s.position_m = {20, 0, 180 * std::tan(60 * M_PI / 180) + 0.1};
     ExpectStableAndDissipative(scene, s, "pebble");
   }
   {  // a 94 t platy block (34 m^3, like Brienz 2014) thrown at 50 m/s onto 35 degrees
-    const Scene scene = scenes::Incline(35, MakeRockShape(MakeBox(6, 4.5, 1.26), 2700), hard, 400, 5);
+    const Scene scene =
+        scenes::Incline(35, MakeRockShape(MakeBox(6, 4.5, 1.26), 2700), hard, 400, 5);
     RockState s;
     s.orientation = RockRandom(3, 1).Orientation();
     s.position_m = {50, 0, 350 * std::tan(35 * M_PI / 180) + 5};
@@ -184,7 +192,8 @@ TEST(Extremes, SmallFastHugeSpinningAndSteepStayStableAndDissipative) {
     ExpectStableAndDissipative(scene, s, "Brienz-size block");
   }
   {  // a block spinning at 60 rad/s landing on snow at 30 degrees
-    const Scene scene = scenes::Incline(30, MakeRockShape(MakeBox(1, 0.6, 0.3), 2700), snow, 200, 2);
+    const Scene scene =
+        scenes::Incline(30, MakeRockShape(MakeBox(1, 0.6, 0.3), 2700), snow, 200, 2);
     RockState s;
     s.orientation = RockRandom(3, 2).Orientation();
     s.position_m = {20, 0, 180 * std::tan(30 * M_PI / 180) + 1};
