@@ -25,6 +25,27 @@
 namespace talus::app {
 namespace {
 
+// "rock <shape> (<mass> kg, <n> hull vertices); <k> releases x <n> rocks, seed <s>", or the runs
+// and blocks of a run table.
+std::string DescribeRocks(const io::SceneFile& scene) {
+  const ensemble::ReleaseSpec& r = scene.release;
+  char line[512];
+  if (!r.runs.empty()) {
+    std::snprintf(line, sizeof line, "%zu runs x %ld rocks, %zu blocks%s, seed %llu", r.runs.size(),
+                  r.rocks_per_release, r.blocks.size(),
+                  r.shape_per_rock ? " (a shape of its own per rock)" : "",
+                  static_cast<unsigned long long>(r.seed));
+  } else {
+    std::snprintf(line, sizeof line,
+                  "rock %s (%.1f kg, %zu hull vertices)%s; %zu releases x %ld rocks, seed %llu",
+                  scene.rock_description.c_str(), scene.scene.rock.mass_kg,
+                  scene.scene.rock.vertices_m.size(),
+                  r.shape_per_rock ? ", a shape of its own per rock" : "", r.releases.size(),
+                  r.rocks_per_release, static_cast<unsigned long long>(r.seed));
+  }
+  return line;
+}
+
 struct SimulateArgs {
   std::string scene;
   std::string out;
@@ -124,11 +145,8 @@ int RunSimulate(const SimulateArgs& args) {
   if (stale > 0)
     std::printf("Removed %d outputs of an earlier run from %s\n", stale, args.out.c_str());
 
-  std::printf(
-      "Scene %s: %s; rock %s (%.1f kg, %zu hull vertices); %zu releases x %ld rocks, seed %llu\n",
-      args.scene.c_str(), scene.terrain_description.c_str(), scene.rock_description.c_str(),
-      scene.scene.rock.mass_kg, scene.scene.rock.vertices_m.size(), scene.release.releases.size(),
-      scene.release.rocks_per_release, static_cast<unsigned long long>(scene.release.seed));
+  std::printf("Scene %s: %s; %s\n", args.scene.c_str(), scene.terrain_description.c_str(),
+              DescribeRocks(scene).c_str());
   try {
     ensemble::EnsembleOptions options;
     options.threads = args.threads;
@@ -141,7 +159,7 @@ int RunSimulate(const SimulateArgs& args) {
     options.progress = [&progress](long done, long total) { progress(done, total); };
 
     std::vector<std::string> outputs = {"rocks.csv"};
-    io::RocksCsvWriter csv(out("rocks.csv"), scene.release.seed);
+    io::RocksCsvWriter csv(out("rocks.csv"), scene.release);
     std::unique_ptr<io::TrajectoryWriter> trajectories;
     if (scene.output.trajectories) {
       trajectories =

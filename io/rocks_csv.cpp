@@ -3,15 +3,26 @@
 #include <stdexcept>
 
 namespace talus::io {
+namespace {
 
-const char* RocksCsvWriter::Header() {
-  return "rock,release,seed,end,x_end,y_end,z_end,runout_m,path_length_m,travel_time_s,max_speed_m_"
-         "s,"
-         "max_kinetic_energy_j,max_jump_height_m,max_angular_speed_rad_s,max_scar_m";
+// A text field quoted when it holds a comma, quote or line break (RFC 4180).
+std::string CsvField(const std::string& text) {
+  if (text.find_first_of(",\"\n\r") == std::string::npos) return text;
+  std::string out = "\"";
+  for (char c : text) out += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return out + "\"";
 }
 
-RocksCsvWriter::RocksCsvWriter(const std::string& path, std::uint64_t seed)
-    : file_(path), seed_(seed) {
+}  // namespace
+
+const char* RocksCsvWriter::Header() {
+  return "rock,release,run,seed,end,x_end,y_end,z_end,runout_m,path_length_m,travel_time_s,"
+         "max_speed_m_s,max_kinetic_energy_j,max_jump_height_m,max_angular_speed_rad_s,max_scar_m,"
+         "block,mass_kg";
+}
+
+RocksCsvWriter::RocksCsvWriter(const std::string& path, const ensemble::ReleaseSpec& release)
+    : file_(path), release_(release) {
   out_ = std::fopen(file_.temp_path().c_str(), "w");
   if (!out_) throw std::runtime_error("cannot create " + file_.temp_path());
   std::fprintf(out_, "%s\n", Header());
@@ -24,12 +35,19 @@ RocksCsvWriter::~RocksCsvWriter() {
 void RocksCsvWriter::Write(const ensemble::RockOutcome& rock) {
   const RockResult& r = rock.result;
   const Eigen::Vector3d& end = r.final_state.position_m;
-  const double runout = (end - rock.start.position_m).head<2>().norm();
+  const ensemble::ReleaseRun* run =
+      release_.runs.empty() ? nullptr : &release_.runs[static_cast<std::size_t>(rock.release)];
+  const std::string block =
+      run && run->block >= 0 ? release_.blocks[static_cast<std::size_t>(run->block)].id : "";
   std::fprintf(
-      out_, "%ld,%d,%llu,%s,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g\n",
-      rock.rock, rock.release, static_cast<unsigned long long>(seed_), ToString(r.end), end.x(),
-      end.y(), end.z(), runout, r.path_length_m, r.travel_time_s, r.max_speed_m_s,
-      r.max_kinetic_energy_j, r.max_jump_height_m, r.max_angular_speed_rad_s, r.max_scar_m);
+      out_,
+      "%ld,%d,%s,%llu,%s,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,"
+      "%s,%.10g\n",
+      rock.rock, rock.release, CsvField(release_.ReleaseName(rock.release)).c_str(),
+      static_cast<unsigned long long>(release_.seed), ToString(r.end), end.x(), end.y(), end.z(),
+      r.runout_m, r.path_length_m, r.travel_time_s, r.max_speed_m_s, r.max_kinetic_energy_j,
+      r.max_jump_height_m, r.max_angular_speed_rad_s, r.max_scar_m, CsvField(block).c_str(),
+      rock.shape ? rock.shape->mass_kg : 0.0);
 }
 
 void RocksCsvWriter::Commit() {

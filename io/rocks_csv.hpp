@@ -13,7 +13,8 @@ namespace talus::io {
 class RocksCsvWriter {
  public:
   // Opens a temporary file next to `path` and writes the header. Throws std::runtime_error.
-  RocksCsvWriter(const std::string& path, std::uint64_t seed);
+  // `release` names each rock's run and block; it must outlive the writer.
+  RocksCsvWriter(const std::string& path, const ensemble::ReleaseSpec& release);
   ~RocksCsvWriter();
   RocksCsvWriter(const RocksCsvWriter&) = delete;
   RocksCsvWriter& operator=(const RocksCsvWriter&) = delete;
@@ -26,7 +27,7 @@ class RocksCsvWriter {
  private:
   AtomicFile file_;
   std::FILE* out_ = nullptr;
-  std::uint64_t seed_;
+  const ensemble::ReleaseSpec& release_;
 };
 
 }  // namespace talus::io

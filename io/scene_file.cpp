@@ -9,6 +9,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "common/csv_table.hpp"
 #include "common/error.hpp"
 #include "io/raster.hpp"
 #include "io/vector.hpp"
@@ -409,6 +410,11 @@ void LoadRock(const Context& context, const Section& s, SceneFile& out) {
   }
   std::string why;
   if (!out.scene.rock.IsValid(&why)) s.Fail("shape", why);
+  if (s.Bool("shape_per_rock", false)) {
+    if (rock.builtin != "rock")
+      s.Fail("shape_per_rock", "only a built-in rock shape has a shape of its own per rock");
+    out.shape_per_rock = true;
+  }
 }
 
 std::vector<Eigen::Vector2d> PointList(const Section& s, const toml::node* node,
@@ -422,6 +428,159 @@ std::vector<Eigen::Vector2d> PointList(const Section& s, const toml::node* node,
     out.emplace_back(xy[0], xy[1]);
   }
   return out;
+}
+
+// Builds one block's shape; errors name `where`.
+std::shared_ptr<const RockShape> MakeBlockShape(const pointclouds::RockSpec& spec,
+                                                const std::string& where) {
+  try {
+    return std::make_shared<const RockShape>(pointclouds::MakeRock(spec));
+  } catch (const InputError& e) {
+    throw InputError(where + ": " + e.what());
+  }
+}
+
+// [blocks]: named rocks that runs refer to, from a table file (block_id, mass_kg, size_x_m,
+// size_y_m, size_z_m) and/or [blocks.<id>] tables (mass_kg, size_m = [x, y, z]), all of the one
+// built-in shape `shape` built from their sizes.
+void LoadBlocks(const Context& context, const toml::table* table, SceneFile& out) {
+  if (!table) return;
+  const std::vector<std::string> reserved = {"file",      "shape",         "points",
+                                             "roughness", "density_kg_m3", "shape_per_rock"};
+  std::vector<std::string> known = reserved;
+  for (const auto& [key, node] : *table)
+    if (node.is_table()) known.emplace_back(key.str());
+  const Section s(context, table, "blocks", known);
+  const std::string shape = s.String("shape", "box");
+  if (shape != "box" && shape != "ellipsoid" && shape != "rock")
+    s.Fail("shape", "'" + shape + "': expected \"box\", \"ellipsoid\" or \"rock\"");
+  pointclouds::RockSpec base;
+  base.builtin = shape;
+  base.density_kg_m3 = s.Checked("density_kg_m3", 2700, kPositive, "must be > 0");
+  if ((s.Has("points") || s.Has("roughness")) && shape != "rock")
+    s.Fail(s.Has("points") ? "points" : "roughness", "only rock blocks take points and roughness");
+  const long points = s.Integer("points", base.points);
+  if (points < 4 || points > 1000000)
+    s.Fail("points", std::to_string(points) + " must be in 4 .. 1000000");
+  base.points = static_cast<int>(points);
+  base.roughness = s.Checked(
+      "roughness", base.roughness, [](double v) { return v >= 0 && v <= 0.5; },
+      "must be in 0 .. 0.5");
+  out.shape_per_rock = s.Bool("shape_per_rock", false);
+  if (out.shape_per_rock && shape != "rock")
+    s.Fail("shape_per_rock", "only rock blocks have a shape of their own per rock");
+
+  auto add = [&](const std::string& id, std::optional<double> mass, const std::vector<double>& size,
+                 const std::string& where) {
+    for (const ensemble::Block& b : out.release.blocks)
+      if (b.id == id) throw InputError(where + ": block '" + id + "' is defined twice");
+    pointclouds::RockSpec spec = base;
+    spec.dimensions_m = size;
+    spec.mass_kg = mass;
+    spec.density_kg_m3 = base.density_kg_m3;
+    out.block_specs.push_back(spec);
+    out.release.blocks.push_back({id, MakeBlockShape(spec, where)});
+  };
+  if (s.Has("file")) {
+    const std::string path = context.Resolve(s.String("file", ""));
+    if (!fs::exists(path)) s.Fail("file", "file not found: " + path);
+    out.inputs.push_back(path);
+    const CsvTable rows = CsvTable::Read(path);
+    rows.Require({"block_id", "size_x_m", "size_y_m", "size_z_m"});
+    for (int k = 0; k < rows.rows(); ++k) {
+      std::vector<double> size;
+      for (const char* c : {"size_x_m", "size_y_m", "size_z_m"}) {
+        size.push_back(rows.Number(k, c));
+        if (size.back() <= 0) throw InputError(rows.Where(k, c) + ": must be > 0");
+      }
+      const std::optional<double> mass = rows.OptionalNumber(k, "mass_kg");
+      if (mass && *mass <= 0) throw InputError(rows.Where(k, "mass_kg") + ": must be > 0");
+      const std::string id = rows.Text(k, "block_id");
+      if (id.empty()) throw InputError(rows.Where(k, "block_id") + ": empty");
+      add(id, mass, size, rows.Where(k, "block_id"));
+    }
+  }
+  for (const auto& [key, node] : *table) {
+    if (!node.is_table()) continue;
+    const std::string id(key.str());
+    const Section b(context, node.as_table(), "blocks." + id, {"mass_kg", "size_m"});
+    if (!b.Has("size_m")) b.Fail("size_m", "missing: the block's size [x, y, z] in m");
+    const std::vector<double> size = b.Numbers("size_m", 3);
+    for (double v : size)
+      if (v <= 0) b.Fail("size_m", "dimensions must be > 0");
+    std::optional<double> mass;
+    if (b.Has("mass_kg")) mass = b.Checked("mass_kg", 0, kPositive, "must be > 0");
+    add(id, mass, size, context.Where(&node) + ": blocks." + id);
+  }
+  if (out.release.blocks.empty())
+    context.Fail(table, "blocks", "no block: give a file or [blocks.<id>] tables");
+}
+
+// [release] runs = "file.csv": one row per run, columns by name (docs/scenes.md).
+void LoadRuns(const Context& context, const Section& s, SceneFile& out) {
+  ensemble::ReleaseSpec& r = out.release;
+  const std::string path = context.Resolve(s.String("runs", ""));
+  if (!fs::exists(path)) s.Fail("runs", "file not found: " + path);
+  out.inputs.push_back(path);
+  const CsvTable rows = CsvTable::Read(path);
+  rows.Require({"trajectory_id", "x_m", "y_m"});
+  if (rows.rows() == 0) throw InputError(path + ": no run (the table has a header only)");
+  const GridGeometry& g = out.scene.terrain.heights().grid;
+  for (int k = 0; k < rows.rows(); ++k) {
+    ensemble::ReleaseRun run;
+    run.id = rows.Text(k, "trajectory_id");
+    if (run.id.empty()) throw InputError(rows.Where(k, "trajectory_id") + ": empty");
+    for (const ensemble::ReleaseRun& other : r.runs)
+      if (other.id == run.id)
+        throw InputError(rows.Where(k, "trajectory_id") + ": run '" + run.id + "' appears twice");
+    run.xy_m = Eigen::Vector2d(rows.Number(k, "x_m"), rows.Number(k, "y_m"));
+    run.z_m = rows.OptionalNumber(k, "z_m");
+    run.height_m = rows.OptionalNumber(k, "height_m");
+    if (run.height_m && *run.height_m < 0)
+      throw InputError(rows.Where(k, "height_m") + ": must be >= 0");
+    const auto vector = [&](const char* x, const char* y, const char* z) {
+      return Eigen::Vector3d(rows.OptionalNumber(k, x).value_or(0),
+                             rows.OptionalNumber(k, y).value_or(0),
+                             rows.OptionalNumber(k, z).value_or(0));
+    };
+    run.velocity_m_s = vector("vx_mps", "vy_mps", "vz_mps");
+    run.angular_velocity_rad_s = vector("wx_radps", "wy_radps", "wz_radps");
+    if (rows.Has("qw") && !rows.Empty(k, "qw")) {
+      const Eigen::Quaterniond q(rows.Number(k, "qw"), rows.Number(k, "qx"), rows.Number(k, "qy"),
+                                 rows.Number(k, "qz"));
+      if (std::abs(q.norm() - 1) > 1e-3)
+        throw InputError(rows.Where(k, "qw") + ": quaternion [qw, qx, qy, qz] has norm " +
+                         Fmt(q.norm()) + ", expected 1");
+      run.orientation = q.normalized();
+    }
+    if (!rows.Empty(k, "block_id")) {
+      const std::string id = rows.Text(k, "block_id");
+      int index = -1;
+      std::vector<std::string> ids;
+      for (std::size_t b = 0; b < r.blocks.size(); ++b) {
+        ids.push_back(r.blocks[b].id);
+        if (r.blocks[b].id == id) index = static_cast<int>(b);
+      }
+      if (index < 0)
+        throw InputError(rows.Where(k, "block_id") + ": unknown block '" + id + "'" +
+                         (r.blocks.empty() ? " (the scene has no [blocks])" : " (known: " + [&] {
+                           std::string all;
+                           for (const auto& i : ids) all += (all.empty() ? "" : ", ") + i;
+                           return all;
+                         }() + ")"));
+      run.block = index;
+    } else if (!out.has_rock) {
+      throw InputError(rows.Where(k, "block_id") +
+                       ": a run without a block needs the scene's [rock]");
+    }
+    double ground_m;
+    if (!out.scene.terrain.Height(run.xy_m.x(), run.xy_m.y(), &ground_m))
+      throw InputError(rows.Where(k, "x_m") + ": (" + Fmt(run.xy_m.x()) + ", " + Fmt(run.xy_m.y()) +
+                       ") is outside the DEM or on nodata (the DEM covers x " + Fmt(g.x0_m) +
+                       " .. " + Fmt(g.x_max_m()) + ", y " + Fmt(g.y0_m) + " .. " +
+                       Fmt(g.y_max_m()) + ")");
+    r.runs.push_back(run);
+  }
 }
 
 void LoadRelease(const Context& context, const Section& s, SceneFile& out) {
@@ -457,8 +616,13 @@ void LoadRelease(const Context& context, const Section& s, SceneFile& out) {
       origin.push_back(s.Key("file") + " (" + path + ", geometry " + std::to_string(k) + ")");
     }
   }
-  if (r.releases.empty())
-    s.Fail("points", "missing: give points, lines, polygons or a vector file");
+  if (s.Has("runs")) {
+    if (!r.releases.empty())
+      s.Fail("runs", "a run table cannot be combined with points, lines, polygons or a file");
+    LoadRuns(context, s, out);
+  }
+  if (r.releases.empty() && r.runs.empty())
+    s.Fail("points", "missing: give points, lines, polygons, a vector file or a run table (runs)");
 
   const long rocks = s.Integer("rocks", 1);
   if (rocks < 1) s.Fail("rocks", std::to_string(rocks) + " must be >= 1");
@@ -588,10 +752,12 @@ SceneFile LoadScene(const std::string& path) {
                      ": TOML syntax error: " + std::string(e.description()));
   }
   const Section top(context, &root, "",
-                    {"terrain", "ground", "rock", "release", "solver", "output"});
-  for (const char* required : {"terrain", "rock", "release"})
+                    {"terrain", "ground", "rock", "blocks", "release", "solver", "output"});
+  for (const char* required : {"terrain", "release"})
     if (!root.get(required))
       context.Fail(nullptr, required, std::string("missing table [") + required + "]");
+  if (!root.get("rock") && !root.get("blocks"))
+    context.Fail(nullptr, "rock", "missing table [rock] (or [blocks] for a run table)");
 
   SceneFile out;
   out.path = path;
@@ -601,14 +767,22 @@ SceneFile LoadScene(const std::string& path) {
               Section(context, SubTable(context, root, "terrain"), "terrain",
                       {"dem", "plane", "ground", "default_ground"}),
               out);
-  LoadRock(context,
-           Section(context, SubTable(context, root, "rock"), "rock",
-                   {"shape", "density_kg_m3", "volume_m3", "mass_kg", "max_vertices"}),
-           out);
+  LoadBlocks(context, SubTable(context, root, "blocks"), out);
+  out.has_rock = root.get("rock") != nullptr;
+  if (out.has_rock) {
+    LoadRock(context,
+             Section(context, SubTable(context, root, "rock"), "rock",
+                     {"shape", "density_kg_m3", "volume_m3", "mass_kg", "max_vertices",
+                      "shape_per_rock"}),
+             out);
+  } else {
+    out.scene.rock = *out.release.blocks.front().shape;  // the shape of runs' first block
+    out.rock_description = "blocks (" + std::to_string(out.release.blocks.size()) + ")";
+  }
   LoadRelease(context,
               Section(context, SubTable(context, root, "release"), "release",
-                      {"points", "lines", "polygons", "file", "height_m", "rocks", "orientation",
-                       "velocity_m_s", "angular_velocity_rad_s", "seed"}),
+                      {"points", "lines", "polygons", "file", "runs", "height_m", "rocks",
+                       "orientation", "velocity_m_s", "angular_velocity_rad_s", "seed"}),
               out);
   LoadSolver(Section(context, SubTable(context, root, "solver"), "solver",
                      {"dt_s", "max_time_s", "gravity_m_s2", "normal_restitution",
@@ -618,6 +792,19 @@ SceneFile LoadScene(const std::string& path) {
   LoadOutput(Section(context, SubTable(context, root, "output"), "output",
                      {"trajectories", "trajectory_interval_s", "rasters", "quicklook"}),
              out.output);
+  if (!out.release.blocks.empty() && out.release.runs.empty())
+    context.Fail(root.get("blocks"), "blocks",
+                 "blocks are for the runs of a run table ([release] runs = \"file.csv\")");
+  if (out.shape_per_rock) {
+    // Each rock its own seeded shape, from its run's block (or the scene's rock).
+    const std::vector<pointclouds::RockSpec> blocks = out.block_specs;
+    const pointclouds::RockSpec rock = out.rock;
+    out.release.shape_per_rock = [blocks, rock](int block, std::uint64_t seed) {
+      pointclouds::RockSpec spec = block >= 0 ? blocks[static_cast<std::size_t>(block)] : rock;
+      spec.shape_seed = seed;
+      return pointclouds::MakeRock(spec);
+    };
+  }
   std::string why;
   if (!out.scene.IsValid(&why)) throw InputError(path + ": " + why);
   out.inputs_hash = HashFiles(out.inputs);

@@ -32,6 +32,9 @@ struct SceneFile {
   ensemble::ReleaseSpec release;  // IsValid() holds, every release vertex on valid DEM cells
   OutputSpec output;
   pointclouds::RockSpec rock;       // the [rock] table
+  bool has_rock = false;            // the scene has a [rock] table (else only [blocks])
+  std::vector<pointclouds::RockSpec> block_specs;  // [blocks], parallel to release.blocks
+  bool shape_per_rock = false;      // every rock has a seeded shape of its own
   std::string rock_description;     // e.g. "eota221 0.93 x 0.93 x 0.47 m, bevel 0.12 m"
   std::string crs_wkt;              // the DEM's CRS; empty for the plane or a DEM without CRS
   std::string terrain_description;  // e.g. "dem.tif (270 x 370 cells of 5 m)"

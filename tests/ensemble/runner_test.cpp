@@ -20,6 +20,61 @@ bool SameBits(const T& a, const T& b) {
   return std::memcmp(&a, &b, sizeof(T)) == 0;
 }
 
+// Runs with their own blocks, start states and a shape of their own per rock (from a seeded
+// generator): bit-identical for 1 and 2 threads, episodes included, and each rock runs with the
+// shape its (seed, rock) gives.
+TEST(RunEnsemble, RunsWithShapesPerRockAreBitIdenticalForAnyThreadCount) {
+  Scene scene = testing::SmallPlane(35, 25, 10);
+  scene.options.max_time_s = 4;
+  ReleaseSpec release;
+  release.blocks.push_back(
+      {"slab", std::make_shared<const RockShape>(MakeRockShape(MakeBox(0.6, 0.4, 0.15), 2700))});
+  ReleaseRun a;
+  a.id = "a";
+  a.xy_m = {3, 0};
+  a.velocity_m_s = {2, 0, 0};
+  ReleaseRun b = a;
+  b.id = "b";
+  b.xy_m = {4, 2};
+  b.block = 0;
+  b.z_m = 25;  // well above ground: falls first
+  release.runs = {a, b};
+  release.rocks_per_release = 3;
+  release.shape_per_rock = [](int block, std::uint64_t seed) {
+    const double c = 0.1 + double(seed % 1000) / 5000.0;  // 0.1 .. 0.3 m
+    return MakeRockShape(MakeBox(block >= 0 ? 0.6 : 0.4, 0.4, c), 2700);
+  };
+  std::string why;
+  ASSERT_TRUE(release.IsValid(&why)) << why;
+  EnsembleOptions options;
+  options.episodes = true;
+  std::vector<Collect> runs(2);
+  for (int threads = 1; threads <= 2; ++threads) {
+    options.threads = threads;
+    RunEnsemble(scene, release, options, &runs[threads - 1]);
+  }
+  ASSERT_EQ(runs[1].rocks.size(), 6u);
+  for (std::size_t r = 0; r < 6; ++r) {
+    const RockOutcome& x = runs[0].rocks[r];
+    const RockOutcome& y = runs[1].rocks[r];
+    EXPECT_EQ(x.release, static_cast<int>(r / 3));
+    EXPECT_TRUE(SameBits(x.result.final_state.position_m, y.result.final_state.position_m));
+    EXPECT_TRUE(SameBits(x.shape->mass_kg, y.shape->mass_kg));
+    const RockShape expected =
+        release.shape_per_rock(x.release == 1 ? 0 : -1, RockShapeSeed(release.seed, x.rock));
+    EXPECT_EQ(x.shape->mass_kg, expected.mass_kg);
+    ASSERT_EQ(x.episodes.size(), y.episodes.size());
+    EXPECT_FALSE(x.episodes.empty());
+    for (std::size_t e = 0; e < x.episodes.size(); ++e)
+      EXPECT_TRUE(SameBits(x.episodes[e].velocity_out_m_s, y.episodes[e].velocity_out_m_s));
+  }
+  // Run b starts at its z_m (no raise needed) with its velocity; run a on the ground.
+  EXPECT_EQ(runs[0].rocks[3].start.position_m.z(), 25);
+  EXPECT_EQ(runs[0].rocks[0].start.velocity_m_s, Eigen::Vector3d(2, 0, 0));
+  // Different seeds give different shapes within a run.
+  EXPECT_NE(runs[0].rocks[0].shape->mass_kg, runs[0].rocks[1].shape->mass_kg);
+}
+
 // Bit-identical results for 1, 2 and 3 threads: rock results, trajectories and every raster.
 TEST(RunEnsemble, BitIdenticalForAnyThreadCount) {
   Scene scene = testing::SmallPlane(35, 25, 10);

@@ -13,7 +13,14 @@ TEST(RocksCsvWriter, OneRowPerRockWithTheContractColumns) {
   const auto dir = testing::FreshDir("csv");
   const auto path = (dir / "rocks.csv").string();
   {
-    RocksCsvWriter csv(path, 7);
+    ensemble::ReleaseSpec release;
+    release.seed = 7;
+    release.blocks.push_back({"plate, thin", nullptr});
+    release.runs.resize(2);
+    release.runs[0].id = "v001";
+    release.runs[1].id = "v002";
+    release.runs[1].block = 0;
+    RocksCsvWriter csv(path, release);
     for (long k = 0; k < 3; ++k) {
       ensemble::RockOutcome rock;
       rock.rock = k;
@@ -22,6 +29,7 @@ TEST(RocksCsvWriter, OneRowPerRockWithTheContractColumns) {
       rock.result.end = EndReason::kRest;
       rock.result.final_state.position_m = Eigen::Vector3d(3, 4, 1);
       rock.result.max_speed_m_s = 12.5;
+      rock.result.runout_m = 5;
       csv.Write(rock);
     }
     EXPECT_FALSE(std::filesystem::exists(path));  // complete or absent
@@ -32,10 +40,12 @@ TEST(RocksCsvWriter, OneRowPerRockWithTheContractColumns) {
   std::getline(in, header);
   EXPECT_EQ(
       header,
-      "rock,release,seed,end,x_end,y_end,z_end,runout_m,path_length_m,travel_time_s,max_speed_m_s,"
-      "max_kinetic_energy_j,max_jump_height_m,max_angular_speed_rad_s,max_scar_m");
+      "rock,release,run,seed,end,x_end,y_end,z_end,runout_m,path_length_m,travel_time_s,"
+      "max_speed_m_s,max_kinetic_energy_j,max_jump_height_m,max_angular_speed_rad_s,max_scar_m,"
+      "block,mass_kg");
   std::getline(in, row);
-  EXPECT_EQ(row, "0,1,7,rest,3,4,1,5,0,0,12.5,0,0,0,0");
+  // The run's id, and its block's id quoted because it holds a comma.
+  EXPECT_EQ(row, "0,1,v002,7,rest,3,4,1,5,0,0,12.5,0,0,0,0,\"plate, thin\",0");
   int rows = 1;
   while (std::getline(in, row)) ++rows;
   EXPECT_EQ(rows, 3);
@@ -43,7 +53,8 @@ TEST(RocksCsvWriter, OneRowPerRockWithTheContractColumns) {
 
 TEST(RocksCsvWriter, AbandonedWriterLeavesNothing) {
   const auto dir = testing::FreshDir("abandon");
-  { RocksCsvWriter csv((dir / "rocks.csv").string(), 1); }
+  ensemble::ReleaseSpec release;
+  { RocksCsvWriter csv((dir / "rocks.csv").string(), release); }
   EXPECT_TRUE(std::filesystem::is_empty(dir));
 }
 

@@ -347,3 +347,108 @@ TEST(LoadScene, PointCloudFileIsTheRocksHull) {
 
 }  // namespace
 }  // namespace talus::io
+
+namespace talus::io {
+namespace {
+
+const char* kRunScene = R"([terrain]
+plane = { slope_deg = 35, slope_length_m = 40, runout_m = 20, width_m = 30, cell_m = 1 }
+
+[blocks]
+file = "blocks.csv"
+shape = "box"
+
+[blocks.slab]
+size_m = [1.0, 0.5, 0.2]
+mass_kg = 250
+
+[release]
+runs = "runs.csv"
+rocks = 3
+)";
+
+const char* kBlocksCsv =
+    "block_id,name,mass_kg,size_x_m,size_y_m,size_z_m\n"
+    "1,\"St. Leonard, the first\",69,0.37,0.32,0.37\n"
+    "4,Plate,40,0.46,0.30,0.20\n";
+
+TEST(LoadScene, RunTableWithBlocksLoadsAsGiven) {
+  const auto dir = testing::FreshDir("runs");
+  testing::WriteText(dir / "blocks.csv", kBlocksCsv);
+  testing::WriteText(dir / "runs.csv",
+                     "trajectory_id,x_m,y_m,z_m,vx_mps,vy_mps,vz_mps,block_id,extra\n"
+                     "v1,5,0,30,1,2,3,4,ignored\n"
+                     "v2,6,1,,0,0,0,slab,\n"
+                     "v3,7,-1,,,,,1,\n");
+  testing::WriteText(dir / "scene.toml", kRunScene);
+  const SceneFile s = LoadScene((dir / "scene.toml").string());
+  ASSERT_EQ(s.release.runs.size(), 3u);
+  ASSERT_EQ(s.release.blocks.size(), 3u);
+  EXPECT_EQ(s.release.total_rocks(), 9);
+  const ensemble::ReleaseRun& v1 = s.release.runs[0];
+  EXPECT_EQ(v1.id, "v1");
+  EXPECT_EQ(v1.xy_m, Eigen::Vector2d(5, 0));
+  ASSERT_TRUE(v1.z_m.has_value());
+  EXPECT_EQ(*v1.z_m, 30);
+  EXPECT_EQ(v1.velocity_m_s, Eigen::Vector3d(1, 2, 3));
+  EXPECT_EQ(s.release.blocks[static_cast<std::size_t>(v1.block)].id, "4");
+  EXPECT_FALSE(s.release.runs[1].z_m.has_value());  // height_m above ground instead
+  EXPECT_EQ(s.release.blocks[static_cast<std::size_t>(s.release.runs[1].block)].id, "slab");
+  // A block of given size and mass keeps its size; the density follows (0.46 x 0.30 x 0.20 m box).
+  const RockShape& plate = *s.release.blocks[1].shape;
+  EXPECT_NEAR(plate.mass_kg, 40, 1e-9);
+  EXPECT_NEAR(plate.volume_m3, 0.46 * 0.30 * 0.20, 1e-12);
+  EXPECT_EQ(s.release.ReleaseName(2), "v3");
+  EXPECT_EQ(s.inputs.size(), 3u);  // scene, blocks, runs
+}
+
+TEST(LoadScene, RunTableErrorsNameFileLineAndColumn) {
+  const auto dir = testing::FreshDir("runs_bad");
+  testing::WriteText(dir / "blocks.csv", kBlocksCsv);
+  const auto error = [&](const std::string& runs, const std::string& scene = kRunScene) {
+    testing::WriteText(dir / "runs.csv", runs);
+    return ErrorOf(scene, dir);
+  };
+  EXPECT_HAS(error("trajectory_id,x_m\nv1,5\n"), "runs.csv: missing column 'y_m'");
+  EXPECT_HAS(error("trajectory_id,x_m,y_m\nv1,5,abc\n"),
+             "runs.csv:2: column 'y_m': 'abc' is not a finite number");
+  EXPECT_HAS(error("trajectory_id,x_m,y_m,block_id\nv1,5,0,1\nv1,6,0,1\n"),
+             "runs.csv:3: column 'trajectory_id': run 'v1' appears twice");
+  EXPECT_HAS(error("trajectory_id,x_m,y_m,block_id\nv1,5,0,9\n"),
+             "runs.csv:2: column 'block_id': unknown block '9' (known: 1, 4, slab)");
+  EXPECT_HAS(error("trajectory_id,x_m,y_m,block_id\nv1,500,0,1\n"),
+             "runs.csv:2: column 'x_m': (500, 0) is outside the DEM");
+  EXPECT_HAS(error("trajectory_id,x_m,y_m,block_id\nv1,5,0\n"), "runs.csv:2: 3 fields");
+  EXPECT_HAS(error("trajectory_id,x_m,y_m\nv1,5,0\n"),
+             "a run without a block needs the scene's [rock]");
+  EXPECT_HAS(error("trajectory_id,x_m,y_m,block_id\nv1,5,0,1\n",
+                   Replace(kRunScene, "shape = \"box\"", "shape = \"cube\"")),
+             "blocks.shape: 'cube': expected \"box\", \"ellipsoid\" or \"rock\"");
+  EXPECT_HAS(error("trajectory_id,x_m,y_m,block_id\nv1,5,0,1\n",
+                   Replace(kRunScene, "rocks = 3", "rocks = 3\npoints = [[1, 1]]")),
+             "release.runs: a run table cannot be combined with points");
+  testing::WriteText(dir / "blocks.csv",
+                     "block_id,mass_kg,size_x_m,size_y_m,size_z_m\n1,69,0,1,1\n");
+  EXPECT_HAS(error("trajectory_id,x_m,y_m,block_id\nv1,5,0,1\n"),
+             "blocks.csv:2: column 'size_x_m': must be > 0");
+}
+
+TEST(LoadScene, ShapePerRockNeedsRockShapes) {
+  const auto dir = testing::FreshDir("per_rock");
+  testing::WriteText(dir / "blocks.csv", kBlocksCsv);
+  testing::WriteText(dir / "runs.csv", "trajectory_id,x_m,y_m,block_id\nv1,5,0,1\n");
+  EXPECT_HAS(
+      ErrorOf(Replace(kRunScene, "shape = \"box\"", "shape = \"box\"\nshape_per_rock = true"), dir),
+      "only rock blocks have a shape of their own per rock");
+  testing::WriteText(dir / "scene.toml", Replace(kRunScene, "shape = \"box\"",
+                                                 "shape = \"rock\"\nshape_per_rock = true"));
+  const SceneFile s = LoadScene((dir / "scene.toml").string());
+  ASSERT_TRUE(static_cast<bool>(s.release.shape_per_rock));
+  const RockShape a = s.release.shape_per_rock(0, 1), b = s.release.shape_per_rock(0, 2);
+  EXPECT_NEAR(a.mass_kg, 69, 1e-9);  // size and mass kept, whatever the seed
+  EXPECT_NEAR(b.mass_kg, 69, 1e-9);
+  EXPECT_NE(a.vertices_m.size() == b.vertices_m.size() && a.vertices_m[0] == b.vertices_m[0], true);
+}
+
+}  // namespace
+}  // namespace talus::io
