@@ -12,5 +12,6 @@ using Runner = std::function<int()>;
 Runner AddDemoCommand(CLI::App& app);
 Runner AddRockCommand(CLI::App& app);
 Runner AddSimulateCommand(CLI::App& app);
+Runner AddValidateCommand(CLI::App& app);
 
 }  // namespace talus::app

@@ -19,6 +19,7 @@ int main(int argc, char** argv) {
       talus::app::AddDemoCommand(app),
       talus::app::AddRockCommand(app),
       talus::app::AddSimulateCommand(app),
+      talus::app::AddValidateCommand(app),
   };
 
   CLI11_PARSE(app, argc, argv);

@@ -39,7 +39,8 @@ const ensemble::RasterLayer* QuickLookLayer(const std::vector<ensemble::RasterLa
 
 void WriteQuickLookPng(const std::string& path, const Heightfield& dem,
                        const ensemble::RasterLayer* layer,
-                       const std::vector<std::vector<Eigen::Vector2d>>& paths) {
+                       const std::vector<std::vector<Eigen::Vector2d>>& paths,
+                       const std::vector<MapMarker>& markers) {
   const GridGeometry& g = dem.grid;
   const int scale = std::max(1, 900 / std::max(g.nx, g.ny));  // pixels per cell
   const int w = g.nx * scale, h = g.ny * scale;
@@ -103,6 +104,18 @@ void WriteQuickLookPng(const std::string& path, const Heightfield& dem,
         c = {0.5 * c[0] + 0.5 * 20, 0.5 * c[1] + 0.5 * 60, 0.5 * c[2] + 0.5 * 200};
       }
     }
+
+  for (const MapMarker& m : markers) {
+    const Eigen::Vector2d centre = pixel(m.xy_m);
+    for (int dy = -m.radius_px; dy <= m.radius_px; ++dy)
+      for (int dx = -m.radius_px; dx <= m.radius_px; ++dx) {
+        if (dx * dx + dy * dy > m.radius_px * m.radius_px) continue;
+        const int x = static_cast<int>(centre.x()) + dx, y = static_cast<int>(centre.y()) + dy;
+        if (x < 0 || y < 0 || x >= w || y >= h) continue;
+        image[static_cast<std::size_t>(y) * w + x] = {double(m.rgb[0]), double(m.rgb[1]),
+                                                      double(m.rgb[2])};
+      }
+  }
 
   RegisterGdal();
   GDALDriver* mem = GetGDALDriverManager()->GetDriverByName("MEM");

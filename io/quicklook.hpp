@@ -5,6 +5,7 @@
 // passed; energy on a log scale) and the paths of a sample of rocks in blue.
 
 #include <Eigen/Core>
+#include <array>
 #include <string>
 #include <vector>
 
@@ -17,9 +18,18 @@ namespace talus::io {
 // in `layers`, or nullptr.
 const ensemble::RasterLayer* QuickLookLayer(const std::vector<ensemble::RasterLayer>& layers);
 
-// Writes the PNG atomically (GDAL's PNG driver). paths: horizontal positions, map coordinates.
+// A filled disc drawn on the map (e.g. observed and simulated rest positions).
+struct MapMarker {
+  Eigen::Vector2d xy_m;                // map coordinates
+  std::array<unsigned char, 3> rgb{};  // colour
+  int radius_px = 3;
+};
+
+// Writes the PNG atomically (GDAL's PNG driver). paths: horizontal positions, map coordinates;
+// markers are drawn last, in order.
 void WriteQuickLookPng(const std::string& path, const Heightfield& dem,
                        const ensemble::RasterLayer* layer,
-                       const std::vector<std::vector<Eigen::Vector2d>>& paths);
+                       const std::vector<std::vector<Eigen::Vector2d>>& paths,
+                       const std::vector<MapMarker>& markers = {});
 
 }  // namespace talus::io

@@ -1,0 +1,131 @@
+#include "fieldobs/observations.hpp"
+
+#include <cmath>
+
+#include "common/error.hpp"
+
+namespace talus::fieldobs {
+
+const char* ToString(Quantity quantity) {
+  switch (quantity) {
+    case Quantity::kRunout:
+      return "runout";
+    case Quantity::kImpactSpeedOut:
+      return "impact_speed_out";
+    case Quantity::kImpactEnergyRatio:
+      return "impact_energy_ratio";
+    case Quantity::kImpactAngularSpeedOut:
+      return "impact_angular_speed_out";
+    case Quantity::kImpactDuration:
+      return "impact_duration";
+    case Quantity::kScarLength:
+      return "scar_length";
+  }
+  return "unknown";
+}
+
+const char* UnitOf(Quantity quantity) {
+  switch (quantity) {
+    case Quantity::kRunout:
+    case Quantity::kScarLength:
+      return "m";
+    case Quantity::kImpactSpeedOut:
+      return "m/s";
+    case Quantity::kImpactEnergyRatio:
+      return "1";
+    case Quantity::kImpactAngularSpeedOut:
+      return "rad/s";
+    case Quantity::kImpactDuration:
+      return "s";
+  }
+  return "";
+}
+
+namespace {
+
+std::string RunOf(const CsvTable& t, const TableColumns& c, int row) {
+  if (!t.Has(c.run)) return "";
+  const std::string run = t.Text(row, c.run);
+  if (run.empty()) throw InputError(t.Where(row, c.run) + ": empty run id");
+  return run;
+}
+
+std::string Where(const CsvTable& t, int row) {
+  return t.path() + ":" + std::to_string(t.line(row));
+}
+
+double NonNegative(const CsvTable& t, int row, const std::string& column) {
+  const double v = t.Number(row, column);
+  if (v < 0) throw InputError(t.Where(row, column) + ": " + t.Text(row, column) + " must be >= 0");
+  return v;
+}
+
+}  // namespace
+
+void ReadRunouts(const CsvTable& t, const TableColumns& c, ObservationSet& out) {
+  t.Require({"observed_runout_m"});
+  for (int row = 0; row < t.rows(); ++row) {
+    if (t.Empty(row, "observed_runout_m")) continue;
+    out.scalars.push_back({Quantity::kRunout, RunOf(t, c, row),
+                           NonNegative(t, row, "observed_runout_m"), Where(t, row)});
+  }
+}
+
+void ReadDeposits(const CsvTable& t, const TableColumns& c, ObservationSet& out) {
+  t.Require({"x_m", "y_m"});
+  for (int row = 0; row < t.rows(); ++row) {
+    if (t.Empty(row, "x_m") && t.Empty(row, "y_m")) continue;
+    DepositObservation d;
+    d.run = RunOf(t, c, row);
+    d.xy_m = Eigen::Vector2d(t.Number(row, "x_m"), t.Number(row, "y_m"));
+    if (!t.Empty(row, "radius_m")) d.radius_m = NonNegative(t, row, "radius_m");
+    d.where = Where(t, row);
+    out.deposits.push_back(d);
+  }
+}
+
+void ReadImpacts(const CsvTable& t, const TableColumns& c, ObservationSet& out) {
+  const bool vectors = t.Has("incoming_vx_mps");
+  if (vectors) {
+    t.Require({"incoming_vx_mps", "incoming_vy_mps", "incoming_vz_mps", "outgoing_vx_mps",
+               "outgoing_vy_mps", "outgoing_vz_mps"});
+  } else {
+    t.Require({"incoming_speed_mps", "outgoing_speed_mps"});
+  }
+  for (int row = 0; row < t.rows(); ++row) {
+    double in = 0, out_speed = 0;
+    if (vectors) {
+      const auto v = [&](const char* x, const char* y, const char* z) {
+        return Eigen::Vector3d(t.Number(row, x), t.Number(row, y), t.Number(row, z));
+      };
+      in = v("incoming_vx_mps", "incoming_vy_mps", "incoming_vz_mps").norm();
+      out_speed = v("outgoing_vx_mps", "outgoing_vy_mps", "outgoing_vz_mps").norm();
+    } else {
+      in = NonNegative(t, row, "incoming_speed_mps");
+      out_speed = NonNegative(t, row, "outgoing_speed_mps");
+    }
+    if (in <= 0)
+      throw InputError(Where(t, row) + ": incoming speed 0: an impact needs an incoming velocity");
+    const std::string run = RunOf(t, c, row);
+    out.scalars.push_back({Quantity::kImpactSpeedOut, run, out_speed, Where(t, row)});
+    out.scalars.push_back(
+        {Quantity::kImpactEnergyRatio, run, (out_speed * out_speed) / (in * in), Where(t, row)});
+    if (!t.Empty(row, "omega_out_radps"))
+      out.scalars.push_back({Quantity::kImpactAngularSpeedOut, run,
+                             NonNegative(t, row, "omega_out_radps"), Where(t, row)});
+    if (!t.Empty(row, "duration_s"))
+      out.scalars.push_back(
+          {Quantity::kImpactDuration, run, NonNegative(t, row, "duration_s"), Where(t, row)});
+  }
+}
+
+void ReadScars(const CsvTable& t, const TableColumns& c, ObservationSet& out) {
+  t.Require({"scar_length_m"});
+  for (int row = 0; row < t.rows(); ++row) {
+    if (t.Empty(row, "scar_length_m")) continue;
+    out.scalars.push_back({Quantity::kScarLength, RunOf(t, c, row),
+                           NonNegative(t, row, "scar_length_m"), Where(t, row)});
+  }
+}
+
+}  // namespace talus::fieldobs

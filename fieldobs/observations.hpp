@@ -1,0 +1,68 @@
+#pragma once
+// Field observations of an event and the readers of their tables. Each observation belongs to a
+// run (an experiment's release, a documented event's block) or to the whole scene, and names the
+// quantity whose simulated counterpart it is scored against (validation.hpp).
+
+#include <Eigen/Core>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "common/csv_table.hpp"
+
+namespace talus::fieldobs {
+
+// A scalar quantity observed in the field, and how each simulated rock of its run gives it.
+enum class Quantity {
+  kRunout,             // m: horizontal distance release -> end (RockResult::runout_m)
+  kImpactSpeedOut,     // m/s: speed leaving the run's first contact episode
+  kImpactEnergyRatio,  // translational kinetic energy after / before the first contact episode
+  kImpactAngularSpeedOut,  // rad/s: angular speed leaving the first contact episode
+  kImpactDuration,         // s: duration of the first contact episode
+  kScarLength,             // m: longest scar of the run's first loaded contact episode
+};
+const char* ToString(Quantity quantity);  // "runout", "impact_speed_out", ...
+const char* UnitOf(Quantity quantity);    // "m", "m/s", "1", "rad/s", "s"
+
+struct ScalarObservation {
+  Quantity quantity = Quantity::kRunout;
+  std::string run;  // run id; empty: the whole scene's rocks
+  double value = 0;
+  std::string where;  // "file:line", for reports
+};
+
+// A surveyed rest position (map coordinates, m), optionally with its uncertainty radius.
+struct DepositObservation {
+  std::string run;  // run id; empty: the whole scene's rocks
+  Eigen::Vector2d xy_m = Eigen::Vector2d::Zero();
+  std::optional<double> radius_m;
+  std::string where;
+};
+
+struct ObservationSet {
+  std::vector<ScalarObservation> scalars;
+  std::vector<DepositObservation> deposits;
+  std::size_t size() const { return scalars.size() + deposits.size(); }
+};
+
+// Which columns a table's values come from; defaults are the documented column names
+// (docs/validation.md), so that tables in that format need no configuration.
+struct TableColumns {
+  std::string run = "trajectory_id";  // absent column: every row is about the whole scene
+};
+
+// Reads the rows of `table` as observations of each kind. Throws InputError naming the file, line
+// and column for a missing column or a bad value. Rows whose value cell is empty are skipped.
+//  - runout: `observed_runout_m`
+//  - deposits: `x_m`, `y_m`, optional `radius_m` (uncertainty, m)
+//  - impacts: incoming and outgoing velocity as `incoming_vx_mps` .. `outgoing_vz_mps` (or the
+//    speeds `incoming_speed_mps`, `outgoing_speed_mps`), optional `omega_out_radps`,
+//    `duration_s`; each gives impact_speed_out, impact_energy_ratio and, where present, angular
+//    speed and duration
+//  - scars: `scar_length_m`
+void ReadRunouts(const CsvTable& table, const TableColumns& columns, ObservationSet& out);
+void ReadDeposits(const CsvTable& table, const TableColumns& columns, ObservationSet& out);
+void ReadImpacts(const CsvTable& table, const TableColumns& columns, ObservationSet& out);
+void ReadScars(const CsvTable& table, const TableColumns& columns, ObservationSet& out);
+
+}  // namespace talus::fieldobs

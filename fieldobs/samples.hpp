@@ -1,0 +1,52 @@
+#pragma once
+// The simulated counterparts of observations: what each rock of an ensemble gives for every
+// observable quantity, kept per run. It is a sink of the ensemble runner, so it sees the rocks in
+// rock order and its contents do not depend on the number of threads. About 100 bytes per rock.
+
+#include <Eigen/Core>
+#include <optional>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "ensemble/runner.hpp"
+#include "fieldobs/observations.hpp"
+
+namespace talus::fieldobs {
+
+class EnsembleSamples : public ensemble::RockSink {
+ public:
+  // `release` names the runs; it must outlive this object. The runner must record episodes
+  // (EnsembleOptions::episodes) for the impact and scar quantities to have values.
+  explicit EnsembleSamples(const ensemble::ReleaseSpec& release);
+  void OnRock(const ensemble::RockOutcome& rock) override;
+
+  // True when `run` is a run (or release) of the ensemble; "" (the whole scene) always is.
+  bool HasRun(const std::string& run) const;
+  // The values of `quantity` over the rocks of `run` ("": every rock), in rock order. Rocks that
+  // do not give the quantity (no contact episode for an impact quantity) are left out.
+  std::vector<double> Values(Quantity quantity, const std::string& run) const;
+  // End positions (map coordinates) of the rocks of `run`, in rock order.
+  std::vector<Eigen::Vector2d> EndPositions(const std::string& run) const;
+  // Start position (horizontal) of `run`'s first rock, or nullopt for "" or an unknown run.
+  std::optional<Eigen::Vector2d> StartOf(const std::string& run) const;
+  long rocks() const { return static_cast<long>(rocks_.size()); }
+
+ private:
+  struct Rock {
+    int release = 0;
+    double runout_m = 0;
+    Eigen::Vector2d end_m = Eigen::Vector2d::Zero();
+    Eigen::Vector2d start_m = Eigen::Vector2d::Zero();
+    // From the first contact episode (and the first loaded one, for the scar).
+    std::optional<double> speed_out_m_s, energy_ratio, angular_speed_out_rad_s, duration_s, scar_m;
+  };
+  template <class F>
+  void ForRun(const std::string& run, F&& f) const;
+
+  const ensemble::ReleaseSpec& release_;
+  std::unordered_map<std::string, int> run_index_;
+  std::vector<Rock> rocks_;
+};
+
+}  // namespace talus::fieldobs

@@ -1,0 +1,236 @@
+#include "fieldobs/validation.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <numeric>
+
+#include "solver/random.hpp"
+
+namespace talus::fieldobs {
+namespace {
+
+// The stream of the PITs' uniforms, apart from the rocks' streams of the same seed.
+constexpr std::uint64_t kPitStream = 0x5049545049545049ULL;
+
+double Mean(const std::vector<double>& v) {
+  return v.empty() ? kNaN : std::accumulate(v.begin(), v.end(), 0.0) / double(v.size());
+}
+
+void ScoreScalarObservation(const ScalarObservation& o, const EnsembleSamples& sim,
+                            const EnsembleSamples* reference,
+                            const std::vector<double>& climatology, double u, int min_members,
+                            ObservationScore& s) {
+  const std::vector<double> values = sim.Values(o.quantity, o.run);
+  s.members = static_cast<int>(values.size());
+  if (!sim.HasRun(o.run)) {
+    s.not_scored = "no run '" + o.run + "' in the scene";
+    return;
+  }
+  if (s.members < min_members) {
+    s.not_scored = "only " + std::to_string(s.members) + " simulated values";
+    return;
+  }
+  const ScalarScore score = ScoreScalar(values, o.value, u);
+  s.scored = true;
+  s.score = score.crps;
+  s.pit = score.pit;
+  s.mean = score.mean;
+  s.median = score.median;
+  s.sd = score.sd;
+  s.q05 = score.q05;
+  s.q95 = score.q95;
+  s.inside_90 = score.inside_90;
+  s.bias = score.bias;
+  if (reference) {
+    const std::vector<double> ref = reference->Values(o.quantity, o.run);
+    if (static_cast<int>(ref.size()) >= min_members) s.reference_score = CrpsEnsemble(ref, o.value);
+  }
+  if (static_cast<int>(climatology.size()) >= min_members)
+    s.climatology_score = CrpsEnsemble(climatology, o.value);
+}
+
+void ScoreDeposit(const DepositObservation& o, const EnsembleSamples& sim,
+                  const EnsembleSamples* reference,
+                  const std::vector<Eigen::Vector2d>& climatology, int min_members,
+                  ObservationScore& s) {
+  const std::vector<Eigen::Vector2d> ends = sim.EndPositions(o.run);
+  s.members = static_cast<int>(ends.size());
+  if (!sim.HasRun(o.run)) {
+    s.not_scored = "no run '" + o.run + "' in the scene";
+    return;
+  }
+  if (s.members < min_members) {
+    s.not_scored = "only " + std::to_string(s.members) + " simulated rocks";
+    return;
+  }
+  s.scored = true;
+  s.score = EnergyScore(ends, o.xy_m);
+  Eigen::Vector2d centroid = Eigen::Vector2d::Zero();
+  for (const Eigen::Vector2d& e : ends) centroid += e;
+  centroid /= double(ends.size());
+  std::vector<double> to_observed, spread;
+  for (const Eigen::Vector2d& e : ends) {
+    to_observed.push_back((e - o.xy_m).norm());
+    spread.push_back((e - centroid).norm());
+  }
+  s.mean = (centroid - o.xy_m).norm();
+  double sum2 = 0;
+  for (double d : spread) sum2 += d * d;
+  s.sd = std::sqrt(sum2 / double(spread.size()));
+  s.median = Quantile(to_observed, 0.5);
+  s.q05 = Quantile(to_observed, 0.05);
+  s.q95 = Quantile(to_observed, 0.95);
+  s.inside_90 = s.mean <= Quantile(spread, 0.9);
+  if (reference) {
+    const std::vector<Eigen::Vector2d> ref = reference->EndPositions(o.run);
+    if (static_cast<int>(ref.size()) >= min_members) s.reference_score = EnergyScore(ref, o.xy_m);
+  }
+  if (static_cast<int>(climatology.size()) >= min_members)
+    s.climatology_score = EnergyScore(climatology, o.xy_m);
+}
+
+std::string Number(double v, const char* format = "%.3g") {
+  if (std::isnan(v)) return "-";
+  char b[64];
+  std::snprintf(b, sizeof b, format, v);
+  return b;
+}
+
+}  // namespace
+
+ValidationReport Validate(const ObservationSet& observations, const EnsembleSamples& simulated,
+                          const EnsembleSamples* reference, const ValidationOptions& options) {
+  ValidationReport report;
+  RockRandom uniforms(options.seed, kPitStream);
+
+  // Scalars. Climatology: the other observations of the same quantity (leave-one-out).
+  for (std::size_t k = 0; k < observations.scalars.size(); ++k) {
+    const ScalarObservation& o = observations.scalars[k];
+    std::vector<double> climatology;
+    for (std::size_t q = 0; q < observations.scalars.size(); ++q)
+      if (q != k && observations.scalars[q].quantity == o.quantity)
+        climatology.push_back(observations.scalars[q].value);
+    ObservationScore s;
+    s.kind = ToString(o.quantity);
+    s.unit = UnitOf(o.quantity);
+    s.run = o.run;
+    s.where = o.where;
+    s.observed = o.value;
+    const double u = uniforms.Uniform();  // drawn for every observation: scores do not shift
+    ScoreScalarObservation(o, simulated, reference, climatology, u, options.min_members, s);
+    report.observations.push_back(s);
+  }
+  // Deposits. Climatology: the other runs' observed displacements from their release, applied to
+  // this run's release (leave-one-out); none for observations of the whole scene.
+  for (std::size_t k = 0; k < observations.deposits.size(); ++k) {
+    const DepositObservation& o = observations.deposits[k];
+    std::vector<Eigen::Vector2d> climatology;
+    const auto start = simulated.StartOf(o.run);
+    if (start)
+      for (std::size_t q = 0; q < observations.deposits.size(); ++q) {
+        const auto other = simulated.StartOf(observations.deposits[q].run);
+        if (q != k && other) climatology.push_back(*start + observations.deposits[q].xy_m - *other);
+      }
+    ObservationScore s;
+    s.kind = "deposit";
+    s.unit = "m";
+    s.run = o.run;
+    s.where = o.where;
+    s.observed_xy_m = o.xy_m;
+    ScoreDeposit(o, simulated, reference, climatology, options.min_members, s);
+    report.observations.push_back(s);
+  }
+
+  // Per kind.
+  std::map<std::string, std::size_t> index;
+  for (const ObservationScore& s : report.observations) {
+    if (!index.count(s.kind)) {
+      index[s.kind] = report.kinds.size();
+      report.kinds.push_back({});
+      report.kinds.back().kind = s.kind;
+      report.kinds.back().unit = s.unit;
+    }
+    ++report.kinds[index[s.kind]].observations;
+  }
+  std::vector<double> ref_skills, clim_skills;
+  for (KindSummary& kind : report.kinds) {
+    std::vector<double> score, ref, clim, bias, sd, pits;
+    int inside = 0;
+    bool all_ref = true, all_clim = true;
+    for (const ObservationScore& s : report.observations) {
+      if (s.kind != kind.kind || !s.scored) continue;
+      ++kind.scored;
+      score.push_back(s.score);
+      ref.push_back(s.reference_score);
+      clim.push_back(s.climatology_score);
+      all_ref = all_ref && !std::isnan(s.reference_score);
+      all_clim = all_clim && !std::isnan(s.climatology_score);
+      inside += s.inside_90;
+      if (!std::isnan(s.bias)) bias.push_back(s.bias);
+      sd.push_back(s.sd);
+      if (!std::isnan(s.pit)) pits.push_back(s.pit);
+    }
+    report.observations_scored += kind.scored;
+    if (kind.scored == 0) continue;
+    kind.mean_score = Mean(score);
+    kind.inside_90_fraction = double(inside) / kind.scored;
+    kind.mean_bias = Mean(bias);
+    kind.mean_sd = Mean(sd);
+    // Baselines count only when every scored observation has one (same observations compared).
+    if (all_ref) {
+      kind.mean_reference_score = Mean(ref);
+      if (kind.mean_reference_score > 0) {
+        kind.skill_vs_reference = SkillScore(kind.mean_score, kind.mean_reference_score);
+        ref_skills.push_back(kind.skill_vs_reference);
+      }
+    }
+    if (all_clim) {
+      kind.mean_climatology_score = Mean(clim);
+      if (kind.mean_climatology_score > 0) {
+        kind.skill_vs_climatology = SkillScore(kind.mean_score, kind.mean_climatology_score);
+        clim_skills.push_back(kind.skill_vs_climatology);
+      }
+    }
+    if (pits.size() >= 2) {
+      const int bins = std::clamp(static_cast<int>(pits.size()) / 5, 2, 10);
+      kind.pit = MakePitHistogram(pits, bins);
+    }
+  }
+  report.skill_vs_reference = Mean(ref_skills);
+  report.skill_vs_climatology = Mean(clim_skills);
+  return report;
+}
+
+std::string ValidationReport::BriefReport() const {
+  char line[256];
+  std::snprintf(line, sizeof line,
+                "%d of %zu observations scored; skill vs reference %s, vs climatology %s",
+                observations_scored, observations.size(), Number(skill_vs_reference).c_str(),
+                Number(skill_vs_climatology).c_str());
+  return line;
+}
+
+std::string ValidationReport::FullReport() const {
+  std::string out;
+  char line[512];
+  std::snprintf(line, sizeof line, "%-26s %5s %10s %10s %10s %8s %8s %8s %10s %8s\n", "kind",
+                "n", "score", "reference", "climatol.", "skill_r", "skill_c", "in 90%", "bias",
+                "PIT p");
+  out += line;
+  for (const KindSummary& k : kinds) {
+    const std::string name = k.kind + " (" + k.unit + ")";
+    std::snprintf(line, sizeof line, "%-26s %2d/%-2d %10s %10s %10s %8s %8s %8s %10s %8s\n",
+                  name.c_str(), k.scored, k.observations, Number(k.mean_score).c_str(),
+                  Number(k.mean_reference_score).c_str(), Number(k.mean_climatology_score).c_str(),
+                  Number(k.skill_vs_reference, "%.2f").c_str(),
+                  Number(k.skill_vs_climatology, "%.2f").c_str(),
+                  Number(k.inside_90_fraction, "%.2f").c_str(), Number(k.mean_bias).c_str(),
+                  k.pit.counts.empty() ? "-" : Number(k.pit.p_value, "%.2g").c_str());
+    out += line;
+  }
+  return out + BriefReport() + "\n";
+}
+
+}  // namespace talus::fieldobs

@@ -1,0 +1,35 @@
+#pragma once
+// Event files (EVENT.toml, docs/validation.md): a scene and the field observations of what
+// happened there. Loading validates everything -- the scene, every observation table, and that
+// every observation's run exists in the scene -- before any rock runs; errors name the file, line
+// and key or column.
+
+#include <string>
+#include <vector>
+
+#include "fieldobs/observations.hpp"
+#include "io/scene_file.hpp"
+
+namespace talus::io {
+
+struct EventFile {
+  std::string path;
+  SceneFile scene;
+  fieldobs::ObservationSet observations;
+  // Which of the observation kinds were given: impacts and scars need contact episodes.
+  bool needs_episodes = false;
+  // The reference parameter set skill scores compare with: "table1" (the seed paper's Table 1
+  // values of the built-in categories the scene uses, user categories unchanged) or "none".
+  std::string reference = "table1";
+  std::vector<std::string> inputs;  // the event file, the scene's inputs, the observation tables
+  std::string inputs_hash;
+};
+
+// Throws InputError "<file>:<line>: <key>: <reason>" (or the table's file:line: column).
+EventFile LoadEvent(const std::string& path);
+
+// The scene's ground table with the Table 1 values for the built-in categories (user categories
+// kept), and whether it differs from the scene's.
+GroundTable ReferenceGround(const GroundTable& scene_ground, bool* differs);
+
+}  // namespace talus::io

@@ -1,0 +1,90 @@
+// Observation tables: each kind's columns, and errors naming file, line and column.
+
+#include "fieldobs/observations.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "common/error.hpp"
+
+namespace talus::fieldobs {
+namespace {
+
+std::string ErrorOf(void (*read)(const CsvTable&, const TableColumns&, ObservationSet&),
+                    const std::string& text) {
+  ObservationSet set;
+  try {
+    read(CsvTable::Parse(text, "obs.csv"), TableColumns{}, set);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+#define EXPECT_HAS(text, part) EXPECT_NE(std::string(text).find(part), std::string::npos) << (text)
+
+TEST(Observations, RunoutsAndDepositsReadByColumnName) {
+  // The Tschamut table's shape: extra columns, a quoted field with a comma.
+  const CsvTable t = CsvTable::Parse(
+      "trajectory_id,x_m,y_m,observed_runout_m,source\n"
+      "v004,86.8,149.81,101.96,\"survey, last sample\"\n"
+      "v005,68.2,161.53,,\"no runout\"\n",
+      "dep.csv");
+  ObservationSet set;
+  ReadRunouts(t, TableColumns{}, set);
+  ReadDeposits(t, TableColumns{}, set);
+  ASSERT_EQ(set.scalars.size(), 1u);  // the empty runout cell is skipped
+  EXPECT_EQ(set.scalars[0].quantity, Quantity::kRunout);
+  EXPECT_EQ(set.scalars[0].run, "v004");
+  EXPECT_EQ(set.scalars[0].value, 101.96);
+  EXPECT_EQ(set.scalars[0].where, "dep.csv:2");
+  ASSERT_EQ(set.deposits.size(), 2u);
+  EXPECT_EQ(set.deposits[1].xy_m, Eigen::Vector2d(68.2, 161.53));
+  EXPECT_FALSE(set.deposits[1].radius_m.has_value());
+}
+
+TEST(Observations, ImpactsGiveSpeedAndEnergyRatio) {
+  // Incoming (3, 0, -4) m/s = 5 m/s, outgoing (2, 0, 0): speed 2 m/s, energy ratio 4/25.
+  const CsvTable t = CsvTable::Parse(
+      "trajectory_id,incoming_vx_mps,incoming_vy_mps,incoming_vz_mps,outgoing_vx_mps,"
+      "outgoing_vy_mps,outgoing_vz_mps,omega_out_radps\n"
+      "s0,3,0,-4,2,0,0,7.5\n",
+      "impacts.csv");
+  ObservationSet set;
+  ReadImpacts(t, TableColumns{}, set);
+  ASSERT_EQ(set.scalars.size(), 3u);
+  EXPECT_EQ(set.scalars[0].quantity, Quantity::kImpactSpeedOut);
+  EXPECT_NEAR(set.scalars[0].value, 2.0, 1e-15);
+  EXPECT_EQ(set.scalars[1].quantity, Quantity::kImpactEnergyRatio);
+  EXPECT_NEAR(set.scalars[1].value, 4.0 / 25.0, 1e-15);
+  EXPECT_EQ(set.scalars[2].quantity, Quantity::kImpactAngularSpeedOut);
+  // Speeds instead of vectors.
+  ObservationSet speeds;
+  ReadImpacts(CsvTable::Parse("incoming_speed_mps,outgoing_speed_mps\n10,5\n", "s.csv"),
+              TableColumns{}, speeds);
+  ASSERT_EQ(speeds.scalars.size(), 2u);
+  EXPECT_EQ(speeds.scalars[0].run, "");  // no run column: the whole scene
+  EXPECT_NEAR(speeds.scalars[1].value, 0.25, 1e-15);
+}
+
+TEST(Observations, BadTablesNameFileLineAndColumn) {
+  EXPECT_HAS(ErrorOf(ReadRunouts, "trajectory_id,runout\nv1,3\n"),
+             "obs.csv: missing column 'observed_runout_m' (the header has: trajectory_id, runout)");
+  EXPECT_HAS(ErrorOf(ReadRunouts, "trajectory_id,observed_runout_m\nv1,-3\n"),
+             "obs.csv:2: column 'observed_runout_m': -3 must be >= 0");
+  EXPECT_HAS(ErrorOf(ReadRunouts, "trajectory_id,observed_runout_m\nv1,1e400\n"),
+             "obs.csv:2: column 'observed_runout_m': '1e400' is not a finite number");
+  EXPECT_HAS(ErrorOf(ReadRunouts, "trajectory_id,observed_runout_m\n,3\n"),
+             "obs.csv:2: column 'trajectory_id': empty run id");
+  EXPECT_HAS(ErrorOf(ReadDeposits, "x_m,y_m\n1,2\n3\n"), "obs.csv:3: 1 fields, but the header has 2");
+  EXPECT_HAS(ErrorOf(ReadDeposits, "x_m,y_m\n1,\"2\n"), "obs.csv:2: unclosed quote");
+  EXPECT_HAS(ErrorOf(ReadImpacts, "incoming_speed_mps,outgoing_speed_mps\n0,1\n"),
+             "obs.csv:2: incoming speed 0");
+  EXPECT_HAS(ErrorOf(ReadImpacts, "incoming_vx_mps\n1\n"), "missing column 'incoming_vy_mps'");
+  EXPECT_HAS(ErrorOf(ReadScars, "x_m,x_m\n1,2\n"), "obs.csv:1: header names column 'x_m' twice");
+  EXPECT_HAS(ErrorOf(ReadScars, ""), "obs.csv: empty file");
+}
+
+}  // namespace
+}  // namespace talus::fieldobs
