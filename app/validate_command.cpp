@@ -94,8 +94,7 @@ int RunValidate(const ValidateArgs& args) {
     run.rocks_per_run = release.rocks_per_release;
     run.seed = release.seed;
     run.threads = run.ensemble.threads;
-    run.wall_time_s =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    run.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     io::WriteTextFile(out("observations.csv"), io::ObservationsCsv(report));
     io::WriteTextFile(out("observed_vs_simulated.svg"), io::ObservedVsSimulatedSvg(report));
     io::WriteTextFile(out("pit.svg"), io::PitSvg(report));

@@ -14,9 +14,9 @@ namespace talus::fieldobs {
 
 // A scalar quantity observed in the field, and how each simulated rock of its run gives it.
 enum class Quantity {
-  kRunout,             // m: horizontal distance release -> end (RockResult::runout_m)
-  kImpactSpeedOut,     // m/s: speed leaving the run's first contact episode
-  kImpactEnergyRatio,  // translational kinetic energy after / before the first contact episode
+  kRunout,                 // m: horizontal distance release -> end (RockResult::runout_m)
+  kImpactSpeedOut,         // m/s: speed leaving the run's first contact episode
+  kImpactEnergyRatio,      // translational kinetic energy after / before the first contact episode
   kImpactAngularSpeedOut,  // rad/s: angular speed leaving the first contact episode
   kImpactDuration,         // s: duration of the first contact episode
   kScarLength,             // m: longest scar of the run's first loaded contact episode

@@ -52,9 +52,8 @@ void ScoreScalarObservation(const ScalarObservation& o, const EnsembleSamples& s
 }
 
 void ScoreDeposit(const DepositObservation& o, const EnsembleSamples& sim,
-                  const EnsembleSamples* reference,
-                  const std::vector<Eigen::Vector2d>& climatology, int min_members,
-                  ObservationScore& s) {
+                  const EnsembleSamples* reference, const std::vector<Eigen::Vector2d>& climatology,
+                  int min_members, ObservationScore& s) {
   const std::vector<Eigen::Vector2d> ends = sim.EndPositions(o.run);
   s.members = static_cast<int>(ends.size());
   if (!sim.HasRun(o.run)) {
@@ -215,9 +214,8 @@ std::string ValidationReport::BriefReport() const {
 std::string ValidationReport::FullReport() const {
   std::string out;
   char line[512];
-  std::snprintf(line, sizeof line, "%-26s %5s %10s %10s %10s %8s %8s %8s %10s %8s\n", "kind",
-                "n", "score", "reference", "climatol.", "skill_r", "skill_c", "in 90%", "bias",
-                "PIT p");
+  std::snprintf(line, sizeof line, "%-26s %5s %10s %10s %10s %8s %8s %8s %10s %8s\n", "kind", "n",
+                "score", "reference", "climatol.", "skill_r", "skill_c", "in 90%", "bias", "PIT p");
   out += line;
   for (const KindSummary& k : kinds) {
     const std::string name = k.kind + " (" + k.unit + ")";

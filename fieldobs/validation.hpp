@@ -39,9 +39,9 @@ struct ObservationScore {
   double pit = kNaN;
   double mean = kNaN, median = kNaN, sd = kNaN, q05 = kNaN, q95 = kNaN;
   bool inside_90 = false;
-  double bias = kNaN;                // scalars: mean - observed
-  double reference_score = kNaN;     // the same score with the reference parameter set
-  double climatology_score = kNaN;   // the same score of the leave-one-out climatology
+  double bias = kNaN;               // scalars: mean - observed
+  double reference_score = kNaN;    // the same score with the reference parameter set
+  double climatology_score = kNaN;  // the same score of the leave-one-out climatology
 };
 
 // Per kind: means over the scored observations, skills, and the PIT histogram (scalars).
@@ -57,12 +57,13 @@ struct KindSummary {
   double inside_90_fraction = kNaN;    // ideal 0.9
   double mean_bias = kNaN;             // scalars
   double mean_sd = kNaN;
-  PitHistogram pit;                    // empty counts for deposits or fewer than 2 scored
+  PitHistogram pit;  // empty counts for deposits or fewer than 2 scored
 };
 
 struct ValidationReport {
-  std::vector<ObservationScore> observations;  // in the order of the ObservationSet (scalars, then deposits)
-  std::vector<KindSummary> kinds;              // in order of first appearance
+  std::vector<ObservationScore>
+      observations;                // in the order of the ObservationSet (scalars, then deposits)
+  std::vector<KindSummary> kinds;  // in order of first appearance
   int observations_scored = 0;
   // Means over kinds of the kinds' skills (kinds without a baseline are left out).
   double skill_vs_reference = kNaN;

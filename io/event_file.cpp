@@ -143,10 +143,9 @@ EventFile LoadEvent(const std::string& path) {
     runs.insert(release.ReleaseName(static_cast<int>(r)));
   const auto check = [&](const std::string& run, const std::string& where) {
     if (!run.empty() && !runs.count(run))
-      throw InputError(where + ": run '" + run + "' is not a run of the scene " +
-                       event.scene.path +
-                       (release.runs.empty() ? " (it has no run table; runs are named 0, 1, ...)"
-                                             : ""));
+      throw InputError(
+          where + ": run '" + run + "' is not a run of the scene " + event.scene.path +
+          (release.runs.empty() ? " (it has no run table; runs are named 0, 1, ...)" : ""));
   };
   for (const auto& o : event.observations.scalars) check(o.run, o.where);
   for (const auto& o : event.observations.deposits) check(o.run, o.where);

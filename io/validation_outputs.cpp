@@ -35,10 +35,14 @@ std::string CsvText(const std::string& text) {
 std::string Xml(const std::string& text) {
   std::string out;
   for (char c : text) {
-    if (c == '<') out += "&lt;";
-    else if (c == '>') out += "&gt;";
-    else if (c == '&') out += "&amp;";
-    else out += c;
+    if (c == '<')
+      out += "&lt;";
+    else if (c == '>')
+      out += "&gt;";
+    else if (c == '&')
+      out += "&amp;";
+    else
+      out += c;
   }
   return out;
 }
@@ -112,9 +116,9 @@ std::string ObservationsCsv(const fieldobs::ValidationReport& report) {
            Csv(s.observed_xy_m.x()) + "," + Csv(s.observed_xy_m.y()) + "," +
            (s.scored ? "1" : "0") + "," + std::to_string(s.members) + "," + Csv(s.score) + "," +
            Csv(s.pit) + "," + Csv(s.mean) + "," + Csv(s.median) + "," + Csv(s.sd) + "," +
-           Csv(s.q05) + "," + Csv(s.q95) + "," + (s.scored ? (s.inside_90 ? "1" : "0") : "") +
-           "," + Csv(s.bias) + "," + Csv(s.reference_score) + "," + Csv(s.climatology_score) +
-           "," + CsvText(s.where) + "," + CsvText(s.not_scored) + "\n";
+           Csv(s.q05) + "," + Csv(s.q95) + "," + (s.scored ? (s.inside_90 ? "1" : "0") : "") + "," +
+           Csv(s.bias) + "," + Csv(s.reference_score) + "," + Csv(s.climatology_score) + "," +
+           CsvText(s.where) + "," + CsvText(s.not_scored) + "\n";
   }
   return out;
 }
@@ -137,8 +141,7 @@ std::string ObservedVsSimulatedSvg(const fieldobs::ValidationReport& report) {
     std::vector<const fieldobs::ObservationScore*> obs;
     for (const auto& s : report.observations)
       if (s.kind == k->kind && s.scored) obs.push_back(&s);
-    std::sort(obs.begin(), obs.end(),
-              [](auto* a, auto* b) { return a->observed < b->observed; });
+    std::sort(obs.begin(), obs.end(), [](auto* a, auto* b) { return a->observed < b->observed; });
     double lo = obs.front()->observed, hi = lo;
     for (const auto* s : obs) {
       lo = std::min({lo, s->observed, s->q05});
@@ -150,15 +153,15 @@ std::string ObservedVsSimulatedSvg(const fieldobs::ValidationReport& report) {
     hi += pad;
     const int x0 = margin + 10, x1 = width - 20, y0 = top + 20, y1 = top + panel;
     auto y = [&](double v) { return y1 - (v - lo) / (hi - lo) * (y1 - y0); };
-    svg << "<text x=\"" << x0 << "\" y=\"" << top + 12 << "\" font-weight=\"bold\">"
-        << Xml(k->kind) << " (" << Xml(k->unit) << "): observed (red) vs simulated 5-95 % band "
+    svg << "<text x=\"" << x0 << "\" y=\"" << top + 12 << "\" font-weight=\"bold\">" << Xml(k->kind)
+        << " (" << Xml(k->unit) << "): observed (red) vs simulated 5-95 % band "
         << "and median (blue); mean CRPS " << Fmt(k->mean_score) << "</text>\n";
     svg << "<rect x=\"" << x0 << "\" y=\"" << y0 << "\" width=\"" << x1 - x0 << "\" height=\""
         << y1 - y0 << "\" fill=\"none\" stroke=\"#888\"/>\n";
     for (int t = 0; t <= 4; ++t) {
       const double v = lo + (hi - lo) * t / 4;
-      svg << "<text x=\"" << x0 - 4 << "\" y=\"" << y(v) + 4 << "\" text-anchor=\"end\">"
-          << Fmt(v) << "</text>\n";
+      svg << "<text x=\"" << x0 - 4 << "\" y=\"" << y(v) + 4 << "\" text-anchor=\"end\">" << Fmt(v)
+          << "</text>\n";
     }
     const double step = double(x1 - x0) / double(obs.size());
     for (std::size_t i = 0; i < obs.size(); ++i) {
@@ -203,16 +206,17 @@ std::string PitSvg(const fieldobs::ValidationReport& report) {
     const double top_value = std::max(double(most), 1.5 * expected);
     const double bar = double(w - 50) / double(pit.counts.size());
     svg << "<text x=\"" << left << "\" y=\"16\" font-weight=\"bold\">PIT: " << Xml(kinds[p]->kind)
-        << "</text>\n<text x=\"" << left << "\" y=\"32\">chi-square p = "
-        << Fmt(pit.p_value, "%.2g") << " (" << total << " observations)</text>\n";
+        << "</text>\n<text x=\"" << left
+        << "\" y=\"32\">chi-square p = " << Fmt(pit.p_value, "%.2g") << " (" << total
+        << " observations)</text>\n";
     for (std::size_t b = 0; b < pit.counts.size(); ++b) {
       const double height = (bottom - top) * pit.counts[b] / top_value;
       svg << "<rect x=\"" << left + b * bar << "\" y=\"" << bottom - height << "\" width=\""
           << bar - 2 << "\" height=\"" << height << "\" fill=\"#6a8fd0\"/>\n";
     }
     const double ey = bottom - (bottom - top) * expected / top_value;
-    svg << "<line x1=\"" << left << "\" x2=\"" << left + (w - 50) << "\" y1=\"" << ey
-        << "\" y2=\"" << ey << "\" stroke=\"black\" stroke-dasharray=\"4 3\"/>\n";
+    svg << "<line x1=\"" << left << "\" x2=\"" << left + (w - 50) << "\" y1=\"" << ey << "\" y2=\""
+        << ey << "\" stroke=\"black\" stroke-dasharray=\"4 3\"/>\n";
     svg << "<text x=\"" << left << "\" y=\"" << bottom + 14 << "\">0</text><text x=\""
         << left + (w - 50) << "\" y=\"" << bottom + 14 << "\" text-anchor=\"end\">1</text>\n";
   }

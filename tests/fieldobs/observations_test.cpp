@@ -77,7 +77,8 @@ TEST(Observations, BadTablesNameFileLineAndColumn) {
              "obs.csv:2: column 'observed_runout_m': '1e400' is not a finite number");
   EXPECT_HAS(ErrorOf(ReadRunouts, "trajectory_id,observed_runout_m\n,3\n"),
              "obs.csv:2: column 'trajectory_id': empty run id");
-  EXPECT_HAS(ErrorOf(ReadDeposits, "x_m,y_m\n1,2\n3\n"), "obs.csv:3: 1 fields, but the header has 2");
+  EXPECT_HAS(ErrorOf(ReadDeposits, "x_m,y_m\n1,2\n3\n"),
+             "obs.csv:3: 1 fields, but the header has 2");
   EXPECT_HAS(ErrorOf(ReadDeposits, "x_m,y_m\n1,\"2\n"), "obs.csv:2: unclosed quote");
   EXPECT_HAS(ErrorOf(ReadImpacts, "incoming_speed_mps,outgoing_speed_mps\n0,1\n"),
              "obs.csv:2: incoming speed 0");

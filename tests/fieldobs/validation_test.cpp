@@ -127,8 +127,8 @@ TEST(Validate, PitOfObservationsDrawnFromTheModelIsUniform) {
   ensemble::RunEnsemble(scene, truth_release, options, &truth);
   ObservationSet obs;
   for (const ensemble::ReleaseRun& run : release.runs)
-    obs.scalars.push_back({Quantity::kRunout, run.id, truth.Values(Quantity::kRunout, run.id)[0],
-                           run.id});
+    obs.scalars.push_back(
+        {Quantity::kRunout, run.id, truth.Values(Quantity::kRunout, run.id)[0], run.id});
   const ValidationReport same = Validate(obs, model, nullptr, {7, 2});
   ASSERT_EQ(same.kinds[0].scored, 60);
   ASSERT_EQ(same.kinds[0].pit.counts.size(), 10u);

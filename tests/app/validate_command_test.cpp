@@ -1,0 +1,140 @@
+// End to end through the talus program: `talus validate` on a tiny event.
+
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path FreshDir(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / "talus_app_tests" / name;
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+int RunCommand(const std::string& command, std::string* output) {
+  std::FILE* pipe = ::popen((command + " 2>&1").c_str(), "r");
+  std::array<char, 4096> buffer;
+  output->clear();
+  while (std::size_t n = std::fread(buffer.data(), 1, buffer.size(), pipe))
+    output->append(buffer.data(), n);
+  const int status = ::pclose(pipe);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+std::string Slurp(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+void Write(const fs::path& path, const std::string& text) { std::ofstream(path) << text; }
+
+// Three runs of two blocks on a short 35 degree slope, observed rest positions and run-outs, and
+// impacts (each run starts 2 m above the ground, so its first contact episode is an impact).
+fs::path MakeEvent(const std::string& name, const std::string& event_extra = "") {
+  const fs::path dir = FreshDir(name);
+  Write(dir / "scene.toml", R"([terrain]
+plane = { slope_deg = 35, slope_length_m = 20, runout_m = 10, width_m = 12, cell_m = 1 }
+default_ground = "medium_soft"
+[blocks]
+file = "blocks.csv"
+shape = "box"
+[release]
+runs = "runs.csv"
+rocks = 6
+seed = 3
+[solver]
+max_time_s = 4
+)");
+  Write(dir / "blocks.csv",
+        "block_id,mass_kg,size_x_m,size_y_m,size_z_m\nA,60,0.4,0.4,0.3\n"
+        "B,80,0.5,0.4,0.3\n");
+  Write(dir / "runs.csv",
+        "trajectory_id,x_m,y_m,height_m,vx_mps,block_id\nr1,3,0,2,1,A\n"
+        "r2,3,2,2,2,B\nr3,4,-2,2,0,A\n");
+  Write(dir / "observed.csv",
+        "trajectory_id,x_m,y_m,observed_runout_m\nr1,20,0,17\n"
+        "r2,22,2,19\nr3,18,-2,14\n");
+  Write(dir / "impacts.csv",
+        "trajectory_id,incoming_speed_mps,outgoing_speed_mps\nr1,6,3\n"
+        "r2,6.5,3.5\n");
+  Write(dir / "event.toml", R"(scene = "scene.toml"
+[[observations]]
+kind = "runout"
+file = "observed.csv"
+[[observations]]
+kind = "deposits"
+file = "observed.csv"
+[[observations]]
+kind = "impacts"
+file = "impacts.csv"
+)" + event_extra);
+  return dir;
+}
+
+TEST(ValidateCommand, WritesScoresThatDoNotDependOnTheThreadCount) {
+  const fs::path dir = MakeEvent("validate");
+  std::string output;
+  for (int threads : {1, 2}) {
+    const std::string out = (dir / ("out" + std::to_string(threads))).string();
+    ASSERT_EQ(RunCommand(std::string(TALUS_BINARY) + " validate " + (dir / "event.toml").string() +
+                             " --out " + out + " --threads " + std::to_string(threads),
+                         &output),
+              0)
+        << output;
+  }
+  for (const char* file :
+       {"scores.json", "observations.csv", "observed_vs_simulated.svg", "pit.svg", "deposits.png"})
+    EXPECT_TRUE(fs::exists(dir / "out1" / file)) << file;
+  EXPECT_EQ(Slurp(dir / "out1" / "observations.csv"), Slurp(dir / "out2" / "observations.csv"));
+  const auto scores = nlohmann::json::parse(Slurp(dir / "out1" / "scores.json"));
+  EXPECT_EQ(scores["runs"], 3);
+  EXPECT_EQ(scores["rocks_per_run"], 6);
+  EXPECT_EQ(scores["observations"], 3 + 3 + 2 * 2);  // runouts, deposits, 2 per impact
+  EXPECT_EQ(scores["kinds"]["runout"]["observations"], 3);
+  EXPECT_EQ(scores["kinds"]["runout"]["scored"], 3);
+  EXPECT_EQ(scores["kinds"]["deposit"]["score"], "energy_score");
+  EXPECT_EQ(scores["kinds"]["impact_energy_ratio"]["scored"], 2);  // episodes were recorded
+  EXPECT_TRUE(scores["kinds"]["runout"]["mean_score"].is_number());
+  EXPECT_EQ(scores["kinds"]["runout"]["skill_vs_reference"], 0.0);  // Table 1 is the scene's
+  EXPECT_NE(output.find("runout (m)"), std::string::npos) << output;
+}
+
+TEST(ValidateCommand, BadEventsFailBeforeAnyRockNamingFileLineAndKey) {
+  std::string output;
+  const fs::path dir = MakeEvent("validate_bad",
+                                 "[[observations]]\nkind = \"runouts\"\n"
+                                 "file = \"observed.csv\"\n");
+  EXPECT_EQ(RunCommand(std::string(TALUS_BINARY) + " validate " + (dir / "event.toml").string() +
+                           " --out " + (dir / "out").string(),
+                       &output),
+            2);
+  EXPECT_NE(output.find("event.toml:12: observations[3].kind: unknown kind 'runouts' (did you "
+                        "mean 'runout'?)"),
+            std::string::npos)
+      << output;
+  EXPECT_FALSE(fs::exists(dir / "out" / "scores.json"));
+  // An observation of a run the scene does not have.
+  const fs::path other = MakeEvent("validate_run");
+  Write(other / "observed.csv", "trajectory_id,x_m,y_m,observed_runout_m\nr1,20,0,17\nr9,1,1,1\n");
+  EXPECT_EQ(RunCommand(std::string(TALUS_BINARY) + " validate " + (other / "event.toml").string() +
+                           " --out " + (other / "out").string(),
+                       &output),
+            2);
+  EXPECT_NE(output.find("observed.csv:3: run 'r9' is not a run of the scene"), std::string::npos)
+      << output;
+}
+
+}  // namespace
