@@ -1,6 +1,7 @@
 // Benchmark: single-rock trajectories of the EOTA221 block down the 40 degree ramp, one core.
 // Prints the machine, trajectories per second (median of repeats), steps per second, contact-solver
-// sweeps per contact step and a per-stage time profile.
+// sweeps per contact step, the ramp statistics that Leine et al. 2021 (Table 2) report for
+// RAMMS::ROCKFALL, and a per-stage time profile.
 
 #include <sys/utsname.h>
 
@@ -11,6 +12,7 @@
 #include <cstdio>
 #include <fstream>
 #include <map>
+#include <numbers>
 #include <string>
 #include <thread>
 #include <vector>
@@ -31,7 +33,8 @@ struct Batch {
   double wall_s = 0;
   long steps = 0, contact_steps = 0, iterations = 0, unconverged = 0;
   double time_sum_s = 0;
-  std::vector<double> runouts_m, max_speeds_m_s;
+  std::vector<double> runouts_m, max_speeds_m_s, rotation_rates_1_s, jump_heights_m, travel_times_s;
+  int stopped_within_5_m = 0;
   std::map<std::string, int> endings;
 };
 
@@ -49,6 +52,10 @@ Batch RunBatch(const talus::Scene& scene, int rocks, std::uint64_t seed, talus::
     batch.unconverged += r.unconverged_steps;
     batch.runouts_m.push_back(r.runout_m);
     batch.max_speeds_m_s.push_back(r.max_speed_m_s);
+    batch.rotation_rates_1_s.push_back(r.max_angular_speed_rad_s / (2 * std::numbers::pi));
+    batch.jump_heights_m.push_back(r.max_jump_height_m);
+    batch.travel_times_s.push_back(r.travel_time_s);
+    batch.stopped_within_5_m += r.end == talus::EndReason::kRest && r.runout_m < 5;
     batch.time_sum_s += r.travel_time_s;
     ++batch.endings[talus::ToString(r.end)];
   }
@@ -64,6 +71,14 @@ double Quantile(std::vector<double> v, double q) {
   return v[lo] + (position - lo) * (v[hi] - v[lo]);
 }
 double Median(const std::vector<double>& v) { return Quantile(v, 0.5); }
+
+// Mean and standard deviation.
+std::pair<double, double> MeanAndSd(const std::vector<double>& v) {
+  double mean = 0, var = 0;
+  for (double x : v) mean += x / v.size();
+  for (double x : v) var += (x - mean) * (x - mean) / (v.size() - 1);
+  return {mean, std::sqrt(var)};
+}
 
 // Mean and its standard error.
 std::pair<double, double> MeanAndError(const std::vector<double>& v) {
@@ -81,6 +96,7 @@ int main(int argc, char** argv) {
   double dt_s = 0.002, tolerance = -1;
   int max_iterations = -1;
   std::uint64_t seed = 1;
+  std::string viscous = talus::ToString(talus::SolverOptions{}.viscous);
   app.add_option("--rocks", rocks, "Trajectories per repeat")->check(CLI::PositiveNumber);
   app.add_option("--repeats", repeats, "Repeats (the median is reported)")
       ->check(CLI::PositiveNumber);
@@ -90,12 +106,16 @@ int main(int argc, char** argv) {
   app.add_option("--max-iterations", max_iterations,
                  "Contact solver sweeps at most (default: solver default)");
   app.add_option("--seed", seed, "Seed of the release orientations");
+  app.add_option("--viscous,--drag", viscous,
+                 "Reading of the viscous ground term: centre_of_mass or contact_friction")
+      ->check(CLI::IsMember({"centre_of_mass", "contact_friction"}));
   CLI11_PARSE(app, argc, argv);
 
   talus::Scene scene = talus::scenes::Ramp40();
   scene.options.dt_s = dt_s;
   if (tolerance > 0) scene.options.tolerance_m_s = tolerance;
   if (max_iterations > 0) scene.options.max_iterations = max_iterations;
+  talus::ParseViscousReading(viscous, &scene.options.viscous);
   std::string why;
   if (!scene.IsValid(&why)) {
     std::fprintf(stderr, "ramp_bench: %s\n", why.c_str());
@@ -115,9 +135,10 @@ int main(int argc, char** argv) {
   );
   std::printf(
       "scene: EOTA221 %.0f kg, %zu hull vertices; 40 deg ramp 200 m + 150 m runout, 2 m cells, "
-      "medium_hard; dt %.4f s, tolerance %.1e m/s, at most %d sweeps\n",
+      "medium_hard; dt %.4f s, tolerance %.1e m/s, at most %d sweeps; viscous term: %s\n",
       scene.rock.mass_kg, scene.rock.vertices_m.size(), scene.options.dt_s,
-      scene.options.tolerance_m_s, scene.options.max_iterations);
+      scene.options.tolerance_m_s, scene.options.max_iterations,
+      talus::ToString(scene.options.viscous));
 
   std::vector<double> rates, step_rates;
   Batch last;
@@ -143,6 +164,25 @@ int main(int argc, char** argv) {
       "unconverged steps: %ld\n",
       100.0 * last.contact_steps / last.steps,
       last.contact_steps ? double(last.iterations) / last.contact_steps : 0.0, last.unconverged);
+  const auto [speed_mean, speed_sd] = MeanAndSd(last.max_speeds_m_s);
+  const auto [rotation_mean, rotation_sd] = MeanAndSd(last.rotation_rates_1_s);
+  const auto [jump_mean, jump_sd] = MeanAndSd(last.jump_heights_m);
+  const auto [time_mean, time_sd] = MeanAndSd(last.travel_times_s);
+  const auto [runout_mean, runout_sd] = MeanAndSd(last.runouts_m);
+  int slow = 0;
+  for (double v : last.max_speeds_m_s) slow += v < 5;
+  std::printf(
+      "ramp statistics per rock (mean +- sd; Leine et al. 2021, Table 2, RAMMS::ROCKFALL: max "
+      "speed "
+      "17.75 +- 7.7 m/s, rotation 4.77 +- 1.9 rot/s, jump height 1.40 +- 1.1 m):\n"
+      "  max speed %.2f +- %.2f m/s (median %.2f); rotation rate (max angular speed / 2 pi) "
+      "%.2f +- %.2f rot/s (median %.2f); max jump height %.2f +- %.2f m (median %.2f)\n"
+      "  runout %.1f +- %.1f m (median %.1f); travel time %.1f +- %.1f s (median %.1f); "
+      "stopped within 5 m %.1f %%; max speed below 5 m/s %.1f %%\n",
+      speed_mean, speed_sd, Median(last.max_speeds_m_s), rotation_mean, rotation_sd,
+      Median(last.rotation_rates_1_s), jump_mean, jump_sd, Median(last.jump_heights_m), runout_mean,
+      runout_sd, Median(last.runouts_m), time_mean, time_sd, Median(last.travel_times_s),
+      100.0 * last.stopped_within_5_m / rocks, 100.0 * slow / rocks);
   std::printf("endings:");
   for (const auto& [end, count] : last.endings) std::printf(" %s %d", end.c_str(), count);
   std::printf(

@@ -672,6 +672,15 @@ void LoadSolver(const Section& s, SolverOptions& o) {
   o.gravity_m_s2 = s.Number("gravity_m_s2", o.gravity_m_s2);
   o.normal_restitution = s.Number("normal_restitution", o.normal_restitution);
   o.tangential_restitution = s.Number("tangential_restitution", o.tangential_restitution);
+  if (s.Has("viscous")) {
+    const std::string name = s.String("viscous", "");
+    if (!ParseViscousReading(name, &o.viscous)) {
+      const std::string hint = ClosestName(name, {"centre_of_mass", "contact_friction"});
+      s.Fail("viscous", "unknown reading '" + name + "'" +
+                            (hint.empty() ? "" : " (did you mean '" + hint + "'?)") +
+                            "; known: centre_of_mass, contact_friction");
+    }
+  }
   o.tolerance_m_s = s.Number("tolerance_m_s", o.tolerance_m_s);
   const long max_iterations = s.Integer("max_iterations", o.max_iterations);
   if (max_iterations != static_cast<int>(max_iterations))
@@ -786,8 +795,8 @@ SceneFile LoadScene(const std::string& path) {
               out);
   LoadSolver(Section(context, SubTable(context, root, "solver"), "solver",
                      {"dt_s", "max_time_s", "gravity_m_s2", "normal_restitution",
-                      "tangential_restitution", "tolerance_m_s", "max_iterations", "prox_alpha",
-                      "rest_speed_m_s", "rest_angular_speed_rad_s", "rest_hold_s"}),
+                      "tangential_restitution", "viscous", "tolerance_m_s", "max_iterations",
+                      "prox_alpha", "rest_speed_m_s", "rest_angular_speed_rad_s", "rest_hold_s"}),
              out.scene.options);
   LoadOutput(Section(context, SubTable(context, root, "output"), "output",
                      {"trajectories", "trajectory_interval_s", "rasters", "quicklook"}),

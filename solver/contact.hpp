@@ -20,6 +20,9 @@ struct Contact {
   Eigen::Matrix3d delassus_inverse;
   double r_normal = 0;  // prox step lengths (kg), used when the exact local solve fails
   double r_tangent = 0;
+  // Contact-friction reading of the viscous term: nu dt m (kg), the tangential damping this
+  // contact gets when it carries the whole normal load; 0 otherwise (SolveContacts).
+  double viscous_kg = 0;
   // Added to the end contact velocity in the laws: xi = gamma_E + eps (.) gamma_B + (gap_m/dt, 0,
   // 0).
   Eigen::Vector3d velocity_bias = Eigen::Vector3d::Zero();

@@ -56,37 +56,82 @@ bool SolveSlip(const Eigen::Matrix3d& g, const Eigen::Vector3d& xi0, double mu,
 }
 
 // Exact solution of one contact's laws with all other percussions held fixed: gamma = xi0 + G P
-// with Signorini in the normal and Coulomb in the tangent plane. Tries separation, then sticking,
-// then slipping. Returns false when the slip iteration does not converge.
-bool SolveLocal(const Contact& c, const Eigen::Vector3d& xi0, Eigen::Vector3d* p) {
+// with Signorini in the normal and Coulomb in the tangent plane (g = G, g_inverse = G^-1). Tries
+// separation, then sticking, then slipping. Returns false when the slip iteration does not
+// converge.
+bool SolveLocal(const Eigen::Matrix3d& g, const Eigen::Matrix3d& g_inverse, double mu,
+                const Eigen::Vector3d& xi0, Eigen::Vector3d* p) {
   if (xi0.x() >= 0) {
     p->setZero();
     return true;
   }
-  const Eigen::Vector3d stick = -(c.delassus_inverse * xi0);
-  if (stick.x() >= 0 && stick.tail<2>().norm() <= c.mu * stick.x()) {
+  const Eigen::Vector3d stick = -(g_inverse * xi0);
+  if (stick.x() >= 0 && stick.tail<2>().norm() <= mu * stick.x()) {
     *p = stick;
     return true;
   }
-  if (c.mu == 0) {
-    *p = Eigen::Vector3d(-xi0.x() / c.delassus(0, 0), 0, 0);
+  if (mu == 0) {
+    *p = Eigen::Vector3d(-xi0.x() / g(0, 0), 0, 0);
     return true;
   }
-  return SolveSlip(c.delassus, xi0, c.mu, p);
+  return SolveSlip(g, xi0, mu, p);
 }
 
 // Fallback: proximal-point iterations on the contact's own 3 x 3 problem.
-Eigen::Vector3d ProxLocal(const Contact& c, const Eigen::Vector3d& xi0, Eigen::Vector3d p,
-                          double tolerance) {
+Eigen::Vector3d ProxLocal(const Eigen::Matrix3d& g, double mu, double r_normal, double r_tangent,
+                          const Eigen::Vector3d& xi0, Eigen::Vector3d p, double tolerance) {
   for (int iter = 0; iter < 1000; ++iter) {
-    const Eigen::Vector3d xi = xi0 + c.delassus * p;
+    const Eigen::Vector3d xi = xi0 + g * p;
     Eigen::Vector3d next;
-    next.x() = std::max(0.0, p.x() - c.r_normal * xi.x());
-    next.tail<2>() = ProjectDisk(p.tail<2>() - c.r_tangent * xi.tail<2>(), c.mu * next.x());
-    const double change = (c.delassus * (next - p)).norm();
+    next.x() = std::max(0.0, p.x() - r_normal * xi.x());
+    next.tail<2>() = ProjectDisk(p.tail<2>() - r_tangent * xi.tail<2>(), mu * next.x());
+    const double change = (g * (next - p)).norm();
     p = next;
     if (change <= tolerance) break;
   }
+  return p;
+}
+
+// One contact's percussion without the viscous term: exact local solve, prox as the fallback.
+Eigen::Vector3d SolveCoulomb(const Contact& c, const Eigen::Vector3d& xi0, double tolerance) {
+  Eigen::Vector3d p;
+  if (!SolveLocal(c.delassus, c.delassus_inverse, c.mu, xi0, &p))
+    p = ProxLocal(c.delassus, c.mu, c.r_normal, c.r_tangent, xi0, c.percussion, tolerance);
+  return p;
+}
+
+// One contact's percussion with the viscous friction of the contact-friction reading:
+// P = P_C - h (0, gamma_T,E), gamma_E = xi - bias, P_C obeying Signorini and Coulomb on xi, and
+// h = nu dt m_c >= 0 (kg) acting only while P_N > 0 (docs/model.md, "The viscous term"). With
+// H = diag(0, h, h) the damping folds into the contact's mass matrix, G^-1 -> G^-1 + H, so that
+// xi = xi0' + G' P_C with G' = (G^-1 + H)^-1 and xi0' = G' (G^-1 xi0 + H bias): the same local
+// problem as without viscosity, solved exactly by the same branches. If the contact would lift off
+// only because of its own viscous traction (xi0_N < 0 <= xi0'_N, a grazing contact), the term is
+// dropped: it never acts without load.
+Eigen::Vector3d SolveViscous(const Contact& c, const Eigen::Vector3d& xi0, double h,
+                             double tolerance) {
+  if (xi0.x() >= 0) return Eigen::Vector3d::Zero();
+  Eigen::Vector3d rhs = c.delassus_inverse * xi0;  // -(stick percussion) of the viscous problem
+  rhs.tail<2>() += h * c.velocity_bias.tail<2>();
+  Eigen::Vector3d coulomb = -rhs;
+  Eigen::Vector2d xi_t = Eigen::Vector2d::Zero();  // sticking: xi = 0
+  if (!(coulomb.x() >= 0 && coulomb.tail<2>().norm() <= c.mu * coulomb.x())) {
+    Eigen::Matrix3d mass = c.delassus_inverse;
+    mass(1, 1) += h;
+    mass(2, 2) += h;
+    const Eigen::Matrix3d g = mass.inverse();
+    const Eigen::Vector3d xi0_viscous = g * rhs;
+    if (xi0_viscous.x() >= 0) return SolveCoulomb(c, xi0, tolerance);
+    if (c.mu == 0) {
+      coulomb = Eigen::Vector3d(-xi0_viscous.x() / g(0, 0), 0, 0);
+    } else if (!SolveSlip(g, xi0_viscous, c.mu, &coulomb)) {
+      coulomb = ProxLocal(g, c.mu, c.r_normal, c.r_tangent, xi0_viscous, c.percussion, tolerance);
+    }
+    xi_t = (xi0_viscous + g * coulomb).tail<2>();
+  }
+  // Add the viscous part -h gamma_T,E, gamma_E = xi - bias.
+  Eigen::Vector3d p = coulomb;
+  p.tail<2>() -= h * (xi_t - c.velocity_bias.tail<2>());
   return p;
 }
 
@@ -105,6 +150,7 @@ ContactSolveReport SolveContacts(const Scene& scene, const RockShape& rock,
   const bool with_restitution = opt.normal_restitution != 0 || opt.tangential_restitution != 0;
   const double inv_mass = 1.0 / mass_eff_kg;
   const double inv_dt = 1.0 / opt.dt_s;
+  const bool viscous_friction = opt.viscous == ViscousReading::kContactFriction;
 
   // Per-contact Jacobians, step lengths and warm start.
   for (Contact& c : workspace.contacts) {
@@ -127,6 +173,8 @@ ContactSolveReport SolveContacts(const Scene& scene, const RockShape& rock,
                                                        c.arms.transpose() * omega_begin))
             : Eigen::Vector3d::Zero();
     c.velocity_bias.x() += c.gap_m * inv_dt;
+    c.viscous_kg =
+        viscous_friction ? scene.ground.params(c.ground).nu_1_s * opt.dt_s * rock.mass_kg : 0.0;
     c.percussion.setZero();
     if (workspace.last_closed[c.vertex]) {
       // Previous step's percussion, re-expressed in this frame and made admissible.
@@ -142,14 +190,30 @@ ContactSolveReport SolveContacts(const Scene& scene, const RockShape& rock,
   // Gauss-Seidel over the contacts, each solved exactly with the others held fixed.
   const double radius = rock.bounding_radius_m;
   report.converged = false;
+  const double local_tolerance = 1e-3 * opt.tolerance_m_s;
   for (int iter = 1; iter <= opt.max_iterations; ++iter) {
     double max_change = 0;
+    // Contact-friction viscosity: contact i's share of the rock's mass is its share of the total
+    // normal percussion, taken from the current iterate (all of it when no other contact carries
+    // load, which makes a single contact's solve exact).
+    double total_normal = 0;
+    if (viscous_friction)
+      for (const Contact& c : workspace.contacts) total_normal += c.percussion.x();
     for (Contact& c : workspace.contacts) {
       const Eigen::Vector3d xi = c.directions.transpose() * velocity_m_s +
                                  c.arms.transpose() * omega_rad_s + c.velocity_bias;
       const Eigen::Vector3d xi0 = xi - c.delassus * c.percussion;
       Eigen::Vector3d p;
-      if (!SolveLocal(c, xi0, &p)) p = ProxLocal(c, xi0, c.percussion, 1e-3 * opt.tolerance_m_s);
+      if (c.viscous_kg > 0) {
+        const double own = c.percussion.x();
+        const double others = total_normal - own;
+        const double share = others > 0 ? own / (own + others) : 1.0;
+        p = share > 0 ? SolveViscous(c, xi0, share * c.viscous_kg, local_tolerance)
+                      : SolveCoulomb(c, xi0, local_tolerance);
+        total_normal += p.x() - own;
+      } else {
+        p = SolveCoulomb(c, xi0, local_tolerance);
+      }
       const Eigen::Vector3d delta = p - c.percussion;
       if (delta.isZero(0.0)) continue;
       c.percussion = p;

@@ -5,6 +5,26 @@
 
 namespace talus {
 
+const char* ToString(ViscousReading reading) {
+  switch (reading) {
+    case ViscousReading::kCentreOfMass:
+      return "centre_of_mass";
+    case ViscousReading::kContactFriction:
+      return "contact_friction";
+  }
+  return "unknown";
+}
+
+bool ParseViscousReading(std::string_view name, ViscousReading* reading) {
+  for (ViscousReading r : {ViscousReading::kCentreOfMass, ViscousReading::kContactFriction}) {
+    if (name == ToString(r)) {
+      *reading = r;
+      return true;
+    }
+  }
+  return false;
+}
+
 bool SolverOptions::IsValid(std::string* why) const {
   std::ostringstream msg;
   auto check = [&](bool ok, const char* field, double value, const char* bound) {
@@ -19,6 +39,8 @@ bool SolverOptions::IsValid(std::string* why) const {
         normal_restitution, "0 <= normal_restitution <= 1");
   check(tangential_restitution >= -1 && tangential_restitution <= 1, "tangential_restitution",
         tangential_restitution, "-1 <= tangential_restitution <= 1");
+  check(viscous == ViscousReading::kCentreOfMass || viscous == ViscousReading::kContactFriction,
+        "viscous", static_cast<double>(viscous), "a ViscousReading value");
   check(tolerance_m_s > 0 && tolerance_m_s < 1, "tolerance_m_s", tolerance_m_s,
         "0 < tolerance_m_s < 1 m/s");
   check(max_iterations >= 1 && max_iterations <= 100000, "max_iterations", max_iterations,

@@ -2,8 +2,25 @@
 // Solver options: every knob a user trades against accuracy, with defaults, units and a check.
 
 #include <string>
+#include <string_view>
 
 namespace talus {
+
+// How the ground's viscous coefficient nu (1/s, GroundParams::nu_1_s) acts (docs/model.md,
+// "The viscous term"). Scene files name the readings "centre_of_mass" and "contact_friction".
+enum class ViscousReading {
+  // Drag -m nu v_S on the centre of mass in every step with a contact (wave 1's reading; caps a
+  // rolling or tumbling rock's speed at g sin(theta) / nu).
+  kCentreOfMass,
+  // Viscous friction in the tangential contact law of each loaded contact, acting on the slip
+  // velocity of the contact point with the Coulomb friction: -nu m_i gamma_T, where the rock's mass
+  // is shared among the loaded contacts in proportion to their normal percussions. A sliding rock
+  // feels -m nu v (the seed's S_v); a rolling contact that does not slip feels nothing.
+  kContactFriction,
+};
+const char* ToString(ViscousReading reading);  // "centre_of_mass", "contact_friction"
+// False when `name` is not one of the names ToString gives.
+bool ParseViscousReading(std::string_view name, ViscousReading* reading);
 
 struct SolverOptions {
   double dt_s = 0.002;                  // time step
@@ -11,6 +28,9 @@ struct SolverOptions {
   double gravity_m_s2 = 9.81;           // along -z
   double normal_restitution = 0.0;      // epsilon_N in [0, 1]; the model is fully plastic (0)
   double tangential_restitution = 0.0;  // epsilon_T in [-1, 1]; 0: no tangential rebound
+  // Reading of the viscous ground term. The default stays wave 1's until the field data have
+  // scored both (issue "ground models").
+  ViscousReading viscous = ViscousReading::kCentreOfMass;
   // Contact solve: Gauss-Seidel sweeps until the largest velocity change a sweep makes at any
   // contact point is below tolerance_m_s, or max_iterations sweeps.
   double tolerance_m_s = 1e-7;

@@ -42,6 +42,19 @@ void UpdateScar(const Scene& scene, const StepReport& report, const StepWorkspac
   }
 }
 
+// Centre-of-mass reading of the viscous term: implicit drag -m nu v_E with the mean nu of the
+// step's contacts, m (1 + nu dt) v_E = m v_free + sum P. Divides the free velocity by 1 + nu dt
+// and returns the effective translational mass m (1 + nu dt) for the contact solve.
+double CentreOfMassDrag(const Scene& scene, const RockShape& rock, const StepWorkspace& workspace,
+                        Eigen::Vector3d& velocity) {
+  double nu = 0;
+  for (const Contact& c : workspace.contacts) nu += scene.ground.params(c.ground).nu_1_s;
+  nu /= static_cast<double>(workspace.contacts.size());
+  const double drag_factor = 1.0 + nu * scene.options.dt_s;
+  velocity /= drag_factor;
+  return rock.mass_kg * drag_factor;
+}
+
 }  // namespace
 
 StepReport Step(const Scene& scene, const RockShape& rock, RockState& state,
@@ -76,18 +89,16 @@ StepReport Step(const Scene& scene, const RockShape& rock, RockState& state,
   }
   clock.Lap(&StageTimes::contacts_s);
 
-  // 4. Velocity update: gravity and, in contact, implicit drag m (1 + nu dt) v_E, then percussions.
-  const double mass = rock.mass_kg;
+  // 4. Velocity update: gravity, the viscous term (centre-of-mass reading: implicit drag
+  // m (1 + nu dt) v_E here; contact-friction reading: inside the contact law), then percussions.
   if (workspace.contacts.empty()) {
     workspace.ForgetPercussions();
   } else {
-    double nu = 0;
-    for (const Contact& c : workspace.contacts) nu += scene.ground.params(c.ground).nu_1_s;
-    nu /= static_cast<double>(workspace.contacts.size());
-    const double drag_factor = 1.0 + nu * dt;
-    velocity /= drag_factor;
+    const double mass_eff = opt.viscous == ViscousReading::kCentreOfMass
+                                ? CentreOfMassDrag(scene, rock, workspace, velocity)
+                                : rock.mass_kg;
     const ContactSolveReport solve =
-        SolveContacts(scene, rock, rotation, mass * drag_factor, begin.velocity_m_s,
+        SolveContacts(scene, rock, rotation, mass_eff, begin.velocity_m_s,
                       begin.angular_velocity_rad_s, velocity, omega, workspace);
     for (const Contact& c : workspace.contacts)
       report.contacts += c.gap_m == 0 || c.percussion.x() > 0;

@@ -137,6 +137,27 @@ TEST(LoadScene, NonPhysicalValuesNameKeyAndReason) {
   EXPECT_HAS(ErrorOf("[terrain\nplane = {}\n", dir), "scene.toml:1: TOML syntax error");
 }
 
+TEST(LoadScene, ViscousReadingIsChosenByNameWithDidYouMean) {
+  const auto dir = testing::FreshDir("viscous");
+  testing::WriteText(dir / "scene.toml", kPlaneScene);
+  EXPECT_EQ(LoadScene((dir / "scene.toml").string()).scene.options.viscous,
+            ViscousReading::kCentreOfMass);  // the default
+  testing::WriteText(
+      dir / "scene.toml",
+      Replace(kPlaneScene, "max_time_s = 20", "max_time_s = 20\nviscous = \"contact_friction\""));
+  EXPECT_EQ(LoadScene((dir / "scene.toml").string()).scene.options.viscous,
+            ViscousReading::kContactFriction);
+  EXPECT_HAS(ErrorOf(Replace(kPlaneScene, "max_time_s = 20",
+                             "max_time_s = 20\nviscous = \"center_of_mass\""),
+                     dir),
+             "scene.toml:23: solver.viscous: unknown reading 'center_of_mass' (did you mean "
+             "'centre_of_mass'?); known: centre_of_mass, contact_friction");
+  EXPECT_HAS(ErrorOf(Replace(kPlaneScene, "max_time_s = 20", "max_time_s = 20\nviscous = 1"), dir),
+             "solver.viscous: expected a string");
+  EXPECT_HAS(ErrorOf(Replace(kPlaneScene, "max_time_s = 20", "max_time_s = 20\nviscus = 1"), dir),
+             "solver.viscus: unknown key (did you mean 'viscous'?)");
+}
+
 TEST(LoadScene, ReleaseOutsideTheDemIsAnError) {
   const auto dir = testing::FreshDir("outside");
   const std::string e = ErrorOf(Replace(kPlaneScene, "[6, 2]", "[6, 200]"), dir);
