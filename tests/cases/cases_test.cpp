@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "ensemble/runner.hpp"
+#include "io/event_file.hpp"
 #include "io/scene_file.hpp"
 
 namespace talus {
@@ -19,7 +20,8 @@ namespace fs = std::filesystem;
 std::vector<fs::path> CaseScenes() {
   std::vector<fs::path> scenes;
   for (const auto& entry : fs::recursive_directory_iterator(fs::path(TALUS_SOURCE_DIR) / "cases"))
-    if (entry.path().extension() == ".toml") scenes.push_back(entry.path());
+    if (entry.path().extension() == ".toml" && entry.path().stem() != "event")
+      scenes.push_back(entry.path());
   std::sort(scenes.begin(), scenes.end());
   return scenes;
 }
@@ -40,6 +42,19 @@ TEST(Cases, EverySceneLoadsAndItsFirstRocksRun) {
     EXPECT_EQ(report.count(EndReason::kFailed), 0);
     EXPECT_EQ(report.rasters.empty(), scene.output.rasters.empty());
   }
+}
+
+// Every case's event file (event.toml) loads: its scene, its observation tables, its runs.
+TEST(Cases, EveryEventLoads) {
+  int events = 0;
+  for (const auto& entry : fs::recursive_directory_iterator(fs::path(TALUS_SOURCE_DIR) / "cases"))
+    if (entry.path().filename() == "event.toml") {
+      SCOPED_TRACE(entry.path().string());
+      const io::EventFile event = io::LoadEvent(entry.path().string());
+      EXPECT_GT(event.observations.size(), 0u);
+      ++events;
+    }
+  EXPECT_GE(events, 1);  // tschamut2014
 }
 
 }  // namespace
