@@ -4,6 +4,7 @@
 
 #include <CLI/CLI.hpp>
 #include <functional>
+#include <string>
 
 namespace talus::app {
 
@@ -13,5 +14,16 @@ Runner AddDemoCommand(CLI::App& app);
 Runner AddRockCommand(CLI::App& app);
 Runner AddSimulateCommand(CLI::App& app);
 Runner AddValidateCommand(CLI::App& app);
+
+// Exit codes, the same for every verb (README.md, "Exit codes").
+constexpr int kExitOk = 0;
+constexpr int kExitRunFailed = 1;  // the input was good but the run failed (e.g. a disk full)
+constexpr int kExitBadInput = 2;   // bad input or usage, reported before any work
+// Interrupted by a signal: 128 + the signal (130 for SIGINT, 143 for SIGTERM), as shells do.
+constexpr int ExitCodeForSignal(int signal) { return 128 + signal; }
+
+// A validator for integer options: a whole number from `min` to `max`, else the message
+// "must be >= min" (or "<= max", or "must be an integer") with the value given.
+CLI::Validator IntegerRange(long long min, long long max);
 
 }  // namespace talus::app

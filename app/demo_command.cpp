@@ -1,7 +1,9 @@
 // talus demo: one EOTA221 block down the 40 degree benchmark ramp.
 
+#include <cstdint>
 #include <cstdio>
 #include <iostream>
+#include <limits>
 #include <memory>
 
 #include "app/commands.hpp"
@@ -16,7 +18,7 @@ int RunDemo(std::uint64_t seed) {
   std::string why;
   if (!scene.IsValid(&why)) {
     std::cerr << "talus demo: " << why << "\n";
-    return 1;
+    return kExitRunFailed;
   }
   const RockState start = scenes::Ramp40Release(scene, seed, 0);
   SimulationWorkspace workspace;
@@ -29,7 +31,7 @@ int RunDemo(std::uint64_t seed) {
   std::printf("  %s\n", result.BriefReport().c_str());
   std::printf("  end position (%.2f, %.2f, %.2f) m, runout %.1f m from release\n", end.x(), end.y(),
               end.z(), result.runout_m);
-  return result.end == EndReason::kFailed ? 1 : 0;
+  return result.end == EndReason::kFailed ? kExitRunFailed : kExitOk;
 }
 
 }  // namespace
@@ -38,7 +40,8 @@ Runner AddDemoCommand(CLI::App& app) {
   auto seed = std::make_shared<std::uint64_t>(1);
   CLI::App* demo =
       app.add_subcommand("demo", "Run one EOTA221 block down the 40 degree benchmark ramp");
-  demo->add_option("--seed", *seed, "Random seed of the release orientation");
+  demo->add_option("--seed", *seed, "Random seed of the release orientation")
+      ->check(IntegerRange(0, std::numeric_limits<std::int64_t>::max()));
   return [demo, seed]() { return *demo ? RunDemo(*seed) : -1; };
 }
 

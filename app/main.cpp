@@ -1,4 +1,5 @@
-// talus: the command-line program. Each verb is registered from its own file (commands.hpp).
+// talus: the command-line program. Each verb is registered from its own file (commands.hpp); all
+// share the exit codes there: 0 done, 1 the run failed, 2 bad input or usage, 128 + signal.
 
 #include <CLI/CLI.hpp>
 #include <vector>
@@ -22,11 +23,16 @@ int main(int argc, char** argv) {
       talus::app::AddValidateCommand(app),
   };
 
-  CLI11_PARSE(app, argc, argv);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    // --help and --version end here with 0; every usage error is bad input.
+    return app.exit(e) == 0 ? talus::app::kExitOk : talus::app::kExitBadInput;
+  }
   // A runner returns -1 when its verb was not the one chosen.
   for (const auto& run : runners) {
     const int status = run();
     if (status >= 0) return status;
   }
-  return 0;
+  return talus::app::kExitOk;
 }

@@ -4,6 +4,7 @@
 #include <Eigen/Geometry>
 #include <iostream>
 #include <memory>
+#include <new>
 #include <string>
 
 #include "app/commands.hpp"
@@ -60,37 +61,41 @@ void AddShapeOptions(CLI::App* verb, RockArgs& args) {
                    "Downsample to one point per voxel of this size in m (0: off)");
 }
 
-// Builds the rock; on bad input prints one line on stderr and returns false.
-bool BuildRock(const char* verb, RockArgs& args, pointclouds::RockReport* report) {
+// Builds the rock; on failure prints one line on stderr and returns the exit code (bad input, or
+// a run that failed for want of memory), else kExitOk.
+int BuildRock(const char* verb, RockArgs& args, pointclouds::RockReport* report) {
   if (args.spec.file.empty() == args.spec.builtin.empty()) {
     std::cerr << "talus rock " << verb
               << ": give a point cloud FILE or --builtin NAME (one of them)\n";
-    return false;
+    return kExitBadInput;
   }
   if (*args.volume) args.spec.volume_m3 = args.volume_m3;
   if (*args.mass) args.spec.mass_kg = args.mass_kg;
   try {
     pointclouds::MakeRock(args.spec, report);
-    return true;
-  } catch (const std::exception& e) {
+    return kExitOk;
+  } catch (const std::bad_alloc&) {
+    std::cerr << "talus rock " << verb << ": out of memory\n";
+    return kExitRunFailed;
+  } catch (const std::exception& e) {  // unreadable or invalid point clouds, impossible shapes
     std::string message = e.what();
     for (char& ch : message)
       if (ch == '\n') ch = ' ';
     std::cerr << "talus rock " << verb << ": " << message << "\n";
-    return false;
+    return kExitBadInput;
   }
 }
 
 int RunInfo(RockArgs& args) {
   pointclouds::RockReport report;
-  if (!BuildRock("info", args, &report)) return 1;
+  if (const int status = BuildRock("info", args, &report); status != kExitOk) return status;
   std::cout << (args.json ? report.ToJson() + "\n" : report.FullReport());
-  return 0;
+  return kExitOk;
 }
 
 int RunHull(RockArgs& args) {
   pointclouds::RockReport report;
-  if (!BuildRock("hull", args, &report)) return 1;
+  if (const int status = BuildRock("hull", args, &report); status != kExitOk) return status;
   Polyhedron hull = report.hull;
   Eigen::Vector3d offset_m = report.recentred_by_m;
   if (args.principal) {
@@ -103,12 +108,12 @@ int RunHull(RockArgs& args) {
     pointclouds::WritePolyhedronPly(hull, offset_m, args.out);
   } catch (const std::exception& e) {
     std::cerr << "talus rock hull: " << e.what() << "\n";
-    return 1;
+    return kExitRunFailed;
   }
   std::cout << "Wrote the hull of " << report.source << " (" << report.hull_vertices
             << " vertices, " << report.hull_faces << " triangles, "
             << (args.principal ? "principal" : "input") << " frame) to " << args.out << "\n";
-  return 0;
+  return kExitOk;
 }
 
 }  // namespace

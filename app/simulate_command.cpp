@@ -1,16 +1,23 @@
 // talus simulate: run a scene's ensemble and write rocks.csv, rasters, trajectories and a summary.
 
+#include <cpl_error.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cerrno>
 #include <chrono>
+#include <csignal>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <iostream>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
 
 #include "app/commands.hpp"
+#include "app/interrupt.hpp"
 #include "common/atomic_file.hpp"
 #include "common/error.hpp"
 #include "ensemble/runner.hpp"
@@ -61,6 +68,7 @@ class FileSink : public ensemble::RockSink {
   FileSink(io::RocksCsvWriter& csv, io::TrajectoryWriter* trajectories, long sample)
       : csv_(csv), trajectories_(trajectories), sample_(sample) {}
   void OnRock(const ensemble::RockOutcome& rock) override {
+    ThrowIfInterrupted();
     csv_.Write(rock);
     if (trajectories_) trajectories_->Write(rock);
     if (rock.rock < sample_) {
@@ -75,6 +83,16 @@ class FileSink : public ensemble::RockSink {
   io::RocksCsvWriter& csv_;
   io::TrajectoryWriter* trajectories_;
   long sample_;
+};
+
+// Keeps GDAL's error messages off stderr while alive (on this thread); they stay readable through
+// CPLGetLastErrorMsg, which the raster writers put in their exceptions.
+class QuietGdal {
+ public:
+  QuietGdal() { CPLPushErrorHandler(CPLQuietErrorHandler); }
+  ~QuietGdal() { CPLPopErrorHandler(); }
+  QuietGdal(const QuietGdal&) = delete;
+  QuietGdal& operator=(const QuietGdal&) = delete;
 };
 
 constexpr long kQuickLookPaths = 20;  // rocks drawn on the quick-look
@@ -95,12 +113,19 @@ class ProgressBar {
     std::fprintf(stderr, "\r[%-*.*s] %ld/%ld rocks  %.1f/s  %s left   ", kWidth, filled,
                  "##############################", done, total, rate,
                  done > 0 ? (std::to_string(static_cast<long>(left + 0.5)) + " s").c_str() : "?");
+    shown_ = done < total;
     if (done == total) std::fprintf(stderr, "\n");
     std::fflush(stderr);
+  }
+  // Ends a bar left unfinished, so that a message starts on a line of its own.
+  void Break() {
+    if (shown_) std::fprintf(stderr, "\n");
+    shown_ = false;
   }
 
  private:
   bool enabled_;
+  bool shown_ = false;
   std::chrono::steady_clock::time_point start_;
 };
 
@@ -115,8 +140,28 @@ std::vector<std::string> TalusOutputNames() {
   return names;
 }
 
+// Creates the output directory; on failure the reason, else "".
+std::string PrepareOutputDirectory(const std::string& dir) {
+  namespace fs = std::filesystem;
+  std::error_code error;
+  if (fs::exists(dir, error) && !fs::is_directory(dir, error))
+    return "--out " + dir + " exists and is not a directory";
+  fs::create_directories(dir, error);
+  if (error) return "cannot create the output directory " + dir + ": " + error.message();
+  if (::access(dir.c_str(), W_OK | X_OK) != 0)
+    return "cannot write to the output directory " + dir + ": " + std::strerror(errno);
+  return "";
+}
+
 int RunSimulate(const SimulateArgs& args) {
   namespace fs = std::filesystem;
+  if (std::error_code error; fs::is_directory(args.scene, error)) {
+    std::cerr << "talus simulate: " << args.scene << " is a directory, not a scene file";
+    if (fs::is_regular_file(fs::path(args.scene) / "scene.toml", error))
+      std::cerr << " (did you mean " << (fs::path(args.scene) / "scene.toml").string() << "?)";
+    std::cerr << "\n";
+    return kExitBadInput;
+  }
   io::SceneFile scene;
   try {
     scene = io::LoadScene(args.scene);
@@ -127,27 +172,32 @@ int RunSimulate(const SimulateArgs& args) {
       throw InputError("--rocks " + std::to_string(args.rocks) + ": " + why);
   } catch (const InputError& e) {
     std::cerr << "talus simulate: " << e.what() << "\n";
-    return 2;
+    return kExitBadInput;
   } catch (const std::exception& e) {  // e.g. out of memory while reading the inputs
     std::cerr << "talus simulate: cannot load " << args.scene << ": " << e.what() << "\n";
-    return 1;
+    return kExitRunFailed;
   }
-  std::error_code error;
-  fs::create_directories(args.out, error);
-  if (error || !fs::is_directory(args.out)) {
-    std::cerr << "talus simulate: cannot create the output directory " << args.out << "\n";
-    return 2;
+  if (const std::string why = PrepareOutputDirectory(args.out); !why.empty()) {
+    std::cerr << "talus simulate: " << why << "\n";
+    return kExitBadInput;
   }
-  const auto out = [&](const std::string& name) { return (fs::path(args.out) / name).string(); };
-  // An earlier run's outputs that this run would not replace must not pass for this run's.
-  int stale = 0;
-  for (const std::string& name : TalusOutputNames()) stale += fs::remove(out(name), error) ? 1 : 0;
-  if (stale > 0)
-    std::printf("Removed %d outputs of an earlier run from %s\n", stale, args.out.c_str());
+  // From here on SIGINT / SIGTERM unwind the run: no temporary file is left behind.
+  const InterruptScope interrupts;
+  std::signal(SIGXFSZ, SIG_IGN);  // a file-size limit is a write error ("File too large")
+  if (const auto stale = RemoveStaleTemporaries(args.out); !stale.empty())
+    std::printf("Removed %zu temporary files of interrupted runs from %s\n", stale.size(),
+                args.out.c_str());
 
   std::printf("Scene %s: %s; %s\n", args.scene.c_str(), scene.terrain_description.c_str(),
               DescribeRocks(scene).c_str());
+  std::fflush(stdout);
+  // Every output is written into a staging directory and moved into --out only when all are
+  // complete: a failed or interrupted run leaves --out as it was.
+  std::optional<StagingDirectory> staging;
+  ProgressBar progress;
   try {
+    staging.emplace(args.out);
+    const auto out = [&](const std::string& name) { return staging->path(name); };
     ensemble::EnsembleOptions options;
     options.threads = args.threads;
     options.trajectories = scene.output.trajectories;
@@ -155,8 +205,11 @@ int RunSimulate(const SimulateArgs& args) {
     options.sample_trajectories = scene.output.quicklook ? kQuickLookPaths : 0;
     const GridGeometry& dem = scene.scene.terrain.heights().grid;
     options.rasters = scene.output.Request(dem);
-    ProgressBar progress;
-    options.progress = [&progress](long done, long total) { progress(done, total); };
+    // Thrown on the calling thread, Interrupted stops the workers and comes out of RunEnsemble.
+    options.progress = [&progress](long done, long total) {
+      ThrowIfInterrupted();
+      progress(done, total);
+    };
 
     std::vector<std::string> outputs = {"rocks.csv"};
     io::RocksCsvWriter csv(out("rocks.csv"), scene.release);
@@ -169,29 +222,56 @@ int RunSimulate(const SimulateArgs& args) {
     FileSink sink(csv, trajectories.get(), options.sample_trajectories);
     const ensemble::EnsembleReport report =
         ensemble::RunEnsemble(scene.scene, scene.release, options, &sink);
+    ThrowIfInterrupted();
     csv.Commit();
     if (trajectories) trajectories->Commit();
+    // GDAL would print every failed write of a full disk; the writers throw with its last message.
+    const QuietGdal quiet_gdal;
     for (const ensemble::RasterLayer& layer : report.rasters) {
+      ThrowIfInterrupted();
       io::WriteGeoTiff(out(layer.name + ".tif"), dem, scene.crs_wkt, layer.values, layer.has_nodata,
                        ensemble::RasterLayer::kNoData, layer.name + " (" + layer.unit + ")");
       outputs.push_back(layer.name + ".tif");
     }
+    ThrowIfInterrupted();
     if (scene.output.quicklook) {
       io::WriteQuickLookPng(out("quicklook.png"), scene.scene.terrain.heights(),
                             io::QuickLookLayer(report.rasters), sink.paths);
       outputs.push_back("quicklook.png");
     }
     WriteFileAtomically(out("summary.json"), io::SummaryJson(scene, report, kVersion, outputs));
+    ThrowIfInterrupted();
+    std::vector<std::string> commit = outputs;
+    commit.push_back("summary.json");  // last: a summary.json is there only with its outputs
+    staging->Commit(commit);
+    // An earlier run's outputs that this run did not replace must not pass for this run's.
+    int stale = 0;
+    for (const std::string& name : TalusOutputNames()) {
+      if (std::find(commit.begin(), commit.end(), name) != commit.end()) continue;
+      std::error_code error;
+      stale += fs::remove(fs::path(args.out) / name, error) ? 1 : 0;
+    }
+    if (stale > 0)
+      std::printf("Removed %d outputs of an earlier run from %s\n", stale, args.out.c_str());
     std::printf("%s\n", report.BriefReport().c_str());
-    std::printf("Wrote %zu files to %s\n", outputs.size() + 1, args.out.c_str());
+    std::printf("Wrote %zu files to %s\n", commit.size(), args.out.c_str());
     if (report.count(EndReason::kFailed) > 0)
       std::fprintf(stderr,
                    "talus simulate: %ld rocks failed numerically (end = failed in rocks.csv)\n",
                    report.count(EndReason::kFailed));
-    return 0;
+    return kExitOk;
+  } catch (const Interrupted& e) {
+    staging.reset();
+    progress.Break();
+    std::cerr << "talus simulate: " << e.what() << "; removed this run's temporary files, "
+              << args.out << " is as it was before the run\n";
+    return ExitCodeForSignal(e.signal());
   } catch (const std::exception& e) {
-    std::cerr << "talus simulate: " << e.what() << "\n";
-    return 1;
+    const std::string message = staging ? staging->Describe(e.what()) : e.what();
+    staging.reset();
+    progress.Break();
+    std::cerr << "talus simulate: " << message << " (no output written)\n";
+    return kExitRunFailed;
   }
 }
 
@@ -204,12 +284,14 @@ Runner AddSimulateCommand(CLI::App& app) {
   cmd->add_option("scene", args->scene, "Scene file (TOML)")->required();
   cmd->add_option("--out", args->out, "Output directory")->required();
   cmd->add_option("--rocks", args->rocks, "Rocks per release (overrides the scene)")
-      ->check(CLI::PositiveNumber);
+      ->check(IntegerRange(1, std::numeric_limits<long>::max()));
   cmd->add_option("--threads", args->threads, "Worker threads (default: all cores)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(IntegerRange(0, std::numeric_limits<int>::max()));
+  // The scene's range: a seed given here can be written in the scene file and the other way round.
   cmd->add_option_function<std::uint64_t>(
-      "--seed", [args](const std::uint64_t& seed) { args->seed = seed; },
-      "Random seed (overrides the scene)");
+         "--seed", [args](const std::uint64_t& seed) { args->seed = seed; },
+         "Random seed (overrides the scene)")
+      ->check(IntegerRange(0, std::numeric_limits<std::int64_t>::max()));
   return [cmd, args]() { return *cmd ? RunSimulate(*args) : -1; };
 }
 

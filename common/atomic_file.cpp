@@ -1,33 +1,61 @@
 #include "common/atomic_file.hpp"
 
+#include <signal.h>
 #include <unistd.h>
 
+#include <cerrno>
+#include <charconv>
+#include <cstdio>
+#include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <stdexcept>
 #include <system_error>
 
 namespace talus {
+namespace {
 
-AtomicFile::AtomicFile(std::string final_path) : final_path_(std::move(final_path)) {
-  const std::filesystem::path p(final_path_);
-  std::string name = ".";
-  name += p.filename().string();
-  name += ".tmp-";
+namespace fs = std::filesystem;
+
+constexpr const char* kTempMarker = ".tmp-";
+
+// ".<name>.tmp-<pid>" in the directory of `path`.
+std::string TemporaryName(const fs::path& path) {
+  std::string name = ".";  // appended piece by piece: GCC 12 warns (-Wrestrict) on a + b + c
+  name += path.filename().string();
+  name += kTempMarker;
   name += std::to_string(::getpid());
-  temp_path_ = (p.parent_path() / name).string();
+  return (path.parent_path() / name).string();
 }
+
+// The process id a temporary name ".<name>.tmp-<pid>" carries; 0 for any other name.
+pid_t OwnerOf(const std::string& name) {
+  const std::size_t at = name.rfind(kTempMarker);
+  if (name.size() < 2 || name[0] != '.' || at == std::string::npos || at < 2) return 0;
+  const char* first = name.data() + at + std::strlen(kTempMarker);
+  const char* last = name.data() + name.size();
+  pid_t pid = 0;
+  const auto [end, error] = std::from_chars(first, last, pid);
+  if (error != std::errc() || end != last || first == last || pid <= 0) return 0;
+  return pid;
+}
+
+bool ProcessExists(pid_t pid) { return ::kill(pid, 0) == 0 || errno == EPERM; }
+
+}  // namespace
+
+AtomicFile::AtomicFile(std::string final_path)
+    : final_path_(std::move(final_path)), temp_path_(TemporaryName(final_path_)) {}
 
 AtomicFile::~AtomicFile() {
   if (!committed_) {
     std::error_code ignored;
-    std::filesystem::remove(temp_path_, ignored);
+    fs::remove(temp_path_, ignored);
   }
 }
 
 void AtomicFile::Commit() {
   std::error_code error;
-  std::filesystem::rename(temp_path_, final_path_, error);
+  fs::rename(temp_path_, final_path_, error);
   if (error)
     throw std::runtime_error("cannot rename " + temp_path_ + " to " + final_path_ + ": " +
                              error.message());
@@ -36,13 +64,71 @@ void AtomicFile::Commit() {
 
 void WriteFileAtomically(const std::string& path, const std::string& contents) {
   AtomicFile file(path);
-  {
-    std::ofstream out(file.temp_path(), std::ios::binary);
-    out << contents;
-    out.flush();
-    if (!out) throw std::runtime_error("cannot write " + file.temp_path());
-  }
+  std::FILE* out = std::fopen(file.temp_path().c_str(), "wb");
+  if (!out)
+    throw std::runtime_error("cannot create " + file.temp_path() + ": " + std::strerror(errno));
+  const bool written = std::fwrite(contents.data(), 1, contents.size(), out) == contents.size() &&
+                       std::fflush(out) == 0;
+  const int write_errno = errno;
+  const bool closed = std::fclose(out) == 0;
+  if (!written || !closed)
+    throw std::runtime_error("cannot write " + path + ": " +
+                             std::strerror(written ? errno : write_errno));
   file.Commit();
+}
+
+StagingDirectory::StagingDirectory(std::string dir)
+    : dir_(std::move(dir)), staging_(TemporaryName(fs::path(dir_) / "talus-run")) {
+  std::error_code error;
+  fs::remove_all(staging_, error);  // a leftover of this very pid (a reused one)
+  if (!fs::create_directory(staging_, error) || error)
+    throw std::runtime_error("cannot create " + staging_ + ": " +
+                             (error ? error.message() : std::string("it exists")));
+}
+
+StagingDirectory::~StagingDirectory() {
+  std::error_code ignored;
+  fs::remove_all(staging_, ignored);
+}
+
+std::string StagingDirectory::path(const std::string& name) const {
+  return (fs::path(staging_) / name).string();
+}
+
+std::string StagingDirectory::Describe(std::string message) const {
+  const std::string from = staging_ + "/";
+  const std::string to = (fs::path(dir_) / "").string();
+  for (std::size_t at = message.find(from); at != std::string::npos;
+       at = message.find(from, at + to.size()))
+    message.replace(at, from.size(), to);
+  return message;
+}
+
+void StagingDirectory::Commit(const std::vector<std::string>& names) {
+  for (const std::string& name : names) {
+    std::error_code error;
+    fs::rename(path(name), fs::path(dir_) / name, error);
+    if (error)
+      throw std::runtime_error("cannot move " + name + " into " + dir_ + ": " + error.message());
+  }
+  std::error_code ignored;
+  fs::remove_all(staging_, ignored);
+}
+
+std::vector<std::string> RemoveStaleTemporaries(const std::string& dir) {
+  std::vector<std::string> stale;
+  std::error_code error;
+  for (fs::directory_iterator it(dir, error), end; !error && it != end; it.increment(error)) {
+    const std::string name = it->path().filename().string();
+    const pid_t owner = OwnerOf(name);
+    if (owner != 0 && owner != ::getpid() && !ProcessExists(owner)) stale.push_back(name);
+  }
+  std::vector<std::string> removed;
+  for (const std::string& name : stale) {
+    std::error_code ignored;
+    if (fs::remove_all(fs::path(dir) / name, ignored) > 0 && !ignored) removed.push_back(name);
+  }
+  return removed;
 }
 
 }  // namespace talus

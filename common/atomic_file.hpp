@@ -1,8 +1,10 @@
 #pragma once
 // Files that are complete or absent: written under a temporary name in the target directory and
-// renamed into place only when complete.
+// renamed into place only when complete. Temporary names are ".<name>.tmp-<pid>", so that a later
+// run can tell the leftovers of a process that died (RemoveStaleTemporaries).
 
 #include <string>
+#include <vector>
 
 namespace talus {
 
@@ -24,7 +26,39 @@ class AtomicFile {
   bool committed_ = false;
 };
 
-// Writes `contents` to `path` atomically.
+// Writes `contents` to `path` atomically. Throws std::runtime_error naming the file and the reason.
 void WriteFileAtomically(const std::string& path, const std::string& contents);
+
+// Files written together: each is written under its final name in a hidden staging directory
+// `<dir>/.talus-run.tmp-<pid>`, and Commit() moves them into `dir` only when all are complete.
+// Until then `dir` is untouched (an earlier run's files in it stay as they were); the staging
+// directory and whatever is in it are removed unless committed.
+class StagingDirectory {
+ public:
+  // Creates the staging directory in the existing directory `dir`. Throws std::runtime_error.
+  explicit StagingDirectory(std::string dir);
+  ~StagingDirectory();
+  StagingDirectory(const StagingDirectory&) = delete;
+  StagingDirectory& operator=(const StagingDirectory&) = delete;
+
+  // Where to write the file that will become `<dir>/<name>`.
+  std::string path(const std::string& name) const;
+  const std::string& staging_path() const { return staging_; }
+  // `message` with the staging directory's path replaced by the target directory's, for errors
+  // that name a file being written.
+  std::string Describe(std::string message) const;
+  // Renames the staged files `names`, in this order, into the target directory (replacing files
+  // of the same name) and removes the staging directory. Throws std::runtime_error.
+  void Commit(const std::vector<std::string>& names);
+
+ private:
+  std::string dir_;
+  std::string staging_;
+};
+
+// Removes from `dir` the temporary files and staging directories (".<name>.tmp-<pid>") of
+// processes that no longer exist; those of live processes, and every other file, are left alone.
+// Returns the names removed. Errors (an unreadable directory) are ignored: this is housekeeping.
+std::vector<std::string> RemoveStaleTemporaries(const std::string& dir);
 
 }  // namespace talus

@@ -1,66 +1,202 @@
 #include "io/trajectory_file.hpp"
 
-#include <H5Cpp.h>
+#include <hdf5.h>
+#include <sys/mman.h>
+#include <sys/resource.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <stdexcept>
+#include <utility>
 #include <vector>
 
 namespace talus::io {
-
-struct TrajectoryWriter::Impl {
-  H5::H5File file;
-  H5::Group rocks;
-  double mass_kg = 0;
-  std::vector<double> inertia;
-};
-
 namespace {
 
-void Attribute(H5::H5Object& object, const char* name, const std::vector<double>& values) {
+// One HDF5 identifier, closed with its own close function when it goes out of scope (errors
+// ignored there: that is the abandon path). Close() reports the error instead.
+class Handle {
+ public:
+  using CloseFunction = herr_t (*)(hid_t);
+  Handle() = default;
+  Handle(hid_t id, CloseFunction close) : id_(id), close_(close) {}
+  Handle(Handle&& other) noexcept { *this = std::move(other); }
+  Handle& operator=(Handle&& other) noexcept {
+    if (this != &other) {
+      Close();
+      id_ = std::exchange(other.id_, H5I_INVALID_HID);
+      close_ = other.close_;
+    }
+    return *this;
+  }
+  ~Handle() { Close(); }
+  hid_t get() const { return id_; }
+  // Closes now; false when HDF5 reports an error (e.g. the data it flushes cannot be written).
+  bool Close() {
+    const hid_t id = std::exchange(id_, H5I_INVALID_HID);
+    return id < 0 || close_(id) >= 0;
+  }
+
+ private:
+  hid_t id_ = H5I_INVALID_HID;
+  CloseFunction close_ = nullptr;
+};
+
+herr_t WalkError(unsigned depth, const H5E_error2_t* error, void* data) {
+  auto* reason = static_cast<std::string*>(data);
+  const std::string desc = error->desc ? error->desc : "";
+  // The system's words for a failed read or write ("No space left on device"), else the message
+  // of the innermost function.
+  const std::string marker = "error message = '";
+  if (const std::size_t at = desc.find(marker); at != std::string::npos) {
+    const std::size_t from = at + marker.size();
+    *reason = desc.substr(from, desc.find('\'', from) - from);
+    return 1;  // stop walking
+  }
+  if (depth == 0) *reason = desc;
+  return 0;
+}
+
+// An HDF5 failure and its reason, read from HDF5's error stack where it happened (the next HDF5
+// call, even a successful close while unwinding, clears the stack).
+struct Hdf5Failure {
+  std::string reason;
+};
+
+[[noreturn]] void Fail(const char* what) {
+  std::string reason;
+  H5Ewalk2(H5E_DEFAULT, H5E_WALK_UPWARD, WalkError, &reason);
+  throw Hdf5Failure{reason.empty() ? std::string("HDF5 failed to ") + what : reason};
+}
+
+// HDF5 would print its error stack on stderr; every failure becomes one exception instead. (The
+// setting is per thread in thread-safe builds, so each entry point makes it.)
+void SilenceHdf5() { H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr); }
+
+hid_t Check(hid_t id, const char* what) {
+  if (id < 0) Fail(what);
+  return id;
+}
+
+void Check(herr_t status, const char* what) {
+  if (status < 0) Fail(what);
+}
+
+// Creation properties that leave out the object's access/modification/change timestamps, so
+// that the same trajectories give the same bytes (the determinism contract covers every file).
+Handle UntimedCreation(hid_t property_class) {
+  Handle properties(Check(H5Pcreate(property_class), "create properties"), H5Pclose);
+  Check(H5Pset_obj_track_times(properties.get(), false), "set properties");
+  return properties;
+}
+
+Handle CreateGroup(hid_t parent, const char* name) {
+  const Handle properties = UntimedCreation(H5P_GROUP_CREATE);
+  return Handle(
+      Check(H5Gcreate2(parent, name, H5P_DEFAULT, properties.get(), H5P_DEFAULT), "create a group"),
+      H5Gclose);
+}
+
+void Attribute(hid_t object, const char* name, const std::vector<double>& values) {
   const hsize_t n = values.size();
-  H5::DataSpace space(1, &n);
-  H5::Attribute a = object.createAttribute(name, H5::PredType::NATIVE_DOUBLE, space);
-  a.write(H5::PredType::NATIVE_DOUBLE, values.data());
+  const Handle space(Check(H5Screate_simple(1, &n, nullptr), "create a dataspace"), H5Sclose);
+  Handle attribute(
+      Check(H5Acreate2(object, name, H5T_NATIVE_DOUBLE, space.get(), H5P_DEFAULT, H5P_DEFAULT),
+            "create an attribute"),
+      H5Aclose);
+  Check(H5Awrite(attribute.get(), H5T_NATIVE_DOUBLE, values.data()), "write an attribute");
+  if (!attribute.Close()) Fail("write an attribute");
 }
 
 template <class T>
-void Dataset(H5::Group& group, const char* name, const H5::PredType& type,
-             const std::vector<T>& data, hsize_t rows, hsize_t columns) {
+void Dataset(hid_t group, const char* name, hid_t type, const std::vector<T>& data, hsize_t rows,
+             hsize_t columns) {
   const hsize_t dims[2] = {rows, columns};
   const int rank = columns == 1 ? 1 : 2;
-  H5::DataSpace space(rank, dims);
-  H5::DSetCreatPropList properties;
+  const Handle space(Check(H5Screate_simple(rank, dims, nullptr), "create a dataspace"), H5Sclose);
+  const Handle properties = UntimedCreation(H5P_DATASET_CREATE);
   if (rows > 0) {
     const hsize_t chunk[2] = {std::min<hsize_t>(rows, 4096), columns};
-    properties.setChunk(rank, chunk);
-    properties.setShuffle();
-    properties.setDeflate(4);
+    Check(H5Pset_chunk(properties.get(), rank, chunk), "set chunks");
+    Check(H5Pset_shuffle(properties.get()), "set shuffle");
+    Check(H5Pset_deflate(properties.get(), 4), "set deflate");
   }
-  H5::DataSet set = group.createDataSet(name, type, space, properties);
-  if (rows > 0) set.write(data.data(), type);
+  Handle set(
+      Check(H5Dcreate2(group, name, type, space.get(), H5P_DEFAULT, properties.get(), H5P_DEFAULT),
+            "create a dataset"),
+      H5Dclose);
+  if (rows > 0)
+    Check(H5Dwrite(set.get(), type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data.data()), "write data");
+  // Closing writes the chunks still in the cache: a full disk shows here.
+  if (!set.Close()) Fail("write data");
+}
+
+// Closes a file that is being abandoned (its temporary file is about to be removed) without
+// writing what HDF5 still holds for it to disk: its descriptor is first pointed at an anonymous
+// memory file, and a soft file-size limit is lifted meanwhile. HDF5 cannot drop a file whose close
+// fails: it keeps a half-freed file that crashes it at exit.
+void Abandon(Handle& file) {
+  void* vfd = nullptr;
+  if (file.get() < 0 || H5Fget_vfd_handle(file.get(), H5P_DEFAULT, &vfd) < 0 || !vfd) {
+    file.Close();
+    return;
+  }
+  const int fd = *static_cast<int*>(vfd);  // the default (sec2) driver's descriptor
+  if (const int memory = ::memfd_create("talus-abandoned.h5", MFD_CLOEXEC); memory >= 0) {
+    ::dup2(memory, fd);
+    ::close(memory);
+  }
+  rlimit limit{};
+  const bool lift = ::getrlimit(RLIMIT_FSIZE, &limit) == 0 && limit.rlim_cur != limit.rlim_max;
+  if (lift) {
+    const rlimit lifted{limit.rlim_max, limit.rlim_max};
+    ::setrlimit(RLIMIT_FSIZE, &lifted);
+  }
+  file.Close();
+  if (lift) ::setrlimit(RLIMIT_FSIZE, &limit);
 }
 
 }  // namespace
 
+struct TrajectoryWriter::Impl {
+  Handle file;  // declared first: closed last
+  Handle rocks;
+  double mass_kg = 0;
+  std::vector<double> inertia;
+  bool committed = false;
+
+  ~Impl() {
+    if (committed) return;
+    rocks.Close();
+    Abandon(file);
+  }
+};
+
 TrajectoryWriter::TrajectoryWriter(const std::string& path, const RockShape& rock) : file_(path) {
-  H5::Exception::dontPrint();
+  SilenceHdf5();
   impl_ = std::make_unique<Impl>();
   impl_->mass_kg = rock.mass_kg;
   impl_->inertia = {rock.inertia_kg_m2.x(), rock.inertia_kg_m2.y(), rock.inertia_kg_m2.z()};
   try {
-    impl_->file = H5::H5File(file_.temp_path(), H5F_ACC_TRUNC);
-    impl_->rocks = impl_->file.createGroup("/rocks");
-    Attribute(impl_->file, "mass_kg", {impl_->mass_kg});
-    Attribute(impl_->file, "principal_inertia_kg_m2", impl_->inertia);
-  } catch (const H5::Exception& e) {
-    throw std::runtime_error("cannot create " + file_.temp_path() + ": " + e.getDetailMsg());
+    impl_->file =
+        Handle(Check(H5Fcreate(file_.temp_path().c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT),
+                     "create the file"),
+               H5Fclose);
+    impl_->rocks = CreateGroup(impl_->file.get(), "/rocks");
+    Attribute(impl_->file.get(), "mass_kg", {impl_->mass_kg});
+    Attribute(impl_->file.get(), "principal_inertia_kg_m2", impl_->inertia);
+  } catch (const Hdf5Failure& failure) {
+    const std::string reason = failure.reason;
+    impl_.reset();
+    throw std::runtime_error("cannot create " + file_.final_path() + ": " + reason);
   }
 }
 
 TrajectoryWriter::~TrajectoryWriter() = default;
 
 void TrajectoryWriter::Write(const ensemble::RockOutcome& rock) {
+  if (!impl_) throw std::logic_error("TrajectoryWriter::Write after a failure or Commit");
+  SilenceHdf5();
   const auto& samples = rock.trajectory;
   const hsize_t n = samples.size();
   std::vector<double> t, position, quaternion, velocity, angular, scar;
@@ -77,30 +213,47 @@ void TrajectoryWriter::Write(const ensemble::RockOutcome& rock) {
     scar.push_back(s.scar_m);
   }
   try {
-    H5::Group group = impl_->rocks.createGroup(std::to_string(rock.rock));
-    Attribute(group, "mass_kg", {impl_->mass_kg});
-    Attribute(group, "principal_inertia_kg_m2", impl_->inertia);
-    const auto& d = H5::PredType::NATIVE_DOUBLE;
-    Dataset(group, "t", d, t, n, 1);
-    Dataset(group, "position", d, position, n, 3);
-    Dataset(group, "quaternion", d, quaternion, n, 4);
-    Dataset(group, "velocity", d, velocity, n, 3);
-    Dataset(group, "angular_velocity", d, angular, n, 3);
-    Dataset(group, "contact", H5::PredType::NATIVE_UINT8, contact, n, 1);
-    Dataset(group, "scar", d, scar, n, 1);
-  } catch (const H5::Exception& e) {
+    Handle group = CreateGroup(impl_->rocks.get(), std::to_string(rock.rock).c_str());
+    // Each rock's own shape (runs with blocks, or a shape per rock), else the scene's rock.
+    if (rock.shape) {
+      const Eigen::Vector3d& inertia = rock.shape->inertia_kg_m2;
+      Attribute(group.get(), "mass_kg", {rock.shape->mass_kg});
+      Attribute(group.get(), "principal_inertia_kg_m2", {inertia.x(), inertia.y(), inertia.z()});
+    } else {
+      Attribute(group.get(), "mass_kg", {impl_->mass_kg});
+      Attribute(group.get(), "principal_inertia_kg_m2", impl_->inertia);
+    }
+    const hid_t d = H5T_NATIVE_DOUBLE;
+    Dataset(group.get(), "t", d, t, n, 1);
+    Dataset(group.get(), "position", d, position, n, 3);
+    Dataset(group.get(), "quaternion", d, quaternion, n, 4);
+    Dataset(group.get(), "velocity", d, velocity, n, 3);
+    Dataset(group.get(), "angular_velocity", d, angular, n, 3);
+    Dataset(group.get(), "contact", H5T_NATIVE_UINT8, contact, n, 1);
+    Dataset(group.get(), "scar", d, scar, n, 1);
+    if (!group.Close()) Fail("close a group");
+  } catch (const Hdf5Failure& failure) {
+    const std::string reason = failure.reason;
+    impl_.reset();  // abandon the file: nothing more is written to it
     throw std::runtime_error("cannot write rock " + std::to_string(rock.rock) + " to " +
-                             file_.temp_path() + ": " + e.getDetailMsg());
+                             file_.final_path() + ": " + reason);
   }
 }
 
 void TrajectoryWriter::Commit() {
+  if (!impl_) throw std::logic_error("TrajectoryWriter::Commit after a failure or Commit");
+  SilenceHdf5();
+  // Flush first: a write that fails while closing must not pass for a complete file.
   try {
-    impl_->rocks.close();
-    impl_->file.close();
-  } catch (const H5::Exception& e) {
-    throw std::runtime_error("cannot close " + file_.temp_path() + ": " + e.getDetailMsg());
+    Check(H5Fflush(impl_->file.get(), H5F_SCOPE_GLOBAL), "flush the file");
+    if (!impl_->rocks.Close()) Fail("close a group");
+    if (!impl_->file.Close()) Fail("close the file");
+    impl_->committed = true;
+  } catch (const Hdf5Failure& failure) {
+    impl_.reset();
+    throw std::runtime_error("cannot write " + file_.final_path() + ": " + failure.reason);
   }
+  impl_.reset();
   file_.Commit();
 }
 

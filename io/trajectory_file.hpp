@@ -3,6 +3,9 @@
 // position (n x 3), quaternion (n x 4, w x y z, the shape as given), velocity (n x 3),
 // angular_velocity (n x 3, world frame), contact (n, 0/1), scar (n); chunked and
 // deflate-compressed, written rock by rock (nothing is kept in memory), complete or absent.
+// Objects carry no timestamps: the same rocks give the same bytes. Every HDF5 failure (a full
+// disk, a file-size limit) is one std::runtime_error naming the file and the reason; HDF5 prints
+// nothing itself; a writer that failed writes nothing more and its temporary file goes with it.
 
 #include <memory>
 #include <string>
@@ -15,7 +18,8 @@ namespace talus::io {
 
 class TrajectoryWriter {
  public:
-  // Creates the file under a temporary name; root attributes mass_kg and principal_inertia_kg_m2.
+  // Creates the file under a temporary name; root attributes mass_kg and principal_inertia_kg_m2
+  // of the scene's rock. Each rock's group carries those of the shape it ran with.
   TrajectoryWriter(const std::string& path, const RockShape& rock);
   ~TrajectoryWriter();
   TrajectoryWriter(const TrajectoryWriter&) = delete;

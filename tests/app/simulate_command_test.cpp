@@ -1,15 +1,29 @@
-// End to end through the talus program: `talus simulate` on a tiny scene.
+// End to end through the talus program: `talus simulate` on a tiny scene, its failures, its
+// interrupts and the command line's messages and exit codes.
 
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/mount.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <array>
+#include <cerrno>
+#include <chrono>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
+#include <thread>
+#include <vector>
+
+extern char** environ;
 
 namespace {
 
@@ -40,6 +54,70 @@ std::string Slurp(const fs::path& path) {
   return s.str();
 }
 
+// Every regular file of `dir` by name, with its contents.
+std::map<std::string, std::string> Snapshot(const fs::path& dir) {
+  std::map<std::string, std::string> files;
+  for (const auto& entry : fs::directory_iterator(dir))
+    if (entry.is_regular_file()) files[entry.path().filename().string()] = Slurp(entry.path());
+  return files;
+}
+
+// Names in `dir` of temporary files or staging directories (".<name>.tmp-<pid>").
+std::vector<std::string> Temporaries(const fs::path& dir) {
+  std::vector<std::string> names;
+  for (const auto& entry : fs::directory_iterator(dir)) {
+    const std::string name = entry.path().filename().string();
+    if (name.find(".tmp-") != std::string::npos) names.push_back(name);
+  }
+  return names;
+}
+
+std::string Talus(const std::string& arguments) {
+  return std::string(TALUS_BINARY) + " " + arguments;
+}
+
+// Starts `talus arguments...` with stdout and stderr into `log`; returns its process id.
+pid_t StartTalus(const std::vector<std::string>& arguments, const fs::path& log) {
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log.c_str(),
+                                   O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
+  std::vector<std::string> words = {TALUS_BINARY};
+  words.insert(words.end(), arguments.begin(), arguments.end());
+  std::vector<char*> argv;
+  for (std::string& word : words) argv.push_back(word.data());
+  argv.push_back(nullptr);
+  pid_t pid = -1;
+  const int error = posix_spawn(&pid, TALUS_BINARY, &actions, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  return error == 0 ? pid : -1;
+}
+
+// Waits up to `seconds` for `pid` to end; its exit code, 256 + the signal if a signal killed it
+// (not an exit code), or -1 if it did not end (it is then killed).
+int WaitFor(pid_t pid, double seconds) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+  int status = 0;
+  while (::waitpid(pid, &status, WNOHANG) == 0) {
+    if (std::chrono::steady_clock::now() > deadline) {
+      ::kill(pid, SIGKILL);
+      ::waitpid(pid, &status, 0);
+      return -1;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 256 + WTERMSIG(status);
+}
+
+// The id of a process that has ended (a child that exited and was reaped).
+pid_t DeadPid() {
+  const pid_t child = ::fork();
+  if (child == 0) ::_exit(0);
+  ::waitpid(child, nullptr, 0);
+  return child;
+}
+
 const char* kScene = R"([terrain]
 plane = { slope_deg = 35, slope_length_m = 20, runout_m = 10, width_m = 12, cell_m = 1 }
 default_ground = "medium_hard"
@@ -55,6 +133,33 @@ max_time_s = 4
 trajectories = true
 trajectory_interval_s = 0.05
 rasters = ["speed", "energy", "jump_height", "passages", "deposits", "reach_probability"]
+)";
+
+// kScene writing only rocks.csv and summary.json.
+std::string LeanScene() {
+  std::string lean = kScene;
+  lean.replace(lean.find("trajectories = true"), 19, "trajectories = false");
+  lean.replace(lean.find("rasters = ["),
+               lean.find("]\n", lean.find("rasters = [")) - lean.find("rasters = [") + 1,
+               "rasters = []\nquicklook = false");
+  return lean;
+}
+
+// The benchmark ramp (cases/ramp40) with far more rocks than a test waits for, and trajectories.
+const char* kSlowScene = R"([terrain]
+plane = { slope_deg = 40, slope_length_m = 200, runout_m = 150, width_m = 100, cell_m = 2 }
+default_ground = "medium_hard"
+[rock]
+shape = { eota = "221", size_m = [0.93, 0.93, 0.47] }
+density_kg_m3 = 2500
+mass_kg = 780
+[release]
+points = [[10, 0]]
+rocks = 100000
+[output]
+trajectories = true
+trajectory_interval_s = 0.05
+rasters = ["speed", "passages"]
 )";
 
 TEST(SimulateCommand, WritesEveryOutputIdenticallyForOneAndTwoThreads) {
@@ -74,12 +179,13 @@ TEST(SimulateCommand, WritesEveryOutputIdenticallyForOneAndTwoThreads) {
   for (const auto& entry : fs::directory_iterator(a)) {
     const std::string name = entry.path().filename().string();
     EXPECT_NE(name[0], '.') << "temporary file left behind: " << name;
-    if (entry.path().extension() == ".tif" || name == "rocks.csv") {
+    if (name != "summary.json") {  // it has the wall time and the threads
       EXPECT_EQ(Slurp(entry.path()), Slurp(b / name)) << name << " differs between 1 and 2 threads";
       tifs += entry.path().extension() == ".tif";
     }
   }
   EXPECT_EQ(tifs, 12);
+  EXPECT_TRUE(Slurp(a / "trajectories.h5") == Slurp(b / "trajectories.h5"));
   for (const char* name : {"rocks.csv", "trajectories.h5", "summary.json", "quicklook.png"})
     EXPECT_TRUE(fs::exists(a / name)) << name;
   const auto summary = nlohmann::json::parse(Slurp(a / "summary.json"));
@@ -139,12 +245,7 @@ TEST(SimulateCommand, BadSceneFailsBeforeAnyWorkNamingFileLineAndKey) {
 TEST(SimulateCommand, ARunRemovesOutputsOfAnEarlierRunThatItDoesNotWrite) {
   const fs::path dir = FreshDir("stale");
   std::ofstream(dir / "all.toml") << kScene;
-  std::string lean = kScene;
-  lean.replace(lean.find("trajectories = true"), 19, "trajectories = false");
-  lean.replace(lean.find("rasters = ["),
-               lean.find("]\n", lean.find("rasters = [")) - lean.find("rasters = [") + 1,
-               "rasters = []\nquicklook = false");
-  std::ofstream(dir / "lean.toml") << lean;
+  std::ofstream(dir / "lean.toml") << LeanScene();
   const std::string out = (dir / "out").string();
   std::string log;
   ASSERT_EQ(RunCommand(std::string(TALUS_BINARY) + " simulate " + (dir / "all.toml").string() +
@@ -166,6 +267,149 @@ TEST(SimulateCommand, ARunRemovesOutputsOfAnEarlierRunThatItDoesNotWrite) {
   EXPECT_TRUE(fs::exists(dir / "out" / "rocks.csv"));
   EXPECT_TRUE(fs::exists(dir / "out" / "summary.json"));
   EXPECT_TRUE(fs::exists(dir / "out" / "notes.txt"));
+}
+
+// SIGINT or SIGTERM in the middle of a run: the workers stop, the temporary files go, the exit
+// code is 128 + the signal, and an earlier run's outputs in the directory are untouched.
+void InterruptARun(int signal, const std::string& name) {
+  const fs::path dir = FreshDir(name);
+  std::ofstream(dir / "scene.toml") << kScene;
+  std::ofstream(dir / "slow.toml") << kSlowScene;
+  const fs::path out = dir / "out";
+  std::string log;
+  ASSERT_EQ(
+      RunCommand(Talus("simulate " + (dir / "scene.toml").string() + " --out " + out.string()),
+                 &log),
+      0)
+      << log;
+  const auto earlier = Snapshot(out);
+  ASSERT_EQ(earlier.size(), 16u);
+
+  const pid_t pid = StartTalus(
+      {"simulate", (dir / "slow.toml").string(), "--out", out.string(), "--threads", "2"},
+      dir / "log.txt");
+  ASSERT_GT(pid, 0);
+  // Interrupt once the run is writing its temporary files (about a second into it).
+  const fs::path staging = out / (".talus-run.tmp-" + std::to_string(pid));
+  const fs::path trajectories = staging / (".trajectories.h5.tmp-" + std::to_string(pid));
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  while (!fs::exists(trajectories) && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  std::this_thread::sleep_for(std::chrono::seconds(1));
+  const bool was_writing = fs::exists(trajectories) && fs::file_size(trajectories) > 0;
+  ::kill(pid, signal);
+  const int status = WaitFor(pid, 30);
+  log = Slurp(dir / "log.txt");
+  EXPECT_TRUE(was_writing) << "the run did not get to write its trajectories\n" << log;
+  EXPECT_EQ(status, 128 + signal) << log;
+  EXPECT_NE(log.find(std::string("talus simulate: interrupted by ") +
+                     (signal == SIGINT ? "SIGINT" : "SIGTERM")),
+            std::string::npos)
+      << log;
+  EXPECT_EQ(Temporaries(out), std::vector<std::string>());
+  EXPECT_TRUE(Snapshot(out) == earlier) << "the earlier run's outputs changed";
+}
+
+TEST(SimulateCommand, SigintStopsTheRunRemovesItsTemporariesAndExits130) {
+  InterruptARun(SIGINT, "sigint");
+}
+
+TEST(SimulateCommand, SigtermStopsTheRunRemovesItsTemporariesAndExits143) {
+  InterruptARun(SIGTERM, "sigterm");
+}
+
+// Out of space (a 512 KiB tmpfs; needs root, skipped otherwise): one line naming the file and the
+// reason, exit 1, no temporary file, and the earlier run's outputs as they were.
+TEST(SimulateCommand, AFullDiskIsOneErrorAndLeavesTheEarlierRunAsItWas) {
+  const fs::path dir = FreshDir("full");
+  std::ofstream(dir / "scene.toml") << kScene;
+  std::ofstream(dir / "lean.toml") << LeanScene();
+  const fs::path disk = dir / "disk";
+  fs::create_directories(disk);
+  if (::mount("tmpfs", disk.c_str(), "tmpfs", 0, "size=512k") != 0)
+    GTEST_SKIP() << "cannot mount a tmpfs at " << disk << " (" << std::strerror(errno)
+                 << "); this test needs root";
+  struct Unmount {
+    const fs::path& path;
+    ~Unmount() { ::umount2(path.c_str(), MNT_DETACH); }
+  } unmount{disk};
+  const fs::path out = disk / "out";
+  std::string log;
+  ASSERT_EQ(RunCommand(Talus("simulate " + (dir / "lean.toml").string() + " --out " + out.string()),
+                       &log),
+            0)
+      << log;
+  const auto earlier = Snapshot(out);
+  EXPECT_EQ(RunCommand(Talus("simulate " + (dir / "scene.toml").string() + " --out " +
+                             out.string() + " --rocks 500"),
+                       &log),
+            1)
+      << log;
+  EXPECT_NE(log.find("talus simulate: cannot write rock "), std::string::npos) << log;
+  EXPECT_NE(log.find((out / "trajectories.h5").string() + ": No space left on device"),
+            std::string::npos)
+      << log;
+  int error_lines = 0;
+  std::istringstream lines(log);
+  for (std::string line; std::getline(lines, line);)
+    error_lines += line.rfind("Scene ", 0) != 0;  // all but the scene's description
+  EXPECT_EQ(error_lines, 1) << log;
+  EXPECT_EQ(Temporaries(out), std::vector<std::string>());
+  EXPECT_TRUE(Snapshot(out) == earlier) << "the earlier run's outputs changed";
+}
+
+TEST(SimulateCommand, RemovesTheTemporariesOfDeadRunsOnly) {
+  const fs::path dir = FreshDir("stale_temporaries");
+  std::ofstream(dir / "lean.toml") << LeanScene();
+  const fs::path out = dir / "out";
+  const std::string dead = std::to_string(DeadPid()), alive = std::to_string(::getpid());
+  fs::create_directories(out / (".talus-run.tmp-" + dead));
+  std::ofstream(out / (".talus-run.tmp-" + dead) / (".trajectories.h5.tmp-" + dead)) << "x";
+  std::ofstream(out / (".rocks.csv.tmp-" + dead)) << "x";
+  std::ofstream(out / (".rocks.csv.tmp-" + alive)) << "x";
+  std::string log;
+  ASSERT_EQ(RunCommand(Talus("simulate " + (dir / "lean.toml").string() + " --out " + out.string()),
+                       &log),
+            0)
+      << log;
+  EXPECT_NE(log.find("Removed 2 temporary files of interrupted runs"), std::string::npos) << log;
+  EXPECT_EQ(Temporaries(out), std::vector<std::string>{".rocks.csv.tmp-" + alive});
+}
+
+// Exit codes: 2 for bad input or usage on every verb, with a message that says what is wrong.
+TEST(TalusCommandLine, BadInputSaysWhatIsWrongAndExits2) {
+  const fs::path dir = FreshDir("bad_input");
+  std::ofstream(dir / "scene.toml") << kScene;
+  std::ofstream(dir / "file") << "not a directory";
+  const std::string scene = (dir / "scene.toml").string(), out = (dir / "out").string();
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"simulate " + scene + " --out " + out + " --rocks 0", "--rocks: must be >= 1, got 0"},
+      {"simulate " + scene + " --out " + out + " --rocks many", "--rocks: must be an integer"},
+      {"simulate " + scene + " --out " + out + " --seed -1", "--seed: must be >= 0, got -1"},
+      {"simulate " + scene + " --out " + out + " --threads -2", "--threads: must be >= 0"},
+      {"simulate " + dir.string() + " --out " + out,
+       dir.string() + " is a directory, not a scene file (did you mean " + scene + "?)"},
+      {"simulate " + scene + " --out " + (dir / "file" / "out").string(),
+       "cannot create the output directory " + (dir / "file" / "out").string() +
+           ": Not a directory"},
+      {"simulate " + scene + " --out " + (dir / "file").string(), "exists and is not a directory"},
+      {"simulate " + scene, "--out is required"},
+      {"demo --seed -1", "--seed: must be >= 0, got -1"},
+      {"rock info", "give a point cloud FILE or --builtin NAME"},
+      {"rock info --builtin nope", "unknown built-in shape 'nope'"},
+      {"rock hull " + (dir / "missing.ply").string() + " -o x.ply", "missing.ply"},
+      {"frobnicate", "A subcommand is required"},
+      {"", "A subcommand is required"},
+  };
+  for (const auto& [arguments, message] : cases) {
+    std::string log;
+    EXPECT_EQ(RunCommand(Talus(arguments), &log), 2) << arguments << "\n" << log;
+    EXPECT_NE(log.find(message), std::string::npos) << arguments << "\n" << log;
+  }
+  EXPECT_FALSE(fs::exists(out));
+  std::string log;
+  EXPECT_EQ(RunCommand(Talus("--help"), &log), 0) << log;
+  EXPECT_EQ(RunCommand(Talus("simulate --help"), &log), 0) << log;
 }
 
 }  // namespace

@@ -1,26 +1,46 @@
 #include "common/atomic_file.hpp"
 
 #include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <stdexcept>
 
 namespace talus {
 namespace {
 
+namespace fs = std::filesystem;
+
 // An empty directory of its own under the system's temporary directory.
-std::filesystem::path FreshDir(const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() / ("talus_common_test_" + name);
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
+fs::path FreshDir(const std::string& name) {
+  const auto dir = fs::temp_directory_path() / ("talus_common_test_" + name);
+  fs::remove_all(dir);
+  fs::create_directories(dir);
   return dir;
 }
 
-int FilesIn(const std::filesystem::path& dir) {
+int FilesIn(const fs::path& dir) {
   int n = 0;
-  for (const auto& entry : std::filesystem::directory_iterator(dir)) n += entry.is_regular_file();
+  for (const auto& entry : fs::directory_iterator(dir)) n += entry.is_regular_file();
   return n;
+}
+
+std::string Slurp(const fs::path& path) {
+  std::ifstream in(path);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// The id of a process that has ended (a child that exited and was reaped).
+pid_t DeadPid() {
+  const pid_t child = ::fork();
+  if (child == 0) ::_exit(0);
+  ::waitpid(child, nullptr, 0);
+  return child;
 }
 
 TEST(AtomicFile, CompleteOrAbsent) {
@@ -29,7 +49,7 @@ TEST(AtomicFile, CompleteOrAbsent) {
   {
     AtomicFile file(path);
     std::ofstream(file.temp_path()) << "half";
-    EXPECT_FALSE(std::filesystem::exists(path));
+    EXPECT_FALSE(fs::exists(path));
   }  // not committed: nothing remains
   EXPECT_EQ(FilesIn(dir), 0);
   WriteFileAtomically(path, "whole\n");
@@ -40,6 +60,65 @@ TEST(AtomicFile, CompleteOrAbsent) {
   EXPECT_EQ(FilesIn(dir), 1);
   EXPECT_THROW(WriteFileAtomically((dir / "no_such_dir" / "x.txt").string(), "x"),
                std::runtime_error);
+}
+
+TEST(AtomicFile, ErrorsSayWhy) {
+  const auto dir = FreshDir("why");
+  try {
+    WriteFileAtomically((dir / "no_such_dir" / "x.txt").string(), "x");
+    FAIL() << "no exception";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("No such file or directory"), std::string::npos)
+        << e.what();
+  }
+}
+
+TEST(StagingDirectory, TargetUntouchedUntilCommit) {
+  const auto dir = FreshDir("staging");
+  std::ofstream(dir / "a.txt") << "earlier a";
+  std::ofstream(dir / "b.txt") << "earlier b";
+  {
+    StagingDirectory staging(dir.string());
+    EXPECT_EQ(fs::path(staging.staging_path()).parent_path(), dir);
+    std::ofstream(staging.path("a.txt")) << "new a";
+    EXPECT_EQ(Slurp(dir / "a.txt"), "earlier a");
+    EXPECT_EQ(staging.Describe("cannot write " + staging.path("a.txt") + ": why"),
+              "cannot write " + (dir / "a.txt").string() + ": why");
+  }  // abandoned: the earlier files are as they were, the staging directory is gone
+  EXPECT_EQ(Slurp(dir / "a.txt"), "earlier a");
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator()), 2);
+  {
+    StagingDirectory staging(dir.string());
+    std::ofstream(staging.path("a.txt")) << "new a";
+    std::ofstream(staging.path("c.txt")) << "new c";
+    staging.Commit({"a.txt", "c.txt"});
+  }
+  EXPECT_EQ(Slurp(dir / "a.txt"), "new a");
+  EXPECT_EQ(Slurp(dir / "b.txt"), "earlier b");
+  EXPECT_EQ(Slurp(dir / "c.txt"), "new c");
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator()), 3);
+}
+
+TEST(RemoveStaleTemporaries, RemovesThoseOfDeadProcessesOnly) {
+  const auto dir = FreshDir("stale");
+  const std::string dead = std::to_string(DeadPid());
+  const std::string alive = std::to_string(::getpid());
+  std::ofstream(dir / (".rocks.csv.tmp-" + dead)) << "x";
+  fs::create_directories(dir / (".talus-run.tmp-" + dead));
+  std::ofstream(dir / (".talus-run.tmp-" + dead) / "rocks.csv") << "x";
+  std::ofstream(dir / (".rocks.csv.tmp-" + alive)) << "x";
+  std::ofstream(dir / (".rocks.csv.tmp-1")) << "x";   // init, always alive
+  std::ofstream(dir / ("notes.tmp-" + dead)) << "x";  // not a temporary name
+  std::ofstream(dir / (".notes.tmp-" + dead + "x")) << "x";
+  std::ofstream(dir / "rocks.csv") << "x";
+  const std::vector<std::string> removed = RemoveStaleTemporaries(dir.string());
+  EXPECT_EQ(removed.size(), 2u);
+  EXPECT_FALSE(fs::exists(dir / (".rocks.csv.tmp-" + dead)));
+  EXPECT_FALSE(fs::exists(dir / (".talus-run.tmp-" + dead)));
+  for (const std::string& kept :
+       {".rocks.csv.tmp-" + alive, std::string(".rocks.csv.tmp-1"), "notes.tmp-" + dead,
+        ".notes.tmp-" + dead + "x", std::string("rocks.csv")})
+    EXPECT_TRUE(fs::exists(dir / kept)) << kept;
 }
 
 }  // namespace

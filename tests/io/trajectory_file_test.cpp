@@ -2,6 +2,14 @@
 
 #include <H5Cpp.h>
 #include <gtest/gtest.h>
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <csignal>
+#include <fstream>
+#include <sstream>
+#include <thread>
 
 #include "solver/shapes.hpp"
 #include "test_files.hpp"
@@ -68,6 +76,80 @@ TEST(TrajectoryWriter, AbandonedWriterLeavesNothing) {
     writer.Write(Rock(0, 5));
   }
   EXPECT_TRUE(std::filesystem::is_empty(dir));
+}
+
+std::string Slurp(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// Writes up to `rocks` rocks of `samples` samples and commits; returns the message of the
+// exception that stopped it ("" if none).
+std::string WriteUntilFailure(const std::string& path, int rocks, int samples) {
+  try {
+    TrajectoryWriter writer(path, MakeRockShape(MakeBox(1, 1, 1), 2000));
+    for (int k = 0; k < rocks; ++k) writer.Write(Rock(k, samples));
+    writer.Commit();
+  } catch (const std::runtime_error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// A full disk: the writer's temporary file (".trajectories.h5.tmp-<pid>", common/atomic_file.hpp)
+// is made /dev/full, on which every write fails with ENOSPC. One exception naming the file and
+// the reason, nothing left behind, and no crash in HDF5's shutdown at exit (ctest runs each test
+// in a process of its own; HDF5's C++ API used to print "H5Dclose failed" for every dataset and
+// then crash there).
+TEST(TrajectoryWriter, FullDiskIsOneErrorNamingTheFileAndLeavesNothing) {
+  const auto dir = testing::FreshDir("full");
+  const auto path = (dir / "trajectories.h5").string();
+  std::filesystem::create_symlink("/dev/full",
+                                  dir / (".trajectories.h5.tmp-" + std::to_string(::getpid())));
+  const std::string message = WriteUntilFailure(path, 20, 200);
+  EXPECT_NE(message.find(path + ": No space left on device"), std::string::npos) << message;
+  EXPECT_TRUE(std::filesystem::is_empty(dir));
+}
+
+// A file-size limit (EFBIG once the file passes it) fails the same way, at whichever rock.
+TEST(TrajectoryWriter, FileSizeLimitIsOneErrorAndLeavesNothing) {
+  const auto dir = testing::FreshDir("limit");
+  const auto path = (dir / "trajectories.h5").string();
+  rlimit old{};
+  ASSERT_EQ(::getrlimit(RLIMIT_FSIZE, &old), 0);
+  constexpr rlim_t kLimit = 64 * 1024;
+  if (old.rlim_max != RLIM_INFINITY && old.rlim_max < 4 * kLimit)
+    GTEST_SKIP() << "the hard file-size limit is already below " << 4 * kLimit << " bytes";
+  std::signal(SIGXFSZ, SIG_IGN);  // else the process is killed at the limit
+  const rlimit small{kLimit, old.rlim_max};
+  ASSERT_EQ(::setrlimit(RLIMIT_FSIZE, &small), 0);
+  const std::string message = WriteUntilFailure(path, 2000, 400);
+  ::setrlimit(RLIMIT_FSIZE, &old);
+  EXPECT_NE(message.find(path + ": File too large"), std::string::npos) << message;
+  EXPECT_NE(message.find("cannot write rock "), std::string::npos) << message;
+  EXPECT_TRUE(std::filesystem::is_empty(dir));
+}
+
+// The determinism contract covers trajectories.h5: no object timestamps, so the same rocks
+// written at different times give the same bytes.
+TEST(TrajectoryWriter, SameRocksGiveTheSameBytesAtAnyTime) {
+  const auto dir = testing::FreshDir("same");
+  const auto a = dir / "a.h5", b = dir / "b.h5";
+  EXPECT_EQ(WriteUntilFailure(a.string(), 3, 30), "");
+  std::this_thread::sleep_for(std::chrono::milliseconds(1100));  // timestamps are in seconds
+  EXPECT_EQ(WriteUntilFailure(b.string(), 3, 30), "");
+  EXPECT_TRUE(Slurp(a) == Slurp(b)) << "the files differ";
+  H5::H5File file(a.string(), H5F_ACC_RDONLY);
+  for (const char* name : {"/rocks", "/rocks/2", "/rocks/2/position", "/rocks/2/contact"}) {
+    H5O_info_t info;
+    ASSERT_GE(H5Oget_info_by_name2(file.getId(), name, &info, H5O_INFO_TIME, H5P_DEFAULT), 0);
+    EXPECT_EQ(info.ctime, 0) << name;
+    EXPECT_EQ(info.mtime, 0) << name;
+    EXPECT_EQ(info.btime, 0) << name;
+    EXPECT_EQ(info.atime, 0) << name;
+  }
 }
 
 }  // namespace

@@ -1,0 +1,31 @@
+// Checks of command-line values shared by the verbs, with messages that name the bound.
+
+#include <charconv>
+#include <string>
+
+#include "app/commands.hpp"
+
+namespace talus::app {
+
+CLI::Validator IntegerRange(long long min, long long max) {
+  const std::string description =
+      "INT in [" + std::to_string(min) + " .. " + std::to_string(max) + "]";
+  return CLI::Validator(
+      [min, max](std::string& text) -> std::string {
+        long long value = 0;
+        const char* last = text.data() + text.size();
+        const auto [end, error] = std::from_chars(text.data(), last, value);
+        if (error == std::errc::result_out_of_range)
+          return (text[0] == '-' ? "must be >= " + std::to_string(min)
+                                 : "must be <= " + std::to_string(max)) +
+                 ", got " + text;
+        if (error != std::errc() || end != last || text.empty())
+          return "must be an integer, got '" + text + "'";
+        if (value < min) return "must be >= " + std::to_string(min) + ", got " + text;
+        if (value > max) return "must be <= " + std::to_string(max) + ", got " + text;
+        return {};
+      },
+      description);
+}
+
+}  // namespace talus::app
