@@ -26,4 +26,8 @@ constexpr int ExitCodeForSignal(int signal) { return 128 + signal; }
 // "must be >= min" (or "<= max", or "must be an integer") with the value given.
 CLI::Validator IntegerRange(long long min, long long max);
 
+// Creates the output directory (--out) and checks that it is writable; on failure the reason,
+// else "".
+std::string PrepareOutputDirectory(const std::string& dir);
+
 }  // namespace talus::app

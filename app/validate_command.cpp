@@ -3,13 +3,17 @@
 // observation and writes scores.json, observations.csv and the plots (docs/validation.md).
 
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <limits>
 #include <memory>
 #include <optional>
 
 #include "app/commands.hpp"
+#include "app/interrupt.hpp"
+#include "common/atomic_file.hpp"
 #include "common/error.hpp"
 #include "fieldobs/samples.hpp"
 #include "fieldobs/validation.hpp"
@@ -29,39 +33,44 @@ struct ValidateArgs {
 };
 
 int RunValidate(const ValidateArgs& args) {
-  namespace fs = std::filesystem;
   const auto t0 = std::chrono::steady_clock::now();
   io::EventFile event;
   try {
     event = io::LoadEvent(args.event);
+    ensemble::ReleaseSpec& release = event.scene.release;
+    if (args.rocks > 0) release.rocks_per_release = args.rocks;
+    if (args.seed) release.seed = *args.seed;
+    if (std::string why; !release.IsValid(&why))
+      throw InputError("--rocks " + std::to_string(args.rocks) + ": " + why);
   } catch (const InputError& e) {
     std::cerr << "talus validate: " << e.what() << "\n";
-    return 2;
+    return kExitBadInput;
+  } catch (const std::exception& e) {
+    std::cerr << "talus validate: cannot load " << args.event << ": " << e.what() << "\n";
+    return kExitRunFailed;
   }
-  ensemble::ReleaseSpec& release = event.scene.release;
-  if (args.rocks > 0) release.rocks_per_release = args.rocks;
-  if (args.seed) release.seed = *args.seed;
-  std::string why;
-  if (!release.IsValid(&why)) {
-    std::cerr << "talus validate: " << args.event << ": " << why << "\n";
-    return 2;
+  if (const std::string why = PrepareOutputDirectory(args.out); !why.empty()) {
+    std::cerr << "talus validate: " << why << "\n";
+    return kExitBadInput;
   }
-  std::error_code error;
-  fs::create_directories(args.out, error);
-  if (error || !fs::is_directory(args.out)) {
-    std::cerr << "talus validate: cannot create the output directory " << args.out << ": "
-              << error.message() << "\n";
-    return 2;
-  }
-  const auto out = [&](const std::string& name) { return (fs::path(args.out) / name).string(); };
+  // From here on SIGINT / SIGTERM unwind the run: no temporary file is left behind.
+  const InterruptScope interrupts;
+  RemoveStaleTemporaries(args.out);
+  const ensemble::ReleaseSpec& release = event.scene.release;
   std::printf("Event %s: %zu observations (%zu scalar, %zu deposits) of %ld runs x %ld rocks\n",
               args.event.c_str(), event.observations.size(), event.observations.scalars.size(),
               event.observations.deposits.size(), release.release_count(),
               release.rocks_per_release);
+  std::fflush(stdout);
+  // Every output is staged and moved into --out only when all are complete.
+  std::optional<StagingDirectory> staging;
   try {
+    staging.emplace(args.out);
+    const auto out = [&](const std::string& name) { return staging->path(name); };
     ensemble::EnsembleOptions options;
     options.threads = args.threads;
     options.episodes = event.needs_episodes;
+    options.progress = [](long, long) { ThrowIfInterrupted(); };
     fieldobs::EnsembleSamples simulated(release);
     io::ValidationRun run;
     run.ensemble = ensemble::RunEnsemble(event.scene.scene, release, options, &simulated);
@@ -95,24 +104,35 @@ int RunValidate(const ValidateArgs& args) {
     run.seed = release.seed;
     run.threads = run.ensemble.threads;
     run.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    std::vector<std::string> outputs = {"observations.csv", "observed_vs_simulated.svg", "pit.svg"};
     io::WriteTextFile(out("observations.csv"), io::ObservationsCsv(report));
     io::WriteTextFile(out("observed_vs_simulated.svg"), io::ObservedVsSimulatedSvg(report));
     io::WriteTextFile(out("pit.svg"), io::PitSvg(report));
-    int files = 4;
     if (!event.observations.deposits.empty()) {
       io::WriteDepositsPng(out("deposits.png"), event, simulated);
-      ++files;
+      outputs.push_back("deposits.png");
     }
     io::WriteTextFile(out("scores.json"), io::ScoresJson(event, report, run));
+    outputs.push_back("scores.json");  // last: scores.json is there only with its outputs
+    ThrowIfInterrupted();
+    staging->Commit(outputs);
     std::printf("%s", report.FullReport().c_str());
-    std::printf("Wrote %d files to %s\n", files, args.out.c_str());
-    return 0;
-  } catch (const InputError& e) {
-    std::cerr << "talus validate: " << e.what() << "\n";
-    return 2;
+    std::printf("Wrote %zu files to %s\n", outputs.size(), args.out.c_str());
+    return kExitOk;
+  } catch (const Interrupted& e) {
+    staging.reset();
+    std::cerr << "talus validate: " << e.what() << "; removed this run's temporary files, "
+              << args.out << " is as it was before the run\n";
+    return ExitCodeForSignal(e.signal());
+  } catch (const InputError& e) {  // a shape per rock that cannot be built, found late
+    staging.reset();
+    std::cerr << "talus validate: " << e.what() << " (no output written)\n";
+    return kExitBadInput;
   } catch (const std::exception& e) {
-    std::cerr << "talus validate: " << e.what() << "\n";
-    return 1;
+    const std::string message = staging ? staging->Describe(e.what()) : e.what();
+    staging.reset();
+    std::cerr << "talus validate: " << message << " (no output written)\n";
+    return kExitRunFailed;
   }
 }
 
@@ -126,12 +146,13 @@ Runner AddValidateCommand(CLI::App& app) {
       ->required();
   cmd->add_option("--out", args->out, "Output directory")->required();
   cmd->add_option("--rocks", args->rocks, "Rocks per run (overrides the scene)")
-      ->check(CLI::PositiveNumber);
+      ->check(IntegerRange(1, std::numeric_limits<long>::max()));
   cmd->add_option("--threads", args->threads, "Worker threads (default: all cores)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(IntegerRange(0, std::numeric_limits<int>::max()));
   cmd->add_option_function<std::uint64_t>(
-      "--seed", [args](const std::uint64_t& seed) { args->seed = seed; },
-      "Random seed (overrides the scene)");
+         "--seed", [args](const std::uint64_t& seed) { args->seed = seed; },
+         "Random seed (overrides the scene)")
+      ->check(IntegerRange(0, std::numeric_limits<std::int64_t>::max()));
   return [cmd, args]() { return *cmd ? RunValidate(*args) : -1; };
 }
 
