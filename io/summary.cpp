@@ -17,7 +17,18 @@ std::string SummaryJson(const SceneFile& scene, const ensemble::EnsembleReport& 
                {"volume_m3", scene.scene.rock.volume_m3},
                {"hull_vertices", scene.scene.rock.vertices_m.size()}};
   j["seed"] = scene.release.seed;
-  j["releases"] = scene.release.releases.size();
+  j["releases"] = scene.release.release_count();  // geometries, or runs of a run table
+  if (!scene.release.runs.empty()) {
+    j["runs"] = scene.release.runs.size();
+    nlohmann::ordered_json blocks = nlohmann::ordered_json::array();
+    for (const ensemble::Block& b : scene.release.blocks)
+      blocks.push_back({{"id", b.id},
+                        {"mass_kg", b.shape->mass_kg},
+                        {"volume_m3", b.shape->volume_m3},
+                        {"hull_vertices", b.shape->vertices_m.size()}});
+    j["blocks"] = blocks;
+  }
+  j["shape_per_rock"] = static_cast<bool>(scene.release.shape_per_rock);
   j["rocks_per_release"] = scene.release.rocks_per_release;
   j["rocks"] = report.rocks;
   j["ends"] = {{"rest", report.count(EndReason::kRest)},
