@@ -8,6 +8,7 @@
 
 #include "common/csv_table.hpp"
 #include "common/error.hpp"
+#include "io/vector.hpp"
 
 namespace talus::io {
 namespace {
@@ -123,12 +124,25 @@ EventFile LoadEvent(const std::string& path) {
     if (!fs::exists(file)) Fail(path, t->get("file"), name + ".file", "file not found: " + file);
     fieldobs::TableColumns columns;
     columns.run = StringKey(path, *t, "run_column", name + ".run_column", false, columns.run);
-    const CsvTable table = CsvTable::Read(file);
     const std::size_t before = event.observations.size();
-    if (kind == "runout") fieldobs::ReadRunouts(table, columns, event.observations);
-    if (kind == "deposits") fieldobs::ReadDeposits(table, columns, event.observations);
-    if (kind == "impacts") fieldobs::ReadImpacts(table, columns, event.observations);
-    if (kind == "scars") fieldobs::ReadScars(table, columns, event.observations);
+    const std::string extension = fs::path(file).extension().string();
+    const bool csv = extension == ".csv" || extension == ".txt";
+    if (!csv && kind != "deposits")
+      Fail(path, t->get("file"), name + ".file",
+           file + ": " + kind + " observations are CSV tables (.csv); vector files hold deposits");
+    if (!csv) {
+      // Rest positions as points of a vector file, placed in the DEM's CRS.
+      const auto points = ReadDepositPoints(file, event.scene.crs_wkt, columns.run,
+                                            Line(path, t->get("file")) + ": " + name + ".file");
+      event.observations.deposits.insert(event.observations.deposits.end(), points.begin(),
+                                         points.end());
+    } else {
+      const CsvTable table = CsvTable::Read(file);
+      if (kind == "runout") fieldobs::ReadRunouts(table, columns, event.observations);
+      if (kind == "deposits") fieldobs::ReadDeposits(table, columns, event.observations);
+      if (kind == "impacts") fieldobs::ReadImpacts(table, columns, event.observations);
+      if (kind == "scars") fieldobs::ReadScars(table, columns, event.observations);
+    }
     if (event.observations.size() == before)
       Fail(path, t->get("file"), name + ".file", file + " holds no observation");
     event.needs_episodes = event.needs_episodes || kind == "impacts" || kind == "scars";

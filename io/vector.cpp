@@ -61,9 +61,12 @@ void Collect(const OGRGeometry& geometry, const std::string& where,
 
 }  // namespace
 
-std::vector<ReleaseGeometry> ReadReleaseGeometries(const std::string& path,
-                                                   const std::string& target_crs_wkt,
-                                                   const std::string& what) {
+namespace {
+
+// Calls visit(feature, geometry in the target CRS, where) for every feature with a geometry.
+template <class Visit>
+void ForEachFeature(const std::string& path, const std::string& target_crs_wkt,
+                    const std::string& what, const std::string& placed, Visit&& visit) {
   RegisterGdal();
   if (!std::filesystem::exists(path)) throw InputError(what + ": file not found: " + path);
   std::unique_ptr<GDALDataset> dataset(GDALDataset::Open(
@@ -74,7 +77,6 @@ std::vector<ReleaseGeometry> ReadReleaseGeometries(const std::string& path,
     target.importFromWkt(target_crs_wkt.c_str());
     target.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
   }
-  std::vector<ReleaseGeometry> out;
   for (OGRLayer* layer : dataset->GetLayers()) {
     std::unique_ptr<OGRCoordinateTransformation> transform;
     const OGRSpatialReference* source = layer->GetSpatialRef();
@@ -86,8 +88,8 @@ std::vector<ReleaseGeometry> ReadReleaseGeometries(const std::string& path,
           std::string(dataset->GetDriver()->GetDescription()) == "GeoJSON" && code &&
           std::string(code) == "4326";
       if (!geojson_default)
-        throw InputError(what + ": " + path +
-                         " has a CRS but the DEM has none, so the release cannot be placed");
+        throw InputError(what + ": " + path + " has a CRS but the DEM has none, so the " + placed +
+                         " cannot be placed");
     } else if (source && !source->IsSame(&target)) {
       OGRSpatialReference s(*source);
       s.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
@@ -102,11 +104,54 @@ std::vector<ReleaseGeometry> ReadReleaseGeometries(const std::string& path,
       if (transform && copy->transform(transform.get()) != OGRERR_NONE)
         throw InputError(what + ": cannot transform feature " + std::to_string(feature->GetFID()) +
                          " of " + path + " to the DEM's CRS");
-      Collect(*copy, what + " (" + path + ", feature " + std::to_string(feature->GetFID()) + ")",
-              out);
+      visit(*feature, *copy,
+            what + " (" + path + ", feature " + std::to_string(feature->GetFID()) + ")");
     }
   }
+}
+
+}  // namespace
+
+std::vector<ReleaseGeometry> ReadReleaseGeometries(const std::string& path,
+                                                   const std::string& target_crs_wkt,
+                                                   const std::string& what) {
+  std::vector<ReleaseGeometry> out;
+  ForEachFeature(path, target_crs_wkt, what, "release",
+                 [&](OGRFeature&, const OGRGeometry& geometry, const std::string& where) {
+                   Collect(geometry, where, out);
+                 });
   if (out.empty()) throw InputError(what + ": " + path + " has no point, line or polygon");
+  return out;
+}
+
+std::vector<fieldobs::DepositObservation> ReadDepositPoints(const std::string& path,
+                                                            const std::string& target_crs_wkt,
+                                                            const std::string& run_field,
+                                                            const std::string& what) {
+  std::vector<fieldobs::DepositObservation> out;
+  ForEachFeature(path, target_crs_wkt, what, "observations",
+                 [&](OGRFeature& feature, const OGRGeometry& geometry, const std::string& where) {
+                   if (wkbFlatten(geometry.getGeometryType()) != wkbPoint)
+                     throw InputError(where + ": a rest position must be a point, not a " +
+                                      std::string(geometry.getGeometryName()));
+                   const auto& p = *geometry.toPoint();
+                   fieldobs::DepositObservation d;
+                   d.xy_m = Eigen::Vector2d(p.getX(), p.getY());
+                   if (!d.xy_m.allFinite()) throw InputError(where + ": non-finite coordinates");
+                   const int run = feature.GetFieldIndex(run_field.c_str());
+                   if (run >= 0) {
+                     d.run = feature.GetFieldAsString(run);
+                     if (d.run.empty()) throw InputError(where + ": empty " + run_field);
+                   }
+                   const int radius = feature.GetFieldIndex("radius_m");
+                   if (radius >= 0 && feature.IsFieldSetAndNotNull(radius)) {
+                     d.radius_m = feature.GetFieldAsDouble(radius);
+                     if (!(*d.radius_m >= 0)) throw InputError(where + ": radius_m must be >= 0");
+                   }
+                   d.where = path + " feature " + std::to_string(feature.GetFID());
+                   out.push_back(d);
+                 });
+  if (out.empty()) throw InputError(what + ": " + path + " has no point");
   return out;
 }
 

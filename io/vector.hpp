@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "ensemble/release.hpp"
+#include "fieldobs/observations.hpp"
 
 namespace talus::io {
 
@@ -15,5 +16,15 @@ namespace talus::io {
 std::vector<ensemble::ReleaseGeometry> ReadReleaseGeometries(const std::string& path,
                                                              const std::string& target_crs_wkt,
                                                              const std::string& what);
+
+// Surveyed rest positions from the point features of a vector file, in the DEM's CRS: reprojected
+// when the file and the DEM both have a CRS; an error when the file has one and the DEM none (a
+// GeoJSON without a "crs" member is taken as local coordinates then, as for releases). Each
+// feature's run is its `run_field` attribute (absent field: the whole scene), its uncertainty the
+// optional `radius_m` attribute. Throws InputError naming `what`, the file and the feature.
+std::vector<fieldobs::DepositObservation> ReadDepositPoints(const std::string& path,
+                                                            const std::string& target_crs_wkt,
+                                                            const std::string& run_field,
+                                                            const std::string& what);
 
 }  // namespace talus::io
