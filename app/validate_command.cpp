@@ -2,6 +2,7 @@
 // (its runs, with an ensemble of orientations each), scores the simulated counterparts of every
 // observation and writes scores.json, observations.csv and the plots (docs/validation.md).
 
+#include <algorithm>
 #include <chrono>
 #include <cstdint>
 #include <cstdio>
@@ -71,6 +72,11 @@ int RunValidate(const ValidateArgs& args) {
     options.threads = args.threads;
     options.episodes = event.needs_episodes;
     options.progress = [](long, long) { ThrowIfInterrupted(); };
+    // Trajectory segments: each rock's statistics over its run's observed window.
+    const std::vector<double> windows = fieldobs::SegmentWindows(event.observations, release);
+    if (std::any_of(windows.begin(), windows.end(), [](double w) { return w > 0; }))
+      options.extra_recorders.push_back(
+          fieldobs::SegmentRecorders(event.scene.scene.terrain, windows));
     fieldobs::EnsembleSamples simulated(release);
     io::ValidationRun run;
     run.ensemble = ensemble::RunEnsemble(event.scene.scene, release, options, &simulated);

@@ -41,6 +41,8 @@ struct RockOutcome {
   std::vector<TrajectorySample> trajectory;
   std::vector<ContactEpisode> episodes;
   Footprint footprint;
+  // Values a caller's own recorder stores (EnsembleOptions::extra_recorders), in its own layout.
+  std::vector<double> extra;
 };
 
 }  // namespace talus::ensemble

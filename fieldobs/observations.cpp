@@ -1,5 +1,6 @@
 #include "fieldobs/observations.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "common/error.hpp"
@@ -20,6 +21,12 @@ const char* ToString(Quantity quantity) {
       return "impact_duration";
     case Quantity::kScarLength:
       return "scar_length";
+    case Quantity::kSegmentMaxSpeed:
+      return "segment_max_speed";
+    case Quantity::kSegmentMeanAngularSpeed:
+      return "segment_mean_angular_speed";
+    case Quantity::kSegmentMaxJumpHeight:
+      return "segment_max_jump_height";
   }
   return "unknown";
 }
@@ -28,9 +35,13 @@ const char* UnitOf(Quantity quantity) {
   switch (quantity) {
     case Quantity::kRunout:
     case Quantity::kScarLength:
+    case Quantity::kSegmentMaxJumpHeight:
       return "m";
     case Quantity::kImpactSpeedOut:
+    case Quantity::kSegmentMaxSpeed:
       return "m/s";
+    case Quantity::kSegmentMeanAngularSpeed:
+      return "rad/s";
     case Quantity::kImpactEnergyRatio:
       return "1";
     case Quantity::kImpactAngularSpeedOut:
@@ -125,6 +136,66 @@ void ReadScars(const CsvTable& t, const TableColumns& c, ObservationSet& out) {
     if (t.Empty(row, "scar_length_m")) continue;
     out.scalars.push_back({Quantity::kScarLength, RunOf(t, c, row),
                            NonNegative(t, row, "scar_length_m"), Where(t, row)});
+  }
+}
+
+void ReadTrajectories(const CsvTable& t, const TableColumns& c, const Terrain& terrain,
+                      ObservationSet& out) {
+  t.Require({"time_s", "x_m", "y_m", "z_m"});
+  const bool speeds = t.Has("speed_mps");
+  if (!speeds) t.Require({"vx_mps", "vy_mps", "vz_mps"});
+  const bool omega = t.Has("omega_x_radps");
+  if (omega) t.Require({"omega_x_radps", "omega_y_radps", "omega_z_radps"});
+  // Runs in the order of their first row; each run's rows in table order.
+  std::vector<std::string> runs;
+  std::vector<std::vector<int>> rows;
+  for (int row = 0; row < t.rows(); ++row) {
+    const std::string run = RunOf(t, c, row);
+    std::size_t k = 0;
+    while (k < runs.size() && runs[k] != run) ++k;
+    if (k == runs.size()) {
+      runs.push_back(run);
+      rows.emplace_back();
+    }
+    rows[k].push_back(row);
+  }
+  for (std::size_t k = 0; k < runs.size(); ++k) {
+    const std::vector<int>& r = rows[k];
+    const std::string where = Where(t, r.front());
+    if (r.size() < 2)
+      throw InputError(where + ": run '" + runs[k] + "' has a single trajectory sample");
+    double max_speed = 0, omega_sum = 0, max_jump = -1e300;
+    bool jump = false;
+    double previous_t = -1e300;
+    for (int row : r) {
+      const double time = t.Number(row, "time_s");
+      if (time <= previous_t)
+        throw InputError(t.Where(row, "time_s") + ": times of run '" + runs[k] + "' must increase");
+      previous_t = time;
+      const double speed = speeds
+                               ? NonNegative(t, row, "speed_mps")
+                               : Eigen::Vector3d(t.Number(row, "vx_mps"), t.Number(row, "vy_mps"),
+                                                 t.Number(row, "vz_mps"))
+                                     .norm();
+      max_speed = std::max(max_speed, speed);
+      if (omega)
+        omega_sum += Eigen::Vector3d(t.Number(row, "omega_x_radps"), t.Number(row, "omega_y_radps"),
+                                     t.Number(row, "omega_z_radps"))
+                         .norm();
+      TerrainSample ground;
+      const double x = t.Number(row, "x_m"), y = t.Number(row, "y_m"), z = t.Number(row, "z_m");
+      if (terrain.Sample(x, y, &ground)) {
+        max_jump = std::max(max_jump, (z - ground.height_m) * ground.normal.z());
+        jump = true;
+      }
+    }
+    const double window = t.Number(r.back(), "time_s") - t.Number(r.front(), "time_s");
+    out.scalars.push_back({Quantity::kSegmentMaxSpeed, runs[k], max_speed, where, window});
+    if (omega)
+      out.scalars.push_back({Quantity::kSegmentMeanAngularSpeed, runs[k],
+                             omega_sum / double(r.size()), where, window});
+    if (jump)
+      out.scalars.push_back({Quantity::kSegmentMaxJumpHeight, runs[k], max_jump, where, window});
   }
 }
 

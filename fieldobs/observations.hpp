@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "common/csv_table.hpp"
+#include "solver/terrain.hpp"
 
 namespace talus::fieldobs {
 
@@ -20,6 +21,10 @@ enum class Quantity {
   kImpactAngularSpeedOut,  // rad/s: angular speed leaving the first contact episode
   kImpactDuration,         // s: duration of the first contact episode
   kScarLength,             // m: longest scar of the run's first loaded contact episode
+  // Over an observed trajectory segment: from the run's start for the segment's duration.
+  kSegmentMaxSpeed,          // m/s: largest speed of the centre of mass
+  kSegmentMeanAngularSpeed,  // rad/s: mean angular speed
+  kSegmentMaxJumpHeight,     // m: largest height of the centre of mass above the terrain (normal)
 };
 const char* ToString(Quantity quantity);  // "runout", "impact_speed_out", ...
 const char* UnitOf(Quantity quantity);    // "m", "m/s", "1", "rad/s", "s"
@@ -28,7 +33,8 @@ struct ScalarObservation {
   Quantity quantity = Quantity::kRunout;
   std::string run;  // run id; empty: the whole scene's rocks
   double value = 0;
-  std::string where;  // "file:line", for reports
+  std::string where;    // "file:line", for reports
+  double window_s = 0;  // segment quantities: the time from the run's start they cover
 };
 
 // A surveyed rest position (map coordinates, m), optionally with its uncertainty radius.
@@ -64,5 +70,14 @@ void ReadRunouts(const CsvTable& table, const TableColumns& columns, Observation
 void ReadDeposits(const CsvTable& table, const TableColumns& columns, ObservationSet& out);
 void ReadImpacts(const CsvTable& table, const TableColumns& columns, ObservationSet& out);
 void ReadScars(const CsvTable& table, const TableColumns& columns, ObservationSet& out);
+
+// Sampled trajectory segments (`time_s`, `x_m`, `y_m`, `z_m` of the centre of mass; `speed_mps` or
+// `vx_mps`, `vy_mps`, `vz_mps`; optional `omega_x_radps`, `omega_y_radps`, `omega_z_radps`), rows
+// grouped by run, each run's samples from its start. Each run gives its segment's largest speed,
+// mean angular speed (when given) and largest jump height over `terrain` (centre of mass above the
+// terrain along its normal, samples over the DEM only), with the segment's duration as the window.
+// A run needs at least 2 samples, in increasing time.
+void ReadTrajectories(const CsvTable& table, const TableColumns& columns, const Terrain& terrain,
+                      ObservationSet& out);
 
 }  // namespace talus::fieldobs

@@ -1,10 +1,93 @@
 #include "fieldobs/samples.hpp"
 
+#include <algorithm>
+#include <memory>
+
 namespace talus::fieldobs {
 
 EnsembleSamples::EnsembleSamples(const ensemble::ReleaseSpec& release) : release_(release) {
   for (long k = 0; k < release.release_count(); ++k)
     run_index_[release.ReleaseName(static_cast<int>(k))] = static_cast<int>(k);
+}
+
+namespace {
+
+class SegmentRecorder : public ensemble::RockRecorder {
+ public:
+  SegmentRecorder(const Terrain& terrain, const std::vector<double>& window_s)
+      : terrain_(terrain), window_s_(window_s) {}
+  void Begin(const ensemble::RockOutcome& outcome) override {
+    const auto r = static_cast<std::size_t>(outcome.release);
+    window_ = r < window_s_.size() ? window_s_[r] : 0.0;
+    if (window_ <= 0) return;
+    t0_ = outcome.start.time_s;
+    last_t_ = t0_;
+    max_speed_ = 0;
+    omega_sum_ = 0;
+    samples_ = 0;
+    max_jump_ = -1e300;
+    TerrainSample ground;
+    const Eigen::Vector3d& p = outcome.start.position_m;
+    Add(outcome.start, terrain_.Sample(p.x(), p.y(), &ground) ? &ground : nullptr);
+  }
+  void OnStep(const RockState& state, const StepReport&, const TerrainSample& ground) override {
+    if (window_ <= 0) return;
+    const double dt = state.time_s - last_t_;
+    last_t_ = state.time_s;
+    if (state.time_s - t0_ <= window_ + 0.5 * dt) Add(state, &ground);
+  }
+  void Finish(ensemble::RockOutcome& outcome) override {
+    if (window_ <= 0) return;
+    outcome.extra = {max_speed_, omega_sum_ / double(samples_), max_jump_};
+  }
+
+ private:
+  void Add(const RockState& s, const TerrainSample* ground) {
+    max_speed_ = std::max(max_speed_, s.velocity_m_s.norm());
+    omega_sum_ += s.angular_velocity_rad_s.norm();
+    ++samples_;
+    if (ground)
+      max_jump_ = std::max(max_jump_, (s.position_m.z() - ground->height_m) * ground->normal.z());
+  }
+
+  const Terrain& terrain_;
+  const std::vector<double>& window_s_;
+  double window_ = 0, t0_ = 0, last_t_ = 0;
+  double max_speed_ = 0, omega_sum_ = 0, max_jump_ = 0;
+  long samples_ = 0;
+};
+
+bool IsSegment(Quantity q) {
+  return q == Quantity::kSegmentMaxSpeed || q == Quantity::kSegmentMeanAngularSpeed ||
+         q == Quantity::kSegmentMaxJumpHeight;
+}
+
+}  // namespace
+
+ensemble::RecorderFactory SegmentRecorders(const Terrain& terrain, std::vector<double> window_s) {
+  auto windows = std::make_shared<const std::vector<double>>(std::move(window_s));
+  return [&terrain, windows]() -> std::unique_ptr<ensemble::RockRecorder> {
+    // The recorder refers to the shared windows, which the factory keeps alive.
+    struct Owning : SegmentRecorder {
+      Owning(const Terrain& t, std::shared_ptr<const std::vector<double>> w)
+          : SegmentRecorder(t, *w), keep(std::move(w)) {}
+      std::shared_ptr<const std::vector<double>> keep;
+    };
+    return std::make_unique<Owning>(terrain, windows);
+  };
+}
+
+std::vector<double> SegmentWindows(const ObservationSet& observations,
+                                   const ensemble::ReleaseSpec& release) {
+  std::vector<double> windows(static_cast<std::size_t>(release.release_count()), 0.0);
+  for (const ScalarObservation& o : observations.scalars) {
+    if (!IsSegment(o.quantity)) continue;
+    for (long r = 0; r < release.release_count(); ++r)
+      if (o.run.empty() || release.ReleaseName(static_cast<int>(r)) == o.run)
+        windows[static_cast<std::size_t>(r)] =
+            std::max(windows[static_cast<std::size_t>(r)], o.window_s);
+  }
+  return windows;
 }
 
 void EnsembleSamples::OnRock(const ensemble::RockOutcome& outcome) {
@@ -25,6 +108,11 @@ void EnsembleSamples::OnRock(const ensemble::RockOutcome& outcome) {
         rock.scar_m = loaded.max_scar_m;
         break;
       }
+  }
+  if (outcome.extra.size() == 3) {
+    rock.segment_max_speed_m_s = outcome.extra[0];
+    rock.segment_mean_angular_speed_rad_s = outcome.extra[1];
+    if (outcome.extra[2] > -1e299) rock.segment_max_jump_m = outcome.extra[2];
   }
   rocks_.push_back(rock);
 }
@@ -69,6 +157,15 @@ std::vector<double> EnsembleSamples::Values(Quantity quantity, const std::string
         break;
       case Quantity::kScarLength:
         v = r.scar_m;
+        break;
+      case Quantity::kSegmentMaxSpeed:
+        v = r.segment_max_speed_m_s;
+        break;
+      case Quantity::kSegmentMeanAngularSpeed:
+        v = r.segment_mean_angular_speed_rad_s;
+        break;
+      case Quantity::kSegmentMaxJumpHeight:
+        v = r.segment_max_jump_m;
         break;
     }
     if (v) out.push_back(*v);

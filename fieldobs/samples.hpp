@@ -14,6 +14,17 @@
 
 namespace talus::fieldobs {
 
+// A recorder (EnsembleOptions::extra_recorders) of each rock's statistics over the first
+// window_s[release] seconds of its run (0: none): largest speed, mean angular speed, largest jump
+// height (centre of mass above the terrain along its normal), the start state included. They are
+// the simulated counterparts of observed trajectory segments; EnsembleSamples reads them.
+ensemble::RecorderFactory SegmentRecorders(const Terrain& terrain, std::vector<double> window_s);
+
+// The windows SegmentRecorders needs for the segment observations of `observations`, per release
+// of `release` (the longest window of a run's observations).
+std::vector<double> SegmentWindows(const ObservationSet& observations,
+                                   const ensemble::ReleaseSpec& release);
+
 class EnsembleSamples : public ensemble::RockSink {
  public:
   // `release` names the runs; it must outlive this object. The runner must record episodes
@@ -40,6 +51,9 @@ class EnsembleSamples : public ensemble::RockSink {
     Eigen::Vector2d start_m = Eigen::Vector2d::Zero();
     // From the first contact episode (and the first loaded one, for the scar).
     std::optional<double> speed_out_m_s, energy_ratio, angular_speed_out_rad_s, duration_s, scar_m;
+    // Over the run's observed segment (SegmentRecorders).
+    std::optional<double> segment_max_speed_m_s, segment_mean_angular_speed_rad_s,
+        segment_max_jump_m;
   };
   template <class F>
   void ForRun(const std::string& run, F&& f) const;

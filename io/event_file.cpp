@@ -37,7 +37,7 @@ std::string StringKey(const std::string& file, const toml::table& t, const std::
   return std::string(*node->value<std::string>());
 }
 
-const std::vector<std::string> kKinds = {"runout", "deposits", "impacts", "scars"};
+const std::vector<std::string> kKinds = {"runout", "deposits", "impacts", "scars", "trajectories"};
 
 }  // namespace
 
@@ -118,7 +118,7 @@ EventFile LoadEvent(const std::string& path) {
       const std::string hint = ClosestName(kind, kKinds);
       Fail(path, t->get("kind"), name + ".kind",
            "unknown kind '" + kind + "'" + (hint.empty() ? "" : " (did you mean '" + hint + "'?)") +
-               "; known: runout, deposits, impacts, scars");
+               "; known: runout, deposits, impacts, scars, trajectories");
     }
     const std::string file = resolve(StringKey(path, *t, "file", name + ".file", true));
     if (!fs::exists(file)) Fail(path, t->get("file"), name + ".file", "file not found: " + file);
@@ -142,6 +142,8 @@ EventFile LoadEvent(const std::string& path) {
       if (kind == "deposits") fieldobs::ReadDeposits(table, columns, event.observations);
       if (kind == "impacts") fieldobs::ReadImpacts(table, columns, event.observations);
       if (kind == "scars") fieldobs::ReadScars(table, columns, event.observations);
+      if (kind == "trajectories")
+        fieldobs::ReadTrajectories(table, columns, event.scene.scene.terrain, event.observations);
     }
     if (event.observations.size() == before)
       Fail(path, t->get("file"), name + ".file", file + " holds no observation");
