@@ -3,7 +3,9 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <map>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "solver/episodes.hpp"
@@ -41,8 +43,9 @@ struct RockOutcome {
   std::vector<TrajectorySample> trajectory;
   std::vector<ContactEpisode> episodes;
   Footprint footprint;
-  // Values a caller's own recorder stores (EnsembleOptions::extra_recorders), in its own layout.
-  std::vector<double> extra;
+  // Values callers' own recorders store (EnsembleOptions::extra_recorders), each under its own
+  // name and in its own layout.
+  std::map<std::string, std::vector<double>> extra;
 };
 
 }  // namespace talus::ensemble

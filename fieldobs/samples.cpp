@@ -38,7 +38,7 @@ class SegmentRecorder : public ensemble::RockRecorder {
   }
   void Finish(ensemble::RockOutcome& outcome) override {
     if (window_ <= 0) return;
-    outcome.extra = {max_speed_, omega_sum_ / double(samples_), max_jump_};
+    outcome.extra["segment"] = {max_speed_, omega_sum_ / double(samples_), max_jump_};
   }
 
  private:
@@ -109,10 +109,11 @@ void EnsembleSamples::OnRock(const ensemble::RockOutcome& outcome) {
         break;
       }
   }
-  if (outcome.extra.size() == 3) {
-    rock.segment_max_speed_m_s = outcome.extra[0];
-    rock.segment_mean_angular_speed_rad_s = outcome.extra[1];
-    if (outcome.extra[2] > -1e299) rock.segment_max_jump_m = outcome.extra[2];
+  if (const auto it = outcome.extra.find("segment"); it != outcome.extra.end()) {
+    const std::vector<double>& s = it->second;
+    rock.segment_max_speed_m_s = s[0];
+    rock.segment_mean_angular_speed_rad_s = s[1];
+    if (s[2] > -1e299) rock.segment_max_jump_m = s[2];
   }
   rocks_.push_back(rock);
 }
