@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <unordered_map>
 
 #include "common/error.hpp"
 
@@ -95,7 +96,41 @@ void ReadDeposits(const CsvTable& t, const TableColumns& c, ObservationSet& out)
   }
 }
 
-void ReadImpacts(const CsvTable& t, const TableColumns& c, ObservationSet& out) {
+std::vector<std::pair<std::string, std::optional<double>>> FirstAngularSpeeds(
+    const CsvTable& t, const TableColumns& c) {
+  t.Require({c.run, "time_s", "omega_x_radps", "omega_y_radps", "omega_z_radps"});
+  std::vector<std::pair<std::string, std::optional<double>>> out;
+  std::unordered_map<std::string, std::size_t> index;
+  std::vector<double> first_time_s;
+  for (int row = 0; row < t.rows(); ++row) {
+    const std::string run = RunOf(t, c, row);
+    const double time_s = t.Number(row, "time_s");
+    const auto [it, added] = index.emplace(run, out.size());
+    if (!added && time_s >= first_time_s[it->second]) continue;
+    std::optional<double> speed;
+    if (!t.Empty(row, "omega_x_radps") || !t.Empty(row, "omega_y_radps") ||
+        !t.Empty(row, "omega_z_radps"))
+      speed = Eigen::Vector3d(t.Number(row, "omega_x_radps"), t.Number(row, "omega_y_radps"),
+                              t.Number(row, "omega_z_radps"))
+                  .norm();
+    if (added) {
+      out.emplace_back(run, speed);
+      first_time_s.push_back(time_s);
+    } else {
+      out[it->second].second = speed;
+      first_time_s[it->second] = time_s;
+    }
+  }
+  return out;
+}
+
+void ReadImpacts(const CsvTable& t, const TableColumns& c, ObservationSet& out,
+                 const CsvTable* next_samples) {
+  std::unordered_map<std::string, std::optional<double>> next_omega;
+  if (next_samples) {
+    t.Require({c.next_run});
+    for (auto& [run, speed] : FirstAngularSpeeds(*next_samples, c)) next_omega[run] = speed;
+  }
   const bool vectors = t.Has("incoming_vx_mps");
   if (vectors) {
     t.Require({"incoming_vx_mps", "incoming_vy_mps", "incoming_vz_mps", "outgoing_vx_mps",
@@ -121,13 +156,26 @@ void ReadImpacts(const CsvTable& t, const TableColumns& c, ObservationSet& out) 
     out.scalars.push_back({Quantity::kImpactSpeedOut, run, out_speed, Where(t, row)});
     out.scalars.push_back(
         {Quantity::kImpactEnergyRatio, run, (out_speed * out_speed) / (in * in), Where(t, row)});
-    if (!t.Empty(row, "omega_out_radps"))
+    if (!t.Empty(row, "omega_out_radps")) {
       out.scalars.push_back({Quantity::kImpactAngularSpeedOut, run,
                              NonNegative(t, row, "omega_out_radps"), Where(t, row)});
+    } else if (next_samples && !t.Empty(row, c.next_run)) {
+      const std::string next = t.Text(row, c.next_run);
+      const auto it = next_omega.find(next);
+      if (it == next_omega.end())
+        throw InputError(t.Where(row, c.next_run) + ": segment '" + next + "' has no sample in " +
+                         next_samples->path());
+      if (it->second)
+        out.scalars.push_back({Quantity::kImpactAngularSpeedOut, run, *it->second, Where(t, row)});
+    }
     if (!t.Empty(row, "duration_s"))
       out.scalars.push_back(
           {Quantity::kImpactDuration, run, NonNegative(t, row, "duration_s"), Where(t, row)});
   }
+}
+
+void ReadImpacts(const CsvTable& t, const TableColumns& c, ObservationSet& out) {
+  ReadImpacts(t, c, out, nullptr);
 }
 
 void ReadScars(const CsvTable& t, const TableColumns& c, ObservationSet& out) {

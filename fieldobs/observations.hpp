@@ -6,6 +6,7 @@
 #include <Eigen/Core>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "common/csv_table.hpp"
@@ -55,6 +56,9 @@ struct ObservationSet {
 // (docs/validation.md), so that tables in that format need no configuration.
 struct TableColumns {
   std::string run = "trajectory_id";  // absent column: every row is about the whole scene
+  // Impacts with a table of trajectory samples (ReadImpacts' `next_samples`): the column naming
+  // the segment (run) that begins after the impact.
+  std::string next_run = "next_segment_id";
 };
 
 // Reads the rows of `table` as observations of each kind. Throws InputError naming the file, line
@@ -70,6 +74,22 @@ void ReadRunouts(const CsvTable& table, const TableColumns& columns, Observation
 void ReadDeposits(const CsvTable& table, const TableColumns& columns, ObservationSet& out);
 void ReadImpacts(const CsvTable& table, const TableColumns& columns, ObservationSet& out);
 void ReadScars(const CsvTable& table, const TableColumns& columns, ObservationSet& out);
+// Impacts as above. With `next_samples`, a table of observed trajectory samples (flight segments:
+// the run column, `time_s`, `omega_x_radps`, `omega_y_radps`, `omega_z_radps` in rad/s, any
+// frame), a row without `omega_out_radps` takes as its angular speed after the impact the |omega|
+// of the first sample (smallest time_s) of the segment named in its `columns.next_run` column:
+// the rotation the block left the ground with. A segment whose first sample has no angular
+// velocity (empty or NaN cells) gives no angular observation; a segment the samples do not hold
+// is an error naming the impact table's line and column.
+void ReadImpacts(const CsvTable& table, const TableColumns& columns, ObservationSet& out,
+                 const CsvTable* next_samples);
+
+// The |omega| (rad/s) of the first sample (smallest time_s, the earlier line on a tie) of every
+// run of a trajectory-sample table (columns as for ReadImpacts' `next_samples`); nullopt for a
+// run whose first sample has no angular velocity. Throws InputError for a missing column or a
+// bad number.
+std::vector<std::pair<std::string, std::optional<double>>> FirstAngularSpeeds(
+    const CsvTable& samples, const TableColumns& columns);
 
 // Sampled trajectory segments (`time_s`, `x_m`, `y_m`, `z_m` of the centre of mass; `speed_mps` or
 // `vx_mps`, `vy_mps`, `vz_mps`; optional `omega_x_radps`, `omega_y_radps`, `omega_z_radps`), rows

@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <set>
 
 #include "common/csv_table.hpp"
@@ -107,8 +108,10 @@ EventFile LoadEvent(const std::string& path) {
     if (!t) Fail(path, tables->get(k), name, "expected a table (kind, file)");
     for (const auto& [key, node] : *t) {
       const std::string key_name(key.str());
-      if (key_name != "kind" && key_name != "file" && key_name != "run_column") {
-        const std::string hint = ClosestName(key_name, {"kind", "file", "run_column"});
+      if (key_name != "kind" && key_name != "file" && key_name != "run_column" &&
+          key_name != "omega_from") {
+        const std::string hint =
+            ClosestName(key_name, {"kind", "file", "run_column", "omega_from"});
         Fail(path, &node, name + "." + key_name,
              "unknown key" + (hint.empty() ? "" : " (did you mean '" + hint + "'?)"));
       }
@@ -124,6 +127,18 @@ EventFile LoadEvent(const std::string& path) {
     if (!fs::exists(file)) Fail(path, t->get("file"), name + ".file", "file not found: " + file);
     fieldobs::TableColumns columns;
     columns.run = StringKey(path, *t, "run_column", name + ".run_column", false, columns.run);
+    // Impacts: the angular speed after each impact from the next segment's first sample.
+    std::optional<CsvTable> omega_samples;
+    std::string omega_file;
+    if (t->get("omega_from")) {
+      if (kind != "impacts")
+        Fail(path, t->get("omega_from"), name + ".omega_from",
+             "only impacts take omega_from (a table of trajectory samples)");
+      omega_file = resolve(StringKey(path, *t, "omega_from", name + ".omega_from", true));
+      if (!fs::exists(omega_file))
+        Fail(path, t->get("omega_from"), name + ".omega_from", "file not found: " + omega_file);
+      omega_samples = CsvTable::Read(omega_file);
+    }
     const std::size_t before = event.observations.size();
     const std::string extension = fs::path(file).extension().string();
     const bool csv = extension == ".csv" || extension == ".txt";
@@ -140,7 +155,9 @@ EventFile LoadEvent(const std::string& path) {
       const CsvTable table = CsvTable::Read(file);
       if (kind == "runout") fieldobs::ReadRunouts(table, columns, event.observations);
       if (kind == "deposits") fieldobs::ReadDeposits(table, columns, event.observations);
-      if (kind == "impacts") fieldobs::ReadImpacts(table, columns, event.observations);
+      if (kind == "impacts")
+        fieldobs::ReadImpacts(table, columns, event.observations,
+                              omega_samples ? &*omega_samples : nullptr);
       if (kind == "scars") fieldobs::ReadScars(table, columns, event.observations);
       if (kind == "trajectories")
         fieldobs::ReadTrajectories(table, columns, event.scene.scene.terrain, event.observations);
@@ -148,8 +165,10 @@ EventFile LoadEvent(const std::string& path) {
     if (event.observations.size() == before)
       Fail(path, t->get("file"), name + ".file", file + " holds no observation");
     event.needs_episodes = event.needs_episodes || kind == "impacts" || kind == "scars";
-    if (std::find(event.inputs.begin(), event.inputs.end(), file) == event.inputs.end())
-      event.inputs.push_back(file);
+    for (const std::string& input : {file, omega_file})
+      if (!input.empty() &&
+          std::find(event.inputs.begin(), event.inputs.end(), input) == event.inputs.end())
+        event.inputs.push_back(input);
   }
 
   // Every observation's run must be a run of the scene.

@@ -26,6 +26,10 @@ struct EventFile {
 };
 
 // Throws InputError "<file>:<line>: <key>: <reason>" (or the table's file:line: column).
+// Keys: `scene`, `reference`, and [[observations]] tables with `kind` (runout, deposits, impacts,
+// scars), `file`, optional `run_column` (default trajectory_id) and, for impacts only,
+// `omega_from`: a table of observed trajectory samples from which each impact's angular speed
+// after the impact is taken (fieldobs::ReadImpacts' `next_samples`).
 EventFile LoadEvent(const std::string& path);
 
 // The scene's ground table with the Table 1 values for the built-in categories (user categories

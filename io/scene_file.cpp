@@ -441,8 +441,10 @@ std::shared_ptr<const RockShape> MakeBlockShape(const pointclouds::RockSpec& spe
 }
 
 // [blocks]: named rocks that runs refer to, from a table file (block_id, mass_kg, size_x_m,
-// size_y_m, size_z_m) and/or [blocks.<id>] tables (mass_kg, size_m = [x, y, z]), all of the one
-// built-in shape `shape` built from their sizes.
+// size_y_m, size_z_m, optional shape) and/or [blocks.<id>] tables (mass_kg, size_m = [x, y, z],
+// optional shape), each a built-in shape built from its size: `shape` of the block, else that of
+// [blocks]. EOTA blocks keep the size as their bounding box and take the bevel for the volume
+// mass_kg / density_kg_m3 (without a mass: the standard bevel-to-side ratio).
 void LoadBlocks(const Context& context, const toml::table* table, SceneFile& out) {
   if (!table) return;
   const std::vector<std::string> reserved = {"file",      "shape",         "points",
@@ -451,14 +453,17 @@ void LoadBlocks(const Context& context, const toml::table* table, SceneFile& out
   for (const auto& [key, node] : *table)
     if (node.is_table()) known.emplace_back(key.str());
   const Section s(context, table, "blocks", known);
+  const std::vector<std::string> shapes = {"box", "ellipsoid", "rock", "eota111", "eota221"};
+  const std::string kShapes =
+      "expected \"box\", \"ellipsoid\", \"rock\", \"eota111\" or \"eota221\"";
+  const auto known_shape = [&](const std::string& name) {
+    return std::find(shapes.begin(), shapes.end(), name) != shapes.end();
+  };
   const std::string shape = s.String("shape", "box");
-  if (shape != "box" && shape != "ellipsoid" && shape != "rock")
-    s.Fail("shape", "'" + shape + "': expected \"box\", \"ellipsoid\" or \"rock\"");
+  if (!known_shape(shape)) s.Fail("shape", "'" + shape + "': " + kShapes);
   pointclouds::RockSpec base;
   base.builtin = shape;
   base.density_kg_m3 = s.Checked("density_kg_m3", 2700, kPositive, "must be > 0");
-  if ((s.Has("points") || s.Has("roughness")) && shape != "rock")
-    s.Fail(s.Has("points") ? "points" : "roughness", "only rock blocks take points and roughness");
   const long points = s.Integer("points", base.points);
   if (points < 4 || points > 1000000)
     s.Fail("points", std::to_string(points) + " must be in 4 .. 1000000");
@@ -467,14 +472,13 @@ void LoadBlocks(const Context& context, const toml::table* table, SceneFile& out
       "roughness", base.roughness, [](double v) { return v >= 0 && v <= 0.5; },
       "must be in 0 .. 0.5");
   out.shape_per_rock = s.Bool("shape_per_rock", false);
-  if (out.shape_per_rock && shape != "rock")
-    s.Fail("shape_per_rock", "only rock blocks have a shape of their own per rock");
 
-  auto add = [&](const std::string& id, std::optional<double> mass, const std::vector<double>& size,
-                 const std::string& where) {
+  auto add = [&](const std::string& id, const std::string& block_shape, std::optional<double> mass,
+                 const std::vector<double>& size, const std::string& where) {
     for (const ensemble::Block& b : out.release.blocks)
       if (b.id == id) throw InputError(where + ": block '" + id + "' is defined twice");
     pointclouds::RockSpec spec = base;
+    spec.builtin = block_shape;
     spec.dimensions_m = size;
     spec.mass_kg = mass;
     spec.density_kg_m3 = base.density_kg_m3;
@@ -497,33 +501,60 @@ void LoadBlocks(const Context& context, const toml::table* table, SceneFile& out
       if (mass && *mass <= 0) throw InputError(rows.Where(k, "mass_kg") + ": must be > 0");
       const std::string id = rows.Text(k, "block_id");
       if (id.empty()) throw InputError(rows.Where(k, "block_id") + ": empty");
-      add(id, mass, size, rows.Where(k, "block_id"));
+      const std::string block_shape = rows.Empty(k, "shape") ? shape : rows.Text(k, "shape");
+      if (!known_shape(block_shape))
+        throw InputError(rows.Where(k, "shape") + ": '" + block_shape + "': " + kShapes);
+      add(id, block_shape, mass, size, rows.Where(k, "block_id"));
     }
   }
   for (const auto& [key, node] : *table) {
     if (!node.is_table()) continue;
     const std::string id(key.str());
-    const Section b(context, node.as_table(), "blocks." + id, {"mass_kg", "size_m"});
+    const Section b(context, node.as_table(), "blocks." + id, {"mass_kg", "size_m", "shape"});
     if (!b.Has("size_m")) b.Fail("size_m", "missing: the block's size [x, y, z] in m");
     const std::vector<double> size = b.Numbers("size_m", 3);
     for (double v : size)
       if (v <= 0) b.Fail("size_m", "dimensions must be > 0");
     std::optional<double> mass;
     if (b.Has("mass_kg")) mass = b.Checked("mass_kg", 0, kPositive, "must be > 0");
-    add(id, mass, size, context.Where(&node) + ": blocks." + id);
+    const std::string block_shape = b.String("shape", shape);
+    if (!known_shape(block_shape)) b.Fail("shape", "'" + block_shape + "': " + kShapes);
+    add(id, block_shape, mass, size, context.Where(&node) + ": blocks." + id);
   }
   if (out.release.blocks.empty())
     context.Fail(table, "blocks", "no block: give a file or [blocks.<id>] tables");
+  // Knobs of the random rock shape need rock blocks.
+  const bool all_rocks =
+      std::all_of(out.block_specs.begin(), out.block_specs.end(),
+                  [](const pointclouds::RockSpec& b) { return b.builtin == "rock"; });
+  const bool any_rock =
+      std::any_of(out.block_specs.begin(), out.block_specs.end(),
+                  [](const pointclouds::RockSpec& b) { return b.builtin == "rock"; });
+  if ((s.Has("points") || s.Has("roughness")) && !any_rock)
+    s.Fail(s.Has("points") ? "points" : "roughness", "only rock blocks take points and roughness");
+  if (out.shape_per_rock && !all_rocks)
+    s.Fail("shape_per_rock", "only rock blocks have a shape of their own per rock");
 }
 
-// [release] runs = "file.csv": one row per run, columns by name (docs/scenes.md).
+// [release] runs = "file.csv": one row per run, columns by name (docs/scenes.md). A run names its
+// block by the text of the column `block_column` (default block_id; e.g. mass_kg when the blocks
+// are told apart by their mass).
 void LoadRuns(const Context& context, const Section& s, SceneFile& out) {
   ensemble::ReleaseSpec& r = out.release;
   const std::string path = context.Resolve(s.String("runs", ""));
   if (!fs::exists(path)) s.Fail("runs", "file not found: " + path);
+  const std::string block_column = s.String("block_column", "block_id");
+  if (block_column.empty()) s.Fail("block_column", "empty: name a column of the run table");
   out.inputs.push_back(path);
   const CsvTable rows = CsvTable::Read(path);
   rows.Require({"trajectory_id", "x_m", "y_m"});
+  if (s.Has("block_column")) {
+    try {
+      rows.Require({block_column});
+    } catch (const InputError& e) {
+      s.Fail("block_column", e.what());
+    }
+  }
   if (rows.rows() == 0) throw InputError(path + ": no run (the table has a header only)");
   const GridGeometry& g = out.scene.terrain.heights().grid;
   for (int k = 0; k < rows.rows(); ++k) {
@@ -553,8 +584,8 @@ void LoadRuns(const Context& context, const Section& s, SceneFile& out) {
                          Fmt(q.norm()) + ", expected 1");
       run.orientation = q.normalized();
     }
-    if (!rows.Empty(k, "block_id")) {
-      const std::string id = rows.Text(k, "block_id");
+    if (!rows.Empty(k, block_column)) {
+      const std::string id = rows.Text(k, block_column);
       int index = -1;
       std::vector<std::string> ids;
       for (std::size_t b = 0; b < r.blocks.size(); ++b) {
@@ -562,7 +593,7 @@ void LoadRuns(const Context& context, const Section& s, SceneFile& out) {
         if (r.blocks[b].id == id) index = static_cast<int>(b);
       }
       if (index < 0)
-        throw InputError(rows.Where(k, "block_id") + ": unknown block '" + id + "'" +
+        throw InputError(rows.Where(k, block_column) + ": unknown block '" + id + "'" +
                          (r.blocks.empty() ? " (the scene has no [blocks])" : " (known: " + [&] {
                            std::string all;
                            for (const auto& i : ids) all += (all.empty() ? "" : ", ") + i;
@@ -570,7 +601,7 @@ void LoadRuns(const Context& context, const Section& s, SceneFile& out) {
                          }() + ")"));
       run.block = index;
     } else if (!out.has_rock) {
-      throw InputError(rows.Where(k, "block_id") +
+      throw InputError(rows.Where(k, block_column) +
                        ": a run without a block needs the scene's [rock]");
     }
     double ground_m;
@@ -790,8 +821,8 @@ SceneFile LoadScene(const std::string& path) {
   }
   LoadRelease(context,
               Section(context, SubTable(context, root, "release"), "release",
-                      {"points", "lines", "polygons", "file", "runs", "height_m", "rocks",
-                       "orientation", "velocity_m_s", "angular_velocity_rad_s", "seed"}),
+                      {"points", "lines", "polygons", "file", "runs", "block_column", "height_m",
+                       "rocks", "orientation", "velocity_m_s", "angular_velocity_rad_s", "seed"}),
               out);
   LoadSolver(Section(context, SubTable(context, root, "solver"), "solver",
                      {"dt_s", "max_time_s", "gravity_m_s2", "normal_restitution",

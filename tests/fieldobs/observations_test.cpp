@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string>
+#include <vector>
 
 #include "common/error.hpp"
 
@@ -66,6 +68,79 @@ TEST(Observations, ImpactsGiveSpeedAndEnergyRatio) {
   ASSERT_EQ(speeds.scalars.size(), 2u);
   EXPECT_EQ(speeds.scalars[0].run, "");  // no run column: the whole scene
   EXPECT_NEAR(speeds.scalars[1].value, 0.25, 1e-15);
+}
+
+// Chant Sura layout: contact events between flight segments, the angular speed after each impact
+// from the first sample of the next segment in a table of trajectory samples.
+TEST(Observations, ImpactAngularSpeedFromTheNextSegmentsFirstSample) {
+  const CsvTable impacts = CsvTable::Parse(
+      "trajectory_id,next_segment_id,incoming_speed_mps,outgoing_speed_mps\n"
+      "r1_seg00,r1_seg01,8,4\n"
+      "r1_seg01,r1_seg02,9,3\n"
+      "r2_seg00,r2_seg01,5,2\n",
+      "impacts.csv");
+  // Samples out of time order: r1_seg01's first sample is the one at t = 0 (|(3, 4, 0)| = 5);
+  // r1_seg02 starts with (0, 0, -2); r2_seg01 has no angular velocity (NaN, as the data have).
+  const CsvTable samples = CsvTable::Parse(
+      "trajectory_id,time_s,omega_x_radps,omega_y_radps,omega_z_radps\n"
+      "r1_seg00,0,1,1,1\n"
+      "r1_seg01,0.005,9,9,9\n"
+      "r1_seg01,0,3,4,0\n"
+      "r1_seg02,0,0,0,-2\n"
+      "r1_seg02,0.01,7,0,0\n"
+      "r2_seg01,0,nan,nan,nan\n",
+      "samples.csv");
+  const auto first = FirstAngularSpeeds(samples, TableColumns{});
+  ASSERT_EQ(first.size(), 4u);
+  EXPECT_EQ(first[1].first, "r1_seg01");
+  EXPECT_NEAR(*first[1].second, 5.0, 1e-15);
+  EXPECT_FALSE(first[3].second.has_value());
+  ObservationSet set;
+  ReadImpacts(impacts, TableColumns{}, set, &samples);
+  std::vector<double> omega;
+  std::vector<std::string> runs;
+  for (const ScalarObservation& o : set.scalars)
+    if (o.quantity == Quantity::kImpactAngularSpeedOut) {
+      omega.push_back(o.value);
+      runs.push_back(o.run);
+    }
+  ASSERT_EQ(omega.size(), 2u);  // r2's next segment has no angular velocity
+  EXPECT_NEAR(omega[0], 5.0, 1e-15);
+  EXPECT_NEAR(omega[1], 2.0, 1e-15);
+  EXPECT_EQ(runs[0], "r1_seg00");  // the run whose first contact episode is the impact
+  EXPECT_EQ(set.scalars.size(), 3u * 2u + 2u);
+  // Without the samples: no angular speed.
+  ObservationSet plain;
+  ReadImpacts(impacts, TableColumns{}, plain);
+  EXPECT_EQ(plain.scalars.size(), 6u);
+
+  // Errors name the file, line and column.
+  const auto error = [&](const std::string& impacts_text, const std::string& samples_text) {
+    ObservationSet out;
+    try {
+      const CsvTable s2 = CsvTable::Parse(samples_text, "samples.csv");
+      ReadImpacts(CsvTable::Parse(impacts_text, "impacts.csv"), TableColumns{}, out, &s2);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  const std::string good_samples =
+      "trajectory_id,time_s,omega_x_radps,omega_y_radps,omega_z_radps\nb,0,1,0,0\n";
+  EXPECT_HAS(error("trajectory_id,next_segment_id,incoming_speed_mps,outgoing_speed_mps\n"
+                   "a,c,8,4\n",
+                   good_samples),
+             "impacts.csv:2: column 'next_segment_id': segment 'c' has no sample in samples.csv");
+  EXPECT_HAS(error("trajectory_id,incoming_speed_mps,outgoing_speed_mps\na,8,4\n", good_samples),
+             "impacts.csv: missing column 'next_segment_id'");
+  EXPECT_HAS(error("trajectory_id,next_segment_id,incoming_speed_mps,outgoing_speed_mps\n"
+                   "a,b,8,4\n",
+                   "trajectory_id,time_s,omega_x_radps\nb,0,1\n"),
+             "samples.csv: missing column 'omega_y_radps'");
+  EXPECT_HAS(error("trajectory_id,next_segment_id,incoming_speed_mps,outgoing_speed_mps\n"
+                   "a,b,8,4\n",
+                   "trajectory_id,time_s,omega_x_radps,omega_y_radps,omega_z_radps\nb,0,1,nan,0\n"),
+             "samples.csv:2: column 'omega_y_radps': 'nan' is not a finite number");
 }
 
 TEST(Observations, BadTablesNameFileLineAndColumn) {

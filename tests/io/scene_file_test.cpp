@@ -444,7 +444,8 @@ TEST(LoadScene, RunTableErrorsNameFileLineAndColumn) {
              "a run without a block needs the scene's [rock]");
   EXPECT_HAS(error("trajectory_id,x_m,y_m,block_id\nv1,5,0,1\n",
                    Replace(kRunScene, "shape = \"box\"", "shape = \"cube\"")),
-             "blocks.shape: 'cube': expected \"box\", \"ellipsoid\" or \"rock\"");
+             "blocks.shape: 'cube': expected \"box\", \"ellipsoid\", \"rock\", \"eota111\" or "
+             "\"eota221\"");
   EXPECT_HAS(error("trajectory_id,x_m,y_m,block_id\nv1,5,0,1\n",
                    Replace(kRunScene, "rocks = 3", "rocks = 3\npoints = [[1, 1]]")),
              "release.runs: a run table cannot be combined with points");
@@ -452,6 +453,104 @@ TEST(LoadScene, RunTableErrorsNameFileLineAndColumn) {
                      "block_id,mass_kg,size_x_m,size_y_m,size_z_m\n1,69,0,1,1\n");
   EXPECT_HAS(error("trajectory_id,x_m,y_m,block_id\nv1,5,0,1\n"),
              "blocks.csv:2: column 'size_x_m': must be > 0");
+}
+
+// The Chant Sura layout: no block_id column; runs name their block by the text of mass_kg, and
+// the blocks are EOTA blocks of given bounding box and mass (the bevel gives the volume).
+const char* kMassBlockScene = R"([terrain]
+plane = { slope_deg = 35, slope_length_m = 40, runout_m = 20, width_m = 30, cell_m = 1 }
+
+[blocks]
+shape = "eota221"
+density_kg_m3 = 2670
+
+[blocks."210"]
+size_m = [0.606, 0.606, 0.303]
+mass_kg = 210
+
+[blocks."250"]
+shape = "eota111"
+size_m = [0.509, 0.509, 0.509]
+mass_kg = 250
+
+[blocks."780"]
+size_m = [0.93, 0.93, 0.47]
+mass_kg = 780
+
+[release]
+runs = "runs.csv"
+block_column = "mass_kg"
+rocks = 2
+)";
+
+TEST(LoadScene, RunsNameBlocksByAnotherColumnAndBlocksAreEota) {
+  const auto dir = testing::FreshDir("mass_blocks");
+  testing::WriteText(dir / "runs.csv",
+                     "trajectory_id,x_m,y_m,z_m,mass_kg,radius_m\n"
+                     "a_seg00,5,0,,210,0.266\n"
+                     "a_seg01,6,0,,780,0.412\n"
+                     "b_seg00,7,0,,250,0.282\n");
+  testing::WriteText(dir / "scene.toml", kMassBlockScene);
+  const SceneFile s = LoadScene((dir / "scene.toml").string());
+  ASSERT_EQ(s.release.runs.size(), 3u);
+  const auto block_of = [&](int run) {
+    return s.release
+        .blocks[static_cast<std::size_t>(s.release.runs[static_cast<std::size_t>(run)].block)];
+  };
+  EXPECT_EQ(block_of(0).id, "210");
+  EXPECT_EQ(block_of(1).id, "780");
+  EXPECT_EQ(block_of(2).id, "250");
+  // Mass kept; the bevel chosen for the volume mass / density inside the given bounding box.
+  for (int run = 0; run < 3; ++run) {
+    const RockShape& rock = *block_of(run).shape;
+    const double mass_kg = std::stod(block_of(run).id);
+    EXPECT_NEAR(rock.mass_kg, mass_kg, 1e-6 * mass_kg);
+    EXPECT_NEAR(rock.volume_m3, mass_kg / 2670, 1e-6 * mass_kg / 2670);
+    EXPECT_EQ(rock.vertices_m.size(), 24u);  // a box with all twelve edges bevelled
+  }
+  EXPECT_EQ(s.block_specs[0].builtin, "eota221");
+  EXPECT_EQ(s.block_specs[1].builtin, "eota111");  // the block's own shape over [blocks]'
+  // The EOTA111 is a cube: equal principal moments; the EOTA221 is not.
+  const RockShape& cube = *block_of(2).shape;
+  EXPECT_NEAR(cube.inertia_kg_m2.minCoeff(), cube.inertia_kg_m2.maxCoeff(),
+              1e-9 * cube.inertia_kg_m2.maxCoeff());
+  const RockShape& wheel = *block_of(1).shape;
+  EXPECT_GT(wheel.inertia_kg_m2.maxCoeff(), 1.3 * wheel.inertia_kg_m2.minCoeff());
+}
+
+TEST(LoadScene, BlockColumnAndEotaBlockErrorsNameFileLineAndKey) {
+  const auto dir = testing::FreshDir("mass_blocks_bad");
+  const auto error = [&](const std::string& runs, const std::string& scene = kMassBlockScene) {
+    testing::WriteText(dir / "runs.csv", runs);
+    return ErrorOf(scene, dir);
+  };
+  const std::string runs = "trajectory_id,x_m,y_m,mass_kg\na,5,0,210\n";
+  // The column is the block's name as text: 210.0 is not block "210".
+  EXPECT_HAS(error("trajectory_id,x_m,y_m,mass_kg\na,5,0,210\nb,5,0,210.0\n"),
+             "runs.csv:3: column 'mass_kg': unknown block '210.0' (known: 210, 250, 780)");
+  EXPECT_HAS(error("trajectory_id,x_m,y_m,block_id\na,5,0,210\n"),
+             "scene.toml:23: release.block_column: ");
+  EXPECT_HAS(error("trajectory_id,x_m,y_m,block_id\na,5,0,210\n"),
+             "runs.csv: missing column 'mass_kg'");
+  EXPECT_HAS(
+      error(runs, Replace(kMassBlockScene, "block_column = \"mass_kg\"", "block_column = \"\"")),
+      "scene.toml:23: release.block_column: empty");
+  EXPECT_HAS(error(runs, Replace(kMassBlockScene, "block_column", "block_colum")),
+             "release.block_colum: unknown key (did you mean 'block_column'?)");
+  EXPECT_HAS(error(runs, Replace(kMassBlockScene, "shape = \"eota111\"", "shape = \"eota112\"")),
+             "scene.toml:13: blocks.250.shape: 'eota112': expected \"box\"");
+  // 780 kg of density 2670 do not fit a 0.5 m cube: no bevel reaches that volume.
+  EXPECT_HAS(error(runs, Replace(kMassBlockScene, "[0.93, 0.93, 0.47]", "[0.5, 0.5, 0.5]")),
+             "scene.toml:17: blocks.780: eota221: no bevel gives a volume of");
+  // A table file may give each block's shape too.
+  testing::WriteText(dir / "blocks.csv",
+                     "block_id,mass_kg,size_x_m,size_y_m,size_z_m,shape\n9,10,1,1,1,eota333\n");
+  EXPECT_HAS(error(runs, Replace(kMassBlockScene, "density_kg_m3 = 2670",
+                                 "density_kg_m3 = 2670\nfile = \"blocks.csv\"")),
+             "blocks.csv:2: column 'shape': 'eota333': expected");
+  EXPECT_HAS(error(runs, Replace(kMassBlockScene, "density_kg_m3 = 2670",
+                                 "density_kg_m3 = 2670\nroughness = 0.2")),
+             "blocks.roughness: only rock blocks take points and roughness");
 }
 
 TEST(LoadScene, ShapePerRockNeedsRockShapes) {
