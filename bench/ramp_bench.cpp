@@ -97,6 +97,7 @@ int main(int argc, char** argv) {
   int max_iterations = -1;
   std::uint64_t seed = 1;
   std::string viscous = talus::ToString(talus::SolverOptions{}.viscous);
+  std::string contact_solve = talus::ToString(talus::SolverOptions{}.contact_solve);
   app.add_option("--rocks", rocks, "Trajectories per repeat")->check(CLI::PositiveNumber);
   app.add_option("--repeats", repeats, "Repeats (the median is reported)")
       ->check(CLI::PositiveNumber);
@@ -109,6 +110,13 @@ int main(int argc, char** argv) {
   app.add_option("--viscous,--drag", viscous,
                  "Reading of the viscous ground term: centre_of_mass or contact_friction")
       ->check(CLI::IsMember({"centre_of_mass", "contact_friction"}));
+  app.add_option("--contact-solve", contact_solve,
+                 "Two-contact steps: gauss_seidel sweeps or one block solve")
+      ->check(CLI::IsMember({"gauss_seidel", "block"}));
+  bool no_profile = false;
+  app.add_flag(
+      "--no-profile", no_profile,
+      "Skip the stage profile run (for instruction counts of exactly --rocks trajectories)");
   CLI11_PARSE(app, argc, argv);
 
   talus::Scene scene = talus::scenes::Ramp40();
@@ -116,6 +124,7 @@ int main(int argc, char** argv) {
   if (tolerance > 0) scene.options.tolerance_m_s = tolerance;
   if (max_iterations > 0) scene.options.max_iterations = max_iterations;
   talus::ParseViscousReading(viscous, &scene.options.viscous);
+  talus::ParseContactSolveMethod(contact_solve, &scene.options.contact_solve);
   std::string why;
   if (!scene.IsValid(&why)) {
     std::fprintf(stderr, "ramp_bench: %s\n", why.c_str());
@@ -135,10 +144,11 @@ int main(int argc, char** argv) {
   );
   std::printf(
       "scene: EOTA221 %.0f kg, %zu hull vertices; 40 deg ramp 200 m + 150 m runout, 2 m cells, "
-      "medium_hard; dt %.4f s, tolerance %.1e m/s, at most %d sweeps; viscous term: %s\n",
+      "medium_hard; dt %.4f s, tolerance %.1e m/s, at most %d sweeps; viscous term: %s; "
+      "contact solve: %s\n",
       scene.rock.mass_kg, scene.rock.vertices_m.size(), scene.options.dt_s,
       scene.options.tolerance_m_s, scene.options.max_iterations,
-      talus::ToString(scene.options.viscous));
+      talus::ToString(scene.options.viscous), talus::ToString(scene.options.contact_solve));
 
   std::vector<double> rates, step_rates;
   Batch last;
@@ -189,6 +199,7 @@ int main(int argc, char** argv) {
       "\nreference: RAMMS::ROCKFALL 1000 trajectories in 161.5 s = 6.2 trajectories/s "
       "(Leine et al. 2021, Table 1)\n");
 
+  if (no_profile) return 0;
   // Stage profile in a separate run (the clock calls cost time of their own).
   talus::StageTimes times;
   const Batch profiled = RunBatch(scene, std::max(1, rocks / 4), seed, &times);

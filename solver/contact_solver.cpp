@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "solver/contact_block.hpp"
+
 namespace talus {
 namespace {
 
@@ -17,15 +19,25 @@ Eigen::Vector2d ProjectDisk(const Eigen::Vector2d& p, double bound) {
 // velocity of gamma = xi0 + G P, and gamma_N = 0. Newton's method on the angle of d for
 // F = d x gamma_T = 0 (analytic derivative; d is turned without trigonometric calls), started
 // opposite to the tangential velocity that a frictionless impact would leave.
-bool SolveSlip(const Eigen::Matrix3d& g, const Eigen::Vector3d& xi0, double mu,
-               Eigen::Vector3d* p) {
+//
+// SlipControl: wave 1 (the default) starts as above and stops when the step is below 1e-13 rad;
+// the block method (ContactSolveMethod::kBlock) starts from `start` when given (the slip direction
+// of the contact's previous iterate, warm-started from the previous step) and stops as soon as the
+// slip velocity normal to d, |d x gamma_T| (m/s), is below f_tolerance.
+struct SlipControl {
+  const Eigen::Vector2d* start = nullptr;
+  double f_tolerance = 0;  // 0: wave 1's stopping rule
+};
+bool SolveSlip(const Eigen::Matrix3d& g, const Eigen::Vector3d& xi0, double mu, Eigen::Vector3d* p,
+               const SlipControl& control = {}) {
   const double a = g(0, 0);
   const Eigen::Vector2d b = g.block<2, 1>(1, 0);
   const Eigen::Matrix2d c = g.block<2, 2>(1, 1);
   auto cross = [](const Eigen::Vector2d& u, const Eigen::Vector2d& v) {
     return u.x() * v.y() - u.y() * v.x();
   };
-  Eigen::Vector2d d = -(xi0.tail<2>() - (xi0.x() / a) * b);
+  Eigen::Vector2d d =
+      control.start ? *control.start : Eigen::Vector2d(-(xi0.tail<2>() - (xi0.x() / a) * b));
   if (d.squaredNorm() == 0) return false;
   d.normalize();
   double normal = 0, denominator = 0;
@@ -37,6 +49,7 @@ bool SolveSlip(const Eigen::Matrix3d& g, const Eigen::Vector3d& xi0, double mu,
     const Eigen::Vector2d lever = b + mu * (c * d);
     gamma_t = xi0.tail<2>() + normal * lever;
     const double f = cross(d, gamma_t);
+    if (control.f_tolerance > 0 && std::abs(f) <= control.f_tolerance) break;
     const double normal_slope = -normal * mu * b.dot(d_perp) / denominator;
     const Eigen::Vector2d gamma_slope = normal_slope * lever + normal * mu * (c * d_perp);
     const double f_slope = -d.dot(gamma_t) + cross(d, gamma_slope);
@@ -50,7 +63,9 @@ bool SolveSlip(const Eigen::Matrix3d& g, const Eigen::Vector3d& xi0, double mu,
   gamma_t = xi0.tail<2>() + normal * (b + mu * (c * d));
   // Admissible only with a compressive normal percussion and d opposite to the slip velocity.
   if (!(denominator > 0 && normal >= 0 && d.dot(gamma_t) <= 0)) return false;
-  if (std::abs(cross(d, gamma_t)) > 1e-9 * (gamma_t.norm() + 1e-12)) return false;
+  if (std::abs(cross(d, gamma_t)) >
+      (control.f_tolerance > 0 ? control.f_tolerance : 1e-9 * (gamma_t.norm() + 1e-12)))
+    return false;
   *p = Eigen::Vector3d(normal, mu * normal * d.x(), mu * normal * d.y());
   return true;
 }
@@ -60,7 +75,7 @@ bool SolveSlip(const Eigen::Matrix3d& g, const Eigen::Vector3d& xi0, double mu,
 // separation, then sticking, then slipping. Returns false when the slip iteration does not
 // converge.
 bool SolveLocal(const Eigen::Matrix3d& g, const Eigen::Matrix3d& g_inverse, double mu,
-                const Eigen::Vector3d& xi0, Eigen::Vector3d* p) {
+                const Eigen::Vector3d& xi0, Eigen::Vector3d* p, const SlipControl& control) {
   if (xi0.x() >= 0) {
     p->setZero();
     return true;
@@ -74,7 +89,7 @@ bool SolveLocal(const Eigen::Matrix3d& g, const Eigen::Matrix3d& g_inverse, doub
     *p = Eigen::Vector3d(-xi0.x() / g(0, 0), 0, 0);
     return true;
   }
-  return SolveSlip(g, xi0, mu, p);
+  return SolveSlip(g, xi0, mu, p, control);
 }
 
 // Fallback: proximal-point iterations on the contact's own 3 x 3 problem.
@@ -93,9 +108,10 @@ Eigen::Vector3d ProxLocal(const Eigen::Matrix3d& g, double mu, double r_normal, 
 }
 
 // One contact's percussion without the viscous term: exact local solve, prox as the fallback.
-Eigen::Vector3d SolveCoulomb(const Contact& c, const Eigen::Vector3d& xi0, double tolerance) {
+Eigen::Vector3d SolveCoulomb(const Contact& c, const Eigen::Vector3d& xi0, double tolerance,
+                             const SlipControl& control) {
   Eigen::Vector3d p;
-  if (!SolveLocal(c.delassus, c.delassus_inverse, c.mu, xi0, &p))
+  if (!SolveLocal(c.delassus, c.delassus_inverse, c.mu, xi0, &p, control))
     p = ProxLocal(c.delassus, c.mu, c.r_normal, c.r_tangent, xi0, c.percussion, tolerance);
   return p;
 }
@@ -109,7 +125,7 @@ Eigen::Vector3d SolveCoulomb(const Contact& c, const Eigen::Vector3d& xi0, doubl
 // only because of its own viscous traction (xi0_N < 0 <= xi0'_N, a grazing contact), the term is
 // dropped: it never acts without load.
 Eigen::Vector3d SolveViscous(const Contact& c, const Eigen::Vector3d& xi0, double h,
-                             double tolerance) {
+                             double tolerance, const SlipControl& control) {
   if (xi0.x() >= 0) return Eigen::Vector3d::Zero();
   Eigen::Vector3d rhs = c.delassus_inverse * xi0;  // -(stick percussion) of the viscous problem
   rhs.tail<2>() += h * c.velocity_bias.tail<2>();
@@ -121,10 +137,10 @@ Eigen::Vector3d SolveViscous(const Contact& c, const Eigen::Vector3d& xi0, doubl
     mass(2, 2) += h;
     const Eigen::Matrix3d g = mass.inverse();
     const Eigen::Vector3d xi0_viscous = g * rhs;
-    if (xi0_viscous.x() >= 0) return SolveCoulomb(c, xi0, tolerance);
+    if (xi0_viscous.x() >= 0) return SolveCoulomb(c, xi0, tolerance, control);
     if (c.mu == 0) {
       coulomb = Eigen::Vector3d(-xi0_viscous.x() / g(0, 0), 0, 0);
-    } else if (!SolveSlip(g, xi0_viscous, c.mu, &coulomb)) {
+    } else if (!SolveSlip(g, xi0_viscous, c.mu, &coulomb, control)) {
       coulomb = ProxLocal(g, c.mu, c.r_normal, c.r_tangent, xi0_viscous, c.percussion, tolerance);
     }
     xi_t = (xi0_viscous + g * coulomb).tail<2>();
@@ -133,6 +149,88 @@ Eigen::Vector3d SolveViscous(const Contact& c, const Eigen::Vector3d& xi0, doubl
   Eigen::Vector3d p = coulomb;
   p.tail<2>() -= h * (xi_t - c.velocity_bias.tail<2>());
   return p;
+}
+
+// Two contacts as one block (ContactSolveMethod::kBlock): the pair problem of the current
+// iterate (solver/contact_block.hpp), solved exactly, and its change applied to the velocities.
+// With the contact-friction viscosity, H = diag(0, h_i, h_i) folds into G as for one contact,
+// G' = (I + G H)^-1 G and xi0' = (I + G H)^-1 (xi0 + G H bias), with h_i from the load shares of
+// the previous solution; repeated until the shares agree with the solution's own to the
+// tolerance. False, with nothing changed, when the block solve finds no verified case.
+bool SolvePairBlock(const RockShape& rock, const Eigen::Matrix3d& rotation, double inv_mass,
+                    double tolerance, Eigen::Vector3d& velocity_m_s, Eigen::Vector3d& omega_rad_s,
+                    std::vector<Contact>& contacts) {
+  Contact& c0 = contacts[0];
+  Contact& c1 = contacts[1];
+  PairProblem pr;
+  pr.g.block<3, 3>(0, 0) = c0.delassus;
+  pr.g.block<3, 3>(3, 3) = c1.delassus;
+  const Eigen::Matrix3d coupling = inv_mass * c0.directions.transpose() * c1.directions +
+                                   c0.arms.transpose() * c1.inv_inertia_arms;
+  pr.g.block<3, 3>(0, 3) = coupling;
+  pr.g.block<3, 3>(3, 0) = coupling.transpose();
+  Vector6d now, xi, bias;
+  now << c0.percussion, c1.percussion;
+  bias << c0.velocity_bias, c1.velocity_bias;
+  xi << c0.directions.transpose() * velocity_m_s + c0.arms.transpose() * omega_rad_s,
+      c1.directions.transpose() * velocity_m_s + c1.arms.transpose() * omega_rad_s;
+  xi += bias;
+  const Vector6d xi0 = xi - pr.g * now;
+  // Internal force: +e at contact 0, -e at contact 1, e along the line through the two vertices.
+  const Eigen::Vector3d e =
+      (rotation * (rock.vertices_m[c0.vertex] - rock.vertices_m[c1.vertex])).normalized();
+  pr.null << c0.directions.transpose() * e, -(c1.directions.transpose() * e);
+  pr.null.normalize();
+  pr.mu[0] = c0.mu;
+  pr.mu[1] = c1.mu;
+
+  Vector6d p;
+  if (c0.viscous_kg == 0 && c1.viscous_kg == 0) {
+    pr.xi0 = xi0;
+    if (!SolvePair(pr, now, tolerance, &p)) return false;
+  } else {
+    Vector6d previous = now;
+    bool agreed = false;
+    for (int outer = 0; outer < 20 && !agreed; ++outer) {
+      const double total = previous(0) + previous(3);
+      Vector6d h = Vector6d::Zero();
+      if (total > 0) {
+        h.segment<2>(1).setConstant(c0.viscous_kg * previous(0) / total);
+        h.segment<2>(4).setConstant(c1.viscous_kg * previous(3) / total);
+      }
+      const Eigen::PartialPivLU<Matrix6d> lu(Matrix6d::Identity() + pr.g * h.asDiagonal());
+      PairProblem viscous = pr;
+      viscous.g = lu.solve(pr.g);
+      viscous.g = 0.5 * (viscous.g + viscous.g.transpose()).eval();
+      viscous.xi0 = lu.solve(xi0 + pr.g * h.cwiseProduct(bias));
+      // The previous solution as the guess: its statuses are those of its Coulomb part (a
+      // slipping contact's |P_T| = mu P_N + h |gamma_T| >= mu P_N) and its slip directions too.
+      Vector6d coulomb;
+      if (!SolvePair(viscous, previous, tolerance, &coulomb)) return false;
+      const Vector6d slip = viscous.xi0 + viscous.g * coulomb - bias;  // gamma_E
+      p = coulomb - h.cwiseProduct(slip);
+      // Shares of this solution against the ones used: the velocity error they make.
+      const double new_total = p(0) + p(3);
+      agreed = true;
+      for (int i = 0; i < 2; ++i) {
+        const double share = new_total > 0 ? p(3 * i) / new_total : 0.0;
+        const double h_new = contacts[i].viscous_kg * share;
+        const double error = std::abs(h_new - h(3 * i + 1)) * slip.segment<2>(3 * i + 1).norm() *
+                             pr.g.block<2, 2>(3 * i + 1, 3 * i + 1).norm();
+        agreed = agreed && error <= tolerance;
+      }
+      previous = p;
+    }
+    if (!agreed) return false;
+  }
+  for (int i = 0; i < 2; ++i) {
+    Contact& c = contacts[i];
+    const Eigen::Vector3d delta = p.segment<3>(3 * i) - c.percussion;
+    c.percussion = p.segment<3>(3 * i);
+    velocity_m_s += inv_mass * (c.directions * delta);
+    omega_rad_s += c.inv_inertia_arms * delta;
+  }
+  return true;
 }
 
 }  // namespace
@@ -191,6 +289,8 @@ ContactSolveReport SolveContacts(const Scene& scene, const RockShape& rock,
   const double radius = rock.bounding_radius_m;
   report.converged = false;
   const double local_tolerance = 1e-3 * opt.tolerance_m_s;
+  const bool block = opt.contact_solve == ContactSolveMethod::kBlock;
+  const bool pair_block = block && workspace.contacts.size() == 2;
   for (int iter = 1; iter <= opt.max_iterations; ++iter) {
     double max_change = 0;
     // Contact-friction viscosity: contact i's share of the rock's mass is its share of the total
@@ -203,16 +303,29 @@ ContactSolveReport SolveContacts(const Scene& scene, const RockShape& rock,
       const Eigen::Vector3d xi = c.directions.transpose() * velocity_m_s +
                                  c.arms.transpose() * omega_rad_s + c.velocity_bias;
       const Eigen::Vector3d xi0 = xi - c.delassus * c.percussion;
+      // Block method: the slip Newton starts from this contact's slipping iterate and stops at
+      // a tenth of the tolerance.
+      SlipControl control;
+      Eigen::Vector2d start;
+      if (block) {
+        control.f_tolerance = 0.1 * opt.tolerance_m_s;
+        const double tangential = c.percussion.tail<2>().norm();
+        if (c.percussion.x() > 0 && tangential >= c.mu * c.percussion.x() * (1 - 1e-6) &&
+            tangential > 0) {
+          start = c.percussion.tail<2>() / tangential;
+          control.start = &start;
+        }
+      }
       Eigen::Vector3d p;
       if (c.viscous_kg > 0) {
         const double own = c.percussion.x();
         const double others = total_normal - own;
         const double share = others > 0 ? own / (own + others) : 1.0;
-        p = share > 0 ? SolveViscous(c, xi0, share * c.viscous_kg, local_tolerance)
-                      : SolveCoulomb(c, xi0, local_tolerance);
+        p = share > 0 ? SolveViscous(c, xi0, share * c.viscous_kg, local_tolerance, control)
+                      : SolveCoulomb(c, xi0, local_tolerance, control);
         total_normal += p.x() - own;
       } else {
-        p = SolveCoulomb(c, xi0, local_tolerance);
+        p = SolveCoulomb(c, xi0, local_tolerance, control);
       }
       const Eigen::Vector3d delta = p - c.percussion;
       if (delta.isZero(0.0)) continue;
@@ -226,6 +339,14 @@ ContactSolveReport SolveContacts(const Scene& scene, const RockShape& rock,
     report.iterations = iter;
     // One contact is solved exactly by its local solve: no second sweep is needed.
     if (max_change <= opt.tolerance_m_s || workspace.contacts.size() == 1) {
+      report.converged = true;
+      break;
+    }
+    // Block method: after the first sweep, the two contacts of an edge as one exact block solve.
+    if (pair_block && iter == 1 &&
+        SolvePairBlock(rock, rotation, inv_mass, opt.tolerance_m_s, velocity_m_s, omega_rad_s,
+                       workspace.contacts)) {
+      report.iterations = iter + 1;
       report.converged = true;
       break;
     }

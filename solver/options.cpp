@@ -25,6 +25,26 @@ bool ParseViscousReading(std::string_view name, ViscousReading* reading) {
   return false;
 }
 
+const char* ToString(ContactSolveMethod method) {
+  switch (method) {
+    case ContactSolveMethod::kGaussSeidel:
+      return "gauss_seidel";
+    case ContactSolveMethod::kBlock:
+      return "block";
+  }
+  return "unknown";
+}
+
+bool ParseContactSolveMethod(std::string_view name, ContactSolveMethod* method) {
+  for (ContactSolveMethod m : {ContactSolveMethod::kGaussSeidel, ContactSolveMethod::kBlock}) {
+    if (name == ToString(m)) {
+      *method = m;
+      return true;
+    }
+  }
+  return false;
+}
+
 bool SolverOptions::IsValid(std::string* why) const {
   std::ostringstream msg;
   auto check = [&](bool ok, const char* field, double value, const char* bound) {
@@ -45,6 +65,9 @@ bool SolverOptions::IsValid(std::string* why) const {
         "0 < tolerance_m_s < 1 m/s");
   check(max_iterations >= 1 && max_iterations <= 100000, "max_iterations", max_iterations,
         "1 <= max_iterations <= 100000");
+  check(contact_solve == ContactSolveMethod::kGaussSeidel ||
+            contact_solve == ContactSolveMethod::kBlock,
+        "contact_solve", static_cast<double>(contact_solve), "a ContactSolveMethod value");
   check(prox_alpha > 0 && prox_alpha < 2, "prox_alpha", prox_alpha, "0 < prox_alpha < 2");
   check(penetration_tolerance > 0 && penetration_tolerance <= 0.5, "penetration_tolerance",
         penetration_tolerance, "0 < penetration_tolerance <= 0.5");

@@ -22,6 +22,21 @@ const char* ToString(ViscousReading reading);  // "centre_of_mass", "contact_fri
 // False when `name` is not one of the names ToString gives.
 bool ParseViscousReading(std::string_view name, ViscousReading* reading);
 
+// How the contact solve treats a step with two contacts (a rock on an edge). Scene files name the
+// methods "gauss_seidel" and "block".
+enum class ContactSolveMethod {
+  // Gauss-Seidel sweeps over the contacts, each solved exactly with the others held fixed.
+  kGaussSeidel,
+  // Two contacts solved as one coupled 6 x 6 problem (solver/contact_block.hpp): after one
+  // warm-started sweep, the active-set case it suggests (each contact separated, sticking or
+  // slipping) is solved exactly and checked against the laws, then the other cases; Gauss-Seidel
+  // goes on when none verifies. Slip directions start from the previous iterate and Newton stops
+  // at the solver tolerance. Other contact counts are solved as with kGaussSeidel.
+  kBlock,
+};
+const char* ToString(ContactSolveMethod method);  // "gauss_seidel", "block"
+bool ParseContactSolveMethod(std::string_view name, ContactSolveMethod* method);
+
 struct SolverOptions {
   double dt_s = 0.002;                  // time step
   double max_time_s = 300;              // a rock still moving then ends as max_time
@@ -35,6 +50,8 @@ struct SolverOptions {
   // contact point is below tolerance_m_s, or max_iterations sweeps.
   double tolerance_m_s = 1e-7;
   int max_iterations = 200;
+  // Two-contact steps: Gauss-Seidel sweeps (wave 1) or one coupled block solve.
+  ContactSolveMethod contact_solve = ContactSolveMethod::kGaussSeidel;
   double prox_alpha = 1.0;  // step length r = alpha / diag(W' M^-1 W), in (0, 2)
   // Contact prediction (plastic normal law only): a vertex that would sink deeper than this
   // fraction of the rock's thickness by the next midpoint joins the contact set early and is

@@ -480,5 +480,25 @@ TEST(Energy, ContactFrictionReadingAddsNoEnergyBeyondTheSchemesOwnDrift) {
   EXPECT_LT(centre.worst_kinetic_gain, 1e-9);
 }
 
+TEST(Energy, BlockSolveNeverAddsEnergy) {
+  // The same ten ramp blocks with the two-contact block solve (ContactSolveMethod::kBlock), both
+  // readings: after every contact solve the kinetic energy is at most that of the free motion
+  // (tolerance 1e-9 relative, as above), and the mechanical energy climbs above its running
+  // minimum by no more than the bounds above (1e-7 of the release energy with the centre-of-mass
+  // drag, 1e-5 with contact friction, the scheme's own order-dt^2 drift).
+  for (ViscousReading reading : {ViscousReading::kCentreOfMass, ViscousReading::kContactFriction}) {
+    Scene scene = RampWith(reading);
+    scene.options.contact_solve = ContactSolveMethod::kBlock;
+    const EnergyCheck check = CheckEnergy(scene);
+    std::printf(
+        "block, %s: worst energy rise %.2e of the release energy, worst kinetic gain of a contact "
+        "solve %.2e, %ld contact steps\n",
+        ToString(reading), check.worst_rise, check.worst_kinetic_gain, check.contact_steps);
+    EXPECT_GT(check.contact_steps, 10000);
+    EXPECT_LT(check.worst_rise, reading == ViscousReading::kCentreOfMass ? 1e-7 : 1e-5);
+    EXPECT_LT(check.worst_kinetic_gain, 1e-9);
+  }
+}
+
 }  // namespace
 }  // namespace talus
