@@ -712,6 +712,15 @@ void LoadSolver(const Section& s, SolverOptions& o) {
                             "; known: centre_of_mass, contact_friction");
     }
   }
+  if (s.Has("contact_solve")) {
+    const std::string name = s.String("contact_solve", "");
+    if (!ParseContactSolveMethod(name, &o.contact_solve)) {
+      const std::string hint = ClosestName(name, {"gauss_seidel", "block"});
+      s.Fail("contact_solve", "unknown method '" + name + "'" +
+                                  (hint.empty() ? "" : " (did you mean '" + hint + "'?)") +
+                                  "; known: gauss_seidel, block");
+    }
+  }
   o.tolerance_m_s = s.Number("tolerance_m_s", o.tolerance_m_s);
   const long max_iterations = s.Integer("max_iterations", o.max_iterations);
   if (max_iterations != static_cast<int>(max_iterations))
@@ -824,11 +833,12 @@ SceneFile LoadScene(const std::string& path) {
                       {"points", "lines", "polygons", "file", "runs", "block_column", "height_m",
                        "rocks", "orientation", "velocity_m_s", "angular_velocity_rad_s", "seed"}),
               out);
-  LoadSolver(Section(context, SubTable(context, root, "solver"), "solver",
-                     {"dt_s", "max_time_s", "gravity_m_s2", "normal_restitution",
-                      "tangential_restitution", "viscous", "tolerance_m_s", "max_iterations",
-                      "prox_alpha", "rest_speed_m_s", "rest_angular_speed_rad_s", "rest_hold_s"}),
-             out.scene.options);
+  LoadSolver(
+      Section(context, SubTable(context, root, "solver"), "solver",
+              {"dt_s", "max_time_s", "gravity_m_s2", "normal_restitution", "tangential_restitution",
+               "viscous", "contact_solve", "tolerance_m_s", "max_iterations", "prox_alpha",
+               "rest_speed_m_s", "rest_angular_speed_rad_s", "rest_hold_s"}),
+      out.scene.options);
   LoadOutput(Section(context, SubTable(context, root, "output"), "output",
                      {"trajectories", "trajectory_interval_s", "rasters", "quicklook"}),
              out.output);

@@ -158,6 +158,21 @@ TEST(LoadScene, ViscousReadingIsChosenByNameWithDidYouMean) {
              "solver.viscus: unknown key (did you mean 'viscous'?)");
 }
 
+TEST(LoadScene, ContactSolveMethodIsChosenByNameWithDidYouMean) {
+  const auto dir = testing::FreshDir("contact_solve");
+  testing::WriteText(dir / "scene.toml", kPlaneScene);
+  EXPECT_EQ(LoadScene((dir / "scene.toml").string()).scene.options.contact_solve,
+            ContactSolveMethod::kGaussSeidel);  // the default
+  testing::WriteText(dir / "scene.toml", Replace(kPlaneScene, "max_time_s = 20",
+                                                 "max_time_s = 20\ncontact_solve = \"block\""));
+  EXPECT_EQ(LoadScene((dir / "scene.toml").string()).scene.options.contact_solve,
+            ContactSolveMethod::kBlock);
+  EXPECT_HAS(ErrorOf(Replace(kPlaneScene, "max_time_s = 20",
+                             "max_time_s = 20\ncontact_solve = \"blok\""),
+                     dir),
+             "scene.toml:23: solver.contact_solve: unknown method 'blok' (did you mean 'block'?)");
+}
+
 TEST(LoadScene, ReleaseOutsideTheDemIsAnError) {
   const auto dir = testing::FreshDir("outside");
   const std::string e = ErrorOf(Replace(kPlaneScene, "[6, 2]", "[6, 200]"), dir);
