@@ -77,6 +77,8 @@ int RunValidate(const ValidateArgs& args) {
     if (std::any_of(windows.begin(), windows.end(), [](double w) { return w > 0; }))
       options.extra_recorders.push_back(
           fieldobs::SegmentRecorders(event.scene.scene.terrain, windows));
+    if (!event.observations.zones.empty())
+      options.extra_recorders.push_back(fieldobs::ZoneRecorders(event.observations.zones));
     fieldobs::EnsembleSamples simulated(release);
     io::ValidationRun run;
     run.ensemble = ensemble::RunEnsemble(event.scene.scene, release, options, &simulated);

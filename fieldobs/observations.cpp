@@ -28,6 +28,14 @@ const char* ToString(Quantity quantity) {
       return "segment_mean_angular_speed";
     case Quantity::kSegmentMaxJumpHeight:
       return "segment_max_jump_height";
+    case Quantity::kZoneSpeed:
+      return "zone_speed";
+    case Quantity::kZoneAngularSpeed:
+      return "zone_angular_speed";
+    case Quantity::kZoneJumpHeight:
+      return "zone_jump_height";
+    case Quantity::kZonePassed:
+      return "zone_passed";
   }
   return "unknown";
 }
@@ -37,7 +45,14 @@ const char* UnitOf(Quantity quantity) {
     case Quantity::kRunout:
     case Quantity::kScarLength:
     case Quantity::kSegmentMaxJumpHeight:
+    case Quantity::kZoneJumpHeight:
       return "m";
+    case Quantity::kZoneSpeed:
+      return "m/s";
+    case Quantity::kZoneAngularSpeed:
+      return "rad/s";
+    case Quantity::kZonePassed:
+      return "1";
     case Quantity::kImpactSpeedOut:
     case Quantity::kSegmentMaxSpeed:
       return "m/s";
@@ -184,6 +199,44 @@ void ReadScars(const CsvTable& t, const TableColumns& c, ObservationSet& out) {
     if (t.Empty(row, "scar_length_m")) continue;
     out.scalars.push_back({Quantity::kScarLength, RunOf(t, c, row),
                            NonNegative(t, row, "scar_length_m"), Where(t, row)});
+  }
+}
+
+void ReadZoneObservations(const CsvTable& t, const TableColumns& c, ObservationSet& out) {
+  t.Require({"zone_id", "quantity", "value"});
+  for (int row = 0; row < t.rows(); ++row) {
+    if (t.Empty(row, "value")) continue;
+    const std::string id = t.Text(row, "zone_id");
+    int zone = -1;
+    std::string known;
+    for (std::size_t k = 0; k < out.zones.size(); ++k) {
+      if (out.zones[k].id == id) zone = static_cast<int>(k);
+      known += (known.empty() ? "" : ", ") + out.zones[k].id;
+    }
+    if (zone < 0)
+      throw InputError(t.Where(row, "zone_id") + ": unknown zone '" + id +
+                       "' (the event's zones: " + (known.empty() ? "none" : known) + ")");
+    const std::string q = t.Text(row, "quantity");
+    Quantity quantity;
+    if (q == "speed_mps") {
+      quantity = Quantity::kZoneSpeed;
+    } else if (q == "angular_speed_radps") {
+      quantity = Quantity::kZoneAngularSpeed;
+    } else if (q == "jump_height_m") {
+      quantity = Quantity::kZoneJumpHeight;
+    } else if (q == "passed") {
+      quantity = Quantity::kZonePassed;
+    } else {
+      throw InputError(t.Where(row, "quantity") + ": unknown quantity '" + q +
+                       "' (known: speed_mps, angular_speed_radps, jump_height_m, passed)");
+    }
+    const double value = quantity == Quantity::kZoneJumpHeight ? t.Number(row, "value")
+                                                               : NonNegative(t, row, "value");
+    if (quantity == Quantity::kZonePassed && value != 0 && value != 1)
+      throw InputError(t.Where(row, "value") + ": passed is 0 or 1, not " + t.Text(row, "value"));
+    ScalarObservation o{quantity, RunOf(t, c, row), value, Where(t, row)};
+    o.zone = zone;
+    out.scalars.push_back(o);
   }
 }
 

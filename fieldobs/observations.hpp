@@ -26,6 +26,21 @@ enum class Quantity {
   kSegmentMaxSpeed,          // m/s: largest speed of the centre of mass
   kSegmentMeanAngularSpeed,  // rad/s: mean angular speed
   kSegmentMaxJumpHeight,     // m: largest height of the centre of mass above the terrain (normal)
+  // At a zone (ObservationSet::zones): a line's first crossing, or the largest value inside a
+  // polygon; only rocks that reached the zone give a value, except kZonePassed (0 or 1, every
+  // rock).
+  kZoneSpeed,         // m/s
+  kZoneAngularSpeed,  // rad/s
+  kZoneJumpHeight,    // m: centre of mass above the terrain along its normal
+  kZonePassed,        // 1: the rock crossed the line or entered the polygon, else 0
+};
+
+// A place where something was observed: an evaluation line (a barrier's line, a survey profile)
+// or a polygon, in map coordinates.
+struct Zone {
+  std::string id;
+  bool polygon = false;
+  std::vector<Eigen::Vector2d> points;  // the line's vertices, or the polygon's ring
 };
 const char* ToString(Quantity quantity);  // "runout", "impact_speed_out", ...
 const char* UnitOf(Quantity quantity);    // "m", "m/s", "1", "rad/s", "s"
@@ -36,6 +51,7 @@ struct ScalarObservation {
   double value = 0;
   std::string where;    // "file:line", for reports
   double window_s = 0;  // segment quantities: the time from the run's start they cover
+  int zone = -1;        // zone quantities: index into ObservationSet::zones
 };
 
 // A surveyed rest position (map coordinates, m), optionally with its uncertainty radius.
@@ -49,6 +65,7 @@ struct DepositObservation {
 struct ObservationSet {
   std::vector<ScalarObservation> scalars;
   std::vector<DepositObservation> deposits;
+  std::vector<Zone> zones;
   std::size_t size() const { return scalars.size() + deposits.size(); }
 };
 
@@ -90,6 +107,10 @@ void ReadImpacts(const CsvTable& table, const TableColumns& columns, Observation
 // bad number.
 std::vector<std::pair<std::string, std::optional<double>>> FirstAngularSpeeds(
     const CsvTable& samples, const TableColumns& columns);
+
+// Zone observations: `zone_id` (one of out.zones), `quantity` (speed_mps, angular_speed_radps,
+// jump_height_m or passed) and `value` (passed: 0 or 1, e.g. one row per observed block).
+void ReadZoneObservations(const CsvTable& table, const TableColumns& columns, ObservationSet& out);
 
 // Sampled trajectory segments (`time_s`, `x_m`, `y_m`, `z_m` of the centre of mass; `speed_mps` or
 // `vx_mps`, `vy_mps`, `vz_mps`; optional `omega_x_radps`, `omega_y_radps`, `omega_z_radps`), rows

@@ -1,6 +1,8 @@
 #include "fieldobs/samples.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 #include <memory>
 
 namespace talus::fieldobs {
@@ -57,6 +59,82 @@ class SegmentRecorder : public ensemble::RockRecorder {
   long samples_ = 0;
 };
 
+// Where the step a -> b crosses the segment p -> q: the fraction along a -> b, or -1.
+double Crossing(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& p,
+                const Eigen::Vector2d& q) {
+  const Eigen::Vector2d r = b - a, s = q - p;
+  const double denominator = r.x() * s.y() - r.y() * s.x();
+  if (denominator == 0) return -1;  // parallel: a grazing path does not cross
+  const Eigen::Vector2d d = p - a;
+  const double t = (d.x() * s.y() - d.y() * s.x()) / denominator;
+  const double u = (d.x() * r.y() - d.y() * r.x()) / denominator;
+  return t >= 0 && t <= 1 && u >= 0 && u <= 1 ? t : -1;
+}
+
+bool Inside(const std::vector<Eigen::Vector2d>& ring, const Eigen::Vector2d& p) {
+  bool inside = false;
+  for (std::size_t k = 0, l = ring.size() - 1; k < ring.size(); l = k++) {
+    const Eigen::Vector2d& a = ring[k];
+    const Eigen::Vector2d& b = ring[l];
+    if ((a.y() > p.y()) != (b.y() > p.y()) &&
+        p.x() < (b.x() - a.x()) * (p.y() - a.y()) / (b.y() - a.y()) + a.x())
+      inside = !inside;
+  }
+  return inside;
+}
+
+class ZoneRecorder : public ensemble::RockRecorder {
+ public:
+  explicit ZoneRecorder(std::shared_ptr<const std::vector<Zone>> zones)
+      : zones_(std::move(zones)) {}
+  void Begin(const ensemble::RockOutcome& outcome) override {
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    values_.assign(4 * zones_->size(), nan);
+    for (std::size_t z = 0; z < zones_->size(); ++z) values_[4 * z] = 0;
+    previous_ = outcome.start;
+    previous_jump_ = nan;  // unknown until the first step's terrain sample
+  }
+  void OnStep(const RockState& state, const StepReport&, const TerrainSample& ground) override {
+    const double jump = (state.position_m.z() - ground.height_m) * ground.normal.z();
+    const Eigen::Vector2d a = previous_.position_m.head<2>(), b = state.position_m.head<2>();
+    const double v0 = previous_.velocity_m_s.norm(), v1 = state.velocity_m_s.norm();
+    const double w0 = previous_.angular_velocity_rad_s.norm(),
+                 w1 = state.angular_velocity_rad_s.norm();
+    const double j0 = std::isnan(previous_jump_) ? jump : previous_jump_;
+    for (std::size_t z = 0; z < zones_->size(); ++z) {
+      const Zone& zone = (*zones_)[z];
+      double* v = &values_[4 * z];
+      if (zone.polygon) {
+        if (!Inside(zone.points, b)) continue;
+        v[0] = 1;
+        v[1] = std::isnan(v[1]) ? v1 : std::max(v[1], v1);
+        v[2] = std::isnan(v[2]) ? w1 : std::max(v[2], w1);
+        v[3] = std::isnan(v[3]) ? jump : std::max(v[3], jump);
+        continue;
+      }
+      if (v[0] == 1) continue;  // the first crossing counts
+      for (std::size_t k = 1; k < zone.points.size(); ++k) {
+        const double t = Crossing(a, b, zone.points[k - 1], zone.points[k]);
+        if (t < 0) continue;
+        v[0] = 1;
+        v[1] = v0 + t * (v1 - v0);
+        v[2] = w0 + t * (w1 - w0);
+        v[3] = j0 + t * (jump - j0);
+        break;
+      }
+    }
+    previous_ = state;
+    previous_jump_ = jump;
+  }
+  void Finish(ensemble::RockOutcome& outcome) override { outcome.extra["zones"] = values_; }
+
+ private:
+  std::shared_ptr<const std::vector<Zone>> zones_;
+  std::vector<double> values_;
+  RockState previous_;
+  double previous_jump_ = 0;
+};
+
 bool IsSegment(Quantity q) {
   return q == Quantity::kSegmentMaxSpeed || q == Quantity::kSegmentMeanAngularSpeed ||
          q == Quantity::kSegmentMaxJumpHeight;
@@ -74,6 +152,13 @@ ensemble::RecorderFactory SegmentRecorders(const Terrain& terrain, std::vector<d
       std::shared_ptr<const std::vector<double>> keep;
     };
     return std::make_unique<Owning>(terrain, windows);
+  };
+}
+
+ensemble::RecorderFactory ZoneRecorders(std::vector<Zone> zones) {
+  auto shared = std::make_shared<const std::vector<Zone>>(std::move(zones));
+  return [shared]() -> std::unique_ptr<ensemble::RockRecorder> {
+    return std::make_unique<ZoneRecorder>(shared);
   };
 }
 
@@ -115,6 +200,8 @@ void EnsembleSamples::OnRock(const ensemble::RockOutcome& outcome) {
     rock.segment_mean_angular_speed_rad_s = s[1];
     if (s[2] > -1e299) rock.segment_max_jump_m = s[2];
   }
+  if (const auto it = outcome.extra.find("zones"); it != outcome.extra.end())
+    rock.zones = it->second;
   rocks_.push_back(rock);
 }
 
@@ -136,7 +223,8 @@ void EnsembleSamples::ForRun(const std::string& run, F&& f) const {
     f(rocks_[static_cast<std::size_t>(k)]);
 }
 
-std::vector<double> EnsembleSamples::Values(Quantity quantity, const std::string& run) const {
+std::vector<double> EnsembleSamples::Values(Quantity quantity, const std::string& run,
+                                            int zone) const {
   std::vector<double> out;
   ForRun(run, [&](const Rock& r) {
     std::optional<double> v;
@@ -168,6 +256,19 @@ std::vector<double> EnsembleSamples::Values(Quantity quantity, const std::string
       case Quantity::kSegmentMaxJumpHeight:
         v = r.segment_max_jump_m;
         break;
+      case Quantity::kZonePassed:
+      case Quantity::kZoneSpeed:
+      case Quantity::kZoneAngularSpeed:
+      case Quantity::kZoneJumpHeight: {
+        const std::size_t at = 4 * static_cast<std::size_t>(zone);
+        if (zone < 0 || at + 3 >= r.zones.size() + 0 || r.zones.size() < at + 4) break;
+        const int offset = quantity == Quantity::kZonePassed         ? 0
+                           : quantity == Quantity::kZoneSpeed        ? 1
+                           : quantity == Quantity::kZoneAngularSpeed ? 2
+                                                                     : 3;
+        if (!std::isnan(r.zones[at + offset])) v = r.zones[at + offset];
+        break;
+      }
     }
     if (v) out.push_back(*v);
   });

@@ -25,6 +25,11 @@ ensemble::RecorderFactory SegmentRecorders(const Terrain& terrain, std::vector<d
 std::vector<double> SegmentWindows(const ObservationSet& observations,
                                    const ensemble::ReleaseSpec& release);
 
+// A recorder of each rock's passage through `zones`: for a line, whether the centre of mass crossed
+// it and the speed, angular speed and jump height at the first crossing (interpolated within the
+// step); for a polygon, whether the centre of mass entered it and the largest values inside.
+ensemble::RecorderFactory ZoneRecorders(std::vector<Zone> zones);
+
 class EnsembleSamples : public ensemble::RockSink {
  public:
   // `release` names the runs; it must outlive this object. The runner must record episodes
@@ -36,7 +41,8 @@ class EnsembleSamples : public ensemble::RockSink {
   bool HasRun(const std::string& run) const;
   // The values of `quantity` over the rocks of `run` ("": every rock), in rock order. Rocks that
   // do not give the quantity (no contact episode for an impact quantity) are left out.
-  std::vector<double> Values(Quantity quantity, const std::string& run) const;
+  // Zone quantities take the zone's index.
+  std::vector<double> Values(Quantity quantity, const std::string& run, int zone = -1) const;
   // End positions (map coordinates) of the rocks of `run`, in rock order.
   std::vector<Eigen::Vector2d> EndPositions(const std::string& run) const;
   // Start position (horizontal) of `run`'s first rock, or nullopt for "" or an unknown run.
@@ -54,6 +60,8 @@ class EnsembleSamples : public ensemble::RockSink {
     // Over the run's observed segment (SegmentRecorders).
     std::optional<double> segment_max_speed_m_s, segment_mean_angular_speed_rad_s,
         segment_max_jump_m;
+    std::vector<double>
+        zones;  // per zone: passed, speed, angular speed, jump height (ZoneRecorders)
   };
   template <class F>
   void ForRun(const std::string& run, F&& f) const;

@@ -22,7 +22,7 @@ void ScoreScalarObservation(const ScalarObservation& o, const EnsembleSamples& s
                             const EnsembleSamples* reference,
                             const std::vector<double>& climatology, double u, int min_members,
                             ObservationScore& s) {
-  const std::vector<double> values = sim.Values(o.quantity, o.run);
+  const std::vector<double> values = sim.Values(o.quantity, o.run, o.zone);
   s.members = static_cast<int>(values.size());
   if (!sim.HasRun(o.run)) {
     s.not_scored = "no run '" + o.run + "' in the scene";
@@ -44,7 +44,7 @@ void ScoreScalarObservation(const ScalarObservation& o, const EnsembleSamples& s
   s.inside_90 = score.inside_90;
   s.bias = score.bias;
   if (reference) {
-    const std::vector<double> ref = reference->Values(o.quantity, o.run);
+    const std::vector<double> ref = reference->Values(o.quantity, o.run, o.zone);
     if (static_cast<int>(ref.size()) >= min_members) s.reference_score = CrpsEnsemble(ref, o.value);
   }
   if (static_cast<int>(climatology.size()) >= min_members)

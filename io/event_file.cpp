@@ -2,6 +2,7 @@
 
 #include <toml++/toml.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <optional>
@@ -38,7 +39,8 @@ std::string StringKey(const std::string& file, const toml::table& t, const std::
   return std::string(*node->value<std::string>());
 }
 
-const std::vector<std::string> kKinds = {"runout", "deposits", "impacts", "scars", "trajectories"};
+const std::vector<std::string> kKinds = {"runout", "deposits",     "impacts",
+                                         "scars",  "trajectories", "zones"};
 
 }  // namespace
 
@@ -77,8 +79,8 @@ EventFile LoadEvent(const std::string& path) {
   };
   for (const auto& [key, node] : root) {
     const std::string k(key.str());
-    if (k != "scene" && k != "reference" && k != "observations") {
-      const std::string hint = ClosestName(k, {"scene", "reference", "observations"});
+    if (k != "scene" && k != "reference" && k != "observations" && k != "zones") {
+      const std::string hint = ClosestName(k, {"scene", "reference", "observations", "zones"});
       Fail(path, &node, k, "unknown key" + (hint.empty() ? "" : " (did you mean '" + hint + "'?)"));
     }
   }
@@ -95,6 +97,51 @@ EventFile LoadEvent(const std::string& path) {
   if (event.reference != "table1" && event.reference != "none")
     Fail(path, root.get("reference"), "reference",
          "'" + event.reference + "': expected \"table1\" or \"none\"");
+
+  // [[zones]]: lines and polygons that zone observations refer to.
+  if (const toml::node* zones = root.get("zones")) {
+    const toml::array* list = zones->as_array();
+    if (!list) Fail(path, zones, "zones", "expected [[zones]] tables (id, line or polygon)");
+    for (std::size_t k = 0; k < list->size(); ++k) {
+      const std::string name = "zones[" + std::to_string(k) + "]";
+      const toml::table* t = list->get(k)->as_table();
+      if (!t) Fail(path, list->get(k), name, "expected a table (id, line or polygon)");
+      for (const auto& [key, node] : *t) {
+        const std::string key_name(key.str());
+        if (key_name != "id" && key_name != "line" && key_name != "polygon") {
+          const std::string hint = ClosestName(key_name, {"id", "line", "polygon"});
+          Fail(path, &node, name + "." + key_name,
+               "unknown key" + (hint.empty() ? "" : " (did you mean '" + hint + "'?)"));
+        }
+      }
+      fieldobs::Zone zone;
+      zone.id = StringKey(path, *t, "id", name + ".id", true);
+      for (const fieldobs::Zone& other : event.observations.zones)
+        if (other.id == zone.id)
+          Fail(path, t->get("id"), name + ".id", "zone '" + zone.id + "' is defined twice");
+      zone.polygon = t->get("polygon") != nullptr;
+      if (zone.polygon == (t->get("line") != nullptr))
+        Fail(path, t, name,
+             "give exactly one of line and polygon ([[x, y], ...], map coordinates)");
+      const char* key = zone.polygon ? "polygon" : "line";
+      const toml::array* points = t->get(key)->as_array();
+      const auto bad = [&] {
+        Fail(path, t->get(key), name + "." + key, "expected a list of [x, y] points (finite, m)");
+      };
+      if (!points) bad();
+      for (const toml::node& p : *points) {
+        const toml::array* xy = p.as_array();
+        if (!xy || xy->size() != 2) bad();
+        const auto x = xy->get(0)->value<double>(), y = xy->get(1)->value<double>();
+        if (!x || !y || !std::isfinite(*x) || !std::isfinite(*y)) bad();
+        zone.points.emplace_back(*x, *y);
+      }
+      if (zone.points.size() < (zone.polygon ? 3u : 2u))
+        Fail(path, t->get(key), name + "." + key,
+             zone.polygon ? "a polygon needs at least 3 points" : "a line needs at least 2 points");
+      event.observations.zones.push_back(zone);
+    }
+  }
 
   const toml::node* list = root.get("observations");
   if (!list) Fail(path, &root, "observations", "missing: give [[observations]] tables");
@@ -121,7 +168,7 @@ EventFile LoadEvent(const std::string& path) {
       const std::string hint = ClosestName(kind, kKinds);
       Fail(path, t->get("kind"), name + ".kind",
            "unknown kind '" + kind + "'" + (hint.empty() ? "" : " (did you mean '" + hint + "'?)") +
-               "; known: runout, deposits, impacts, scars, trajectories");
+               "; known: runout, deposits, impacts, scars, trajectories, zones");
     }
     const std::string file = resolve(StringKey(path, *t, "file", name + ".file", true));
     if (!fs::exists(file)) Fail(path, t->get("file"), name + ".file", "file not found: " + file);
@@ -161,6 +208,7 @@ EventFile LoadEvent(const std::string& path) {
       if (kind == "scars") fieldobs::ReadScars(table, columns, event.observations);
       if (kind == "trajectories")
         fieldobs::ReadTrajectories(table, columns, event.scene.scene.terrain, event.observations);
+      if (kind == "zones") fieldobs::ReadZoneObservations(table, columns, event.observations);
     }
     if (event.observations.size() == before)
       Fail(path, t->get("file"), name + ".file", file + " holds no observation");

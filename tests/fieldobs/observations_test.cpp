@@ -162,5 +162,32 @@ TEST(Observations, BadTablesNameFileLineAndColumn) {
   EXPECT_HAS(ErrorOf(ReadScars, ""), "obs.csv: empty file");
 }
 
+TEST(Observations, ZoneObservationsNameTheirZoneAndQuantity) {
+  ObservationSet set;
+  set.zones.push_back({"barrier", false, {{0, 0}, {1, 0}}});
+  ReadZoneObservations(CsvTable::Parse("zone_id,quantity,value\nbarrier,speed_mps,12.5\n"
+                                       "barrier,passed,1\nbarrier,jump_height_m,\n",
+                                       "zones.csv"),
+                       TableColumns{}, set);
+  ASSERT_EQ(set.scalars.size(), 2u);  // the empty value is skipped
+  EXPECT_EQ(set.scalars[0].quantity, Quantity::kZoneSpeed);
+  EXPECT_EQ(set.scalars[0].zone, 0);
+  EXPECT_EQ(set.scalars[1].quantity, Quantity::kZonePassed);
+  const auto error = [&](const std::string& text) {
+    try {
+      ReadZoneObservations(CsvTable::Parse(text, "zones.csv"), TableColumns{}, set);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_HAS(error("zone_id,quantity,value\nwall,passed,1\n"),
+             "zones.csv:2: column 'zone_id': unknown zone 'wall' (the event's zones: barrier)");
+  EXPECT_HAS(error("zone_id,quantity,value\nbarrier,energy,1\n"),
+             "zones.csv:2: column 'quantity': unknown quantity 'energy'");
+  EXPECT_HAS(error("zone_id,quantity,value\nbarrier,passed,0.5\n"),
+             "zones.csv:2: column 'value': passed is 0 or 1, not 0.5");
+}
+
 }  // namespace
 }  // namespace talus::fieldobs

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <tuple>
 
 #include "ensemble/runner.hpp"
 #include "solver/shapes.hpp"
@@ -206,6 +207,61 @@ TEST(Validate, FreeFlightSegmentsAreReproduced) {
   for (double z : simulated.Values(Quantity::kSegmentMaxJumpHeight, "seg"))
     EXPECT_NEAR(z, observed_jump, 3e-5);
   EXPECT_LT(report.observations[0].score, 0.01);  // CRPS of a near-exact ensemble, m/s
+}
+
+// Zones on a block sliding down a 30 degree incline with constant Coulomb friction mu = 0.3 (no
+// viscous term): it slides at a = g (sin 30 - mu cos 30) = 2.356 m/s^2 (closed form; the solver's
+// incline test holds it to 1e-6), so it crosses a line 10 m downhill (horizontally) at
+// v = sqrt(2 a s), s = 10 / cos 30, = 7.376 m/s; its centre of mass stays 0.25 m above the slope. A
+// polygon from 10 to 20 m downhill sees it as fast as when it leaves: sqrt(2 a 20 / cos 30), to
+// within one step (a dt = 0.005 m/s). A line beside its path is never crossed.
+TEST(Validate, ZoneCrossingsOfASlidingBlockFollowTheClosedForm) {
+  Scene scene;
+  PlaneSpec plane{30, 60, 10, 40, 1};
+  const int test = scene.ground.Set({"test", 100, GroundParams{0.3, 0.3, 150, 2, 0}});
+  scene.terrain = Terrain(MakePlaneHeightfield(plane), test);
+  scene.rock = MakeRockShape(MakeBox(1.0, 1.0, 0.5), 2700);
+  scene.options.max_time_s = 6;
+  ensemble::ReleaseSpec release;
+  ensemble::ReleaseRun run;
+  run.id = "slide";
+  run.xy_m = {5, 0};
+  run.height_m = 0;  // raised until the box rests on the slope
+  run.orientation = Eigen::Quaterniond(Eigen::AngleAxisd(M_PI / 6, Eigen::Vector3d::UnitY()));
+  release.runs = {run};
+  release.rocks_per_release = 3;
+  ObservationSet obs;
+  obs.zones.push_back({"line10", false, {{15, -10}, {15, 10}}});
+  obs.zones.push_back({"band", true, {{15, -10}, {25, -10}, {25, 10}, {15, 10}}});
+  obs.zones.push_back({"aside", false, {{15, 5}, {15, 10}}});
+  const double a = 9.81 * (0.5 - 0.3 * std::cos(M_PI / 6));
+  const double v10 = std::sqrt(2 * a * 10 / std::cos(M_PI / 6));
+  const double v20 = std::sqrt(2 * a * 20 / std::cos(M_PI / 6));
+  for (const auto& [zone, q, value] :
+       std::vector<std::tuple<int, Quantity, double>>{{0, Quantity::kZoneSpeed, v10},
+                                                      {0, Quantity::kZoneJumpHeight, 0.25},
+                                                      {0, Quantity::kZonePassed, 1},
+                                                      {1, Quantity::kZoneSpeed, v20},
+                                                      {2, Quantity::kZonePassed, 0}}) {
+    ScalarObservation o{q, "slide", value, "z"};
+    o.zone = zone;
+    obs.scalars.push_back(o);
+  }
+  ensemble::EnsembleOptions options;
+  options.extra_recorders.push_back(ZoneRecorders(obs.zones));
+  EnsembleSamples simulated(release);
+  ensemble::RunEnsemble(scene, release, options, &simulated);
+  const auto speeds = simulated.Values(Quantity::kZoneSpeed, "slide", 0);
+  ASSERT_EQ(speeds.size(), 3u);
+  for (double v : speeds) EXPECT_NEAR(v, v10, 0.01);
+  for (double h : simulated.Values(Quantity::kZoneJumpHeight, "slide", 0))
+    EXPECT_NEAR(h, 0.25, 1e-3);
+  for (double v : simulated.Values(Quantity::kZoneSpeed, "slide", 1)) EXPECT_NEAR(v, v20, 0.01);
+  EXPECT_EQ(simulated.Values(Quantity::kZonePassed, "slide", 2), std::vector<double>(3, 0.0));
+  EXPECT_TRUE(simulated.Values(Quantity::kZoneSpeed, "slide", 2).empty());  // never reached
+  const ValidationReport report = Validate(obs, simulated, nullptr);
+  EXPECT_EQ(report.observations_scored, 5);
+  for (const ObservationScore& s : report.observations) EXPECT_LT(s.score, 0.01) << s.kind;
 }
 
 TEST(Observations, TrajectorySegmentsNeedIncreasingTimesAndTwoSamples) {

@@ -149,6 +149,32 @@ TEST(LoadEvent, BadEventsNameFileLineAndKey) {
              "holds no observation");
 }
 
+TEST(LoadEvent, ZonesAreLinesOrPolygonsThatZoneObservationsName) {
+  const auto dir = MakeEvent("zones", 32632);
+  testing::WriteText(dir / "zones.csv", "trajectory_id,zone_id,quantity,value\nA,fence,passed,1\n");
+  const auto write = [&](const std::string& zones) {
+    testing::WriteText(dir / "event.toml", "scene = \"scene.toml\"\n" + zones +
+                                               "[[observations]]\nkind = \"zones\"\n"
+                                               "file = \"zones.csv\"\n");
+    return ErrorOf(dir / "event.toml");
+  };
+  EXPECT_EQ(write("[[zones]]\nid = \"fence\"\nline = [[680000, 5240100], [680200, 5240100]]\n"),
+            "");
+  const EventFile e = LoadEvent((dir / "event.toml").string());
+  ASSERT_EQ(e.observations.zones.size(), 1u);
+  EXPECT_FALSE(e.observations.zones[0].polygon);
+  EXPECT_EQ(e.observations.scalars.size(), 1u);
+  EXPECT_HAS(write("[[zones]]\nid = \"fence\"\nline = [[0, 0]]\n"),
+             "event.toml:4: zones[0].line: a line needs at least 2 points");
+  EXPECT_HAS(write("[[zones]]\nid = \"fence\"\nline = [[0, 0], [1, 1]]\npolygon = [[0, 0], [1, "
+                   "0], [1, 1]]\n"),
+             "zones[0]: give exactly one of line and polygon");
+  EXPECT_HAS(write("[[zones]]\nid = \"fence\"\nlne = [[0, 0], [1, 1]]\n"),
+             "zones[0].lne: unknown key (did you mean 'line'?)");
+  EXPECT_HAS(write(""),
+             "zones.csv:2: column 'zone_id': unknown zone 'fence' (the event's zones: none)");
+}
+
 TEST(ReferenceGround, Table1ValuesForBuiltInCategoriesOnly) {
   GroundTable table = GroundTable::BuiltIn();
   bool differs = true;
