@@ -1,6 +1,11 @@
 // Checks of command-line values shared by the verbs, with messages that name the bound.
 
+#include <unistd.h>
+
+#include <cerrno>
 #include <charconv>
+#include <cstring>
+#include <filesystem>
 #include <string>
 
 #include "app/commands.hpp"
@@ -26,6 +31,18 @@ CLI::Validator IntegerRange(long long min, long long max) {
         return {};
       },
       description);
+}
+
+std::string PrepareOutputDirectory(const std::string& dir) {
+  namespace fs = std::filesystem;
+  std::error_code error;
+  if (fs::exists(dir, error) && !fs::is_directory(dir, error))
+    return "--out " + dir + " exists and is not a directory";
+  fs::create_directories(dir, error);
+  if (error) return "cannot create the output directory " + dir + ": " + error.message();
+  if (::access(dir.c_str(), W_OK | X_OK) != 0)
+    return "cannot write to the output directory " + dir + ": " + std::strerror(errno);
+  return "";
 }
 
 }  // namespace talus::app

@@ -140,19 +140,6 @@ std::vector<std::string> TalusOutputNames() {
   return names;
 }
 
-// Creates the output directory; on failure the reason, else "".
-std::string PrepareOutputDirectory(const std::string& dir) {
-  namespace fs = std::filesystem;
-  std::error_code error;
-  if (fs::exists(dir, error) && !fs::is_directory(dir, error))
-    return "--out " + dir + " exists and is not a directory";
-  fs::create_directories(dir, error);
-  if (error) return "cannot create the output directory " + dir + ": " + error.message();
-  if (::access(dir.c_str(), W_OK | X_OK) != 0)
-    return "cannot write to the output directory " + dir + ": " + std::strerror(errno);
-  return "";
-}
-
 int RunSimulate(const SimulateArgs& args) {
   namespace fs = std::filesystem;
   if (std::error_code error; fs::is_directory(args.scene, error)) {

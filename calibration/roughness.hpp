@@ -28,7 +28,7 @@ struct RoughnessOptions {
   std::vector<double> steps = {1e-4, 1e-3, 1e-2, 1e-1};  // relative to each coordinate's range
   int seeds = 2;  // evaluations with other release seeds (seed + 1, seed + 2, ...)
   // The finite-difference step is the smallest step whose typical change is at least
-  // signal_to_noise times the roughness.
+  // signal_to_noise times the roughness (the largest step when none is).
   double signal_to_noise = 10;
   bool IsValid(std::string* why) const;
 };
