@@ -75,7 +75,7 @@ class ParameterSet {
   // category it touched with GroundParams::IsValid (which includes mu_min <= mu_max). False, with
   // the reason in *why, when u is not finite, lies outside [0, 1] or a check fails: the table is
   // then edited but invalid and must not be run. *violation (when given) measures how far u is
-  // from feasibility: the sum of max(0, mu_min - mu_max) over the touched categories plus the
+  // from feasibility: the largest mu_min - mu_max over the touched categories (if > 0) plus the
   // distance of u outside the unit cube (0 when feasible; infinity for a non-finite u).
   bool Apply(const Eigen::VectorXd& u, GroundTable& table, std::string* why,
              double* violation = nullptr) const;

@@ -64,7 +64,8 @@ Moments RunoutMoments(double mu) {
 // mu_min to about sigma / (|dm/dmu| sqrt(N)), and the model's own ensemble of R rocks per run adds
 // a factor sqrt(1 + 1/R). The test allows 3 such standard errors, plus the optimiser's xtol
 // (1e-3 of the 0.1 .. 0.9 range). sigma and dm/dmu are measured here (central difference over
-// +-0.05 around the truth), not assumed.
+// +-0.05 around the truth), not assumed. Measured: fitted 0.5215 in 12 evaluations; sigma 0.97 m,
+// dm/dmu -8.1 m, standard error 0.027, tolerance 0.081.
 TEST(Calibrate, BobyqaRecoversMuMinFromADistantStart) {
   const auto& p = Problem();
   ObjectiveOptions objective_options;
@@ -101,7 +102,8 @@ TEST(Calibrate, BobyqaRecoversMuMinFromADistantStart) {
 // Rocks that slide and roll down the plane from a low release barely fly, and beta (the scar's
 // decay rate in flight) cannot change much: its profile from 50 to 400 1/s stays within 3x the
 // noise level (roughness and the spread over other seeds, measured here), and it is reported
-// unidentified; mu_min's profile from 0.1 to 0.9 is far above it.
+// unidentified; mu_min's profile from 0.1 to 0.9 is far above it. Measured: noise 0.039 at a step
+// of 1e-4, sd over 3 seeds 0.098, threshold 0.295; profile ranges mu_min 5.39, beta 0.008.
 TEST(Calibrate, BetaIsUnidentifiedWhereRocksBarelyFlyAndMuMinIsIdentified) {
   const auto& p = Problem();
   ObjectiveOptions objective_options;
