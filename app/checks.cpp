@@ -33,7 +33,6 @@ CLI::Validator IntegerRange(long long min, long long max) {
       description);
 }
 
-// Creates the output directory; on failure the reason, else "".
 std::string PrepareOutputDirectory(const std::string& dir) {
   namespace fs = std::filesystem;
   std::error_code error;

@@ -14,6 +14,7 @@ Runner AddDemoCommand(CLI::App& app);
 Runner AddRockCommand(CLI::App& app);
 Runner AddSimulateCommand(CLI::App& app);
 Runner AddValidateCommand(CLI::App& app);
+Runner AddCalibrateCommand(CLI::App& app);
 
 // Exit codes, the same for every verb (README.md, "Exit codes").
 constexpr int kExitOk = 0;
@@ -26,8 +27,8 @@ constexpr int ExitCodeForSignal(int signal) { return 128 + signal; }
 // "must be >= min" (or "<= max", or "must be an integer") with the value given.
 CLI::Validator IntegerRange(long long min, long long max);
 
-// Creates the output directory (--out) and checks that it is writable; on failure the reason,
-// else "".
+// Creates the output directory `dir` (with its parents) and checks that it can be written; on
+// failure the reason ("--out <dir> exists and is not a directory", ...), else "".
 std::string PrepareOutputDirectory(const std::string& dir);
 
 }  // namespace talus::app

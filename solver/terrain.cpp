@@ -20,22 +20,34 @@ bool GridGeometry::IsValid(std::string* why) const {
   return false;
 }
 
+Terrain::Terrain()
+    : heights_(std::make_shared<const Heightfield>()),
+      ground_(std::make_shared<const GroundGrid>()),
+      grid_(heights_->grid) {}
+
 Terrain::Terrain(Heightfield heights, int default_ground)
-    : heights_(std::move(heights)),
-      inv_dx_(1.0 / heights_.grid.dx_m),
-      inv_dy_(1.0 / heights_.grid.dy_m),
+    : heights_(std::make_shared<const Heightfield>(std::move(heights))),
+      ground_(std::make_shared<const GroundGrid>()),
+      grid_(heights_->grid),
+      z_(heights_->z_m.data()),
+      inv_dx_(1.0 / grid_.dx_m),
+      inv_dy_(1.0 / grid_.dy_m),
       default_ground_(default_ground) {}
 
-void Terrain::SetGroundGrid(GroundGrid ground) { ground_ = std::move(ground); }
+void Terrain::SetGroundGrid(GroundGrid ground) {
+  ground_ = std::make_shared<const GroundGrid>(std::move(ground));
+  ground_geometry_ = ground_->grid;
+  ground_index_ = ground_->index.empty() ? nullptr : ground_->index.data();
+}
 
 bool Terrain::Locate(double x_m, double y_m, Cell* cell) const {
-  const GridGeometry& g = heights_.grid;
+  const GridGeometry& g = grid_;
   const double fx = (x_m - g.x0_m) * inv_dx_;
   const double fy = (y_m - g.y0_m) * inv_dy_;
   if (!(fx >= 0 && fy >= 0 && fx <= g.nx - 1 && fy <= g.ny - 1)) return false;
   const int i = std::min(static_cast<int>(fx), g.nx - 2);
   const int j = std::min(static_cast<int>(fy), g.ny - 2);
-  cell->row0 = heights_.z_m.data() + static_cast<std::size_t>(j) * g.nx + i;
+  cell->row0 = z_ + static_cast<std::size_t>(j) * g.nx + i;
   cell->row1 = cell->row0 + g.nx;
   cell->u = fx - i;
   cell->w = fy - j;
@@ -67,17 +79,17 @@ bool Terrain::Sample(double x_m, double y_m, TerrainSample* out) const {
 }
 
 int Terrain::GroundAt(double x_m, double y_m) const {
-  if (ground_.index.empty()) return default_ground_;
-  const GridGeometry& g = ground_.grid;
+  if (!ground_index_) return default_ground_;
+  const GridGeometry& g = ground_geometry_;
   const long i = std::lround((x_m - g.x0_m) / g.dx_m);
   const long j = std::lround((y_m - g.y0_m) / g.dy_m);
   if (i < 0 || j < 0 || i >= g.nx || j >= g.ny) return default_ground_;
-  const std::uint8_t index = ground_.index[static_cast<std::size_t>(j) * g.nx + i];
+  const std::uint8_t index = ground_index_[static_cast<std::size_t>(j) * g.nx + i];
   return index == GroundGrid::kNoGround ? default_ground_ : index;
 }
 
 bool Terrain::PlaneAround(double x_m, double y_m, double r_m, LocalPlane* out) const {
-  const GridGeometry& g = heights_.grid;
+  const GridGeometry& g = grid_;
   const double i_lo = std::floor((x_m - r_m - g.x0_m) * inv_dx_);
   const double i_hi = std::ceil((x_m + r_m - g.x0_m) * inv_dx_);
   const double j_lo = std::floor((y_m - r_m - g.y0_m) * inv_dy_);
@@ -89,7 +101,7 @@ bool Terrain::PlaneAround(double x_m, double y_m, double r_m, LocalPlane* out) c
   out->slope_y = -n.y() / n.z();
   double deviation = 0;
   for (int j = static_cast<int>(j_lo); j <= static_cast<int>(j_hi); ++j) {
-    const double* row = heights_.z_m.data() + static_cast<std::size_t>(j) * g.nx;
+    const double* row = z_ + static_cast<std::size_t>(j) * g.nx;
     const double dy = g.y0_m + j * g.dy_m - y_m;
     for (int i = static_cast<int>(i_lo); i <= static_cast<int>(i_hi); ++i) {
       const double dx = g.x0_m + i * g.dx_m - x_m;
@@ -103,28 +115,28 @@ bool Terrain::PlaneAround(double x_m, double y_m, double r_m, LocalPlane* out) c
 }
 
 bool Terrain::IsValid(std::string* why) const {
-  const GridGeometry& g = heights_.grid;
+  const Heightfield& heights = *heights_;
+  const GridGeometry& g = heights.grid;
   if (!g.IsValid(why)) return false;
-  if (heights_.z_m.size() != static_cast<std::size_t>(g.nx) * g.ny) {
+  if (heights.z_m.size() != static_cast<std::size_t>(g.nx) * g.ny) {
     if (why)
-      *why = "heightfield has " + std::to_string(heights_.z_m.size()) + " values for a " +
+      *why = "heightfield has " + std::to_string(heights.z_m.size()) + " values for a " +
              std::to_string(g.nx) + " x " + std::to_string(g.ny) + " grid";
     return false;
   }
-  for (double z : heights_.z_m) {
+  for (double z : heights.z_m) {
     if (std::isinf(z)) {
       if (why) *why = "heightfield contains an infinite height";
       return false;
     }
   }
-  if (std::all_of(heights_.z_m.begin(), heights_.z_m.end(),
-                  [](double z) { return std::isnan(z); })) {
+  if (std::all_of(heights.z_m.begin(), heights.z_m.end(), [](double z) { return std::isnan(z); })) {
     if (why) *why = "heightfield has no valid height (all nodata)";
     return false;
   }
-  if (!ground_.index.empty()) {
-    if (!ground_.grid.IsValid(why)) return false;
-    if (ground_.index.size() != static_cast<std::size_t>(ground_.grid.nx) * ground_.grid.ny) {
+  if (!ground_->index.empty()) {
+    if (!ground_->grid.IsValid(why)) return false;
+    if (ground_->index.size() != static_cast<std::size_t>(ground_->grid.nx) * ground_->grid.ny) {
       if (why) *why = "ground grid size does not match its geometry";
       return false;
     }

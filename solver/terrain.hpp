@@ -4,6 +4,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -45,9 +46,12 @@ struct TerrainSample {
   Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  // unit, upward, normal of the bilinear patch
 };
 
+// The heights and the ground grid are immutable once set and shared between copies (a copy of a
+// Terrain, and so of a Scene, costs two reference counts, not the DEM): calibration runs many
+// scenes that differ only in their ground table.
 class Terrain {
  public:
-  Terrain() = default;
+  Terrain();
   // heights: the DEM; default_ground: ground index used where there is no ground grid or it has
   // no value.
   Terrain(Heightfield heights, int default_ground);
@@ -75,10 +79,12 @@ class Terrain {
   };
   bool PlaneAround(double x_m, double y_m, double r_m, LocalPlane* out) const;
 
-  const Heightfield& heights() const { return heights_; }
+  const Heightfield& heights() const { return *heights_; }
   int default_ground() const { return default_ground_; }
-  bool has_ground_grid() const { return !ground_.index.empty(); }
-  const GroundGrid& ground_grid() const { return ground_; }
+  bool has_ground_grid() const { return !ground_->index.empty(); }
+  const GroundGrid& ground_grid() const { return *ground_; }
+  // True when this terrain and `other` share one heightfield in memory (copies do).
+  bool SharesHeightsWith(const Terrain& other) const { return heights_ == other.heights_; }
 
   // Checks the grid, array sizes and that there is at least one valid cell.
   bool IsValid(std::string* why) const;
@@ -94,9 +100,14 @@ class Terrain {
   // False outside the grid.
   bool Locate(double x_m, double y_m, Cell* cell) const;
 
-  Heightfield heights_;
-  double inv_dx_ = 1, inv_dy_ = 1;  // 1 / node spacing, 1/m
-  GroundGrid ground_;
+  // Shared, immutable. The hot path reads the cached grid and pointers below, not through these.
+  std::shared_ptr<const Heightfield> heights_;
+  std::shared_ptr<const GroundGrid> ground_;
+  GridGeometry grid_;                           // heights_->grid
+  const double* z_ = nullptr;                   // heights_->z_m.data()
+  GridGeometry ground_geometry_;                // ground_->grid
+  const std::uint8_t* ground_index_ = nullptr;  // ground_->index.data(); null: no ground grid
+  double inv_dx_ = 1, inv_dy_ = 1;              // 1 / node spacing, 1/m
   int default_ground_ = 0;
 };
 

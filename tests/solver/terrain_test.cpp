@@ -70,6 +70,29 @@ TEST(Terrain, GroundGridUsesNearestCellAndDefault) {
   EXPECT_EQ(t.GroundAt(20, 21), 0);      // outside the ground grid: default
 }
 
+// Copies share the heights and the ground grid (calibration copies scenes for every evaluation)
+// and answer exactly as the original; a default terrain has empty grids, not null ones.
+TEST(Terrain, CopiesShareTheirGridsAndAnswerAlike) {
+  Terrain t = Saddle();
+  GroundGrid g;
+  g.grid = {3, 3, 10.0, 20.0, 2.0, 2.0};
+  g.index = {1, 2, 3, 4, 5, 6, 7, 8, GroundGrid::kNoGround};
+  t.SetGroundGrid(g);
+  const Terrain copy = t;
+  EXPECT_TRUE(copy.SharesHeightsWith(t));
+  EXPECT_EQ(&copy.ground_grid(), &t.ground_grid());
+  TerrainSample a, b;
+  ASSERT_TRUE(t.Sample(11.3, 21.7, &a));
+  ASSERT_TRUE(copy.Sample(11.3, 21.7, &b));
+  EXPECT_EQ(a.height_m, b.height_m);
+  EXPECT_EQ(a.normal, b.normal);
+  EXPECT_EQ(copy.GroundAt(12.1, 22.2), 5);
+  const Terrain empty;
+  EXPECT_FALSE(empty.has_ground_grid());
+  EXPECT_EQ(empty.heights().z_m.size(), 0u);
+  EXPECT_FALSE(empty.IsValid(nullptr));
+}
+
 TEST(Terrain, ValidityNamesTheProblem) {
   std::string why;
   EXPECT_TRUE(Saddle().IsValid(&why)) << why;

@@ -1,0 +1,222 @@
+#include "calibration/objective.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+#include "common/error.hpp"
+#include "ensemble/runner.hpp"
+#include "fieldobs/samples.hpp"
+#include "fieldobs/scores.hpp"
+
+namespace talus::calibration {
+namespace {
+
+// Mirrors fieldobs::Validate: scalars score against ensembles of at least 2 members.
+constexpr int kMinMembers = 2;
+
+double Mean(const std::vector<double>& v) {
+  if (v.empty()) return kNaN;
+  double sum = 0;
+  for (double x : v) sum += x;
+  return sum / double(v.size());
+}
+
+}  // namespace
+
+bool ObjectiveOptions::IsValid(std::string* why) const {
+  std::ostringstream msg;
+  for (const auto& [kind, weight] : weights)
+    if (!std::isfinite(weight) || weight < 0)
+      msg << "weights." << kind << " = " << weight << " must be >= 0";
+  if (msg.str().empty() && (!std::isfinite(prior_weight) || prior_weight < 0))
+    msg << "prior_weight = " << prior_weight << " must be >= 0";
+  if (msg.str().empty() && prior_weight > 0 && !prior_reference)
+    msg << "prior_weight = " << prior_weight << " needs a prior_reference table";
+  if (msg.str().empty() && threads < 0) msg << "threads = " << threads << " must be >= 0";
+  if (msg.str().empty() && !(infeasible_value > 0 && std::isfinite(infeasible_value)))
+    msg << "infeasible_value = " << infeasible_value << " must be > 0 and finite";
+  if (msg.str().empty()) return true;
+  if (why) *why = msg.str();
+  return false;
+}
+
+Objective::Objective(const Scene& scene, const ensemble::ReleaseSpec& release,
+                     const fieldobs::ObservationSet& observations,
+                     std::vector<ParameterSpec> parameters, ObjectiveOptions options)
+    : scene_(scene),
+      release_(release),
+      observations_(observations),
+      parameters_(std::move(parameters), scene.ground),
+      options_(std::move(options)) {
+  std::string why;
+  if (!options_.IsValid(&why)) throw InputError(why);
+  if (!scene_.IsValid(&why)) throw InputError("scene: " + why);
+  if (!release_.IsValid(&why)) throw InputError("release: " + why);
+  if (observations_.size() == 0) throw InputError("no observation to calibrate against");
+
+  // Kinds in order of first appearance, as fieldobs::Validate orders them.
+  const auto add_kind = [&](const std::string& kind) {
+    for (const std::string& k : kinds_)
+      if (k == kind) return;
+    kinds_.push_back(kind);
+  };
+  for (const auto& o : observations_.scalars) {
+    add_kind(fieldobs::ToString(o.quantity));
+    episodes_ = episodes_ || o.quantity != fieldobs::Quantity::kRunout;
+  }
+  if (!observations_.deposits.empty()) add_kind("deposit");
+  for (const auto& [kind, weight] : options_.weights) {
+    bool known = false;
+    for (const std::string& k : kinds_) known = known || k == kind;
+    if (!known) {
+      std::string list;
+      for (const std::string& k : kinds_) list += (list.empty() ? "" : ", ") + k;
+      throw InputError("weights." + kind + ": no observation of kind '" + kind +
+                       "' (the observations are of: " + list + ")");
+    }
+  }
+  for (const std::string& kind : kinds_) {
+    const auto it = options_.weights.find(kind);
+    weights_.push_back(it == options_.weights.end() ? 1.0 : it->second);
+  }
+
+  // Climatology scales: the leave-one-out climatology of fieldobs::Validate, which depends on the
+  // observations (and, for deposits, on the runs' start positions) only.
+  scales_.assign(kinds_.size(), 1.0);
+  if (options_.normalise) {
+    for (std::size_t k = 0; k < kinds_.size(); ++k) {
+      std::vector<double> scores;
+      if (kinds_[k] != "deposit") {
+        for (std::size_t i = 0; i < observations_.scalars.size(); ++i) {
+          const auto& o = observations_.scalars[i];
+          if (kinds_[k] != fieldobs::ToString(o.quantity)) continue;
+          std::vector<double> others;
+          for (std::size_t q = 0; q < observations_.scalars.size(); ++q)
+            if (q != i && observations_.scalars[q].quantity == o.quantity)
+              others.push_back(observations_.scalars[q].value);
+          if (static_cast<int>(others.size()) >= kMinMembers)
+            scores.push_back(fieldobs::CrpsEnsemble(others, o.value));
+        }
+      } else {
+        // The other runs' observed displacements from their own release, from this run's start.
+        const auto start_of = [&](const std::string& run) -> std::optional<Eigen::Vector2d> {
+          for (long r = 0; r < release_.release_count(); ++r)
+            if (release_.ReleaseName(static_cast<int>(r)) == run)
+              return ensemble::Release(scene_, release_, r * release_.rocks_per_release)
+                  .start.position_m.head<2>();
+          return std::nullopt;
+        };
+        std::vector<std::optional<Eigen::Vector2d>> starts;
+        for (const auto& o : observations_.deposits)
+          starts.push_back(o.run.empty() ? std::nullopt : start_of(o.run));
+        for (std::size_t i = 0; i < observations_.deposits.size(); ++i) {
+          if (!starts[i]) continue;
+          std::vector<Eigen::Vector2d> others;
+          for (std::size_t q = 0; q < observations_.deposits.size(); ++q)
+            if (q != i && starts[q])
+              others.push_back(*starts[i] + observations_.deposits[q].xy_m - *starts[q]);
+          if (static_cast<int>(others.size()) >= kMinMembers)
+            scores.push_back(fieldobs::EnergyScore(others, observations_.deposits[i].xy_m));
+        }
+      }
+      const double scale = Mean(scores);
+      if (weights_[k] > 0 && !(scale > 0))
+        throw InputError("objective: kind '" + kinds_[k] +
+                         "' has no climatology score to normalise by (it needs at least 3 "
+                         "observations of runs); set normalise = false or its weight to 0");
+      scales_[k] = scale;
+    }
+  }
+
+  if (options_.prior_weight > 0) {
+    prior_center_ = parameters_.UnitOf(*options_.prior_reference);
+    *prior_center_ = prior_center_->cwiseMax(0.0).cwiseMin(1.0);
+  }
+}
+
+GroundTable Objective::GroundOf(const Eigen::VectorXd& u) const {
+  GroundTable table = scene_.ground;
+  parameters_.Apply(u, table, nullptr);
+  return table;
+}
+
+Evaluation Objective::Evaluate(const Eigen::VectorXd& u) const { return Run(u, release_); }
+
+Evaluation Objective::EvaluateWithSeed(const Eigen::VectorXd& u, std::uint64_t seed) const {
+  ensemble::ReleaseSpec release = release_;
+  release.seed = seed;
+  return Run(u, release);
+}
+
+Evaluation Objective::Run(const Eigen::VectorXd& u, const ensemble::ReleaseSpec& release) const {
+  const auto t0 = std::chrono::steady_clock::now();
+  Evaluation e;
+  e.u = u;
+  e.values = parameters_.Values(u.cwiseMax(0.0).cwiseMin(1.0));
+  e.kind_scores.assign(kinds_.size(), kNaN);
+  e.kind_scored.assign(kinds_.size(), 0);
+  const long m = static_cast<long>(observations_.size());
+  e.residuals = Eigen::VectorXd::Zero(m + (prior_center_ ? dimension() : 0));
+  const auto elapsed = [&] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  };
+  const auto infeasible = [&](const std::string& why, double violation) {
+    e.feasible = false;
+    e.infeasible = why;
+    e.value = options_.infeasible_value * (1 + (std::isfinite(violation) ? violation : 1e3));
+    e.data = kNaN;
+    e.residuals.setConstant(std::sqrt(e.value / double(e.residuals.size())));
+    e.wall_time_s = elapsed();
+    return e;
+  };
+
+  // The scene's copy shares terrain and shapes; only its ground table changes.
+  Scene scene = scene_;
+  std::string why;
+  double violation = 0;
+  if (!parameters_.Apply(u, scene.ground, &why, &violation)) return infeasible(why, violation);
+
+  ensemble::EnsembleOptions options;
+  options.threads = options_.threads;
+  options.episodes = episodes_;
+  options.progress = options_.progress;
+  fieldobs::EnsembleSamples samples(release);
+  const ensemble::EnsembleReport report = ensemble::RunEnsemble(scene, release, options, &samples);
+  e.rocks = report.rocks;
+  e.failed_rocks = report.count(EndReason::kFailed);
+  fieldobs::ValidationOptions validation;
+  validation.min_members = kMinMembers;
+  const fieldobs::ValidationReport scores =
+      fieldobs::Validate(observations_, samples, nullptr, validation);
+
+  e.data = 0;
+  for (std::size_t k = 0; k < kinds_.size(); ++k) {
+    for (const fieldobs::KindSummary& s : scores.kinds)
+      if (s.kind == kinds_[k]) {
+        e.kind_scores[k] = s.mean_score;
+        e.kind_scored[k] = s.scored;
+      }
+    if (weights_[k] == 0) continue;
+    if (e.kind_scored[k] == 0)
+      return infeasible("no observation of kind '" + kinds_[k] + "' could be scored", 0);
+    e.data += weights_[k] * e.kind_scores[k] / scales_[k];
+  }
+  for (long i = 0; i < m; ++i) {
+    const fieldobs::ObservationScore& s = scores.observations[static_cast<std::size_t>(i)];
+    if (!s.scored) continue;
+    for (std::size_t k = 0; k < kinds_.size(); ++k)
+      if (s.kind == kinds_[k] && weights_[k] > 0)
+        e.residuals[i] = std::sqrt(weights_[k] / (e.kind_scored[k] * scales_[k]) * s.score);
+  }
+  if (prior_center_) {
+    const Eigen::VectorXd d = u - *prior_center_;
+    e.prior = options_.prior_weight * d.squaredNorm();
+    e.residuals.tail(dimension()) = std::sqrt(options_.prior_weight) * d;
+  }
+  e.value = e.data + e.prior;
+  e.wall_time_s = elapsed();
+  return e;
+}
+
+}  // namespace talus::calibration

@@ -1,0 +1,125 @@
+#pragma once
+// The calibration objective: a parameter vector (unit coordinates, parameters.hpp) -> ground table
+// -> the same rocks again (common random numbers: the same release, seed and per-rock streams for
+// every evaluation) -> fieldobs scores -> one number.
+//
+//   f(u) = sum_kind weight_kind * mean_score_kind(u) / scale_kind  +  prior_weight * |u - u_ref|^2
+//
+// mean_score_kind is the mean over the kind's scored observations of the CRPS (scalars) or energy
+// score (deposits), in the kind's unit. scale_kind is the kind's climatology score (the mean of
+// the leave-one-out climatology's scores, fieldobs/validation.hpp) when `normalise` is on, else 1:
+// normalised, each term is 1 - skill vs climatology, dimensionless, so kinds of different units
+// (m, m/s, rad/s) add up and a weight of 1 means "as important as explaining the spread between
+// runs". Being fixed by the observations alone, the scale does not change the optimum of a single
+// kind. The prior pulls in unit coordinates towards a reference table (Table 1 by default).
+//
+// The objective owns a copy of the scene whose terrain and shapes are shared, immutable
+// (solver/terrain.hpp); each evaluation copies that scene (cheap), edits only its ground table and
+// runs the ensemble. Evaluate is const and may be called from several threads at once; its
+// result does not depend on the number of threads.
+
+#include <Eigen/Core>
+#include <functional>
+#include <limits>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "calibration/parameters.hpp"
+#include "ensemble/release.hpp"
+#include "fieldobs/observations.hpp"
+#include "fieldobs/validation.hpp"
+#include "solver/scene.hpp"
+
+namespace talus::calibration {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+struct ObjectiveOptions {
+  // Weight per observation kind ("runout", "deposit", "impact_speed_out", ... as in
+  // fieldobs::ObservationScore::kind); kinds not listed weigh 1. A weight of 0 leaves a kind out.
+  std::map<std::string, double> weights;
+  bool normalise = true;  // divide each kind's mean score by its climatology score
+  // Prior: prior_weight * |u - u_ref|^2 with u_ref the unit coordinates of `prior_reference`
+  // (clamped to [0, 1]). Weight 0 (the default): no prior. Dimensionless when normalised.
+  double prior_weight = 0;
+  std::optional<GroundTable> prior_reference;
+  int threads = 0;  // worker threads of each evaluation; 0: all cores
+  // Value of an infeasible vector (mu_min > mu_max, outside the box): no rock runs and the value
+  // is infeasible_value * (1 + violation), finite so that every NLopt algorithm can use it.
+  double infeasible_value = 1e3;
+  // Called on the calling thread while rocks run (rocks done, total); may throw to stop.
+  std::function<void(long, long)> progress;
+
+  bool IsValid(std::string* why) const;
+};
+
+// What one evaluation gave.
+struct Evaluation {
+  Eigen::VectorXd u;       // unit coordinates
+  Eigen::VectorXd values;  // parameter values, one per coordinate
+  bool feasible = true;
+  std::string infeasible;  // why, when not feasible
+  double value = kNaN;     // the objective
+  double data = kNaN;      // the weighted score term
+  double prior = 0;        // the prior term
+  // Per kind (in the order of ObjectiveKinds()): mean score in the kind's unit, and scored count.
+  std::vector<double> kind_scores;
+  std::vector<int> kind_scored;
+  // One per observation (scalars, then deposits): sqrt(weight / (n_kind * scale_kind) * score),
+  // so that the sum of squares is the data term; 0 for an observation that was not scored.
+  // Then one per coordinate for the prior: sqrt(prior_weight) (u - u_ref).
+  Eigen::VectorXd residuals;
+  long rocks = 0;
+  long failed_rocks = 0;
+  double wall_time_s = 0;
+};
+
+class Objective {
+ public:
+  // Copies what it needs. Throws talus::InputError when the parameters do not fit the scene's
+  // ground table, an observation kind with a positive weight has no climatology scale while
+  // normalising, or the options are invalid.
+  Objective(const Scene& scene, const ensemble::ReleaseSpec& release,
+            const fieldobs::ObservationSet& observations, std::vector<ParameterSpec> parameters,
+            ObjectiveOptions options);
+
+  Evaluation Evaluate(const Eigen::VectorXd& u) const;
+  // The same with another release seed (other rocks): for the roughness measurement.
+  Evaluation EvaluateWithSeed(const Eigen::VectorXd& u, std::uint64_t seed) const;
+
+  // The scene's ground table as given, and its unit coordinates (the natural start).
+  const GroundTable& base_ground() const { return scene_.ground; }
+  Eigen::VectorXd StartPoint() const { return parameters_.UnitOf(scene_.ground); }
+  // The ground table of a unit vector (the scene's table with the free fields set).
+  GroundTable GroundOf(const Eigen::VectorXd& u) const;
+
+  const ParameterSet& parameters() const { return parameters_; }
+  int dimension() const { return parameters_.size(); }
+  const std::vector<std::string>& kinds() const { return kinds_; }
+  const std::vector<double>& kind_scales() const { return scales_; }
+  const std::vector<double>& kind_weights() const { return weights_; }
+  const ObjectiveOptions& options() const { return options_; }
+  const fieldobs::ObservationSet& observations() const { return observations_; }
+  const ensemble::ReleaseSpec& release() const { return release_; }
+  const Scene& scene() const { return scene_; }
+  std::optional<Eigen::VectorXd> prior_center() const { return prior_center_; }
+  bool needs_episodes() const { return episodes_; }
+
+ private:
+  Evaluation Run(const Eigen::VectorXd& u, const ensemble::ReleaseSpec& release) const;
+
+  Scene scene_;
+  ensemble::ReleaseSpec release_;
+  fieldobs::ObservationSet observations_;
+  ParameterSet parameters_;
+  ObjectiveOptions options_;
+  bool episodes_ = false;
+  std::vector<std::string> kinds_;  // observation kinds in order of first appearance
+  std::vector<double> weights_, scales_;
+  std::optional<Eigen::VectorXd> prior_center_;
+};
+
+}  // namespace talus::calibration

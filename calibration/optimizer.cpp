@@ -1,0 +1,264 @@
+#include "calibration/optimizer.hpp"
+
+#include <nlopt.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <exception>
+#include <sstream>
+#include <stdexcept>
+
+#include "calibration/designs.hpp"
+
+namespace talus::calibration {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+nlopt_algorithm AlgorithmOf(const std::string& name) {
+  if (name == "bobyqa") return NLOPT_LN_BOBYQA;
+  if (name == "sbplx") return NLOPT_LN_SBPLX;
+  if (name == "crs2_lm") return NLOPT_GN_CRS2_LM;
+  if (name == "direct_l") return NLOPT_GN_DIRECT_L;
+  return NLOPT_GN_ISRES;
+}
+
+// The state the NLopt callback works on.
+struct Run {
+  const Objective& objective;
+  const OptimizerOptions& options;
+  Summary& summary;
+  Clock::time_point t0;
+  nlopt_opt opt = nullptr;
+  int start = 0;
+  std::exception_ptr error;
+  bool out_of_time = false;
+};
+
+double Callback(unsigned n, const double* x, double* /*grad*/, void* data) {
+  Run& run = *static_cast<Run*>(data);
+  try {
+    const Eigen::Map<const Eigen::VectorXd> u(x, n);
+    // The objective is deterministic: a point asked for again is answered from the history.
+    for (const Evaluation& e : run.summary.history)
+      if (e.u == u) {
+        ++run.summary.cache_hits;
+        return e.value;
+      }
+    Evaluation e = run.objective.Evaluate(u);
+    run.summary.history.push_back(e);
+    run.summary.history_start.push_back(run.start);
+    const int index = run.summary.evaluations() - 1;
+    if (e.feasible && (!run.summary.best.feasible || !(e.value >= run.summary.best.value)))
+      run.summary.best = e;
+    if (run.options.on_evaluation) run.options.on_evaluation(e, index);
+    if (run.options.max_time_s > 0 &&
+        std::chrono::duration<double>(Clock::now() - run.t0).count() >= run.options.max_time_s) {
+      run.out_of_time = true;
+      nlopt_force_stop(run.opt);
+    }
+    return e.value;
+  } catch (...) {
+    run.error = std::current_exception();
+    nlopt_force_stop(run.opt);
+    return HUGE_VAL;
+  }
+}
+
+std::string Num(double v, const char* format = "%.6g") {
+  if (std::isnan(v)) return "-";
+  char b[64];
+  std::snprintf(b, sizeof b, format, v);
+  return b;
+}
+
+}  // namespace
+
+const std::vector<std::string>& AlgorithmNames() {
+  static const std::vector<std::string> names = {"bobyqa", "sbplx", "crs2_lm", "direct_l", "isres"};
+  return names;
+}
+
+bool IsLocalAlgorithm(const std::string& name) { return name == "bobyqa" || name == "sbplx"; }
+
+const char* ToString(Termination t) {
+  switch (t) {
+    case Termination::kConvergence:
+      return "convergence";
+    case Termination::kMaxEvaluations:
+      return "max_evaluations";
+    case Termination::kMaxTime:
+      return "max_time";
+    case Termination::kFailure:
+      break;
+  }
+  return "failure";
+}
+
+bool OptimizerOptions::IsValid(std::string* why) const {
+  std::ostringstream msg;
+  const auto& names = AlgorithmNames();
+  if (std::find(names.begin(), names.end(), algorithm) == names.end())
+    msg << "algorithm = '" << algorithm
+        << "' is not one of bobyqa, sbplx, crs2_lm, direct_l, isres";
+  else if (max_evaluations < 1)
+    msg << "max_evaluations = " << max_evaluations << " must be >= 1";
+  else if (!(max_time_s >= 0) || !std::isfinite(max_time_s))
+    msg << "max_time_s = " << max_time_s << " must be >= 0 (0: no limit)";
+  else if (!(ftol_rel >= 0) || !(ftol_abs >= 0) || !(xtol_abs >= 0))
+    msg << "tolerances must be >= 0 (ftol_rel = " << ftol_rel << ", ftol_abs = " << ftol_abs
+        << ", xtol_abs = " << xtol_abs << ")";
+  else if (!(initial_step > 0 && initial_step <= 1))
+    msg << "initial_step = " << initial_step << " must be in (0, 1] (a fraction of the range)";
+  else if (population < 0)
+    msg << "population = " << population << " must be >= 0 (0: NLopt's default)";
+  else if (starts < 1 || starts > max_evaluations)
+    msg << "starts = " << starts << " must be in 1 .. max_evaluations = " << max_evaluations;
+  else if (start_design != "sobol" && start_design != "lhs")
+    msg << "start_design = '" << start_design << "' must be \"sobol\" or \"lhs\"";
+  if (msg.str().empty()) return true;
+  if (why) *why = msg.str();
+  return false;
+}
+
+Summary Calibrate(const Objective& objective, const OptimizerOptions& options) {
+  std::string why;
+  if (!options.IsValid(&why)) throw std::invalid_argument("Calibrate: " + why);
+  const int n = objective.dimension();
+  if (options.start_design == "sobol" && options.starts > 1 && n > kMaxSobolDimension)
+    throw std::invalid_argument("Calibrate: Sobol starts for more than 16 parameters; use lhs");
+
+  Summary summary;
+  summary.algorithm = options.algorithm;
+  for (const Coordinate& c : objective.parameters().coordinates()) summary.names.push_back(c.name);
+  Run run{objective, options, summary, Clock::now(), nullptr, 0, nullptr, false};
+
+  // Start points: the given one (or the scene's table), then the design's.
+  Eigen::VectorXd x0 = options.start ? *options.start : objective.StartPoint();
+  if (x0.size() != n) throw std::invalid_argument("Calibrate: start has the wrong dimension");
+  x0 = x0.cwiseMax(0.0).cwiseMin(1.0);
+  std::vector<Eigen::VectorXd> starts = {x0};
+  if (options.starts > 1) {
+    const Eigen::MatrixXd design = options.start_design == "sobol"
+                                       ? Sobol(options.starts - 1, n, options.seed)
+                                       : LatinHypercube(options.starts - 1, n, options.seed);
+    for (int k = 0; k < design.rows(); ++k) starts.push_back(design.row(k).transpose());
+  }
+
+  // The initial point's evaluation is the first of the history (the optimiser reuses it).
+  summary.initial = objective.Evaluate(x0);
+  summary.history.push_back(summary.initial);
+  summary.history_start.push_back(0);
+  if (summary.initial.feasible) summary.best = summary.initial;
+  if (options.on_evaluation) options.on_evaluation(summary.initial, 0);
+
+  const std::vector<double> lower(static_cast<std::size_t>(n), 0.0);
+  const std::vector<double> upper(static_cast<std::size_t>(n), 1.0);
+  const std::vector<double> step(static_cast<std::size_t>(n), options.initial_step);
+  const std::vector<double> xtol(static_cast<std::size_t>(n), options.xtol_abs);
+  nlopt_result last = NLOPT_SUCCESS;
+  for (std::size_t s = 0; s < starts.size(); ++s) {
+    const int used = summary.evaluations();
+    const int left = options.max_evaluations - used;
+    const double elapsed = std::chrono::duration<double>(Clock::now() - run.t0).count();
+    if (left <= 0 || run.out_of_time || (options.max_time_s > 0 && elapsed >= options.max_time_s))
+      break;
+    run.start = static_cast<int>(s);
+    run.opt = nlopt_create(AlgorithmOf(options.algorithm), static_cast<unsigned>(n));
+    if (!run.opt) throw std::runtime_error("Calibrate: NLopt could not create its optimiser");
+    nlopt_set_min_objective(run.opt, Callback, &run);
+    nlopt_set_lower_bounds(run.opt, lower.data());
+    nlopt_set_upper_bounds(run.opt, upper.data());
+    // This start's share of the evaluations left (its first point may be answered by the cache).
+    const int share = std::max(1, left / static_cast<int>(starts.size() - s));
+    nlopt_set_maxeval(run.opt, share + (s == 0 ? 1 : 0));
+    if (options.max_time_s > 0) nlopt_set_maxtime(run.opt, options.max_time_s - elapsed);
+    nlopt_set_ftol_rel(run.opt, options.ftol_rel);
+    nlopt_set_ftol_abs(run.opt, options.ftol_abs);
+    nlopt_set_xtol_abs(run.opt, xtol.data());
+    if (IsLocalAlgorithm(options.algorithm)) nlopt_set_initial_step(run.opt, step.data());
+    if (options.population > 0)
+      nlopt_set_population(run.opt, static_cast<unsigned>(options.population));
+    nlopt_srand(static_cast<unsigned long>(options.seed + s));  // CRS2-LM, ISRES
+
+    std::vector<double> x(starts[s].data(), starts[s].data() + n);
+    double f = 0;
+    const int before = summary.evaluations();
+    last = nlopt_optimize(run.opt, x.data(), &f);
+    nlopt_destroy(run.opt);
+    run.opt = nullptr;
+    if (run.error) std::rethrow_exception(run.error);
+
+    StartRecord record;
+    record.u0 = starts[s];
+    record.best_u = Eigen::Map<const Eigen::VectorXd>(x.data(), n);
+    record.best_value = f;
+    record.evaluations = summary.evaluations() - before;
+    record.nlopt_result = nlopt_result_to_string(last);
+    summary.starts.push_back(record);
+  }
+
+  summary.wall_time_s = std::chrono::duration<double>(Clock::now() - run.t0).count();
+  std::ostringstream msg;
+  if (run.out_of_time || last == NLOPT_MAXTIME_REACHED) {
+    summary.termination = Termination::kMaxTime;
+    msg << "wall-time budget of " << options.max_time_s << " s spent";
+  } else if (last == NLOPT_MAXEVAL_REACHED || summary.evaluations() >= options.max_evaluations) {
+    summary.termination = Termination::kMaxEvaluations;
+    msg << "evaluation budget of " << options.max_evaluations << " spent";
+  } else if (last > 0) {
+    summary.termination = Termination::kConvergence;
+    msg << "converged (" << nlopt_result_to_string(last) << ")";
+  } else {
+    summary.termination = Termination::kFailure;
+    msg << "NLopt stopped with " << nlopt_result_to_string(last);
+  }
+  if (!summary.IsSolutionUsable()) msg << "; no feasible evaluation";
+  summary.message = msg.str();
+  return summary;
+}
+
+std::string Summary::BriefReport() const {
+  char line[512];
+  std::snprintf(line, sizeof line,
+                "NLopt %s: %s after %d evaluations in %.1f s; objective %s -> %s (%d starts)",
+                algorithm.c_str(), ToString(termination), evaluations(), wall_time_s,
+                Num(initial.value).c_str(), Num(best.value).c_str(),
+                static_cast<int>(starts.size()));
+  return line;
+}
+
+std::string Summary::FullReport() const {
+  std::string out = "\nCalibration report\n";
+  char line[512];
+  std::snprintf(line, sizeof line, "  %-28s %s\n  %-28s %s\n  %-28s %d (%d asked again)\n",
+                "Algorithm", algorithm.c_str(), "Termination", message.c_str(), "Evaluations",
+                evaluations(), cache_hits);
+  out += line;
+  std::snprintf(line, sizeof line, "  %-28s %s\n  %-28s %s (data %s + prior %s)\n  %-28s %.2f s\n",
+                "Initial objective", Num(initial.value).c_str(), "Final objective",
+                Num(best.value).c_str(), Num(best.data).c_str(), Num(best.prior).c_str(),
+                "Wall time", wall_time_s);
+  out += line;
+  std::snprintf(line, sizeof line, "\n  %-28s %14s %14s %10s\n", "parameter", "initial", "final",
+                "final u");
+  out += line;
+  for (std::size_t j = 0; j < names.size(); ++j) {
+    const auto k = static_cast<Eigen::Index>(j);
+    std::snprintf(line, sizeof line, "  %-28s %14s %14s %10s\n", names[j].c_str(),
+                  Num(initial.values.size() > k ? initial.values[k] : kNaN).c_str(),
+                  Num(best.values.size() > k ? best.values[k] : kNaN).c_str(),
+                  Num(best.u.size() > k ? best.u[k] : kNaN, "%.4f").c_str());
+    out += line;
+  }
+  out += "\n  start  evaluations  best objective  NLopt result\n";
+  for (std::size_t s = 0; s < starts.size(); ++s) {
+    std::snprintf(line, sizeof line, "  %5zu  %11d  %14s  %s\n", s, starts[s].evaluations,
+                  Num(starts[s].best_value).c_str(), starts[s].nlopt_result.c_str());
+    out += line;
+  }
+  return out + BriefReport() + "\n";
+}
+
+}  // namespace talus::calibration

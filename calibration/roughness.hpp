@@ -1,0 +1,79 @@
+#pragma once
+// How rough the objective of a chaotic ensemble is, and which parameters the observations see.
+//
+// Roughness: with common random numbers the objective is a deterministic function of the
+// parameters, but a tiny change of a parameter changes which way some rock turns at some impact,
+// and its score jumps. MeasureRoughness re-evaluates at relative steps h (fractions of each
+// coordinate's range) and with other seeds. A smooth objective changes by about |grad| h; the
+// change at the smallest steps, where that is negligible, is the roughness (noise level) of the
+// objective. Finite-difference steps and tolerances are chosen above it.
+//
+// Identifiability: a parameter whose profile (the objective along its coordinate from 0 to 1, the
+// others at the optimum) changes by no more than a few times the noise level -- the larger of the
+// roughness and the spread over other seeds, which is what a parameter that only scrambles which
+// way rocks turn can do -- is not constrained by the observations: it is reported unidentified.
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "calibration/objective.hpp"
+
+namespace talus::calibration {
+
+struct RoughnessOptions {
+  std::vector<double> steps = {1e-4, 1e-3, 1e-2, 1e-1};  // relative to each coordinate's range
+  int seeds = 2;  // evaluations with other release seeds (seed + 1, seed + 2, ...)
+  // The finite-difference step is the smallest step whose typical change is at least
+  // signal_to_noise times the roughness (the largest step when none is).
+  double signal_to_noise = 10;
+  bool IsValid(std::string* why) const;
+};
+
+struct RoughnessReport {
+  double value = kNaN;  // f(u)
+  std::vector<double> steps;
+  // change[s][j] = |f(u +- steps[s] e_j) - f(u)| (the step goes inwards at a bound).
+  std::vector<std::vector<double>> change;
+  // The roughness: the largest change at the smallest step; 0 for a smooth objective there.
+  double noise = 0;
+  // Objective values with other seeds (other rocks) and their standard deviation: the sampling
+  // noise of the ensemble, which common random numbers remove from comparisons between vectors.
+  std::vector<double> seed_values;
+  double seed_sd = kNaN;
+  // The noise level identifiability is judged against: max(noise, seed_sd).
+  double level() const { return std::isnan(seed_sd) ? noise : std::max(noise, seed_sd); }
+  double fd_step = kNaN;   // recommended finite-difference step (unit coordinates)
+  double ftol_abs = kNaN;  // recommended absolute tolerance on f: 2 x noise
+  int evaluations = 0;
+  double wall_time_s = 0;
+  std::string Report() const;  // a few lines for people
+};
+
+RoughnessReport MeasureRoughness(const Objective& objective, const Eigen::VectorXd& u,
+                                 const RoughnessOptions& options = {});
+
+struct ProfileOptions {
+  int points = 5;                // evaluations along each coordinate, 0 .. 1 evenly
+  double noise_multiple = 3;     // identified when the profile's range exceeds this x noise
+  double relative_floor = 1e-6;  // ... and this x |f(u)| (for a noise of 0)
+};
+
+struct ParameterProfile {
+  std::string name;
+  std::vector<double> u, values, f;  // along the coordinate
+  double range = 0;                  // max f - min f
+  double threshold = 0;              // what range had to exceed
+  bool identified = false;
+};
+
+// Profiles every coordinate through u (f(u) given: it is not re-evaluated), with `noise` the
+// noise level from MeasureRoughness (RoughnessReport::level()).
+std::vector<ParameterProfile> ProfileParameters(const Objective& objective,
+                                                const Eigen::VectorXd& u, double f_u, double noise,
+                                                const ProfileOptions& options = {});
+
+}  // namespace talus::calibration

@@ -1,0 +1,259 @@
+#include "io/calibration_file.hpp"
+
+#include <toml++/toml.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "calibration/designs.hpp"
+#include "common/error.hpp"
+#include "io/toml_section.hpp"
+
+namespace talus::io {
+namespace {
+
+namespace fs = std::filesystem;
+using calibration::GroundField;
+using calibration::ParameterSpec;
+
+const std::vector<std::string> kFields = {"mu_min", "mu_max", "beta", "kappa", "nu"};
+
+std::string Hint(const std::string& word, const std::vector<std::string>& known) {
+  const std::string hint = ClosestName(word, known);
+  return hint.empty() ? "" : " (did you mean '" + hint + "'?)";
+}
+
+std::vector<std::string> ObservedKinds(const fieldobs::ObservationSet& observations) {
+  std::vector<std::string> kinds;
+  const auto add = [&](const std::string& kind) {
+    if (std::find(kinds.begin(), kinds.end(), kind) == kinds.end()) kinds.push_back(kind);
+  };
+  for (const auto& o : observations.scalars) add(fieldobs::ToString(o.quantity));
+  if (!observations.deposits.empty()) add("deposit");
+  return kinds;
+}
+
+std::string Join(const std::vector<std::string>& items) {
+  std::string out;
+  for (const std::string& s : items) out += (out.empty() ? "" : ", ") + s;
+  return out;
+}
+
+void LoadParameters(const Context& context, const toml::table& root, CalibrationFile& out) {
+  const toml::node* node = root.get("parameters");
+  if (!node)
+    context.Fail(&root, "parameters",
+                 "missing: give [[parameters]] tables (category, field, lower, upper)");
+  const toml::array* array = node->as_array();
+  if (!array || array->empty())
+    context.Fail(node, "parameters",
+                 "expected [[parameters]] tables (category, field, lower, upper)");
+  const GroundTable& table = out.event.scene.scene.ground;
+  std::vector<std::string> categories;
+  for (int k = 0; k < table.size(); ++k) categories.push_back(table.category(k).name);
+  std::vector<const toml::node*> where;
+  for (std::size_t k = 0; k < array->size(); ++k) {
+    const std::string name = "parameters[" + std::to_string(k) + "]";
+    const toml::table* t = array->get(k)->as_table();
+    if (!t) context.Fail(array->get(k), name, "expected a table (category, field, lower, upper)");
+    const Section s(context, t, name, {"category", "field", "lower", "upper", "log", "tie"});
+    ParameterSpec spec;
+    if (!s.Has("category")) s.Fail("category", "missing: a ground category of the scene");
+    spec.category = s.String("category", "");
+    if (table.IndexOfName(spec.category) < 0)
+      s.Fail("category", "unknown ground category '" + spec.category + "'" +
+                             Hint(spec.category, categories) + "; the scene has " +
+                             Join(categories));
+    if (!s.Has("field")) s.Fail("field", "missing: one of mu_min, mu_max, beta, kappa, nu");
+    const std::string field = s.String("field", "");
+    if (!calibration::ParseGroundField(field, &spec.field))
+      s.Fail("field", "unknown parameter '" + field + "'" + Hint(field, kFields) +
+                          "; known: mu_min, mu_max, beta, kappa, nu");
+    for (const char* bound : {"lower", "upper"})
+      if (!s.Has(bound))
+        s.Fail(bound, std::string("missing: the ") + bound + " bound, in " +
+                          calibration::UnitOf(spec.field));
+    spec.lower = s.Number("lower", 0);
+    spec.upper = s.Number("upper", 0);
+    if (s.Has("log")) spec.log = s.Bool("log", false);
+    spec.tie = s.String("tie", "");
+    std::string why;
+    if (!spec.IsValid(&why)) s.Fail(spec.upper > spec.lower ? "lower" : "upper", why);
+    out.parameters.push_back(spec);
+    where.push_back(t);
+  }
+  // Ties, duplicates and mu_min <= mu_max, against the scene's table.
+  try {
+    const calibration::ParameterSet set(out.parameters, table);
+  } catch (const InputError& e) {
+    // Name the parameter the message starts with.
+    const std::string message = e.what();
+    const toml::node* at = node;
+    for (std::size_t k = 0; k < out.parameters.size(); ++k)
+      if (message.rfind(out.parameters[k].Name() + ":", 0) == 0) at = where[k];
+    context.Fail(at, "parameters", message);
+  }
+}
+
+void LoadObjective(const Context& context, const toml::table* table, CalibrationFile& out) {
+  const Section s(context, table, "objective",
+                  {"weights", "normalise", "prior_weight", "prior_reference"});
+  const std::vector<std::string> kinds = ObservedKinds(out.event.observations);
+  if (const toml::node* node = s.Node("weights")) {
+    if (!node->is_table()) s.Fail("weights", "expected a table { runout = 1, deposit = 1, ... }");
+    for (const auto& [key, value] : *node->as_table())
+      if (std::find(kinds.begin(), kinds.end(), std::string(key.str())) == kinds.end())
+        context.Fail(&value, "objective.weights." + std::string(key.str()),
+                     "no observation of this kind" + Hint(std::string(key.str()), kinds) +
+                         "; the event observes " + Join(kinds));
+    const Section w(context, node->as_table(), "objective.weights", kinds);
+    for (const auto& [key, value] : *node->as_table()) {
+      const std::string kind(key.str());
+      out.objective.weights[kind] = w.Checked(
+          kind, 1.0, [](double v) { return v >= 0; }, "must be >= 0");
+    }
+  }
+  out.objective.normalise = s.Bool("normalise", true);
+  out.objective.prior_weight = s.Checked(
+      "prior_weight", 0.0, [](double v) { return v >= 0; }, "must be >= 0");
+  out.prior_reference = s.String("prior_reference", "table1");
+  if (out.prior_reference != "table1" && out.prior_reference != "scene")
+    s.Fail("prior_reference", "'" + out.prior_reference + "': expected \"table1\" or \"scene\"");
+  if (out.objective.prior_weight > 0)
+    out.objective.prior_reference = out.prior_reference == "scene"
+                                        ? out.event.scene.scene.ground
+                                        : ReferenceGround(out.event.scene.scene.ground, nullptr);
+  bool any = false;
+  for (const std::string& kind : kinds) {
+    const auto it = out.objective.weights.find(kind);
+    any = any || it == out.objective.weights.end() || it->second > 0;
+  }
+  if (!any) s.Fail("weights", "every kind has weight 0: nothing to fit");
+}
+
+void LoadOptimizer(const Context& context, const toml::table* table, CalibrationFile& out) {
+  const Section s(context, table, "optimizer",
+                  {"algorithm", "max_evaluations", "max_time_s", "ftol_rel", "ftol_abs", "xtol_abs",
+                   "initial_step", "population", "starts", "start_design", "seed"});
+  calibration::OptimizerOptions& o = out.optimizer;
+  o.algorithm = s.String("algorithm", o.algorithm);
+  const auto& names = calibration::AlgorithmNames();
+  if (std::find(names.begin(), names.end(), o.algorithm) == names.end())
+    s.Fail("algorithm", "unknown algorithm '" + o.algorithm + "'" + Hint(o.algorithm, names) +
+                            "; known: " + Join(names));
+  const long evaluations = s.Integer("max_evaluations", o.max_evaluations);
+  if (evaluations < 1 || evaluations > 1000000)
+    s.Fail("max_evaluations", std::to_string(evaluations) + " must be in 1 .. 1000000");
+  o.max_evaluations = static_cast<int>(evaluations);
+  o.max_time_s = s.Checked(
+      "max_time_s", o.max_time_s, [](double v) { return v >= 0; }, "must be >= 0 (0: no limit)");
+  const auto non_negative = [](double v) { return v >= 0; };
+  o.ftol_rel = s.Checked("ftol_rel", o.ftol_rel, non_negative, "must be >= 0");
+  o.ftol_abs = s.Checked("ftol_abs", o.ftol_abs, non_negative, "must be >= 0");
+  o.xtol_abs = s.Checked("xtol_abs", o.xtol_abs, non_negative, "must be >= 0");
+  o.initial_step = s.Checked(
+      "initial_step", o.initial_step, [](double v) { return v > 0 && v <= 1; },
+      "must be in (0, 1] (a fraction of each parameter's range)");
+  const long population = s.Integer("population", 0);
+  if (population < 0 || population > 100000)
+    s.Fail("population", std::to_string(population) + " must be in 0 .. 100000 (0: NLopt's)");
+  o.population = static_cast<int>(population);
+  const long starts = s.Integer("starts", 1);
+  if (starts < 1 || starts > o.max_evaluations)
+    s.Fail("starts", std::to_string(starts) + " must be in 1 .. max_evaluations (" +
+                         std::to_string(o.max_evaluations) + ")");
+  o.starts = static_cast<int>(starts);
+  o.start_design = s.String("start_design", o.start_design);
+  if (o.start_design != "sobol" && o.start_design != "lhs")
+    s.Fail("start_design", "'" + o.start_design + "': expected \"sobol\" or \"lhs\"");
+  if (o.start_design == "sobol" && o.starts > 1 &&
+      out.parameters.size() > static_cast<std::size_t>(calibration::kMaxSobolDimension))
+    s.Fail("start_design", "Sobol starts take at most 16 parameters; use \"lhs\"");
+  const long seed = s.Integer("seed", 1);
+  if (seed < 0) s.Fail("seed", std::to_string(seed) + " must be >= 0");
+  o.seed = static_cast<std::uint64_t>(seed);
+  std::string why;
+  if (!o.IsValid(&why)) context.Fail(table, "optimizer", why);
+}
+
+void LoadRoughness(const Context& context, const toml::table* table, CalibrationFile& out) {
+  const Section s(context, table, "roughness", {"enabled", "steps", "seeds", "profile_points"});
+  out.roughness = s.Bool("enabled", true);
+  if (const toml::node* node = s.Node("steps")) {
+    const toml::array* array = node->as_array();
+    if (!array || array->empty()) s.Fail("steps", "expected a list of steps, e.g. [1e-4, 1e-2]");
+    out.roughness_options.steps = s.Numbers("steps", array->size());
+  }
+  const long seeds = s.Integer("seeds", out.roughness_options.seeds);
+  if (seeds < 0 || seeds > 100) s.Fail("seeds", std::to_string(seeds) + " must be in 0 .. 100");
+  out.roughness_options.seeds = static_cast<int>(seeds);
+  const long points = s.Integer("profile_points", out.profile_options.points);
+  if (points < 2 || points > 1000)
+    s.Fail("profile_points", std::to_string(points) + " must be in 2 .. 1000");
+  out.profile_options.points = static_cast<int>(points);
+  std::string why;
+  if (!out.roughness_options.IsValid(&why)) s.Fail("steps", why);
+}
+
+}  // namespace
+
+CalibrationFile LoadCalibration(const std::string& path) {
+  const Context context(path);
+  if (!fs::exists(path)) throw InputError(path + ": calibration file not found");
+  if (fs::is_directory(path)) throw InputError(path + ": is a directory, not a calibration file");
+  toml::table root;
+  try {
+    root = toml::parse_file(path);
+  } catch (const toml::parse_error& e) {
+    throw InputError(path + ":" + std::to_string(e.source().begin.line) +
+                     ": TOML syntax error: " + std::string(e.description()));
+  }
+  const Section top(
+      context, &root, "",
+      {"event", "rocks", "seed", "parameters", "objective", "optimizer", "roughness"});
+  CalibrationFile out;
+  out.path = path;
+  if (!top.Has("event"))
+    top.Fail("event", "missing: the event file (EVENT.toml of talus validate)");
+  const std::string event = context.Resolve(top.String("event", ""));
+  try {
+    out.event = LoadEvent(event);
+  } catch (const InputError& e) {
+    throw InputError(context.Where(top.Node("event")) + ": event: " + e.what());
+  }
+  ensemble::ReleaseSpec& release = out.event.scene.release;
+  const long rocks = top.Integer("rocks", release.rocks_per_release);
+  if (rocks < 2 || rocks > 100000)
+    top.Fail("rocks", std::to_string(rocks) +
+                          " must be in 2 .. 100000 (rocks per run; a score "
+                          "needs at least 2)");
+  release.rocks_per_release = rocks;
+  const long seed = top.Integer("seed", static_cast<long>(release.seed));
+  if (seed < 0) top.Fail("seed", std::to_string(seed) + " must be >= 0");
+  release.seed = static_cast<std::uint64_t>(seed);
+  if (std::string why; !release.IsValid(&why)) top.Fail("rocks", why);
+
+  LoadParameters(context, root, out);
+  LoadObjective(context, SubTable(context, root, "objective"), out);
+  LoadOptimizer(context, SubTable(context, root, "optimizer"), out);
+  LoadRoughness(context, SubTable(context, root, "roughness"), out);
+
+  out.inputs.push_back(path);
+  for (const std::string& input : out.event.inputs) out.inputs.push_back(input);
+  std::uint64_t h = 1469598103934665603ULL;
+  std::ifstream in(path, std::ios::binary);
+  for (unsigned char c : std::string(std::istreambuf_iterator<char>(in), {})) {
+    h ^= c;
+    h *= 1099511628211ULL;
+  }
+  for (unsigned char c : out.event.inputs_hash) {
+    h ^= c;
+    h *= 1099511628211ULL;
+  }
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
+  out.inputs_hash = hex;
+  return out;
+}
+
+}  // namespace talus::io

@@ -1,0 +1,35 @@
+#pragma once
+// Calibration files (CAL.toml, docs/calibration.md): an event (the EVENT.toml of talus validate,
+// which names the scene and the observations), the free parameters with bounds and ties, the
+// objective's weights and prior, the optimiser and its budget, and the roughness measurement.
+// Loading validates everything before any rock runs; errors are "<file>:<line>: <key>: <reason>".
+
+#include <string>
+#include <vector>
+
+#include "calibration/objective.hpp"
+#include "calibration/optimizer.hpp"
+#include "calibration/parameters.hpp"
+#include "calibration/roughness.hpp"
+#include "io/event_file.hpp"
+
+namespace talus::io {
+
+struct CalibrationFile {
+  std::string path;
+  EventFile event;  // its release has the file's rocks and seed applied
+  std::vector<calibration::ParameterSpec> parameters;
+  calibration::ObjectiveOptions objective;  // threads left at 0: the command sets them
+  std::string prior_reference = "table1";   // "table1" or "scene"
+  calibration::OptimizerOptions optimizer;
+  bool roughness = true;  // measure roughness and profile every parameter at the optimum
+  calibration::RoughnessOptions roughness_options;
+  calibration::ProfileOptions profile_options;
+  std::vector<std::string> inputs;  // the calibration file and the event's inputs
+  std::string inputs_hash;
+};
+
+// Throws InputError "<file>:<line>: <key>: <reason>".
+CalibrationFile LoadCalibration(const std::string& path);
+
+}  // namespace talus::io

@@ -1,0 +1,209 @@
+#include "io/calibration_outputs.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <nlohmann/json.hpp>
+#include <set>
+
+namespace talus::io {
+namespace {
+
+using calibration::Evaluation;
+using calibration::Objective;
+using nlohmann::json;
+
+std::string G(double v) {
+  if (std::isnan(v)) return "";
+  char b[64];
+  std::snprintf(b, sizeof b, "%.10g", v);
+  return b;
+}
+
+// NaN and infinities as null.
+json Number(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+
+json Vector(const Eigen::VectorXd& v) {
+  json out = json::array();
+  for (Eigen::Index k = 0; k < v.size(); ++k) out.push_back(Number(v[k]));
+  return out;
+}
+
+// Touched categories, in table order.
+std::vector<int> Touched(const Objective& objective, const GroundTable& table) {
+  std::set<int> indices;
+  for (const auto& spec : objective.parameters().specs())
+    indices.insert(table.IndexOfName(spec.category));
+  return {indices.begin(), indices.end()};
+}
+
+json Kinds(const Objective& objective, const Evaluation& before, const Evaluation& after) {
+  json out = json::array();
+  for (std::size_t k = 0; k < objective.kinds().size(); ++k) {
+    const std::string& kind = objective.kinds()[k];
+    std::string unit = "m";
+    for (const auto& o : objective.observations().scalars)
+      if (kind == fieldobs::ToString(o.quantity)) unit = fieldobs::UnitOf(o.quantity);
+    out.push_back({{"kind", kind},
+                   {"unit", unit},
+                   {"weight", objective.kind_weights()[k]},
+                   {"scale", Number(objective.kind_scales()[k])},
+                   {"score_before",
+                    before.kind_scores.size() > k ? Number(before.kind_scores[k]) : json(nullptr)},
+                   {"score_after",
+                    after.kind_scores.size() > k ? Number(after.kind_scores[k]) : json(nullptr)},
+                   {"scored_before", before.kind_scored.size() > k ? before.kind_scored[k] : 0},
+                   {"scored_after", after.kind_scored.size() > k ? after.kind_scored[k] : 0}});
+  }
+  return out;
+}
+
+}  // namespace
+
+std::string GroundTableToml(const CalibrationFile& file, const Objective& objective,
+                            const GroundTable& fitted) {
+  std::string out = "# Ground table fitted by talus calibrate " + file.path +
+                    " (docs/calibration.md).\n# Paste into a scene file, or append to one.\n";
+  for (int k : Touched(objective, fitted)) {
+    const GroundCategory& c = fitted.category(k);
+    out += "\n[ground." + c.name + "]\ncode = " + std::to_string(c.code) +
+           "\nmu_min = " + G(c.params.mu_min) + "\nmu_max = " + G(c.params.mu_max) +
+           "\nbeta = " + G(c.params.beta_1_s) + "\nkappa = " + G(c.params.kappa_1_m) +
+           "\nnu = " + G(c.params.nu_1_s) + "\n";
+  }
+  return out;
+}
+
+std::string GroundTableCsv(const Objective& objective, const GroundTable& fitted) {
+  std::string out = "category,code,mu_min,mu_max,beta,kappa,nu\n";
+  for (int k : Touched(objective, fitted)) {
+    const GroundCategory& c = fitted.category(k);
+    out += c.name + "," + std::to_string(c.code) + "," + G(c.params.mu_min) + "," +
+           G(c.params.mu_max) + "," + G(c.params.beta_1_s) + "," + G(c.params.kappa_1_m) + "," +
+           G(c.params.nu_1_s) + "\n";
+  }
+  return out;
+}
+
+std::string CalibrationJson(const CalibrationFile& file, const Objective& objective,
+                            const CalibrationRun& run) {
+  const calibration::Summary& s = run.summary;
+  json parameters = json::array();
+  const auto& coordinates = objective.parameters().coordinates();
+  for (std::size_t j = 0; j < coordinates.size(); ++j) {
+    const auto& c = coordinates[j];
+    const auto k = static_cast<Eigen::Index>(j);
+    json members = json::array();
+    for (int m : c.members) members.push_back(objective.parameters().specs()[m].Name());
+    const auto& first = objective.parameters().specs()[c.members.front()];
+    json p = {{"name", c.name},
+              {"parameters", members},
+              {"field", calibration::ToString(first.field)},
+              {"unit", calibration::UnitOf(first.field)},
+              {"lower", c.lower},
+              {"upper", c.upper},
+              {"log", c.log},
+              {"initial", Number(s.initial.values[k])},
+              {"final", Number(s.best.values[k])},
+              {"final_unit_coordinate", Number(s.best.u[k])}};
+    if (j < run.profiles.size()) {
+      const auto& profile = run.profiles[j];
+      p["identified"] = profile.identified;
+      p["profile"] = {{"u", profile.u},
+                      {"values", profile.values},
+                      {"objective", profile.f},
+                      {"range", Number(profile.range)},
+                      {"threshold", Number(profile.threshold)}};
+    } else {
+      p["identified"] = nullptr;
+    }
+    parameters.push_back(p);
+  }
+  json starts = json::array();
+  for (const auto& r : s.starts)
+    starts.push_back({{"start", Vector(r.u0)},
+                      {"best", Vector(r.best_u)},
+                      {"best_objective", Number(r.best_value)},
+                      {"evaluations", r.evaluations},
+                      {"nlopt_result", r.nlopt_result}});
+  const ensemble::ReleaseSpec& release = objective.release();
+  json j = {{"version", run.version},
+            {"calibration_file", file.path},
+            {"event", file.event.path},
+            {"inputs", file.inputs},
+            {"inputs_hash", file.inputs_hash},
+            {"runs", release.release_count()},
+            {"rocks_per_run", release.rocks_per_release},
+            {"seed", release.seed},
+            {"threads", run.threads},
+            {"algorithm", s.algorithm},
+            {"termination", calibration::ToString(s.termination)},
+            {"message", s.message},
+            {"parameters", parameters},
+            {"objective",
+             {{"before", Number(s.initial.value)},
+              {"after", Number(s.best.value)},
+              {"data_after", Number(s.best.data)},
+              {"prior_after", Number(s.best.prior)},
+              {"normalised", objective.options().normalise},
+              {"prior_weight", objective.options().prior_weight},
+              {"prior_reference",
+               objective.options().prior_weight > 0 ? json(file.prior_reference) : json(nullptr)}}},
+            {"kinds", Kinds(objective, s.initial, s.best)},
+            {"evaluations", s.evaluations()},
+            {"cache_hits", s.cache_hits},
+            {"starts", starts},
+            {"timings",
+             {{"calibration_s", s.wall_time_s},
+              {"evaluations_per_s", s.wall_time_s > 0 ? s.evaluations() / s.wall_time_s : 0.0},
+              {"roughness_and_profiles_s",
+               run.roughness ? json(run.roughness->wall_time_s) : json(nullptr)},
+              {"total_s", run.wall_time_s}}}};
+  if (run.roughness) {
+    const auto& r = *run.roughness;
+    j["roughness"] = {{"at_objective", Number(r.value)},
+                      {"steps", r.steps},
+                      {"change", r.change},
+                      {"noise", Number(r.noise)},
+                      {"seed_values", r.seed_values},
+                      {"seed_sd", Number(r.seed_sd)},
+                      {"level", Number(r.level())},
+                      {"finite_difference_step", Number(r.fd_step)},
+                      {"ftol_abs", Number(r.ftol_abs)},
+                      {"evaluations", r.evaluations}};
+  } else {
+    j["roughness"] = nullptr;
+  }
+  return j.dump(2) + "\n";
+}
+
+std::string HistoryCsv(const Objective& objective, const calibration::Summary& summary) {
+  std::string out = "evaluation,start,feasible,objective,data,prior";
+  // Cells appended one by one (GCC 12 warns wrongly about chains of std::string operator+).
+  const auto cell = [&out](const std::string& text) {
+    out += ',';
+    out += text;
+  };
+  for (const auto& c : objective.parameters().coordinates()) cell(c.name);
+  for (const std::string& kind : objective.kinds()) cell("score_" + kind);
+  out += ",wall_time_s,note\n";
+  for (std::size_t i = 0; i < summary.history.size(); ++i) {
+    const Evaluation& e = summary.history[i];
+    out += std::to_string(i);
+    cell(std::to_string(summary.history_start[i]));
+    cell(e.feasible ? "1" : "0");
+    cell(G(e.value));
+    cell(G(e.data));
+    cell(G(e.prior));
+    for (Eigen::Index k = 0; k < e.values.size(); ++k) cell(G(e.values[k]));
+    for (double v : e.kind_scores) cell(G(v));
+    std::string note = e.infeasible;
+    for (char& c : note)
+      if (c == ',' || c == '"' || c == '\n') c = ';';
+    cell(G(e.wall_time_s));
+    cell(note);
+    out += '\n';
+  }
+  return out;
+}
+
+}  // namespace talus::io

@@ -1,0 +1,37 @@
+#pragma once
+// What `talus calibrate` writes (docs/calibration.md): the fitted ground table as a TOML block a
+// scene can use ([ground.<name>]) and as CSV in the shape of the seed paper's Table 1,
+// calibration.json (stable keys) and history.csv (every evaluation).
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "calibration/objective.hpp"
+#include "calibration/optimizer.hpp"
+#include "calibration/roughness.hpp"
+#include "io/calibration_file.hpp"
+
+namespace talus::io {
+
+// Everything a calibration run gave, for calibration.json.
+struct CalibrationRun {
+  std::string version;
+  int threads = 1;
+  double wall_time_s = 0;
+  calibration::Summary summary;
+  std::optional<calibration::RoughnessReport> roughness;
+  std::vector<calibration::ParameterProfile> profiles;
+};
+
+// The categories the calibration touched, with every field, as [ground.<name>] blocks.
+std::string GroundTableToml(const CalibrationFile& file, const calibration::Objective& objective,
+                            const GroundTable& fitted);
+// category, code, mu_min, mu_max, beta, kappa, nu: one row per touched category.
+std::string GroundTableCsv(const calibration::Objective& objective, const GroundTable& fitted);
+std::string CalibrationJson(const CalibrationFile& file, const calibration::Objective& objective,
+                            const CalibrationRun& run);
+std::string HistoryCsv(const calibration::Objective& objective,
+                       const calibration::Summary& summary);
+
+}  // namespace talus::io

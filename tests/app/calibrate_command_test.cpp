@@ -1,0 +1,171 @@
+// End to end through the talus program: `talus calibrate` on a tiny event, and calibration files
+// with mistakes, each refused with its file, line, key and reason before any rock runs.
+
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path FreshDir(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / "talus_calibrate_tests" / name;
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+int RunCommand(const std::string& command, std::string* output) {
+  std::FILE* pipe = ::popen((command + " 2>&1").c_str(), "r");
+  std::array<char, 4096> buffer;
+  output->clear();
+  while (std::size_t n = std::fread(buffer.data(), 1, buffer.size(), pipe))
+    output->append(buffer.data(), n);
+  const int status = ::pclose(pipe);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+std::string Slurp(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+void Write(const fs::path& path, const std::string& text) { std::ofstream(path) << text; }
+
+// Four runs of a block on a short 35 degree slope with observed run-outs.
+fs::path MakeEvent(const std::string& name) {
+  const fs::path dir = FreshDir(name);
+  Write(dir / "scene.toml", R"([terrain]
+plane = { slope_deg = 35, slope_length_m = 20, runout_m = 10, width_m = 12, cell_m = 1 }
+default_ground = "medium_soft"
+[rock]
+shape = { box = [0.4, 0.4, 0.3] }
+[release]
+runs = "runs.csv"
+rocks = 4
+seed = 3
+[solver]
+max_time_s = 3
+)");
+  Write(dir / "runs.csv",
+        "trajectory_id,x_m,y_m,height_m,vx_mps\nr1,3,0,1,1\nr2,3,2,1,2\nr3,4,-2,1,0\nr4,4,3,1,1\n");
+  Write(dir / "observed.csv", "trajectory_id,observed_runout_m\nr1,17\nr2,19\nr3,14\nr4,16\n");
+  Write(dir / "event.toml", R"(scene = "scene.toml"
+[[observations]]
+kind = "runout"
+file = "observed.csv"
+)");
+  return dir;
+}
+
+const char* kGood = R"(event = "event.toml"
+[[parameters]]
+category = "medium_soft"
+field = "mu_min"
+lower = 0.1
+upper = 0.9
+[optimizer]
+algorithm = "bobyqa"
+max_evaluations = 6
+[roughness]
+steps = [1e-2]
+seeds = 1
+profile_points = 3
+)";
+
+// A small calibration completes, writes its four files and prints the summary. Budget: 6
+// evaluations plus 1 + 1 + 1 for the roughness and 3 for the profile, of 16 rocks each.
+TEST(CalibrateCommand, WritesTheGroundTableJsonAndHistory) {
+  const fs::path dir = MakeEvent("good");
+  Write(dir / "cal.toml", kGood);
+  std::string output;
+  const int code =
+      RunCommand(std::string(TALUS_BINARY) + " calibrate " + (dir / "cal.toml").string() +
+                     " --out " + (dir / "out").string() + " --threads 2",
+                 &output);
+  ASSERT_EQ(code, 0) << output;
+  EXPECT_NE(output.find("Calibration report"), std::string::npos) << output;
+  for (const char* name :
+       {"ground_table.toml", "ground_table.csv", "history.csv", "calibration.json"})
+    EXPECT_TRUE(fs::exists(dir / "out" / name)) << name;
+  const auto json = nlohmann::json::parse(Slurp(dir / "out" / "calibration.json"));
+  EXPECT_EQ(json["parameters"][0]["name"], "medium_soft.mu_min");
+  EXPECT_LE(json["objective"]["after"].get<double>(), json["objective"]["before"].get<double>());
+  EXPECT_LE(json["evaluations"].get<int>(), 6);
+  EXPECT_TRUE(json["roughness"].is_object());
+  EXPECT_TRUE(json["parameters"][0]["identified"].is_boolean());
+  const std::string csv = Slurp(dir / "out" / "ground_table.csv");
+  EXPECT_EQ(csv.rfind("category,code,mu_min,mu_max,beta,kappa,nu\nmedium_soft,3,", 0), 0u) << csv;
+  // One header line and one line per evaluation.
+  const std::string history = Slurp(dir / "out" / "history.csv");
+  EXPECT_EQ(std::count(history.begin(), history.end(), '\n'), json["evaluations"].get<int>() + 1);
+  // The fitted table is a [ground.<name>] block a scene takes as it is.
+  const std::string toml = Slurp(dir / "out" / "ground_table.toml");
+  EXPECT_NE(toml.find("[ground.medium_soft]\ncode = 3\nmu_min = "), std::string::npos) << toml;
+  std::string scene = Slurp(dir / "scene.toml") + toml;
+  Write(dir / "fitted_scene.toml", scene);
+  EXPECT_EQ(
+      RunCommand(std::string(TALUS_BINARY) + " simulate " + (dir / "fitted_scene.toml").string() +
+                     " --out " + (dir / "sim").string() + " --rocks 2",
+                 &output),
+      0)
+      << output;
+}
+
+// Each mistake is refused with exit code 2, naming the file, line and key, before any rock runs
+// (no output directory is created).
+TEST(CalibrateCommand, BadFilesAreRefusedBeforeAnyRun) {
+  const fs::path dir = MakeEvent("bad");
+  const std::string cal = (dir / "cal.toml").string();
+  const struct {
+    std::string from, to, expected;
+  } cases[] = {
+      {"[optimizer]", "[optimiser]",
+       cal + ":7: optimiser: unknown key (did you mean 'optimizer'?)"},
+      {"field = \"mu_min\"", "field = \"mu_mn\"",
+       cal + ":4: parameters[0].field: unknown parameter 'mu_mn' (did you mean 'mu_min'?); "
+             "known: mu_min, mu_max, beta, kappa, nu"},
+      {"upper = 0.9", "upper = 0.1",
+       cal + ":6: parameters[0].upper: medium_soft.mu_min: upper = 0.1 must be > lower = 0.1 (the "
+             "bounds are empty)"},
+      {"category = \"medium_soft\"", "category = \"medium_sft\"",
+       cal + ":3: parameters[0].category: unknown ground category 'medium_sft' (did you mean "
+             "'medium_soft'?); the scene has extra_soft, soft, medium_soft, medium, medium_hard, "
+             "hard, extra_hard, snow"},
+      {"algorithm = \"bobyqa\"", "algorithm = \"bobyqua\"",
+       cal + ":8: optimizer.algorithm: unknown algorithm 'bobyqua' (did you mean 'bobyqa'?); "
+             "known: bobyqa, sbplx, crs2_lm, direct_l, isres"},
+      {"[optimizer]", "[objective]\nweights = { scar_length = 1 }\n[optimizer]",
+       cal + ":8: objective.weights.scar_length: no observation of this kind; the event "
+             "observes runout"},
+      {"upper = 0.9",
+       "upper = 0.9\n[[parameters]]\ncategory = \"medium_soft\"\nfield = "
+       "\"mu_max\"\nlower = 0.01\nupper = 0.05",
+       cal + ":2: parameters: medium_soft: mu_min >= 0.1 and mu_max <= 0.05 within the bounds: no "
+             "parameter vector has mu_min <= mu_max"},
+  };
+  for (const auto& c : cases) {
+    std::string text = kGood;
+    text.replace(text.find(c.from), c.from.size(), c.to);
+    Write(cal, text);
+    std::string output;
+    const int code = RunCommand(
+        std::string(TALUS_BINARY) + " calibrate " + cal + " --out " + (dir / "out").string(),
+        &output);
+    EXPECT_EQ(code, 2) << output;
+    EXPECT_EQ(output, "talus calibrate: " + c.expected + "\n");
+    EXPECT_FALSE(fs::exists(dir / "out"));
+  }
+}
+
+}  // namespace

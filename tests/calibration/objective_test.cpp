@@ -1,0 +1,140 @@
+// The calibration objective: common random numbers, no state carried between evaluations,
+// thread-count independence, infeasible vectors, residuals and the climatology scale.
+
+#include "calibration/objective.hpp"
+
+#include <gtest/gtest.h>
+
+#include "common/error.hpp"
+#include "fieldobs/validation.hpp"
+#include "tests/calibration/fixtures.hpp"
+
+namespace talus::calibration {
+namespace {
+
+ParameterSpec MuMin(double lower = 0.1, double upper = 0.9) {
+  ParameterSpec s;
+  s.category = "medium_hard";
+  s.field = GroundField::kMuMin;
+  s.lower = lower;
+  s.upper = upper;
+  return s;
+}
+
+ObjectiveOptions Threads(int threads) {
+  ObjectiveOptions o;
+  o.threads = threads;
+  return o;
+}
+
+const testing::SyntheticRunouts& Problem() {
+  static const testing::SyntheticRunouts problem(20, 8, 0.5);
+  return problem;
+}
+
+// Scene copies share the DEM: a copy costs reference counts, not the heights.
+TEST(Objective, SceneCopiesShareTheTerrain) {
+  const Scene copy = Problem().scene;
+  EXPECT_TRUE(copy.terrain.SharesHeightsWith(Problem().scene.terrain));
+  EXPECT_EQ(&copy.terrain.heights(), &Problem().scene.terrain.heights());
+}
+
+// Evaluating u1 between two evaluations of u0 changes nothing (bit for bit), and an evaluation
+// equals running the never-edited scene with the same table directly.
+TEST(Objective, EditEvaluateRestoreIsBitIdenticalToNeverEditing) {
+  const auto& p = Problem();
+  const Objective objective(p.scene, p.release, p.observations, {MuMin()}, Threads(2));
+  const Eigen::VectorXd u0 = Eigen::VectorXd::Constant(1, 0.3);
+  const Evaluation a = objective.Evaluate(u0);
+  const Evaluation other = objective.Evaluate(Eigen::VectorXd::Constant(1, 0.9));
+  const Evaluation b = objective.Evaluate(u0);
+  ASSERT_TRUE(a.feasible);
+  EXPECT_NE(a.value, other.value);
+  EXPECT_EQ(a.value, b.value);
+  EXPECT_EQ(a.residuals, b.residuals);
+  EXPECT_EQ(a.kind_scores, b.kind_scores);
+
+  Scene direct = p.scene;
+  direct.ground = objective.GroundOf(u0);
+  fieldobs::EnsembleSamples samples(p.release);
+  ensemble::EnsembleOptions options;
+  options.threads = 2;
+  ensemble::RunEnsemble(direct, p.release, options, &samples);
+  const fieldobs::ValidationReport report = fieldobs::Validate(p.observations, samples, nullptr);
+  EXPECT_EQ(a.kind_scores[0], report.kinds[0].mean_score);
+
+  // A ground table edited and restored runs exactly as one never edited.
+  Scene edited = p.scene;
+  const int g = edited.ground.IndexOfName("medium_hard");
+  const GroundParams saved = edited.ground.params(g);
+  objective.parameters().Apply(Eigen::VectorXd::Constant(1, 0.9), edited.ground, nullptr);
+  edited.ground.mutable_params(g) = saved;
+  fieldobs::EnsembleSamples restored(p.release), never(p.release);
+  ensemble::RunEnsemble(edited, p.release, options, &restored);
+  ensemble::RunEnsemble(p.scene, p.release, options, &never);
+  EXPECT_EQ(restored.Values(fieldobs::Quantity::kRunout, ""),
+            never.Values(fieldobs::Quantity::kRunout, ""));
+}
+
+TEST(Objective, IsTheSameForOneAndTwoThreads) {
+  const auto& p = Problem();
+  const Objective one(p.scene, p.release, p.observations, {MuMin()}, Threads(1));
+  const Objective two(p.scene, p.release, p.observations, {MuMin()}, Threads(2));
+  const Eigen::VectorXd u = Eigen::VectorXd::Constant(1, 0.45);
+  const Evaluation a = one.Evaluate(u), b = two.Evaluate(u);
+  EXPECT_EQ(a.value, b.value);
+  EXPECT_EQ(a.residuals, b.residuals);
+}
+
+// The normalised runout term is the mean CRPS over the climatology's mean CRPS, the same number
+// fieldobs::Validate reports; the residuals' squares add up to the data term (to round-off,
+// 1e-12 relative: a sum of 20 squares of square roots).
+TEST(Objective, ScaleIsTheClimatologyScoreAndResidualsSquareToTheValue) {
+  const auto& p = Problem();
+  ObjectiveOptions options = Threads(2);
+  const Objective objective(p.scene, p.release, p.observations, {MuMin()}, options);
+  const Evaluation e = objective.Evaluate(Eigen::VectorXd::Constant(1, 0.5));
+  fieldobs::EnsembleSamples samples(p.release);
+  ensemble::EnsembleOptions run;
+  run.threads = 2;
+  Scene scene = p.scene;
+  scene.ground = objective.GroundOf(e.u);
+  ensemble::RunEnsemble(scene, p.release, run, &samples);
+  const fieldobs::ValidationReport report = fieldobs::Validate(p.observations, samples, nullptr);
+  EXPECT_NEAR(objective.kind_scales()[0], report.kinds[0].mean_climatology_score,
+              1e-12 * report.kinds[0].mean_climatology_score);
+  EXPECT_NEAR(e.data, 1 - report.kinds[0].skill_vs_climatology, 1e-12);
+  EXPECT_NEAR(e.residuals.squaredNorm(), e.value, 1e-12 * e.value);
+  EXPECT_EQ(e.rocks, 20 * 8);
+}
+
+// mu_min above mu_max: no rock runs, the value is the stated finite penalty.
+TEST(Objective, InfeasibleVectorsRunNoRockAndGetTheStatedPenalty) {
+  const auto& p = Problem();
+  ParameterSpec mu_max = MuMin(0.3, 1.5);
+  mu_max.field = GroundField::kMuMax;
+  const Objective objective(p.scene, p.release, p.observations, {MuMin(0.1, 0.9), mu_max},
+                            Threads(2));
+  const Evaluation e = objective.Evaluate(Eigen::Vector2d(1.0, 0.0));  // 0.9 > 0.3
+  EXPECT_FALSE(e.feasible);
+  EXPECT_EQ(e.rocks, 0);
+  EXPECT_DOUBLE_EQ(e.value, 1e3 * (1 + 0.6));
+  EXPECT_EQ(e.infeasible, "medium_hard: mu_max = 0.3 violates mu_min <= mu_max < infinity");
+}
+
+TEST(Objective, WeightOfAKindWithoutObservationsIsAnError) {
+  const auto& p = Problem();
+  ObjectiveOptions options;
+  options.weights["scar_length"] = 1;
+  try {
+    const Objective objective(p.scene, p.release, p.observations, {MuMin()}, options);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(),
+                 "weights.scar_length: no observation of kind 'scar_length' (the observations "
+                 "are of: runout)");
+  }
+}
+
+}  // namespace
+}  // namespace talus::calibration
