@@ -25,22 +25,6 @@ double RingArea(const std::vector<Eigen::Vector2d>& ring) {
   return 0.5 * twice;
 }
 
-// Even-odd rule over all rings, so that inner rings are holes.
-bool InsidePolygon(const std::vector<std::vector<Eigen::Vector2d>>& rings,
-                   const Eigen::Vector2d& p) {
-  bool inside = false;
-  for (const auto& ring : rings) {
-    for (std::size_t k = 0, l = ring.size() - 1; k < ring.size(); l = k++) {
-      const Eigen::Vector2d& a = ring[k];
-      const Eigen::Vector2d& b = ring[l];
-      if ((a.y() > p.y()) != (b.y() > p.y()) &&
-          p.x() < (b.x() - a.x()) * (p.y() - a.y()) / (b.y() - a.y()) + a.x())
-        inside = !inside;
-    }
-  }
-  return inside;
-}
-
 double LineLength(const std::vector<Eigen::Vector2d>& line) {
   double total = 0;
   for (std::size_t k = 1; k < line.size(); ++k) total += (line[k] - line[k - 1]).norm();
@@ -78,6 +62,21 @@ Eigen::Vector2d PointInPolygon(const std::vector<std::vector<Eigen::Vector2d>>& 
 
 std::string ReleaseSpec::ReleaseName(int release) const {
   return runs.empty() ? std::to_string(release) : runs[static_cast<std::size_t>(release)].id;
+}
+
+bool InsidePolygon(const std::vector<std::vector<Eigen::Vector2d>>& rings,
+                   const Eigen::Vector2d& p) {
+  bool inside = false;
+  for (const auto& ring : rings) {
+    for (std::size_t k = 0, l = ring.size() - 1; k < ring.size(); l = k++) {
+      const Eigen::Vector2d& a = ring[k];
+      const Eigen::Vector2d& b = ring[l];
+      if ((a.y() > p.y()) != (b.y() > p.y()) &&
+          p.x() < (b.x() - a.x()) * (p.y() - a.y()) / (b.y() - a.y()) + a.x())
+        inside = !inside;
+    }
+  }
+  return inside;
 }
 
 bool ReleaseSpec::IsValid(std::string* why) const {

@@ -78,6 +78,11 @@ struct ReleaseSpec {
   bool IsValid(std::string* why) const;
 };
 
+// Whether p lies inside the polygon of `rings` by the even-odd rule over all rings, so that inner
+// rings are holes.
+bool InsidePolygon(const std::vector<std::vector<Eigen::Vector2d>>& rings,
+                   const Eigen::Vector2d& p);
+
 // A point of `release` where the terrain has no height (outside the DEM or on a nodata cell), or
 // nullopt when rocks can start anywhere on it: its vertices, its lines or rings (checked every
 // quarter cell) and, for a polygon, the centres of the cells without height that it covers.

@@ -71,18 +71,6 @@ double Crossing(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen:
   return t >= 0 && t <= 1 && u >= 0 && u <= 1 ? t : -1;
 }
 
-bool Inside(const std::vector<Eigen::Vector2d>& ring, const Eigen::Vector2d& p) {
-  bool inside = false;
-  for (std::size_t k = 0, l = ring.size() - 1; k < ring.size(); l = k++) {
-    const Eigen::Vector2d& a = ring[k];
-    const Eigen::Vector2d& b = ring[l];
-    if ((a.y() > p.y()) != (b.y() > p.y()) &&
-        p.x() < (b.x() - a.x()) * (p.y() - a.y()) / (b.y() - a.y()) + a.x())
-      inside = !inside;
-  }
-  return inside;
-}
-
 class ZoneRecorder : public ensemble::RockRecorder {
  public:
   explicit ZoneRecorder(std::shared_ptr<const std::vector<Zone>> zones)
@@ -105,7 +93,7 @@ class ZoneRecorder : public ensemble::RockRecorder {
       const Zone& zone = (*zones_)[z];
       double* v = &values_[4 * z];
       if (zone.polygon) {
-        if (!Inside(zone.points, b)) continue;
+        if (!ensemble::InsidePolygon({zone.points}, b)) continue;
         v[0] = 1;
         v[1] = std::isnan(v[1]) ? v1 : std::max(v[1], v1);
         v[2] = std::isnan(v[2]) ? w1 : std::max(v[2], w1);

@@ -11,35 +11,21 @@
 #include <sstream>
 #include <string>
 
+#include "run_talus.hpp"
+
 namespace {
 
 namespace fs = std::filesystem;
 
 fs::path FreshDir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / "talus_app_tests" / name;
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
+  return talus::app::testing::FreshDir("talus_app_tests", name);
 }
 
-int RunCommand(const std::string& command, std::string* output) {
-  std::FILE* pipe = ::popen((command + " 2>&1").c_str(), "r");
-  std::array<char, 4096> buffer;
-  output->clear();
-  while (std::size_t n = std::fread(buffer.data(), 1, buffer.size(), pipe))
-    output->append(buffer.data(), n);
-  const int status = ::pclose(pipe);
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
+using talus::app::testing::RunCommand;
 
-std::string Slurp(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using talus::app::testing::Slurp;
 
-void Write(const fs::path& path, const std::string& text) { std::ofstream(path) << text; }
+using talus::app::testing::Write;
 
 // Three runs of two blocks on a short 35 degree slope, observed rest positions and run-outs, and
 // impacts (each run starts 2 m above the ground, so its first contact episode is an impact).
