@@ -2,6 +2,7 @@
 
 #include <gdal_priv.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <memory>
@@ -90,6 +91,19 @@ bool SameCrs(const std::string& a_wkt, const std::string& b_wkt) {
       b.importFromWkt(b_wkt.c_str()) != OGRERR_NONE)
     return false;
   return a.IsSame(&b);
+}
+
+bool IsGeographicCrs(const std::string& crs_wkt) {
+  if (crs_wkt.empty()) return false;
+  OGRSpatialReference srs;
+  if (srs.importFromWkt(crs_wkt.c_str()) != OGRERR_NONE) return false;
+  return srs.IsGeographic();
+}
+
+std::string UtmEpsgFor(double lon_deg, double lat_deg) {
+  if (!(std::abs(lon_deg) <= 180 && std::abs(lat_deg) <= 84)) return "";
+  const int zone = std::clamp(static_cast<int>(std::floor((lon_deg + 180) / 6)) + 1, 1, 60);
+  return "EPSG:" + std::to_string((lat_deg >= 0 ? 32600 : 32700) + zone);
 }
 
 std::array<double, 6> GeoTransformOf(const GridGeometry& grid) {

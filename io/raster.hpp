@@ -28,6 +28,13 @@ Raster ReadRaster(const std::string& path, const std::string& what);
 // True when two WKT CRS definitions describe the same CRS.
 bool SameCrs(const std::string& a_wkt, const std::string& b_wkt);
 
+// True when a WKT CRS is geographic (coordinates in degrees, not metres); false when empty.
+bool IsGeographicCrs(const std::string& crs_wkt);
+
+// "EPSG:326zz" or "EPSG:327zz": the WGS 84 / UTM zone holding the point (lon, lat) in degrees, or
+// "" when (lon, lat) is not a point UTM covers (|lat| > 84 or |lon| > 180).
+std::string UtmEpsgFor(double lon_deg, double lat_deg);
+
 // The GDAL geotransform of a grid whose nodes are cell centres (north-up).
 std::array<double, 6> GeoTransformOf(const GridGeometry& grid);
 

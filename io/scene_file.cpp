@@ -47,6 +47,33 @@ int EditDistance(const std::string& a, const std::string& b) {
 
 const auto kPositive = [](double v) { return v > 0; };
 
+// Bounds of plausible input (docs/scenes.md): finite values beyond them are typos or wrong units,
+// which would otherwise run and give wrong results.
+constexpr double kMaxAbsHeight_m = 20000;  // DEM heights
+constexpr double kMinDensity_kg_m3 = 100, kMaxDensity_kg_m3 = 30000;
+constexpr double kMinVolume_m3 = 1e-9, kMaxVolume_m3 = 1e6;
+constexpr double kMaxSpeed_m_s = 200, kMaxAngularSpeed_rad_s = 1000;
+constexpr double kMaxReleaseHeight_m = 10000;
+constexpr double kMinGravity_m_s2 = 0.1, kMaxGravity_m_s2 = 100;
+
+// "<v> is outside <lo> .. <hi> <unit>", or "" when lo <= v <= hi.
+std::string OutsideBounds(double v, double lo, double hi, const std::string& unit) {
+  if (v >= lo && v <= hi) return "";
+  return Fmt(v) + " is outside " + Fmt(lo) + " .. " + Fmt(hi) + " " + unit;
+}
+
+// Fails on `key` unless lo <= v <= hi.
+void RequireWithin(const Section& s, const std::string& key, double v, double lo, double hi,
+                   const std::string& unit) {
+  if (const std::string why = OutsideBounds(v, lo, hi, unit); !why.empty()) s.Fail(key, why);
+}
+
+// "" when |v| <= max, else "|v| = <|v|> <unit> is more than <max> <unit>".
+std::string TooFast(const Eigen::Vector3d& v, double max, const std::string& unit) {
+  if (v.norm() <= max) return "";
+  return "|v| = " + Fmt(v.norm()) + " " + unit + " is more than " + Fmt(max) + " " + unit;
+}
+
 // [ground.<name>]: user categories, or overrides of built-in ones.
 void LoadGround(const Context& context, const toml::table* ground, GroundTable& table) {
   if (!ground) return;
@@ -144,6 +171,23 @@ void LoadTerrain(const Context& context, const Section& s, SceneFile& out) {
   } else {
     const std::string path = context.Resolve(s.String("dem", ""));
     Raster dem = ReadRaster(path, context.Where(s.Node("dem")) + ": " + s.Key("dem"));
+    if (IsGeographicCrs(dem.crs_wkt)) {
+      const std::string utm = UtmEpsgFor(0.5 * (dem.grid.x0_m + dem.grid.x_max_m()),
+                                         0.5 * (dem.grid.y0_m + dem.grid.y_max_m()));
+      s.Fail("dem", path +
+                        " is in a geographic CRS (degrees); Talus needs a projected CRS in metres: "
+                        "reproject it (e.g. gdalwarp -t_srs " +
+                        (utm.empty() ? "EPSG:<a projected CRS in metres>"
+                                     : utm + ", the UTM zone of its centre") +
+                        ")");
+    }
+    for (std::size_t k = 0; k < dem.values.size(); ++k)
+      if (std::abs(dem.values[k]) > kMaxAbsHeight_m)  // false for nodata (NaN)
+        s.Fail("dem", path + " has the height " + Fmt(dem.values[k]) + " m (cell " +
+                          std::to_string(k % static_cast<std::size_t>(dem.grid.nx)) + ", " +
+                          std::to_string(k / static_cast<std::size_t>(dem.grid.nx)) +
+                          " from the south-west), beyond +-" + Fmt(kMaxAbsHeight_m) +
+                          " m: a nodata value the file does not declare, or not metres?");
     out.inputs.push_back(path);
     out.crs_wkt = dem.crs_wkt;
     heights.grid = dem.grid;
@@ -174,6 +218,16 @@ void LoadTerrain(const Context& context, const Section& s, SceneFile& out) {
       throw InputError(what + ": " + path +
                        " is in another CRS than the DEM; reprojecting ground rasters is not "
                        "supported yet (warp it onto the DEM's CRS first, e.g. with gdalwarp)");
+    // A ground raster off the DEM would give the default ground everywhere.
+    const GridGeometry& d = scene.terrain.heights().grid;
+    const GridGeometry& c = codes.grid;
+    const double cx0 = c.x0_m - 0.5 * c.dx_m, cx1 = c.x_max_m() + 0.5 * c.dx_m;
+    const double cy0 = c.y0_m - 0.5 * c.dy_m, cy1 = c.y_max_m() + 0.5 * c.dy_m;
+    if (!(cx0 < d.x_max_m() && cx1 > d.x0_m && cy0 < d.y_max_m() && cy1 > d.y0_m))
+      s.Fail("ground", path + " covers x " + Fmt(cx0) + " .. " + Fmt(cx1) + ", y " + Fmt(cy0) +
+                           " .. " + Fmt(cy1) + ", which does not overlap the DEM (x " +
+                           Fmt(d.x0_m) + " .. " + Fmt(d.x_max_m()) + ", y " + Fmt(d.y0_m) + " .. " +
+                           Fmt(d.y_max_m()) + "): every contact would get the default ground");
     GroundGrid grid;
     grid.grid = codes.grid;
     grid.index.resize(codes.values.size());
@@ -202,9 +256,14 @@ void LoadRock(const Context& context, const Section& s, SceneFile& out) {
   if (!s.Has("shape"))
     s.Fail("shape", "missing: a point cloud file or a built-in such as { box = [1, 1, 1] }");
   rock.density_kg_m3 = s.Checked("density_kg_m3", 2700, kPositive, "must be > 0");
+  RequireWithin(s, "density_kg_m3", rock.density_kg_m3, kMinDensity_kg_m3, kMaxDensity_kg_m3,
+                "kg/m3");
   if (s.Has("volume_m3") && s.Has("mass_kg"))
     s.Fail("mass_kg", "give volume_m3 or mass_kg, not both");
-  if (s.Has("volume_m3")) rock.volume_m3 = s.Checked("volume_m3", 0, kPositive, "must be > 0");
+  if (s.Has("volume_m3")) {
+    rock.volume_m3 = s.Checked("volume_m3", 0, kPositive, "must be > 0");
+    RequireWithin(s, "volume_m3", *rock.volume_m3, kMinVolume_m3, kMaxVolume_m3, "m3");
+  }
   if (s.Has("mass_kg")) rock.mass_kg = s.Checked("mass_kg", 0, kPositive, "must be > 0");
   const long max_vertices = s.Integer("max_vertices", 0);
   if (max_vertices != 0 && (max_vertices < 4 || max_vertices > 100000))
@@ -292,6 +351,10 @@ void LoadRock(const Context& context, const Section& s, SceneFile& out) {
   }
   std::string why;
   if (!out.scene.rock.IsValid(&why)) s.Fail("shape", why);
+  if (const std::string bad =
+          OutsideBounds(out.scene.rock.volume_m3, kMinVolume_m3, kMaxVolume_m3, "m3");
+      !bad.empty())
+    s.Fail(s.Has("mass_kg") ? "mass_kg" : "shape", "the rock's volume " + bad);
   if (s.Bool("shape_per_rock", false)) {
     if (rock.builtin != "rock")
       s.Fail("shape_per_rock", "only a built-in rock shape has a shape of its own per rock");
@@ -346,6 +409,8 @@ void LoadBlocks(const Context& context, const toml::table* table, SceneFile& out
   pointclouds::RockSpec base;
   base.builtin = shape;
   base.density_kg_m3 = s.Checked("density_kg_m3", 2700, kPositive, "must be > 0");
+  RequireWithin(s, "density_kg_m3", base.density_kg_m3, kMinDensity_kg_m3, kMaxDensity_kg_m3,
+                "kg/m3");
   const long points = s.Integer("points", base.points);
   if (points < 4 || points > 1000000)
     s.Fail("points", std::to_string(points) + " must be in 4 .. 1000000");
@@ -365,7 +430,12 @@ void LoadBlocks(const Context& context, const toml::table* table, SceneFile& out
     spec.mass_kg = mass;
     spec.density_kg_m3 = base.density_kg_m3;
     out.block_specs.push_back(spec);
-    out.release.blocks.push_back({id, MakeBlockShape(spec, where)});
+    auto block_shape_made = MakeBlockShape(spec, where);
+    if (const std::string bad =
+            OutsideBounds(block_shape_made->volume_m3, kMinVolume_m3, kMaxVolume_m3, "m3");
+        !bad.empty())
+      throw InputError(where + ": block '" + id + "': the volume " + bad);
+    out.release.blocks.push_back({id, std::move(block_shape_made)});
   };
   if (s.Has("file")) {
     const std::string path = context.Resolve(s.String("file", ""));
@@ -451,6 +521,9 @@ void LoadRuns(const Context& context, const Section& s, SceneFile& out) {
     run.height_m = rows.OptionalNumber(k, "height_m");
     if (run.height_m && *run.height_m < 0)
       throw InputError(rows.Where(k, "height_m") + ": must be >= 0");
+    if (run.height_m && *run.height_m > kMaxReleaseHeight_m)
+      throw InputError(rows.Where(k, "height_m") + ": " + Fmt(*run.height_m) + " is more than " +
+                       Fmt(kMaxReleaseHeight_m) + " m");
     const auto vector = [&](const char* x, const char* y, const char* z) {
       return Eigen::Vector3d(rows.OptionalNumber(k, x).value_or(0),
                              rows.OptionalNumber(k, y).value_or(0),
@@ -458,6 +531,21 @@ void LoadRuns(const Context& context, const Section& s, SceneFile& out) {
     };
     run.velocity_m_s = vector("vx_mps", "vy_mps", "vz_mps");
     run.angular_velocity_rad_s = vector("wx_radps", "wy_radps", "wz_radps");
+    // Errors name the column of the largest component.
+    const auto largest = [](const Eigen::Vector3d& v, const char* x, const char* y, const char* z) {
+      Eigen::Index at = 0;
+      v.cwiseAbs().maxCoeff(&at);
+      return at == 0 ? x : at == 1 ? y : z;
+    };
+    if (const std::string bad = TooFast(run.velocity_m_s, kMaxSpeed_m_s, "m/s"); !bad.empty())
+      throw InputError(rows.Where(k, largest(run.velocity_m_s, "vx_mps", "vy_mps", "vz_mps")) +
+                       ": start velocity " + bad);
+    if (const std::string bad =
+            TooFast(run.angular_velocity_rad_s, kMaxAngularSpeed_rad_s, "rad/s");
+        !bad.empty())
+      throw InputError(
+          rows.Where(k, largest(run.angular_velocity_rad_s, "wx_radps", "wy_radps", "wz_radps")) +
+          ": start angular velocity " + bad);
     if (rows.Has("qw") && !rows.Empty(k, "qw")) {
       const Eigen::Quaterniond q(rows.Number(k, "qw"), rows.Number(k, "qx"), rows.Number(k, "qy"),
                                  rows.Number(k, "qz"));
@@ -492,6 +580,10 @@ void LoadRuns(const Context& context, const Section& s, SceneFile& out) {
                        ") is outside the DEM or on nodata (the DEM covers x " + Fmt(g.x0_m) +
                        " .. " + Fmt(g.x_max_m()) + ", y " + Fmt(g.y0_m) + " .. " +
                        Fmt(g.y_max_m()) + ")");
+    if (run.z_m && *run.z_m - ground_m > kMaxReleaseHeight_m)
+      throw InputError(rows.Where(k, "z_m") + ": " + Fmt(*run.z_m) + " m is " +
+                       Fmt(*run.z_m - ground_m) + " m above the ground, more than " +
+                       Fmt(kMaxReleaseHeight_m) + " m");
     r.runs.push_back(run);
   }
 }
@@ -542,6 +634,8 @@ void LoadRelease(const Context& context, const Section& s, SceneFile& out) {
   r.rocks_per_release = rocks;
   r.height_m = s.Checked(
       "height_m", 1.0, [](double v) { return v >= 0; }, "must be >= 0");
+  if (r.height_m > kMaxReleaseHeight_m)
+    s.Fail("height_m", Fmt(r.height_m) + " is more than " + Fmt(kMaxReleaseHeight_m) + " m");
   if (const toml::node* node = s.Node("orientation")) {
     if (node->is_string()) {
       if (s.String("orientation", "") != "random")
@@ -558,10 +652,15 @@ void LoadRelease(const Context& context, const Section& s, SceneFile& out) {
   if (s.Has("velocity_m_s")) {
     const auto v = s.Numbers("velocity_m_s", 3);
     r.velocity_m_s = Eigen::Vector3d(v[0], v[1], v[2]);
+    if (const std::string bad = TooFast(r.velocity_m_s, kMaxSpeed_m_s, "m/s"); !bad.empty())
+      s.Fail("velocity_m_s", bad);
   }
   if (s.Has("angular_velocity_rad_s")) {
     const auto w = s.Numbers("angular_velocity_rad_s", 3);
     r.angular_velocity_rad_s = Eigen::Vector3d(w[0], w[1], w[2]);
+    if (const std::string bad = TooFast(r.angular_velocity_rad_s, kMaxAngularSpeed_rad_s, "rad/s");
+        !bad.empty())
+      s.Fail("angular_velocity_rad_s", bad);
   }
   const long seed = s.Integer("seed", 1);
   if (seed < 0) s.Fail("seed", std::to_string(seed) + " must be >= 0");
@@ -583,6 +682,7 @@ void LoadSolver(const Section& s, SolverOptions& o) {
   o.dt_s = s.Number("dt_s", o.dt_s);
   o.max_time_s = s.Number("max_time_s", o.max_time_s);
   o.gravity_m_s2 = s.Number("gravity_m_s2", o.gravity_m_s2);
+  RequireWithin(s, "gravity_m_s2", o.gravity_m_s2, kMinGravity_m_s2, kMaxGravity_m_s2, "m/s2");
   o.normal_restitution = s.Number("normal_restitution", o.normal_restitution);
   o.tangential_restitution = s.Number("tangential_restitution", o.tangential_restitution);
   if (s.Has("viscous")) {

@@ -163,5 +163,22 @@ TEST(WriteGeoTiff, OutputCellLinesUpWithTheDemCell) {
       EXPECT_EQ(pixels[r * 9 + c], (r == row && c == column) ? 2.0f : 0.0f) << r << "," << c;
 }
 
+TEST(IsGeographicCrs, TellsDegreesFromMetres) {
+  EXPECT_TRUE(IsGeographicCrs(testing::Wkt(4326)));    // WGS 84
+  EXPECT_TRUE(IsGeographicCrs(testing::Wkt(4258)));    // ETRS89
+  EXPECT_FALSE(IsGeographicCrs(testing::Wkt(31287)));  // MGI / Austria Lambert
+  EXPECT_FALSE(IsGeographicCrs(testing::Wkt(32632)));  // WGS 84 / UTM 32N
+  EXPECT_FALSE(IsGeographicCrs(""));
+}
+
+TEST(UtmEpsgFor, ZoneAndHemisphereOfThePoint) {
+  EXPECT_EQ(UtmEpsgFor(11.0, 47.0), "EPSG:32632");
+  EXPECT_EQ(UtmEpsgFor(-70.6, -33.4), "EPSG:32719");
+  EXPECT_EQ(UtmEpsgFor(-180.0, 0.0), "EPSG:32601");
+  EXPECT_EQ(UtmEpsgFor(180.0, 0.0), "EPSG:32660");
+  EXPECT_EQ(UtmEpsgFor(11.0, 88.0), "");      // polar: no UTM zone
+  EXPECT_EQ(UtmEpsgFor(600000, 250000), "");  // metres, not degrees
+}
+
 }  // namespace
 }  // namespace talus::io

@@ -585,5 +585,131 @@ TEST(LoadScene, ShapePerRockNeedsRockShapes) {
   EXPECT_NE(a.vertices_m.size() == b.vertices_m.size() && a.vertices_m[0] == b.vertices_m[0], true);
 }
 
+// Reliability item 4: inputs that used to be accepted without a word and give wrong results.
+
+// A DEM in degrees would be read as metres: slopes of thousands of kilometres per cell.
+TEST(LoadScene, DemInAGeographicCrsIsAnError) {
+  const auto dir = testing::FreshDir("dem_wgs84");
+  std::filesystem::create_directories(dir / "data");
+  testing::WriteGdalRaster(dir / "data" / "dem.tif",
+                           std::vector<std::vector<double>>(7, std::vector<double>(7, 500.0)),
+                           {11.0, 0.001, 0.0, 47.0, 0.0, -0.001}, 4326, -9999.0);
+  const std::string e = ErrorOf(
+      "[terrain]\ndem = \"data/dem.tif\"\n[rock]\nshape = { sphere = 0.3 }\n"
+      "[release]\npoints = [[11.003, 46.997]]\n",
+      dir);
+  EXPECT_HAS(e, "scene.toml:2: terrain.dem: " + (dir / "data" / "dem.tif").string() +
+                    " is in a geographic CRS (degrees); Talus needs a projected CRS in metres: "
+                    "reproject it (e.g. gdalwarp -t_srs EPSG:32632");
+}
+
+// 1e30 is a common undeclared nodata value; heights in mm are another mistake.
+TEST(LoadScene, DemHeightsBeyondTwentyKilometresAreErrors) {
+  const auto dir = testing::FreshDir("dem_huge");
+  std::filesystem::create_directories(dir / "data");
+  std::vector<std::vector<double>> dem(5, std::vector<double>(6, 500.0));
+  dem[0][2] = 1e30;  // no nodata declared
+  testing::WriteGdalRaster(dir / "data" / "dem.tif", dem, kGeo, 31287, std::nullopt);
+  const std::string scene =
+      "[terrain]\ndem = \"data/dem.tif\"\n[rock]\nshape = { sphere = 0.3 }\n"
+      "[release]\npoints = [[1015, 2015]]\n";
+  EXPECT_HAS(ErrorOf(scene, dir),
+             "scene.toml:2: terrain.dem: " + (dir / "data" / "dem.tif").string() +
+                 " has the height 1e+30 m (cell 2, 4 from the south-west), "
+                 "beyond +-20000 m");
+  dem[0][2] = -20001;
+  testing::WriteGdalRaster(dir / "data" / "dem.tif", dem, kGeo, 31287, std::nullopt);
+  EXPECT_HAS(ErrorOf(scene, dir), "has the height -20001 m");
+  dem[0][2] = 8848;
+  testing::WriteGdalRaster(dir / "data" / "dem.tif", dem, kGeo, 31287, std::nullopt);
+  EXPECT_EQ(ErrorOf(scene, dir), "");
+}
+
+// A ground map of another site used to give the default ground everywhere, silently.
+TEST(LoadScene, GroundRasterOffTheDemIsAnError) {
+  const auto dir = testing::FreshDir("ground_off");
+  WriteDemCase(dir);
+  testing::WriteGdalRaster(dir / "data" / "ground_far.tif", {{6, 6}, {6, 6}},
+                           {5000.0, 20.0, 0.0, 6000.0, 0.0, -20.0}, 31287, 255.0);
+  const std::string e =
+      ErrorOf(Replace(kDemScene, "\"data/ground.tif\"", "\"data/ground_far.tif\""), dir);
+  EXPECT_HAS(e, "scene.toml:3: terrain.ground: " + (dir / "data" / "ground_far.tif").string() +
+                    " covers x 5000 .. 5040, y 5960 .. 6000, which does not overlap the DEM "
+                    "(x 1005 .. 1055, y 2005 .. 2045)");
+  // Touching the DEM's edge only is no overlap either.
+  testing::WriteGdalRaster(dir / "data" / "ground_edge.tif", {{6, 6}, {6, 6}},
+                           {1055.0, 20.0, 0.0, 2050.0, 0.0, -20.0}, 31287, 255.0);
+  EXPECT_HAS(ErrorOf(Replace(kDemScene, "\"data/ground.tif\"", "\"data/ground_edge.tif\""), dir),
+             "does not overlap the DEM");
+  // Partial overlap is fine: the default ground applies where the map has no cell.
+  testing::WriteGdalRaster(dir / "data" / "ground_part.tif", {{6, 6}, {6, 6}},
+                           {1040.0, 20.0, 0.0, 2070.0, 0.0, -20.0}, 31287, 255.0);
+  testing::WriteText(dir / "scene.toml",
+                     Replace(kDemScene, "\"data/ground.tif\"", "\"data/ground_part.tif\""));
+  const SceneFile s = LoadScene((dir / "scene.toml").string());
+  EXPECT_EQ(s.scene.terrain.GroundAt(1045, 2045), s.scene.ground.IndexOfName("hard"));
+  EXPECT_EQ(s.scene.terrain.GroundAt(1005, 2005), s.scene.ground.IndexOfName("medium"));
+}
+
+// Finite but absurd values (typos, wrong units) are errors stating the bound.
+TEST(LoadScene, AbsurdFiniteValuesAreErrorsStatingTheBound) {
+  const auto dir = testing::FreshDir("absurd");
+  const auto error = [&](const std::string& from, const std::string& to) {
+    return ErrorOf(Replace(kPlaneScene, from, to), dir);
+  };
+  EXPECT_HAS(error("density_kg_m3 = 2600", "density_kg_m3 = 2.6"),
+             "scene.toml:7: rock.density_kg_m3: 2.6 is outside 100 .. 30000 kg/m3");
+  EXPECT_HAS(error("density_kg_m3 = 2600", "density_kg_m3 = 2600000"),
+             "rock.density_kg_m3: 2600000 is outside 100 .. 30000 kg/m3");
+  const std::string eota = "shape = { box = [0.5, 0.4, 0.3] }\ndensity_kg_m3 = 2600";
+  EXPECT_HAS(error(eota, "shape = { eota = \"221\" }\nvolume_m3 = 1e-12"),
+             "scene.toml:7: rock.volume_m3: 1e-12 is outside 1e-09 .. 1000000 m3");
+  EXPECT_HAS(error(eota, "shape = { eota = \"221\" }\nvolume_m3 = 2e6"),
+             "rock.volume_m3: 2000000 is outside 1e-09 .. 1000000 m3");
+  EXPECT_HAS(error("box = [0.5, 0.4, 0.3]", "box = [500, 400, 300]"),
+             "scene.toml:6: rock.shape: the rock's volume 60000000 is outside 1e-09 .. 1000000 m3");
+  EXPECT_HAS(error("velocity_m_s = [1, 0, 0]", "velocity_m_s = [300, 0, 400]"),
+             "scene.toml:16: release.velocity_m_s: |v| = 500 m/s is more than 200 m/s");
+  EXPECT_HAS(error("angular_velocity_rad_s = [0, 0, 1]", "angular_velocity_rad_s = [0, 0, 2000]"),
+             "scene.toml:17: release.angular_velocity_rad_s: |v| = 2000 rad/s is more than 1000 "
+             "rad/s");
+  EXPECT_HAS(error("height_m = 1.5", "height_m = 15000"),
+             "scene.toml:14: release.height_m: 15000 is more than 10000 m");
+  EXPECT_HAS(error("max_time_s = 20", "max_time_s = 20\ngravity_m_s2 = 981"),
+             "scene.toml:23: solver.gravity_m_s2: 981 is outside 0.1 .. 100 m/s2");
+  EXPECT_HAS(error("max_time_s = 20", "max_time_s = 20\ngravity_m_s2 = 0"),
+             "solver.gravity_m_s2: 0 is outside 0.1 .. 100 m/s2");
+  // The bounds themselves are accepted.
+  EXPECT_EQ(error("max_time_s = 20", "max_time_s = 20\ngravity_m_s2 = 0.1"), "");
+  EXPECT_EQ(error("velocity_m_s = [1, 0, 0]", "velocity_m_s = [200, 0, 0]"), "");
+  EXPECT_EQ(error("height_m = 1.5", "height_m = 10000"), "");
+}
+
+TEST(LoadScene, AbsurdRunTableAndBlockValuesAreErrorsStatingTheBound) {
+  const auto dir = testing::FreshDir("absurd_runs");
+  testing::WriteText(dir / "blocks.csv", kBlocksCsv);
+  const auto error = [&](const std::string& runs, const std::string& scene = kRunScene) {
+    testing::WriteText(dir / "runs.csv", runs);
+    return ErrorOf(scene, dir);
+  };
+  EXPECT_HAS(error("trajectory_id,x_m,y_m,block_id,vx_mps,vy_mps\nv1,5,0,1,0,250\n"),
+             "runs.csv:2: column 'vy_mps': start velocity |v| = 250 m/s is more than 200 m/s");
+  EXPECT_HAS(error("trajectory_id,x_m,y_m,block_id,wz_radps\nv1,5,0,1,1e4\n"),
+             "runs.csv:2: column 'wz_radps': start angular velocity |v| = 10000 rad/s is more "
+             "than 1000 rad/s");
+  EXPECT_HAS(error("trajectory_id,x_m,y_m,block_id,height_m\nv1,5,0,1,20000\n"),
+             "runs.csv:2: column 'height_m': 20000 is more than 10000 m");
+  EXPECT_HAS(error("trajectory_id,x_m,y_m,block_id,z_m\nv1,5,0,1,20000\n"),
+             "runs.csv:2: column 'z_m': 20000 m is ");
+  const std::string ok = "trajectory_id,x_m,y_m,block_id\nv1,5,0,1\n";
+  EXPECT_EQ(error(ok), "");
+  EXPECT_HAS(
+      error(ok, Replace(kRunScene, "shape = \"box\"", "shape = \"box\"\ndensity_kg_m3 = 50")),
+      "scene.toml:7: blocks.density_kg_m3: 50 is outside 100 .. 30000 kg/m3");
+  EXPECT_HAS(
+      error(ok, Replace(kRunScene, "size_m = [1.0, 0.5, 0.2]", "size_m = [1e-4, 1e-4, 1e-4]")),
+      "blocks.slab: block 'slab': the volume 1e-12 is outside 1e-09 .. 1000000 m3");
+}
+
 }  // namespace
 }  // namespace talus::io
