@@ -199,15 +199,7 @@ void LoadRoughness(const Context& context, const toml::table* table, Calibration
 
 CalibrationFile LoadCalibration(const std::string& path) {
   const Context context(path);
-  if (!fs::exists(path)) throw InputError(path + ": calibration file not found");
-  if (fs::is_directory(path)) throw InputError(path + ": is a directory, not a calibration file");
-  toml::table root;
-  try {
-    root = toml::parse_file(path);
-  } catch (const toml::parse_error& e) {
-    throw InputError(path + ":" + std::to_string(e.source().begin.line) +
-                     ": TOML syntax error: " + std::string(e.description()));
-  }
+  const toml::table root = ParseTomlFile(path, "calibration file");
   const Section top(
       context, &root, "",
       {"event", "rocks", "seed", "parameters", "objective", "optimizer", "roughness"});

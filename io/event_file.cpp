@@ -42,15 +42,7 @@ GroundTable ReferenceGround(const GroundTable& scene_ground, bool* differs) {
 }
 
 EventFile LoadEvent(const std::string& path) {
-  if (!fs::exists(path)) throw InputError(path + ": event file not found");
-  if (fs::is_directory(path)) throw InputError(path + ": is a directory, not an event file");
-  toml::table root;
-  try {
-    root = toml::parse_file(path);
-  } catch (const toml::parse_error& e) {
-    throw InputError(path + ":" + std::to_string(e.source().begin.line) +
-                     ": TOML syntax error: " + std::string(e.description()));
-  }
+  const toml::table root = ParseTomlFile(path, "event file");
   const Context context(path);
   const Section top(context, &root, "", {"scene", "reference", "observations", "zones"});
 

@@ -774,14 +774,7 @@ ensemble::RasterRequest OutputSpec::Request(const GridGeometry& grid) const {
 
 SceneFile LoadScene(const std::string& path) {
   const Context context(path);
-  if (!fs::exists(path)) throw InputError(path + ": scene file not found");
-  toml::table root;
-  try {
-    root = toml::parse_file(path);
-  } catch (const toml::parse_error& e) {
-    throw InputError(path + ":" + std::to_string(e.source().begin.line) +
-                     ": TOML syntax error: " + std::string(e.description()));
-  }
+  const toml::table root = ParseTomlFile(path, "scene file");
   const Section top(context, &root, "",
                     {"terrain", "ground", "rock", "blocks", "release", "solver", "output"});
   for (const char* required : {"terrain", "release"})

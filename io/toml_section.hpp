@@ -25,6 +25,20 @@ inline std::string FormatNumber(double v) {
   return buffer;
 }
 
+// Reads a TOML file (a scene, event or calibration file: `what`), with errors "<path>: <what> not
+// found", "<path>: is a directory, not the <what>" and "<path>:<line>: TOML syntax error: ...".
+inline toml::table ParseTomlFile(const std::string& path, const std::string& what) {
+  if (!std::filesystem::exists(path)) throw InputError(path + ": " + what + " not found");
+  if (std::filesystem::is_directory(path))
+    throw InputError(path + ": is a directory, not the " + what);
+  try {
+    return toml::parse_file(path);
+  } catch (const toml::parse_error& e) {
+    throw InputError(path + ":" + std::to_string(e.source().begin.line) +
+                     ": TOML syntax error: " + std::string(e.description()));
+  }
+}
+
 // The file being loaded: resolves paths and formats errors as "<file>:<line>: <key>: <reason>".
 class Context {
  public:
