@@ -55,9 +55,10 @@ std::string EnsembleReport::BriefReport() const {
   std::snprintf(
       line, sizeof line,
       "%ld rocks in %.2f s on %d threads (%.1f trajectories/s): %ld rest, %ld left the domain, "
-      "%ld max time, %ld failed; %ld raised at release",
+      "%ld max time, %ld failed; %ld raised at release, %ld stayed at release",
       rocks, wall_time_s, threads, trajectories_per_s(), count(EndReason::kRest),
-      count(EndReason::kLeftDomain), count(EndReason::kMaxTime), count(EndReason::kFailed), raised);
+      count(EndReason::kLeftDomain), count(EndReason::kMaxTime), count(EndReason::kFailed), raised,
+      stayed_at_release);
   return line;
 }
 
@@ -98,6 +99,7 @@ EnsembleReport RunEnsemble(const Scene& scene, const ReleaseSpec& release,
     ++report.rocks;
     ++report.by_end[static_cast<std::size_t>(out.result.end)];
     if (out.lift_m > 0) ++report.raised;
+    if (out.result.StayedAtRelease(*out.shape)) ++report.stayed_at_release;
     report.steps += out.result.steps;
     report.unconverged_steps += out.result.unconverged_steps;
     if (rasters) rasters->Add(out.footprint);

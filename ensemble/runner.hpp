@@ -45,6 +45,10 @@ struct EnsembleReport {
   long rocks = 0;
   std::array<long, 4> by_end{};  // indexed by EndReason
   long raised = 0;               // rocks whose start had to be raised above the terrain
+  // Rocks whose centre of mass never got further from its start than the rock's length
+  // (RockResult::StayedAtRelease): held at release by the ground model, e.g. a slab landing flat
+  // where mu(s) exceeds the slope's tangent.
+  long stayed_at_release = 0;
   long steps = 0;
   long unconverged_steps = 0;
   int threads = 1;

@@ -82,7 +82,8 @@ void LoadGround(const Context& context, const toml::table* ground, GroundTable& 
     if (!node.is_table())
       context.Fail(&node, "ground." + name, "expected a table ([ground." + name + "])");
     const Section s(context, node.as_table(), "ground." + name,
-                    {"code", "mu_min", "mu_max", "beta", "kappa", "nu"});
+                    {"code", "mu_min", "mu_max", "beta", "kappa", "nu", "drag_height_m",
+                     "drag_translational", "drag_rotational"});
     const int existing = table.IndexOfName(name);
     GroundCategory category;
     category.name = name;
@@ -113,6 +114,9 @@ void LoadGround(const Context& context, const toml::table* ground, GroundTable& 
     p.beta_1_s = s.Number("beta", p.beta_1_s);
     p.kappa_1_m = s.Number("kappa", p.kappa_1_m);
     p.nu_1_s = s.Number("nu", p.nu_1_s);
+    p.drag_height_m = s.Number("drag_height_m", p.drag_height_m);
+    p.drag_translational_1_s = s.Number("drag_translational", p.drag_translational_1_s);
+    p.drag_rotational_1_s = s.Number("drag_rotational", p.drag_rotational_1_s);
     std::string why;
     if (!p.IsValid(&why)) context.Fail(&node, "ground." + name, why);
     const int other = table.IndexOfCode(category.code);

@@ -36,6 +36,8 @@ std::string SummaryJson(const SceneFile& scene, const ensemble::EnsembleReport& 
                {"max_time", report.count(EndReason::kMaxTime)},
                {"failed", report.count(EndReason::kFailed)}};
   j["raised_at_release"] = report.raised;
+  // Rocks that never moved further than their own length from the start (held by the ground).
+  j["stayed_at_release"] = report.stayed_at_release;
   j["steps"] = report.steps;
   j["unconverged_steps"] = report.unconverged_steps;
   j["dt_s"] = scene.scene.options.dt_s;

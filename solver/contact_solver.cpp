@@ -236,17 +236,17 @@ bool SolvePairBlock(const RockShape& rock, const Eigen::Matrix3d& rotation, doub
 }  // namespace
 
 ContactSolveReport SolveContacts(const Scene& scene, const RockShape& rock,
-                                 const Eigen::Matrix3d& rotation, double mass_eff_kg,
+                                 const Eigen::Matrix3d& rotation, const EffectiveInertia& inertia,
                                  const Eigen::Vector3d& v_begin, const Eigen::Vector3d& omega_begin,
                                  Eigen::Vector3d& velocity_m_s, Eigen::Vector3d& omega_rad_s,
                                  StepWorkspace& workspace) {
   ContactSolveReport report;
   const SolverOptions& opt = scene.options;
-  const Eigen::Vector3d inv_inertia = rock.inertia_kg_m2.cwiseInverse();
+  const Eigen::Vector3d inv_inertia = rock.inertia_kg_m2.cwiseInverse() / inertia.inertia_scale;
   const Eigen::Vector3d restitution(opt.normal_restitution, opt.tangential_restitution,
                                     opt.tangential_restitution);
   const bool with_restitution = opt.normal_restitution != 0 || opt.tangential_restitution != 0;
-  const double inv_mass = 1.0 / mass_eff_kg;
+  const double inv_mass = 1.0 / inertia.mass_kg;
   const double inv_dt = 1.0 / opt.dt_s;
   const bool viscous_friction = opt.viscous == ViscousReading::kContactFriction;
 

@@ -15,10 +15,17 @@ struct ContactSolveReport {
   bool loaded = false;  // at least one contact carries a positive normal percussion
 };
 
+// How a percussion P changes the end velocities: dv = P / mass_kg, dOmega = Theta^-1 W P /
+// inertia_scale. The rock's own mass and inertia (scale 1), or larger ones where the step folds a
+// drag into the velocity update (centre-of-mass viscous term, drag layer; solver/step.cpp).
+struct EffectiveInertia {
+  double mass_kg = 0;
+  double inertia_scale = 1;
+};
+
 // Solves for the percussions of workspace.contacts and updates the end velocities in place.
-// On entry velocity_m_s and omega_rad_s hold the free (contact-less) end velocities, with
-// translational mass mass_eff_kg (the centre-of-mass drag folded in implicitly, or the rock's
-// mass); v_begin, omega_begin are the step's begin velocities (needed only for restitution).
+// On entry velocity_m_s and omega_rad_s hold the free (contact-less) end velocities, with the
+// effective mass and inertia `inertia`; v_begin, omega_begin are the step's begin velocities (needed only for restitution).
 // Contact laws are imposed on xi = gamma_E + eps gamma_B + (gap_m / dt, 0, 0): Signorini/Newton in
 // the normal direction, Coulomb disk in the tangent plane; with ViscousReading::kContactFriction
 // the tangential percussion of a loaded contact adds -nu dt m (P_N / sum P_N) gamma_T,E, which does
@@ -29,7 +36,7 @@ struct ContactSolveReport {
 // iteration stops when no contact changes the velocity of any body point by more than the
 // tolerance.
 ContactSolveReport SolveContacts(const Scene& scene, const RockShape& rock,
-                                 const Eigen::Matrix3d& rotation, double mass_eff_kg,
+                                 const Eigen::Matrix3d& rotation, const EffectiveInertia& inertia,
                                  const Eigen::Vector3d& v_begin, const Eigen::Vector3d& omega_begin,
                                  Eigen::Vector3d& velocity_m_s, Eigen::Vector3d& omega_rad_s,
                                  StepWorkspace& workspace);

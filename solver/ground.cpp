@@ -29,7 +29,22 @@ bool GroundParams::IsValid(std::string* why) const {
                "beta >= 0 (1/s)") &&
          Check(std::isfinite(kappa_1_m) && kappa_1_m >= 0, why, "kappa", kappa_1_m,
                "kappa >= 0 (1/m)") &&
-         Check(std::isfinite(nu_1_s) && nu_1_s >= 0, why, "nu", nu_1_s, "nu >= 0 (1/s)");
+         Check(std::isfinite(nu_1_s) && nu_1_s >= 0, why, "nu", nu_1_s, "nu >= 0 (1/s)") &&
+         Check(std::isfinite(drag_height_m) && drag_height_m >= 0 && drag_height_m <= 100, why,
+               "drag_height_m", drag_height_m, "0 <= drag_height_m <= 100 (m)") &&
+         Check(std::isfinite(drag_translational_1_s) && drag_translational_1_s >= 0 &&
+                   drag_translational_1_s <= 1000,
+               why, "drag_translational", drag_translational_1_s,
+               "0 <= drag_translational <= 1000 (1/s)") &&
+         Check(std::isfinite(drag_rotational_1_s) && drag_rotational_1_s >= 0 &&
+                   drag_rotational_1_s <= 1000,
+               why, "drag_rotational", drag_rotational_1_s, "0 <= drag_rotational <= 1000 (1/s)");
+}
+
+bool GroundTable::AnyDragLayer() const {
+  for (const GroundCategory& c : categories_)
+    if (c.params.HasDragLayer()) return true;
+  return false;
 }
 
 GroundTable GroundTable::BuiltIn() {

@@ -73,6 +73,7 @@ RockShape MakeRockShape(const Polyhedron& hull, double density_kg_m3) {
     hi = hi.cwiseMax(b);
   }
   rock.thickness_m = (hi - lo).minCoeff();
+  rock.length_m = (hi - lo).maxCoeff();
   return rock;
 }
 

@@ -36,6 +36,7 @@ struct RockShape {
   Eigen::Vector3d inertia_kg_m2 = Eigen::Vector3d::Ones();  // principal moments, ascending
   double bounding_radius_m = 0;                             // max |vertex|
   double thickness_m = 0;  // smallest extent of the vertices along the principal axes
+  double length_m = 0;     // largest extent of the vertices along the principal axes
   // x_input = centroid_input_m + principal_to_input * x_principal: how the principal frame sits in
   // the frame the shape was given in (point cloud axes, or a built-in's a, b, c along x, y, z).
   Eigen::Quaterniond principal_to_input = Eigen::Quaterniond::Identity();

@@ -76,6 +76,8 @@ RockResult SimulateRock(const Scene& scene, const RockShape& rock, const RockSta
     result.max_angular_speed_rad_s =
         std::max(result.max_angular_speed_rad_s, state.angular_velocity_rad_s.norm());
     result.max_scar_m = std::max(result.max_scar_m, state.scar_m);
+    result.max_displacement_m =
+        std::max(result.max_displacement_m, (state.position_m - start.position_m).norm());
   };
   record(ground);
 

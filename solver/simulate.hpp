@@ -21,6 +21,9 @@ struct RockResult {
   double travel_time_s = 0;
   double runout_m = 0;       // horizontal distance of the centre of mass from start to end
   double path_length_m = 0;  // horizontal path of the centre of mass
+  // Largest distance (3-D) of the centre of mass from its start along the path: a rock that never
+  // got further than its own length (RockShape::length_m) stayed where it was released.
+  double max_displacement_m = 0;
   double max_speed_m_s = 0;
   double max_kinetic_energy_j = 0;  // translational + rotational
   double max_jump_height_m = 0;     // centre of mass above ground, along the terrain normal
@@ -30,6 +33,9 @@ struct RockResult {
   long contact_steps = 0;      // steps with at least one closed contact
   long solver_iterations = 0;  // Gauss-Seidel sweeps, summed over steps
   long unconverged_steps = 0;  // steps whose contact solve hit max_iterations
+
+  // True when the centre of mass never got further from its start than the rock's length.
+  bool StayedAtRelease(const RockShape& rock) const { return max_displacement_m <= rock.length_m; }
 
   // One line: ending, time, speeds, energy.
   std::string BriefReport() const;

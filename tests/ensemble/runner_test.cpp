@@ -186,5 +186,21 @@ TEST(RunEnsemble, RaisedStartsAreCounted) {
   EXPECT_EQ(report.count(EndReason::kRest), 3);
 }
 
+TEST(RunEnsemble, RocksThatStayAtTheirReleaseAreCounted) {
+  // A cube set down on flat ground never moves further than its own length (0.4 m): counted.
+  const Scene flat = testing::SmallPlane(0, 0, 10, 10);
+  ReleaseSpec release = testing::PointRelease({{5, 0}}, 3);
+  release.height_m = 0.2;
+  release.orientation = Eigen::Quaterniond::Identity();
+  const EnsembleReport stayed = RunEnsemble(flat, release, EnsembleOptions{});
+  EXPECT_EQ(stayed.stayed_at_release, 3);
+  // Dropped 1 m onto a 40 degree slope, it tumbles away: none counted.
+  const Scene steep = testing::SmallPlane(40, 40, 10, 10);
+  release = testing::PointRelease({{5, 0}}, 3);
+  const EnsembleReport moved = RunEnsemble(steep, release, EnsembleOptions{});
+  EXPECT_EQ(moved.stayed_at_release, 0);
+  EXPECT_EQ(moved.rocks, 3);
+}
+
 }  // namespace
 }  // namespace talus::ensemble

@@ -158,6 +158,29 @@ TEST(LoadScene, ViscousReadingIsChosenByNameWithDidYouMean) {
              "solver.viscus: unknown key (did you mean 'viscous'?)");
 }
 
+TEST(LoadScene, DragLayerPerCategoryWithBounds) {
+  const auto dir = testing::FreshDir("drag_layer");
+  testing::WriteText(dir / "scene.toml",
+                     std::string(kPlaneScene) +
+                         "[ground.medium]\ndrag_height_m = 5\ndrag_translational = 0.3\n"
+                         "drag_rotational = 0.2\n");
+  const SceneFile s = LoadScene((dir / "scene.toml").string());
+  const GroundParams& p = s.scene.ground.params(s.scene.ground.IndexOfName("medium"));
+  EXPECT_EQ(p.drag_height_m, 5);
+  EXPECT_EQ(p.drag_translational_1_s, 0.3);
+  EXPECT_EQ(p.drag_rotational_1_s, 0.2);
+  EXPECT_EQ(p.mu_min, 0.35);  // the built-in's other keys stay
+  EXPECT_TRUE(s.scene.ground.AnyDragLayer());
+  testing::WriteText(dir / "scene.toml", kPlaneScene);
+  EXPECT_FALSE(LoadScene((dir / "scene.toml").string()).scene.ground.AnyDragLayer());  // off
+  EXPECT_HAS(ErrorOf(std::string(kPlaneScene) + "[ground.medium]\ndrag_height_m = 500\n", dir),
+             "ground.medium: drag_height_m = 500 violates 0 <= drag_height_m <= 100 (m)");
+  EXPECT_HAS(ErrorOf(std::string(kPlaneScene) + "[ground.medium]\ndrag_rotational = -1\n", dir),
+             "drag_rotational = -1 violates");
+  EXPECT_HAS(ErrorOf(std::string(kPlaneScene) + "[ground.medium]\ndrag_hight_m = 5\n", dir),
+             "did you mean 'drag_height_m'?");
+}
+
 TEST(LoadScene, ContactSolveMethodIsChosenByNameWithDidYouMean) {
   const auto dir = testing::FreshDir("contact_solve");
   testing::WriteText(dir / "scene.toml", kPlaneScene);

@@ -19,6 +19,7 @@ TEST(SummaryJson, CarriesHashVersionCountsAndRate) {
   report.rocks = 10;
   report.by_end = {7, 2, 1, 0};
   report.raised = 3;
+  report.stayed_at_release = 4;
   report.wall_time_s = 2.0;
   const auto j = nlohmann::json::parse(SummaryJson(scene, report, "9.9.9", {"rocks.csv"}));
   EXPECT_EQ(j["talus_version"], "9.9.9");
@@ -27,6 +28,7 @@ TEST(SummaryJson, CarriesHashVersionCountsAndRate) {
   EXPECT_EQ(j["ends"]["left_domain"], 2);
   EXPECT_EQ(j["ends"]["max_time"], 1);
   EXPECT_EQ(j["raised_at_release"], 3);
+  EXPECT_EQ(j["stayed_at_release"], 4);
   EXPECT_DOUBLE_EQ(j["trajectories_per_s"].get<double>(), 5.0);
   EXPECT_DOUBLE_EQ(j["wall_time_s"].get<double>(), 2.0);
 }
