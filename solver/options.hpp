@@ -43,9 +43,9 @@ struct SolverOptions {
   double gravity_m_s2 = 9.81;           // along -z
   double normal_restitution = 0.0;      // epsilon_N in [0, 1]; the model is fully plastic (0)
   double tangential_restitution = 0.0;  // epsilon_T in [-1, 1]; 0: no tangential rebound
-  // Reading of the viscous ground term. The default stays wave 1's until the field data have
-  // scored both (issue "ground models").
-  ViscousReading viscous = ViscousReading::kCentreOfMass;
+  // Reading of the viscous ground term: the seed paper's viscous friction by default, the one the
+  // field data and the ramp support (docs/model.md, "Which reading the data support").
+  ViscousReading viscous = ViscousReading::kContactFriction;
   // Contact solve: Gauss-Seidel sweeps until the largest velocity change a sweep makes at any
   // contact point is below tolerance_m_s, or max_iterations sweeps.
   double tolerance_m_s = 1e-7;

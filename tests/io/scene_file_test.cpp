@@ -141,12 +141,12 @@ TEST(LoadScene, ViscousReadingIsChosenByNameWithDidYouMean) {
   const auto dir = testing::FreshDir("viscous");
   testing::WriteText(dir / "scene.toml", kPlaneScene);
   EXPECT_EQ(LoadScene((dir / "scene.toml").string()).scene.options.viscous,
-            ViscousReading::kCentreOfMass);  // the default
+            ViscousReading::kContactFriction);  // the default
   testing::WriteText(
       dir / "scene.toml",
-      Replace(kPlaneScene, "max_time_s = 20", "max_time_s = 20\nviscous = \"contact_friction\""));
+      Replace(kPlaneScene, "max_time_s = 20", "max_time_s = 20\nviscous = \"centre_of_mass\""));
   EXPECT_EQ(LoadScene((dir / "scene.toml").string()).scene.options.viscous,
-            ViscousReading::kContactFriction);
+            ViscousReading::kCentreOfMass);
   EXPECT_HAS(ErrorOf(Replace(kPlaneScene, "max_time_s = 20",
                              "max_time_s = 20\nviscous = \"center_of_mass\""),
                      dir),

@@ -156,7 +156,7 @@ TEST(Options, DefaultsAreValidAndBadValuesAreNamed) {
 }
 
 TEST(Options, ViscousReadingNamesRoundTrip) {
-  EXPECT_EQ(SolverOptions{}.viscous, ViscousReading::kCentreOfMass);  // until the field data choose
+  EXPECT_EQ(SolverOptions{}.viscous, ViscousReading::kContactFriction);  // docs/model.md
   for (ViscousReading r : {ViscousReading::kCentreOfMass, ViscousReading::kContactFriction}) {
     ViscousReading parsed = r == ViscousReading::kCentreOfMass ? ViscousReading::kContactFriction
                                                                : ViscousReading::kCentreOfMass;
