@@ -149,7 +149,7 @@ Runner AddCalibrateCommand(CLI::App& app) {
       ->required();
   cmd->add_option("--out", args->out, "Output directory")->required();
   cmd->add_option("--threads", args->threads, "Worker threads (default: all cores)")
-      ->check(IntegerRange(0, std::numeric_limits<int>::max()));
+      ->check(ThreadCount());
   return [cmd, args]() { return *cmd ? RunCalibrate(*args) : -1; };
 }
 

@@ -2,11 +2,13 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <charconv>
 #include <cstring>
 #include <filesystem>
 #include <string>
+#include <thread>
 
 #include "app/commands.hpp"
 
@@ -31,6 +33,27 @@ CLI::Validator IntegerRange(long long min, long long max) {
         return {};
       },
       description);
+}
+
+int MaxThreads() {
+  const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  return std::max(kMinMaxThreads, kThreadsPerCore * cores);
+}
+
+CLI::Validator ThreadCount() {
+  const int max = MaxThreads();
+  const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  const CLI::Validator range = IntegerRange(0, max);
+  return CLI::Validator(
+      [range, max, cores](std::string& text) -> std::string {
+        std::string why = range(text);
+        if (why.rfind("must be <=", 0) == 0)
+          why += " (this machine has " + std::to_string(cores) + " cores; at most " +
+                 std::to_string(kThreadsPerCore) + " threads per core, or " +
+                 std::to_string(kMinMaxThreads) + ", are allowed: more threads only cost memory)";
+        return why;
+      },
+      "INT in [0 .. " + std::to_string(max) + "], 0: one per core");
 }
 
 std::string PrepareOutputDirectory(const std::string& dir) {

@@ -27,6 +27,17 @@ constexpr int ExitCodeForSignal(int signal) { return 128 + signal; }
 // "must be >= min" (or "<= max", or "must be an integer") with the value given.
 CLI::Validator IntegerRange(long long min, long long max);
 
+// The most worker threads a run may ask for: kThreadsPerCore per core of this machine, at least
+// kMinMaxThreads. Threads beyond the cores only add memory (a raster footprint grid and finished
+// rocks waiting to be written per thread) and no speed.
+constexpr int kThreadsPerCore = 4;
+constexpr int kMinMaxThreads = 16;
+int MaxThreads();
+
+// A validator for --threads: 0 (one per core) to MaxThreads(), else a message naming the bound and
+// the machine's cores.
+CLI::Validator ThreadCount();
+
 // Creates the output directory `dir` (with its parents) and checks that it can be written; on
 // failure the reason ("--out <dir> exists and is not a directory", ...), else "".
 std::string PrepareOutputDirectory(const std::string& dir);

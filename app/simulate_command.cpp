@@ -23,6 +23,7 @@
 #include "ensemble/runner.hpp"
 #include "io/quicklook.hpp"
 #include "io/raster.hpp"
+#include "io/resources.hpp"
 #include "io/rocks_csv.hpp"
 #include "io/scene_file.hpp"
 #include "io/summary.hpp"
@@ -168,6 +169,14 @@ int RunSimulate(const SimulateArgs& args) {
     std::cerr << "talus simulate: " << why << "\n";
     return kExitBadInput;
   }
+  // A run too large for this machine fails now, with the estimate and the knob to turn.
+  const io::ResourceEstimate needs = io::EstimateResources(
+      scene, ensemble::WorkerThreads(args.threads, scene.release.total_rocks()));
+  const io::MachineCapacity capacity = io::MeasureCapacity(args.out);
+  if (const std::string why = io::CheckResources(needs, capacity); !why.empty()) {
+    std::cerr << "talus simulate: " << why << "\n";
+    return kExitBadInput;
+  }
   // From here on SIGINT / SIGTERM unwind the run: no temporary file is left behind.
   const InterruptScope interrupts;
   std::signal(SIGXFSZ, SIG_IGN);  // a file-size limit is a write error ("File too large")
@@ -177,6 +186,10 @@ int RunSimulate(const SimulateArgs& args) {
 
   std::printf("Scene %s: %s; %s\n", args.scene.c_str(), scene.terrain_description.c_str(),
               DescribeRocks(scene).c_str());
+  std::printf(
+      "Needs about %s of memory (%s available) and %s of disk (%s free)\n",
+      io::FormatBytes(needs.memory_bytes()).c_str(), io::FormatBytes(capacity.memory_bytes).c_str(),
+      io::FormatBytes(needs.disk_bytes()).c_str(), io::FormatBytes(capacity.disk_bytes).c_str());
   std::fflush(stdout);
   // Every output is written into a staging directory and moved into --out only when all are
   // complete: a failed or interrupted run leaves --out as it was.
@@ -273,7 +286,7 @@ Runner AddSimulateCommand(CLI::App& app) {
   cmd->add_option("--rocks", args->rocks, "Rocks per release (overrides the scene)")
       ->check(IntegerRange(1, std::numeric_limits<long>::max()));
   cmd->add_option("--threads", args->threads, "Worker threads (default: all cores)")
-      ->check(IntegerRange(0, std::numeric_limits<int>::max()));
+      ->check(ThreadCount());
   // The scene's range: a seed given here can be written in the scene file and the other way round.
   cmd->add_option_function<std::uint64_t>(
          "--seed", [args](const std::uint64_t& seed) { args->seed = seed; },

@@ -156,7 +156,7 @@ Runner AddValidateCommand(CLI::App& app) {
   cmd->add_option("--rocks", args->rocks, "Rocks per run (overrides the scene)")
       ->check(IntegerRange(1, std::numeric_limits<long>::max()));
   cmd->add_option("--threads", args->threads, "Worker threads (default: all cores)")
-      ->check(IntegerRange(0, std::numeric_limits<int>::max()));
+      ->check(ThreadCount());
   cmd->add_option_function<std::uint64_t>(
          "--seed", [args](const std::uint64_t& seed) { args->seed = seed; },
          "Random seed (overrides the scene)")

@@ -16,7 +16,7 @@ void RunInOrder(long total, const OrderedPoolOptions& options,
   using Clock = std::chrono::steady_clock;
   const int threads = options.threads < 1 ? 1 : options.threads;
   // Finished items wait in a ring of `window` slots until every earlier item is merged.
-  const long window = 8L * threads + 16;
+  const long window = OrderedPoolWindow(threads);
 
   std::mutex mutex;
   std::condition_variable worker_cv, merger_cv;

@@ -15,6 +15,10 @@ struct OrderedPoolOptions {
   std::function<void(long, long)> progress;
 };
 
+// How many finished items may wait for an earlier one on `threads` threads (each is held in
+// memory until merged).
+constexpr long OrderedPoolWindow(int threads) { return 8L * (threads < 1 ? 1 : threads) + 16; }
+
 // Runs work(i) for every i in [0, total): each worker thread first calls make_worker() once (on
 // that thread) to get its work function, which may keep per-thread scratch state. merge(outcome)
 // is called on the calling thread in order of i. An exception from a worker or from merge stops

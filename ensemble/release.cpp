@@ -49,7 +49,8 @@ Eigen::Vector2d PointInPolygon(const std::vector<std::vector<Eigen::Vector2d>>& 
     lo = lo.cwiseMin(v);
     hi = hi.cwiseMax(v);
   }
-  // Rejection sampling in the bounding box; IsValid ensures a positive area.
+  // Rejection sampling in the bounding box. IsValid ensures the polygon covers at least
+  // kMinPolygonFill of its box, so all attempts fail with probability (1 - 1e-3)^1e5 < 1e-43.
   for (int attempt = 0; attempt < 100000; ++attempt) {
     const double u = random.Uniform(), v = random.Uniform();
     const Eigen::Vector2d p(lo.x() + u * (hi.x() - lo.x()), lo.y() + v * (hi.y() - lo.y()));
@@ -137,39 +138,52 @@ bool ReleaseSpec::IsValid(std::string* why) const {
     s << "orientation must be a unit quaternion [w, x, y, z] (norm " << orientation->norm() << ")";
     return Fail(why, s.str());
   }
-  for (std::size_t r = 0; r < releases.size(); ++r) {
-    const ReleaseGeometry& g = releases[r];
-    if (g.rings.empty() || g.rings[0].empty()) {
-      s << "release " << r << " has no coordinates";
+  for (std::size_t r = 0; r < releases.size(); ++r)
+    if (const std::string problem = ReleaseGeometryProblem(releases[r]); !problem.empty()) {
+      s << "release " << r << ": " << problem;
       return Fail(why, s.str());
     }
-    for (const auto& ring : g.rings)
-      for (const Eigen::Vector2d& v : ring)
-        if (!v.allFinite()) {
-          s << "release " << r << " has a non-finite coordinate";
-          return Fail(why, s.str());
-        }
-    if (g.kind == ReleaseGeometry::Kind::kLine &&
-        (g.rings[0].size() < 2 || LineLength(g.rings[0]) <= 0)) {
-      s << "release " << r << ": a line needs at least 2 points and a positive length";
-      return Fail(why, s.str());
-    }
-    if (g.kind == ReleaseGeometry::Kind::kPolygon &&
-        (g.rings[0].size() < 3 || std::abs(RingArea(g.rings[0])) <= 0)) {
-      s << "release " << r << ": a polygon needs at least 3 points and a positive area";
-      return Fail(why, s.str());
-    }
-    if (g.kind == ReleaseGeometry::Kind::kPolygon) {
-      // Holes (inner rings) must leave some area to sample from.
-      double holes = 0;
-      for (std::size_t k = 1; k < g.rings.size(); ++k) holes += std::abs(RingArea(g.rings[k]));
-      if (holes >= std::abs(RingArea(g.rings[0]))) {
-        s << "release " << r << ": the polygon's holes cover all of its area";
-        return Fail(why, s.str());
-      }
-    }
-  }
   return true;
+}
+
+std::string ReleaseGeometryProblem(const ReleaseGeometry& g) {
+  std::ostringstream s;
+  if (g.rings.empty() || g.rings[0].empty()) return "no coordinates";
+  for (const auto& ring : g.rings)
+    for (const Eigen::Vector2d& v : ring)
+      if (!v.allFinite()) return "a non-finite coordinate";
+  if (g.kind == ReleaseGeometry::Kind::kLine) {
+    const double length = LineLength(g.rings[0]);
+    if (g.rings[0].size() < 2 || !(length > 0))
+      return "a line needs at least 2 points and a positive length";
+    if (!std::isfinite(length))
+      return "coordinates out of range: the length of the line is not a finite number";
+  }
+  if (g.kind != ReleaseGeometry::Kind::kPolygon) return "";
+  if (g.rings[0].size() < 3) return "a polygon needs at least 3 points";
+  // Start points are drawn uniformly in the bounding box and kept when inside: the polygon must
+  // cover a fair part of its box, or the draws would run out (kMinPolygonFill).
+  double holes = 0;
+  for (std::size_t k = 1; k < g.rings.size(); ++k) holes += std::abs(RingArea(g.rings[k]));
+  const double area = std::abs(RingArea(g.rings[0])) - holes;
+  Eigen::Vector2d lo = g.rings[0][0], hi = lo;
+  for (const Eigen::Vector2d& v : g.rings[0]) {
+    lo = lo.cwiseMin(v);
+    hi = hi.cwiseMax(v);
+  }
+  const double box = (hi - lo).prod();
+  if (!std::isfinite(area) || !std::isfinite(box))
+    return "coordinates out of range: the area of the polygon is not a finite number";
+  if (g.rings.size() > 1 && area <= 0) return "the polygon's holes cover all of its area";
+  if (!(area > kMinPolygonFill * box)) {
+    s << "a sliver: its area (" << area << " m2) is " << (box > 0 ? 100 * area / box : 0)
+      << " % of its bounding box (" << hi.x() - lo.x() << " x " << hi.y() - lo.y()
+      << " m), less than " << 100 * kMinPolygonFill
+      << " %: too thin to draw start points from; give a line instead, or a polygon with some "
+         "width";
+    return s.str();
+  }
+  return "";
 }
 
 std::optional<Eigen::Vector2d> PointOffTerrain(const Terrain& terrain,

@@ -78,6 +78,15 @@ struct ReleaseSpec {
   bool IsValid(std::string* why) const;
 };
 
+// The smallest fraction of its bounding box a release polygon (net of holes) may cover: start
+// points are drawn in the box and kept when inside.
+inline constexpr double kMinPolygonFill = 1e-3;
+
+// "" when rocks can start on `g`, else what is wrong with it: no or non-finite coordinates, a line
+// of zero or non-finite length, a polygon of fewer than 3 points, of non-finite area, whose holes
+// cover it, or a sliver (covering less than kMinPolygonFill of its bounding box).
+std::string ReleaseGeometryProblem(const ReleaseGeometry& g);
+
 // Whether p lies inside the polygon of `rings` by the even-odd rule over all rings, so that inner
 // rings are holes.
 bool InsidePolygon(const std::vector<std::vector<Eigen::Vector2d>>& rings,

@@ -62,13 +62,17 @@ std::string EnsembleReport::BriefReport() const {
   return line;
 }
 
+int WorkerThreads(int requested, long total_rocks) {
+  const int threads =
+      requested > 0 ? requested : static_cast<int>(std::thread::hardware_concurrency());
+  return static_cast<int>(std::clamp<long>(threads, 1, std::max<long>(total_rocks, 1)));
+}
+
 EnsembleReport RunEnsemble(const Scene& scene, const ReleaseSpec& release,
                            const EnsembleOptions& options, RockSink* sink) {
   const auto t0 = std::chrono::steady_clock::now();
   const long total = release.total_rocks();
-  int threads =
-      options.threads > 0 ? options.threads : static_cast<int>(std::thread::hardware_concurrency());
-  threads = static_cast<int>(std::clamp<long>(threads, 1, std::max<long>(total, 1)));
+  const int threads = WorkerThreads(options.threads, total);
 
   // Worker side: release, run with the recorders, hand over the outcome.
   auto make_worker = [&]() -> std::function<RockOutcome(long)> {

@@ -60,6 +60,10 @@ struct EnsembleReport {
   std::string BriefReport() const;
 };
 
+// The worker threads a run of `total_rocks` rocks uses when `requested` are asked for (0: one per
+// core): never more than there are rocks, at least one.
+int WorkerThreads(int requested, long total_rocks);
+
 // Runs rocks 0 .. release.total_rocks() - 1. Requires scene.IsValid() and release.IsValid().
 // An exception thrown by the sink stops the workers and is rethrown.
 EnsembleReport RunEnsemble(const Scene& scene, const ReleaseSpec& release,

@@ -173,7 +173,7 @@ void LoadOptimizer(const Context& context, const toml::table* table, Calibration
   if (seed < 0) s.Fail("seed", std::to_string(seed) + " must be >= 0");
   o.seed = static_cast<std::uint64_t>(seed);
   std::string why;
-  if (!o.IsValid(&why)) context.Fail(table, "optimizer", why);
+  if (!o.IsValid(&why)) s.FailCheck(why);
 }
 
 void LoadRoughness(const Context& context, const toml::table* table, CalibrationFile& out) {

@@ -75,8 +75,8 @@ Raster ReadRaster(const std::string& path, const std::string& what) {
     const int j = ny - 1 - r;  // GDAL row r (from the north) is grid row j (from the south)
     for (int i = 0; i < nx; ++i) {
       double v = rows[static_cast<std::size_t>(r) * nx + i];
-      if ((has_nodata && (v == nodata || (std::isnan(nodata) && std::isnan(v)))) ||
-          !std::isfinite(v))
+      // Infinite values stay: callers reject them (an undeclared nodata, or a broken file).
+      if ((has_nodata && (v == nodata || (std::isnan(nodata) && std::isnan(v)))) || std::isnan(v))
         v = std::nan("");
       raster.values[static_cast<std::size_t>(j) * nx + i] = v;
     }
@@ -98,6 +98,18 @@ bool IsGeographicCrs(const std::string& crs_wkt) {
   OGRSpatialReference srs;
   if (srs.importFromWkt(crs_wkt.c_str()) != OGRERR_NONE) return false;
   return srs.IsGeographic();
+}
+
+std::string DescribeCrs(const std::string& crs_wkt) {
+  if (crs_wkt.empty()) return "no CRS";
+  OGRSpatialReference srs;
+  if (srs.importFromWkt(crs_wkt.c_str()) != OGRERR_NONE) return "an unreadable CRS";
+  const char* name = srs.GetName();
+  const std::string named = name ? name : "an unnamed CRS";
+  const char* authority = srs.GetAuthorityName(nullptr);
+  const char* code = srs.GetAuthorityCode(nullptr);
+  if (!authority || !code) return named;
+  return std::string(authority) + ":" + code + " (" + named + ")";
 }
 
 std::string UtmEpsgFor(double lon_deg, double lat_deg) {

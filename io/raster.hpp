@@ -11,7 +11,8 @@
 namespace talus::io {
 
 // A single-band raster in the solver's convention: node (i, j) at the centre of cell (i, j), i
-// along x, j along y (GDAL's rows are flipped), values row j after row j - 1, NaN where nodata.
+// along x, j along y (GDAL's rows are flipped), values row j after row j - 1, NaN where nodata
+// (the declared nodata value, or NaN); infinite values are kept as they are.
 struct Raster {
   GridGeometry grid;
   std::vector<double> values;
@@ -30,6 +31,10 @@ bool SameCrs(const std::string& a_wkt, const std::string& b_wkt);
 
 // True when a WKT CRS is geographic (coordinates in degrees, not metres); false when empty.
 bool IsGeographicCrs(const std::string& crs_wkt);
+
+// A CRS for messages: "EPSG:31287 (MGI / Austria Lambert)", its name alone when it has no EPSG
+// code, "no CRS" when empty.
+std::string DescribeCrs(const std::string& crs_wkt);
 
 // "EPSG:326zz" or "EPSG:327zz": the WGS 84 / UTM zone holding the point (lon, lat) in degrees, or
 // "" when (lon, lat) is not a point UTM covers (|lat| > 84 or |lon| > 180).

@@ -118,7 +118,7 @@ void LoadGround(const Context& context, const toml::table* ground, GroundTable& 
     p.drag_translational_1_s = s.Number("drag_translational", p.drag_translational_1_s);
     p.drag_rotational_1_s = s.Number("drag_rotational", p.drag_rotational_1_s);
     std::string why;
-    if (!p.IsValid(&why)) context.Fail(&node, "ground." + name, why);
+    if (!p.IsValid(&why)) s.FailCheck(why);
     const int other = table.IndexOfCode(category.code);
     if (other >= 0 && table.category(other).name != name)
       s.Fail("code",
@@ -167,7 +167,7 @@ void LoadTerrain(const Context& context, const Section& s, SceneFile& out) {
     spec.width_m = p.Number("width_m", spec.width_m);
     spec.cell_m = p.Number("cell_m", spec.cell_m);
     std::string why;
-    if (!spec.IsValid(&why)) s.Fail("plane", why);
+    if (!spec.IsValid(&why)) p.FailCheck(why);
     heights = MakePlaneHeightfield(spec);
     out.terrain_description =
         "plane " + Fmt(spec.slope_deg) + " deg, " + std::to_string(heights.grid.nx) + " x " +
@@ -219,9 +219,12 @@ void LoadTerrain(const Context& context, const Section& s, SceneFile& out) {
     const Raster codes = ReadRaster(path, what);
     out.inputs.push_back(path);
     if (!codes.crs_wkt.empty() && !out.crs_wkt.empty() && !SameCrs(codes.crs_wkt, out.crs_wkt))
-      throw InputError(what + ": " + path +
-                       " is in another CRS than the DEM; reprojecting ground rasters is not "
-                       "supported yet (warp it onto the DEM's CRS first, e.g. with gdalwarp)");
+      s.Fail("ground", path + " is in another CRS than the DEM: " + DescribeCrs(codes.crs_wkt) +
+                           (IsGeographicCrs(codes.crs_wkt) ? ", in degrees," : "") +
+                           " where the DEM is in " + DescribeCrs(out.crs_wkt) +
+                           "; reprojecting ground rasters is not supported yet: warp it onto the "
+                           "DEM's CRS and grid first (gdalwarp -t_srs with the DEM's CRS, "
+                           "-r near to keep the codes)");
     // A ground raster off the DEM would give the default ground everywhere.
     const GridGeometry& d = scene.terrain.heights().grid;
     const GridGeometry& c = codes.grid;
@@ -594,13 +597,14 @@ void LoadRuns(const Context& context, const Section& s, SceneFile& out) {
 
 void LoadRelease(const Context& context, const Section& s, SceneFile& out) {
   ensemble::ReleaseSpec& r = out.release;
-  // Remember where each release came from, for errors.
+  // Where each release came from, for errors: "<file>:<line>: <key>[k]".
   std::vector<std::string> origin;
   if (s.Has("points")) {
     const auto points = PointList(s, s.Node("points"), s.Key("points"));
     for (std::size_t k = 0; k < points.size(); ++k) {
       r.releases.push_back({ReleaseGeometry::Kind::kPoint, {{points[k]}}});
-      origin.push_back(s.Key("points") + "[" + std::to_string(k) + "]");
+      origin.push_back(context.Where(s.Node("points")->as_array()->get(k)) + ": " +
+                       s.Key("points") + "[" + std::to_string(k) + "]");
     }
   }
   for (const auto& [key, kind] :
@@ -612,7 +616,7 @@ void LoadRelease(const Context& context, const Section& s, SceneFile& out) {
     for (std::size_t k = 0; k < array->size(); ++k) {
       const std::string name = s.Key(key) + "[" + std::to_string(k) + "]";
       r.releases.push_back({kind, {PointList(s, array->get(k), name)}});
-      origin.push_back(name);
+      origin.push_back(context.Where(array->get(k)) + ": " + name);
     }
   }
   if (s.Has("file")) {
@@ -622,7 +626,8 @@ void LoadRelease(const Context& context, const Section& s, SceneFile& out) {
     out.inputs.push_back(path);
     for (std::size_t k = 0; k < geometries.size(); ++k) {
       r.releases.push_back(geometries[k]);
-      origin.push_back(s.Key("file") + " (" + path + ", geometry " + std::to_string(k) + ")");
+      origin.push_back(context.Where(s.Node("file")) + ": " + s.Key("file") + " (" + path +
+                       ", geometry " + std::to_string(k) + ")");
     }
   }
   if (s.Has("runs")) {
@@ -670,15 +675,19 @@ void LoadRelease(const Context& context, const Section& s, SceneFile& out) {
   if (seed < 0) s.Fail("seed", std::to_string(seed) + " must be >= 0");
   r.seed = static_cast<std::uint64_t>(seed);
 
+  for (std::size_t k = 0; k < r.releases.size(); ++k)
+    if (const std::string problem = ensemble::ReleaseGeometryProblem(r.releases[k]);
+        !problem.empty())
+      throw InputError(origin[k] + ": " + problem);
   std::string why;
-  if (!r.IsValid(&why)) context.Fail(s.table(), "release", why);
+  if (!r.IsValid(&why)) s.FailCheck(why);
   // Every point a rock can start from must lie on valid terrain: vertices, lines, polygon insides.
   const GridGeometry& g = out.scene.terrain.heights().grid;
   for (std::size_t k = 0; k < r.releases.size(); ++k)
     if (const auto v = ensemble::PointOffTerrain(out.scene.terrain, r.releases[k]))
-      throw InputError(context.Where(s.table()) + ": " + origin[k] + ": (" + Fmt(v->x()) + ", " +
-                       Fmt(v->y()) + ") is outside the DEM or on nodata (the DEM covers x " +
-                       Fmt(g.x0_m) + " .. " + Fmt(g.x_max_m()) + ", y " + Fmt(g.y0_m) + " .. " +
+      throw InputError(origin[k] + ": (" + Fmt(v->x()) + ", " + Fmt(v->y()) +
+                       ") is outside the DEM or on nodata (the DEM covers x " + Fmt(g.x0_m) +
+                       " .. " + Fmt(g.x_max_m()) + ", y " + Fmt(g.y0_m) + " .. " +
                        Fmt(g.y_max_m()) + ")");
 }
 
@@ -717,7 +726,7 @@ void LoadSolver(const Section& s, SolverOptions& o) {
   o.rest_angular_speed_rad_s = s.Number("rest_angular_speed_rad_s", o.rest_angular_speed_rad_s);
   o.rest_hold_s = s.Number("rest_hold_s", o.rest_hold_s);
   std::string why;
-  if (!o.IsValid(&why)) s.context().Fail(s.table(), "solver", why);
+  if (!o.IsValid(&why)) s.FailCheck(why);
 }
 
 void LoadOutput(const Section& s, OutputSpec& o) {

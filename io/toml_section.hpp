@@ -90,6 +90,15 @@ class Section {
     context_.Fail(Node(key) ? Node(key) : static_cast<const toml::node*>(table_), Key(key), reason);
   }
 
+  // Fails with the reason an options check gave (the IsValid functions' "<field> = <value> ...",
+  // fields named as the keys) on the line of the key that set <field>; on the table's line when
+  // the table does not set it (a default that another key's value violates).
+  [[noreturn]] void FailCheck(const std::string& why) const {
+    const std::string field = why.substr(0, why.find(' '));
+    if (Has(field)) Fail(field, why);
+    context_.Fail(table_, name_, why);
+  }
+
   double Number(const std::string& key, double fallback) const {
     const toml::node* node = Node(key);
     if (!node) return fallback;

@@ -93,6 +93,14 @@ std::array<std::size_t, 4> SpanningTetrahedron(const std::vector<Eigen::Vector3d
         << "; a rock needs at least 4 points that are not coplanar";
     throw InputError(msg.str());
   }
+  for (std::size_t i = 0; i < n; ++i)
+    if (!(points_m[i].cwiseAbs().maxCoeff() <= kMaxCoordinate_m)) {  // NaN fails too
+      std::ostringstream msg;
+      msg << source << ": point " << i + 1 << " (" << points_m[i].transpose()
+          << "): coordinates out of range (finite and within +-" << kMaxCoordinate_m
+          << " m); not metres?";
+      throw InputError(msg.str());
+    }
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
   for (const auto& p : points_m) mean += p;
   mean /= static_cast<double>(n);

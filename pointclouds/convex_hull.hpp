@@ -16,10 +16,16 @@ namespace talus::pointclouds {
 // single-precision arithmetic inside PCL.
 inline constexpr double kDegenerateTolerance = 1e-6;
 
+// Largest coordinate magnitude accepted (m): far beyond any georeferenced coordinate (UTM
+// northings are below 10^7 m), small enough that squared distances stay finite. Larger values
+// are not metres (or not numbers the file meant).
+inline constexpr double kMaxCoordinate_m = 1e9;
+
 // Four points that span a solid: the point farthest from the mean, the point farthest from it,
 // the point farthest from their line and the point farthest from the plane of the three.
-// Throws InputError, naming `source`, for fewer than 4 points or points that all coincide,
-// are collinear or coplanar (within kDegenerateTolerance of their extent).
+// Throws InputError, naming `source`, for fewer than 4 points, a coordinate that is not finite
+// or beyond kMaxCoordinate_m, or points that all coincide, are collinear or coplanar (within
+// kDegenerateTolerance of their extent).
 std::array<std::size_t, 4> SpanningTetrahedron(const std::vector<Eigen::Vector3d>& points_m,
                                                const std::string& source);
 

@@ -22,6 +22,7 @@
 
 #include "common/atomic_file.hpp"
 #include "common/error.hpp"
+#include "pointclouds/convex_hull.hpp"
 
 namespace talus::pointclouds {
 namespace {
@@ -434,6 +435,20 @@ PointCloud ReadPointCloud(const std::string& path) {
 
   PointCloud cloud = pcd || ply ? ReadPclPoints(path, pcd) : ReadTextPoints(path, pts);
   if (cloud.points_m.empty()) throw InputError(path + ": the file contains no points");
+  // Beyond any georeferenced coordinate; squares of such numbers overflow to infinity.
+  for (std::size_t i = 0; i < cloud.points_m.size(); ++i) {
+    const Eigen::Vector3d& p = cloud.points_m[i];
+    if (!p.allFinite() || p.cwiseAbs().maxCoeff() <= kMaxCoordinate_m) continue;
+    std::ostringstream msg;
+    msg << path << ":";
+    if (cloud.source_lines.empty())
+      msg << " point " << i + 1;
+    else
+      msg << cloud.source_lines[i];
+    msg << ": coordinates (" << p.transpose() << ") out of range: beyond +-" << kMaxCoordinate_m
+        << " m, not metres?";
+    throw InputError(msg.str());
+  }
   Recentre(cloud);
   return cloud;
 }

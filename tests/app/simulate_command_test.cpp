@@ -9,6 +9,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <cerrno>
 #include <chrono>
@@ -303,15 +304,16 @@ TEST(SimulateCommand, SigtermStopsTheRunRemovesItsTemporariesAndExits143) {
   InterruptARun(SIGTERM, "sigterm");
 }
 
-// Out of space (a 512 KiB tmpfs; needs root, skipped otherwise): one line naming the file and the
-// reason, exit 1, no temporary file, and the earlier run's outputs as they were.
+// Out of space (a 64 MiB tmpfs, filled up once the run writes; needs root, skipped otherwise):
+// one line naming the file and the reason, exit 1, no temporary file, and the earlier run's
+// outputs as they were. (Filled before the run, the disk would fail the run's estimate instead.)
 TEST(SimulateCommand, AFullDiskIsOneErrorAndLeavesTheEarlierRunAsItWas) {
   const fs::path dir = FreshDir("full");
   std::ofstream(dir / "scene.toml") << kScene;
   std::ofstream(dir / "lean.toml") << LeanScene();
   const fs::path disk = dir / "disk";
   fs::create_directories(disk);
-  if (::mount("tmpfs", disk.c_str(), "tmpfs", 0, "size=512k") != 0)
+  if (::mount("tmpfs", disk.c_str(), "tmpfs", 0, "size=64m") != 0)
     GTEST_SKIP() << "cannot mount a tmpfs at " << disk << " (" << std::strerror(errno)
                  << "); this test needs root";
   struct Unmount {
@@ -325,11 +327,26 @@ TEST(SimulateCommand, AFullDiskIsOneErrorAndLeavesTheEarlierRunAsItWas) {
             0)
       << log;
   const auto earlier = Snapshot(out);
-  EXPECT_EQ(RunCommand(Talus("simulate " + (dir / "scene.toml").string() + " --out " +
-                             out.string() + " --rocks 500"),
-                       &log),
-            1)
-      << log;
+  const pid_t pid = StartTalus(
+      {"simulate", (dir / "scene.toml").string(), "--out", out.string(), "--rocks", "500"},
+      dir / "log.txt");
+  ASSERT_GT(pid, 0);
+  const fs::path trajectories = out / (".talus-run.tmp-" + std::to_string(pid)) /
+                                (".trajectories.h5.tmp-" + std::to_string(pid));
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  while (!fs::exists(trajectories) && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  {  // Fill the disk.
+    std::FILE* ballast = std::fopen((disk / "ballast").c_str(), "wb");
+    ASSERT_NE(ballast, nullptr);
+    const std::vector<char> block(1 << 16, 'x');
+    while (std::fwrite(block.data(), 1, block.size(), ballast) == block.size()) {
+    }
+    std::fclose(ballast);
+  }
+  EXPECT_EQ(WaitFor(pid, 60), 1);
+  fs::remove(disk / "ballast");
+  log = Slurp(dir / "log.txt");
   EXPECT_NE(log.find("talus simulate: cannot write rock "), std::string::npos) << log;
   EXPECT_NE(log.find((out / "trajectories.h5").string() + ": No space left on device"),
             std::string::npos)
@@ -337,7 +354,8 @@ TEST(SimulateCommand, AFullDiskIsOneErrorAndLeavesTheEarlierRunAsItWas) {
   int error_lines = 0;
   std::istringstream lines(log);
   for (std::string line; std::getline(lines, line);)
-    error_lines += line.rfind("Scene ", 0) != 0;  // all but the scene's description
+    // All but the scene's description and the run's estimate.
+    error_lines += line.rfind("Scene ", 0) != 0 && line.rfind("Needs about ", 0) != 0;
   EXPECT_EQ(error_lines, 1) << log;
   EXPECT_EQ(Temporaries(out), std::vector<std::string>());
   EXPECT_TRUE(Snapshot(out) == earlier) << "the earlier run's outputs changed";
@@ -361,6 +379,74 @@ TEST(SimulateCommand, RemovesTheTemporariesOfDeadRunsOnly) {
   EXPECT_EQ(Temporaries(out), std::vector<std::string>{".rocks.csv.tmp-" + alive});
 }
 
+// More threads than a few per core only cost memory (10 000 threads took 854 MB on a toy scene).
+TEST(TalusCommandLine, ThreadsAreCappedAtAFewPerCore) {
+  const fs::path dir = FreshDir("threads_cap");
+  std::ofstream(dir / "scene.toml") << LeanScene();
+  const std::string cores = std::to_string(std::max(1u, std::thread::hardware_concurrency()));
+  for (const char* verb : {"simulate", "validate", "calibrate"}) {
+    std::string log;
+    EXPECT_EQ(RunCommand(Talus(std::string(verb) + " " + (dir / "scene.toml").string() + " --out " +
+                               (dir / "out").string() + " --threads 10000"),
+                         &log),
+              2)
+        << log;
+    EXPECT_NE(log.find("--threads: must be <= "), std::string::npos) << log;
+    EXPECT_NE(
+        log.find(", got 10000 (this machine has " + cores + " cores; at most 4 threads per core"),
+        std::string::npos)
+        << log;
+  }
+  std::string log;
+  EXPECT_EQ(RunCommand(Talus("simulate " + (dir / "scene.toml").string() + " --out " +
+                             (dir / "out").string() + " --threads 16"),
+                       &log),
+            0)
+      << log;  // 16 are allowed on any machine
+}
+
+// A run whose estimated memory or disk exceeds what any machine has is refused before any rock
+// runs (exit 2, nothing written), with the estimate, what is available and the knob to turn.
+TEST(SimulateCommand, ARunTooLargeForTheMachineIsRefusedBeforeAnyRock) {
+  const fs::path dir = FreshDir("too_large");
+  // 3500 x 1000 cells; 10^9 rocks, each assumed to cross the diagonal: ~65 TB of p95 values.
+  const std::string memory_scene = R"([terrain]
+plane = { slope_deg = 35, slope_length_m = 300, runout_m = 50, width_m = 100, cell_m = 0.1 }
+[rock]
+shape = { box = [0.4, 0.4, 0.3] }
+[release]
+points = [[10, 0], [20, 0]]
+rocks = 500000000
+[output]
+rasters = ["speed", "energy", "jump_height"]
+)";
+  // 10^9 rocks' trajectories of 100 s every 0.01 s: hundreds of TB.
+  std::string disk_scene = memory_scene;
+  disk_scene.replace(disk_scene.find("rasters = "), std::string::npos,
+                     "trajectories = true\nquicklook = false\n");
+  const std::vector<std::pair<std::string, std::vector<std::string>>> cases = {
+      {memory_scene,
+       {"of memory besides the ", " is available (", "values behind the p95 rasters",
+        "(fewer rocks (--rocks)", "nothing was run"}},
+      {disk_scene,
+       {"the outputs need about ", " TB of disk, but ", "trajectories.h5 (10002 samples per rock",
+        "(trajectories = false", "nothing was run"}},
+  };
+  for (const auto& [text, parts] : cases) {
+    std::ofstream(dir / "scene.toml") << text;
+    const fs::path out = dir / "out";
+    std::string log;
+    EXPECT_EQ(
+        RunCommand(Talus("simulate " + (dir / "scene.toml").string() + " --out " + out.string()),
+                   &log),
+        2)
+        << log;
+    for (const std::string& part : parts) EXPECT_NE(log.find(part), std::string::npos) << log;
+    EXPECT_EQ(log.find("rocks in"), std::string::npos) << log;  // no rock ran
+    EXPECT_TRUE(fs::is_empty(out)) << "nothing is written";
+  }
+}
+
 // Exit codes: 2 for bad input or usage on every verb, with a message that says what is wrong.
 TEST(TalusCommandLine, BadInputSaysWhatIsWrongAndExits2) {
   const fs::path dir = FreshDir("bad_input");
@@ -372,6 +458,9 @@ TEST(TalusCommandLine, BadInputSaysWhatIsWrongAndExits2) {
       {"simulate " + scene + " --out " + out + " --rocks many", "--rocks: must be an integer"},
       {"simulate " + scene + " --out " + out + " --seed -1", "--seed: must be >= 0, got -1"},
       {"simulate " + scene + " --out " + out + " --threads -2", "--threads: must be >= 0"},
+      {"simulate " + scene + " --out " + out + " --threads 10000",
+       "--threads: must be <= "},  // and the machine's cores: a test below
+
       {"simulate " + dir.string() + " --out " + out,
        dir.string() + " is a directory, not a scene file (did you mean " + scene + "?)"},
       {"simulate " + scene + " --out " + (dir / "file" / "out").string(),

@@ -75,7 +75,39 @@ TEST(Release, InvalidSpecsNameTheField) {
   spec.rocks_per_release = 1;
   spec.releases.push_back({ReleaseGeometry::Kind::kPolygon, {{{0, 0}, {1, 1}, {2, 2}}}});
   EXPECT_FALSE(spec.IsValid(&why));
-  EXPECT_NE(why.find("positive area"), std::string::npos) << why;
+  EXPECT_NE(why.find("sliver"), std::string::npos) << why;
+}
+
+// A polygon of (nearly) no area would start every rock at its first vertex (the sampler finds no
+// inside point): it is invalid, with its area and bounding box. A thin strip across its box that
+// covers more than kMinPolygonFill of it is fine, and rocks start inside it.
+TEST(Release, SliverPolygonsAreInvalidThinStripsAreNot) {
+  const ReleaseGeometry sliver{ReleaseGeometry::Kind::kPolygon,
+                               {{{0, 0}, {100, 100}, {99.9999, 100.0001}}}};
+  const std::string why = ReleaseGeometryProblem(sliver);
+  EXPECT_NE(why.find("a sliver: its area (0.01 m2)"), std::string::npos) << why;
+  EXPECT_NE(why.find("bounding box (100 x 100 m)"), std::string::npos) << why;
+  ReleaseSpec spec = testing::PointRelease({{1, 1}}, 1);
+  spec.releases = {sliver};
+  std::string spec_why;
+  EXPECT_FALSE(spec.IsValid(&spec_why));
+  EXPECT_NE(spec_why.find("release 0: a sliver"), std::string::npos) << spec_why;
+
+  // 1.4 m wide along the diagonal of a 20 x 20 m box: 38 m2 of 400, 9.5 %.
+  const ReleaseGeometry strip{ReleaseGeometry::Kind::kPolygon,
+                              {{{0, -9}, {1, -10}, {20, 9}, {19, 10}}}};
+  EXPECT_EQ(ReleaseGeometryProblem(strip), "");
+  const Scene scene = testing::SmallPlane(30, 20, 10);
+  spec.releases = {strip};
+  spec.rocks_per_release = 200;
+  for (long rock = 0; rock < 200; ++rock) {
+    const Eigen::Vector3d p = Release(scene, spec, rock).start.position_m;
+    EXPECT_TRUE(InsidePolygon(strip.rings, p.head<2>())) << p.transpose();
+  }
+
+  const ReleaseGeometry far{ReleaseGeometry::Kind::kPolygon, {{{0, 0}, {1e300, 0}, {0, 1e300}}}};
+  EXPECT_NE(ReleaseGeometryProblem(far).find("coordinates out of range"), std::string::npos)
+      << ReleaseGeometryProblem(far);
 }
 
 // Specs that would silently misplace rocks are invalid: a line of zero length (every rock at one

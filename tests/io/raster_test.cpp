@@ -171,6 +171,12 @@ TEST(IsGeographicCrs, TellsDegreesFromMetres) {
   EXPECT_FALSE(IsGeographicCrs(""));
 }
 
+TEST(DescribeCrs, NamesCodeAndName) {
+  EXPECT_EQ(DescribeCrs(testing::Wkt(31287)), "EPSG:31287 (MGI / Austria Lambert)");
+  EXPECT_EQ(DescribeCrs(testing::Wkt(4326)), "EPSG:4326 (WGS 84)");
+  EXPECT_EQ(DescribeCrs(""), "no CRS");
+}
+
 TEST(UtmEpsgFor, ZoneAndHemisphereOfThePoint) {
   EXPECT_EQ(UtmEpsgFor(11.0, 47.0), "EPSG:32632");
   EXPECT_EQ(UtmEpsgFor(-70.6, -33.4), "EPSG:32719");

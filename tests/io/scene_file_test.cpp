@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
+
 #include "common/error.hpp"
 #include "test_files.hpp"
 
@@ -117,7 +119,7 @@ TEST(LoadScene, NonPhysicalValuesNameKeyAndReason) {
   const auto dir = testing::FreshDir("values");
   EXPECT_HAS(ErrorOf(Replace(kPlaneScene, "density_kg_m3 = 2600", "density_kg_m3 = -1"), dir),
              "rock.density_kg_m3: -1 must be > 0");
-  EXPECT_HAS(ErrorOf(Replace(kPlaneScene, "dt_s = 0.004", "dt_s = -0.1"), dir), "solver: dt_s");
+  EXPECT_HAS(ErrorOf(Replace(kPlaneScene, "dt_s = 0.004", "dt_s = -0.1"), dir), "solver.dt_s");
   EXPECT_HAS(ErrorOf(Replace(kPlaneScene, "slope_deg = 35", "slope_deg = 95"), dir), "slope_deg");
   EXPECT_HAS(ErrorOf(Replace(kPlaneScene, "rocks = 7", "rocks = 0"), dir),
              "release.rocks: 0 must be >= 1");
@@ -135,6 +137,23 @@ TEST(LoadScene, NonPhysicalValuesNameKeyAndReason) {
   EXPECT_HAS(ErrorOf(std::string(kPlaneScene) + "[ground.soft]\nmu_min = 3\n", dir),
              "ground.soft: mu_max");
   EXPECT_HAS(ErrorOf("[terrain\nplane = {}\n", dir), "scene.toml:1: TOML syntax error");
+}
+
+// A value that an options check rejects is reported on its key's line, not its table's header.
+TEST(LoadScene, RejectedValuesGiveTheLineOfTheirKey) {
+  const auto dir = testing::FreshDir("key_lines");
+  EXPECT_HAS(ErrorOf(Replace(kPlaneScene, "dt_s = 0.004", "dt_s = -0.1"), dir),
+             "scene.toml:21: solver.dt_s: dt_s = -0.1 violates 0 < dt_s <= 0.1 s");
+  EXPECT_HAS(
+      ErrorOf(Replace(kPlaneScene, "max_time_s = 20", "max_time_s = 20\nprox_alpha = 3"), dir),
+      "scene.toml:23: solver.prox_alpha: prox_alpha = 3 violates 0 < prox_alpha < 2");
+  EXPECT_HAS(ErrorOf(std::string(kPlaneScene) + "[ground.soft]\nmu_min = 0.5\nmu_max = 0.1\n", dir),
+             "scene.toml:30: ground.soft.mu_max: mu_max = 0.1 violates");
+  EXPECT_HAS(
+      ErrorOf(Replace(kPlaneScene, "rocks = 7", "rocks = 900000000"), dir),
+      "scene.toml:13: release.rocks: rocks = 900000000 per release x 4 releases is more than");
+  EXPECT_HAS(ErrorOf(Replace(kPlaneScene, "runout_m = 20", "runout_m = -20"), dir),
+             "scene.toml:2: terrain.plane.runout_m: runout_m = -20 must be >= 0");
 }
 
 TEST(LoadScene, ViscousReadingIsChosenByNameWithDidYouMean) {
@@ -190,20 +209,37 @@ TEST(LoadScene, ContactSolveMethodIsChosenByNameWithDidYouMean) {
                                                  "max_time_s = 20\ncontact_solve = \"block\""));
   EXPECT_EQ(LoadScene((dir / "scene.toml").string()).scene.options.contact_solve,
             ContactSolveMethod::kBlock);
-  EXPECT_HAS(ErrorOf(Replace(kPlaneScene, "max_time_s = 20",
-                             "max_time_s = 20\ncontact_solve = \"blok\""),
-                     dir),
-             "scene.toml:23: solver.contact_solve: unknown method 'blok' (did you mean 'block'?)");
+  EXPECT_HAS(
+      ErrorOf(Replace(kPlaneScene, "max_time_s = 20", "max_time_s = 20\ncontact_solve = \"blok\""),
+              dir),
+      "scene.toml:23: solver.contact_solve: unknown method 'blok' (did you mean 'block'?)");
 }
 
 TEST(LoadScene, ReleaseOutsideTheDemIsAnError) {
   const auto dir = testing::FreshDir("outside");
   const std::string e = ErrorOf(Replace(kPlaneScene, "[6, 2]", "[6, 200]"), dir);
   EXPECT_HAS(e,
-             "release.points[1]: (6, 200) is outside the DEM or on nodata (the DEM covers x 0 .. "
+             "scene.toml:10: release.points[1]: (6, 200) is outside the DEM or on nodata (the DEM "
+             "covers x 0 .. "
              "60, y -15 .. 15)");
   EXPECT_HAS(ErrorOf(Replace(kPlaneScene, "[10, 2], [8, 2]", "[10, 2], [-8, 2]"), dir),
              "release.polygons[0]");
+}
+
+// A release polygon of (nearly) no area would start every rock at its first vertex; one of
+// coordinates whose area overflows is out of range. Both name the polygon and its line.
+TEST(LoadScene, SliverAndOutOfRangePolygonsAreErrors) {
+  const auto dir = testing::FreshDir("sliver");
+  const std::string polygon = "polygons = [[[8, -2], [10, -2], [10, 2], [8, 2]]]";
+  EXPECT_HAS(ErrorOf(Replace(kPlaneScene, polygon,
+                             "polygons = [[[8, -2], [10, -2], [10, 2], [8, 2]],\n"
+                             "            [[8, -2], [10, 0], [9.999999, 0.000001]]]"),
+                     dir),
+             "scene.toml:13: release.polygons[1]: a sliver: its area (");
+  const std::string far = ErrorOf(
+      Replace(kPlaneScene, polygon, "polygons = [[[8, -2], [1e300, -2], [8, 1e300]]]"), dir);
+  EXPECT_HAS(far, "scene.toml:12: release.polygons[0]: coordinates out of range");
+  EXPECT_EQ(far.find("collinear"), std::string::npos) << far;
 }
 
 TEST(LoadScene, MissingPiecesAndFiles) {
@@ -299,8 +335,12 @@ TEST(LoadScene, GdalDemErrors) {
              "ground.my_scree.code: 6 is already the code of 'hard'");
   testing::WriteGdalRaster(dir / "data" / "ground_wgs84.tif", {{6}},
                            {11.0, 0.1, 0.0, 47.0, 0.0, -0.1}, 4326, 255.0);
+  // A ground raster in degrees under a projected DEM: the file and both CRSs, not a warp.
   EXPECT_HAS(ErrorOf(Replace(kDemScene, "\"data/ground.tif\"", "\"data/ground_wgs84.tif\""), dir),
-             "is in another CRS than the DEM");
+             "scene.toml:3: terrain.ground: " + (dir / "data" / "ground_wgs84.tif").string() +
+                 " is in another CRS than the DEM: EPSG:4326 (WGS 84), in degrees, where the DEM "
+                 "is in EPSG:31287 (MGI / Austria Lambert); reprojecting ground rasters is not "
+                 "supported yet");
   EXPECT_HAS(ErrorOf(Replace(kDemScene, "\"data/ground.tif\"", "\"data/grund.tif\""), dir),
              "scene.toml:3: terrain.ground: file not found");
 }
@@ -640,6 +680,10 @@ TEST(LoadScene, DemHeightsBeyondTwentyKilometresAreErrors) {
              "scene.toml:2: terrain.dem: " + (dir / "data" / "dem.tif").string() +
                  " has the height 1e+30 m (cell 2, 4 from the south-west), "
                  "beyond +-20000 m");
+  // An infinite height is not silently nodata either.
+  dem[0][2] = -std::numeric_limits<double>::infinity();
+  testing::WriteGdalRaster(dir / "data" / "dem.tif", dem, kGeo, 31287, std::nullopt);
+  EXPECT_HAS(ErrorOf(scene, dir), "has the height -inf m (cell 2, 4 from the south-west)");
   dem[0][2] = -20001;
   testing::WriteGdalRaster(dir / "data" / "dem.tif", dem, kGeo, 31287, std::nullopt);
   EXPECT_HAS(ErrorOf(scene, dir), "has the height -20001 m");

@@ -79,6 +79,11 @@ TEST(ComputeConvexHull, DegenerateInputIsAClearError) {
   }
   EXPECT_NE(HullError(line).find("collinear"), std::string::npos) << HullError(line);
   EXPECT_NE(HullError(plane).find("coplanar"), std::string::npos) << HullError(plane);
+  // Coordinates whose squares overflow are out of range, not "collinear".
+  const std::string far = HullError({{0, 0, 0}, {1e300, 0, 0}, {0, 1e300, 0}, {0, 0, 1e300}});
+  EXPECT_NE(far.find("point 2 ("), std::string::npos) << far;
+  EXPECT_NE(far.find("coordinates out of range"), std::string::npos) << far;
+  EXPECT_EQ(far.find("collinear"), std::string::npos) << far;
   // A thin but solid slab is fine.
   std::vector<Eigen::Vector3d> slab = testing::BoxCorners(1, 1, 1e-3);
   EXPECT_EQ(HullError(slab), "");

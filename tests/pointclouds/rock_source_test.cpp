@@ -446,6 +446,10 @@ TEST(MakeRock, BadInputSaysWhatIsWrong) {
       {dir.Write("three.xyz", "0 0 0\n1 0 0\n0 1 0\n"), "3 points; a rock needs at least 4"},
       {dir.Write("flat.xyz", "0 0 0\n1 0 0\n0 1 0\n1 1 0\n0.5 0.5 0\n"), "coplanar"},
       {dir.Write("line.csv", "0,0,0\n1,1,1\n2,2,2\n3,3,3\n"), "collinear"},
+      // Numbers whose squares overflow are out of range, not "collinear".
+      {dir.Write("far.xyz", "0 0 0\n1e300 0 0\n0 1e300 0\n0 0 1e300\n"),
+       "far.xyz:2: coordinates (1e+300"},
+      {dir.Write("far.csv", "0,0,0\n1e10,0,0\n0,1,0\n0,0,1\n"), "out of range: beyond +-1e+09 m"},
       {dir.Write("nan.xyz", "nan 0 0\n0 nan 0\n0 0 nan\n1 2 3\n4 5 6\n"),
        "only 2 of 5 points are usable (3 non-finite"},
       // Fewer than 4 points in the file, some of them dropped: say so, not "1 point".

@@ -1,0 +1,217 @@
+#include "io/resources.hpp"
+
+#include <sys/statvfs.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <limits>
+#include <numeric>
+#include <sstream>
+
+#include "ensemble/ordered_pool.hpp"
+#include "ensemble/outcome.hpp"
+
+namespace talus::io {
+namespace {
+
+// Sizes of the output files, measured on cases/tirol (200 rocks, 157 499 samples at 0.1 s and
+// 16 027 at 1 s: 17 625 136 and 5 730 968 bytes; bench/README.md, "Output sizes"):
+// trajectories.h5 takes a fixed part per rock (its group, seven datasets and two attributes,
+// 21.9 kB) and a part per sample (deflate-compressed doubles, 84 bytes); a row of rocks.csv
+// (148 bytes). GeoTIFFs are counted uncompressed (4 bytes per cell), an upper bound.
+constexpr double kTrajectoryBytesPerRock = 22000;
+constexpr double kTrajectoryBytesPerSample = 84;
+constexpr double kRocksCsvBytesPerRow = 150;
+constexpr double kGeoTiffBytesPerCell = 4;
+
+// The heap's own bytes per allocation (glibc: an 8-byte header, 16-byte granularity), and the
+// spare capacity of a std::vector grown by push_back (capacity doubles: 1.5 on average).
+constexpr double kHeapBlockOverhead = 16;
+constexpr double kVectorGrowth = 1.5;
+
+// The quick-look image per pixel: an RGB triple of doubles, a byte band and GDAL's 3-band canvas.
+constexpr double kQuickLookBytesPerPixel = 3 * sizeof(double) + 1 + 3;
+
+std::string Cells(const GridGeometry& g) {
+  return std::to_string(g.nx) + " x " + std::to_string(g.ny) + " cells";
+}
+
+}  // namespace
+
+double PercentileStorageBytes(int stats, double cells, double passes) {
+  // RasterAccumulator::Stat::values: a std::vector<float> per cell with every rock's value.
+  const double touched = std::min(cells, passes);  // cells with at least one value
+  return stats * (cells * sizeof(std::vector<float>) + touched * kHeapBlockOverhead +
+                  passes * sizeof(float) * kVectorGrowth);
+}
+
+double ResourceEstimate::memory_bytes() const {
+  return std::accumulate(memory.begin(), memory.end(), 0.0,
+                         [](double sum, const ResourceTerm& t) { return sum + t.bytes; });
+}
+
+double ResourceEstimate::disk_bytes() const {
+  return std::accumulate(disk.begin(), disk.end(), 0.0,
+                         [](double sum, const ResourceTerm& t) { return sum + t.bytes; });
+}
+
+ResourceEstimate EstimateResources(const SceneFile& scene, int threads) {
+  ResourceEstimate e;
+  const Terrain& terrain = scene.scene.terrain;
+  const GridGeometry& dem = terrain.heights().grid;
+  const double cells = double(dem.nx) * double(dem.ny);
+  const double rocks = double(scene.release.total_rocks());
+  const OutputSpec& output = scene.output;
+  const ensemble::RasterRequest rasters = output.Request(dem);
+
+  // The scene, loaded already.
+  e.memory.push_back({"DEM heights (" + Cells(dem) + ")", cells * sizeof(double), "a coarser DEM"});
+  if (terrain.has_ground_grid()) {
+    const GridGeometry& g = terrain.ground_grid().grid;
+    e.memory.push_back({"ground raster (" + Cells(g) + ")", double(g.nx) * double(g.ny),
+                        "a coarser ground raster"});
+  }
+  e.loaded_bytes = e.memory_bytes();
+
+  // How far and how long a rock goes (see the header): the DEM's diagonal in cells, and the
+  // assumed travel time in trajectory samples.
+  const double footprint = std::min(cells, std::hypot(double(dem.nx), double(dem.ny)));
+  const double travel_s = std::min(scene.scene.options.max_time_s, kAssumedTravelTime_s);
+  const double samples = travel_s / output.trajectory_interval_s + 2;
+
+  const int stats = int(rasters.speed) + int(rasters.energy) + int(rasters.jump_height);
+  const std::string fewer_rasters = "fewer rasters in [output] rasters, or a coarser DEM";
+  if (rasters.any()) {
+    // FootprintRecorder: a slot per cell on every worker thread.
+    e.memory.push_back({"raster footprint grids of " + std::to_string(threads) + " threads",
+                        double(threads) * cells * sizeof(int),
+                        "fewer threads (--threads), or a coarser DEM"});
+    // RasterAccumulator: counters, and a maximum (float) and a sum (double) per statistic.
+    const double counters =
+        (rasters.passages || rasters.reach_probability ? 1 : 0) + (rasters.deposits ? 1 : 0);
+    e.memory.push_back({"raster accumulators",
+                        cells * (counters * sizeof(int) + stats * (sizeof(float) + sizeof(double))),
+                        fewer_rasters});
+    if (stats > 0)
+      e.memory.push_back(
+          {"values behind the p95 rasters of speed, energy or jump_height (" +
+               std::to_string(stats) + " of them)",
+           PercentileStorageBytes(stats, cells, rocks * footprint),
+           "fewer rocks (--rocks), or leave speed, energy and jump_height out of [output] "
+           "rasters"});
+    const double layers =
+        3 * stats + int(rasters.passages) + int(rasters.deposits) + int(rasters.reach_probability);
+    e.memory.push_back({"output rasters", cells * layers * sizeof(float), fewer_rasters});
+    e.disk.push_back({"GeoTIFFs (" + std::to_string(int(layers)) + ")",
+                      cells * layers * kGeoTiffBytesPerCell, fewer_rasters});
+  }
+  // Finished rocks wait in the ordered pool's window (and one runs on each thread).
+  const double in_flight = double(ensemble::OrderedPoolWindow(threads) + threads);
+  double rock_bytes = sizeof(ensemble::RockOutcome) + footprint * (sizeof(int) + stats * 4.0);
+  if (output.trajectories) rock_bytes += samples * sizeof(ensemble::TrajectorySample);
+  e.memory.push_back({"finished rocks waiting to be written", in_flight * rock_bytes,
+                      output.trajectories ? "fewer threads (--threads), or a larger "
+                                            "trajectory_interval_s"
+                                          : "fewer threads (--threads)"});
+  if (output.quicklook) {
+    const int scale = std::max(1, 900 / std::max(dem.nx, dem.ny));  // as WriteQuickLookPng draws
+    e.memory.push_back({"quick-look image", cells * scale * scale * kQuickLookBytesPerPixel,
+                        "quicklook = false in [output], or a coarser DEM"});
+  }
+
+  e.disk.push_back({"rocks.csv", rocks * kRocksCsvBytesPerRow, "fewer rocks (--rocks)"});
+  if (output.trajectories) {
+    char what[160];
+    std::snprintf(what, sizeof what, "trajectories.h5 (%.0f samples per rock: %.0f s every %g s)",
+                  samples, travel_s, output.trajectory_interval_s);
+    e.disk.push_back(
+        {what, rocks * (kTrajectoryBytesPerRock + samples * kTrajectoryBytesPerSample),
+         "trajectories = false or a larger trajectory_interval_s in [output], or fewer rocks "
+         "(--rocks)"});
+  }
+  return e;
+}
+
+MachineCapacity MeasureCapacity(const std::string& out_dir) {
+  constexpr double kUnknown = std::numeric_limits<double>::infinity();
+  MachineCapacity c;
+  c.memory_bytes = kUnknown;
+  c.disk_bytes = kUnknown;
+  std::ifstream meminfo("/proc/meminfo");
+  std::string key;
+  double kb = 0;
+  std::string unit;
+  while (meminfo >> key >> kb) {
+    std::getline(meminfo, unit);
+    if (key == "MemAvailable:") {
+      c.memory_bytes = kb * 1024;
+      break;
+    }
+  }
+  // A container's own limit (cgroup v2), when it is lower.
+  std::ifstream max_file("/sys/fs/cgroup/memory.max"),
+      current_file("/sys/fs/cgroup/memory.current");
+  std::string max_text;
+  double current = 0;
+  if (max_file >> max_text && max_text != "max" && current_file >> current) {
+    const double left = std::max(0.0, std::strtod(max_text.c_str(), nullptr) - current);
+    if (left < c.memory_bytes) {
+      c.memory_bytes = left;
+      c.memory_source = "the cgroup's memory.max less memory.current";
+    }
+  }
+  struct statvfs fs {};
+  if (::statvfs(out_dir.c_str(), &fs) == 0)
+    c.disk_bytes = double(fs.f_bavail) * double(fs.f_frsize);
+  return c;
+}
+
+namespace {
+
+// "<size> <what> (<knob>)" for the largest terms, up to three.
+std::string LargestTerms(std::vector<ResourceTerm> terms) {
+  std::stable_sort(terms.begin(), terms.end(),
+                   [](const ResourceTerm& a, const ResourceTerm& b) { return a.bytes > b.bytes; });
+  std::string out;
+  for (std::size_t k = 0; k < std::min<std::size_t>(3, terms.size()); ++k) {
+    if (terms[k].bytes <= 0) break;
+    out += (k ? "; " : "") + FormatBytes(terms[k].bytes) + " " + terms[k].what + " (" +
+           terms[k].knob + ")";
+  }
+  return out;
+}
+
+}  // namespace
+
+std::string CheckResources(const ResourceEstimate& estimate, const MachineCapacity& capacity) {
+  if (estimate.run_bytes() > capacity.memory_bytes) {
+    return "the run needs about " + FormatBytes(estimate.run_bytes()) + " of memory besides the " +
+           FormatBytes(estimate.loaded_bytes) + " of the loaded scene, but " +
+           FormatBytes(capacity.memory_bytes) + " is available (" + capacity.memory_source +
+           "); largest parts: " + LargestTerms(estimate.memory) + "; nothing was run";
+  }
+  if (estimate.disk_bytes() > capacity.disk_bytes)
+    return "the outputs need about " + FormatBytes(estimate.disk_bytes()) + " of disk, but " +
+           FormatBytes(capacity.disk_bytes) +
+           " is free in the output directory; largest parts: " + LargestTerms(estimate.disk) +
+           "; nothing was run";
+  return "";
+}
+
+std::string FormatBytes(double bytes) {
+  if (!std::isfinite(bytes)) return "an unknown amount";
+  const char* units[] = {"B", "kB", "MB", "GB", "TB", "PB"};
+  int u = 0;
+  while (bytes >= 1000 && u < 5) {
+    bytes /= 1000;
+    ++u;
+  }
+  char text[32];
+  std::snprintf(text, sizeof text, u == 0 || bytes >= 100 ? "%.0f %s" : "%.1f %s", bytes, units[u]);
+  return text;
+}
+
+}  // namespace talus::io

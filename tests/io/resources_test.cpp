@@ -1,0 +1,135 @@
+#include "io/resources.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "test_files.hpp"
+
+namespace talus::io {
+namespace {
+
+// 61 x 31 cells of 1 m; 4 releases x 7 rocks; trajectories every 0.1 s, max_time_s 20.
+const char* kScene = R"([terrain]
+plane = { slope_deg = 35, slope_length_m = 40, runout_m = 20, width_m = 30, cell_m = 1 }
+[rock]
+shape = { box = [0.5, 0.4, 0.3] }
+[release]
+points = [[5, 0], [6, 2]]
+lines = [[[3, -5], [3, 5]]]
+polygons = [[[8, -2], [10, -2], [10, 2], [8, 2]]]
+rocks = 7
+[solver]
+max_time_s = 20
+[output]
+trajectories = true
+trajectory_interval_s = 0.1
+rasters = ["speed", "energy", "passages", "reach_probability"]
+)";
+
+SceneFile Load(const std::string& text) {
+  const auto dir = testing::FreshDir("scene");
+  testing::WriteText(dir / "scene.toml", text);
+  return LoadScene((dir / "scene.toml").string());
+}
+
+const ResourceTerm* Find(const std::vector<ResourceTerm>& terms, const std::string& start) {
+  const auto it = std::find_if(terms.begin(), terms.end(),
+                               [&](const ResourceTerm& t) { return t.what.rfind(start, 0) == 0; });
+  return it == terms.end() ? nullptr : &*it;
+}
+
+#define EXPECT_HAS(text, part) EXPECT_NE(std::string(text).find(part), std::string::npos) << (text)
+
+TEST(PercentileStorageBytes, AVectorPerCellAndEveryValue) {
+  // Per statistic: a std::vector<float> (24 bytes) per cell, a heap block (16 bytes) per cell
+  // with a value, 4 bytes per value with half again of spare capacity.
+  EXPECT_DOUBLE_EQ(PercentileStorageBytes(1, 100, 1000), 100 * 24 + 100 * 16 + 1000 * 4 * 1.5);
+  EXPECT_DOUBLE_EQ(PercentileStorageBytes(1, 100, 10), 100 * 24 + 10 * 16 + 10 * 4 * 1.5);
+  EXPECT_DOUBLE_EQ(PercentileStorageBytes(3, 100, 1000), 3 * PercentileStorageBytes(1, 100, 1000));
+  EXPECT_DOUBLE_EQ(PercentileStorageBytes(0, 100, 1000), 0);
+}
+
+TEST(EstimateResources, CountsEachPartFromTheScene) {
+  const SceneFile scene = Load(kScene);
+  const double cells = 61.0 * 31.0, rocks = 28;
+  const ResourceEstimate one = EstimateResources(scene, 1);
+  const ResourceTerm* dem = Find(one.memory, "DEM heights (61 x 31 cells)");
+  ASSERT_NE(dem, nullptr);
+  EXPECT_DOUBLE_EQ(dem->bytes, cells * 8);
+  EXPECT_DOUBLE_EQ(one.loaded_bytes, cells * 8);  // no ground raster
+  EXPECT_DOUBLE_EQ(one.run_bytes(), one.memory_bytes() - cells * 8);
+  // Speed and energy: each rock assumed to cross the DEM's diagonal.
+  const ResourceTerm* p95 = Find(one.memory, "values behind the p95 rasters");
+  ASSERT_NE(p95, nullptr);
+  EXPECT_DOUBLE_EQ(p95->bytes, PercentileStorageBytes(2, cells, rocks * std::hypot(61.0, 31.0)));
+  EXPECT_HAS(p95->knob, "fewer rocks (--rocks)");
+  // Each thread keeps a footprint grid of an int per cell.
+  const ResourceEstimate four = EstimateResources(scene, 4);
+  EXPECT_DOUBLE_EQ(Find(four.memory, "raster footprint grids of 4 threads")->bytes, 4 * cells * 4);
+  EXPECT_GT(four.memory_bytes(), one.memory_bytes());
+  // trajectories.h5: 20 s (max_time_s, shorter than the assumed travel) every 0.1 s.
+  const ResourceTerm* h5 =
+      Find(one.disk, "trajectories.h5 (202 samples per rock: 20 s every 0.1 s)");
+  ASSERT_NE(h5, nullptr);
+  EXPECT_HAS(h5->knob, "trajectories = false");
+  ASSERT_NE(Find(one.disk, "rocks.csv"), nullptr);
+  // 8 rasters: max, mean and p95 of speed and energy, passages, reach probability.
+  EXPECT_DOUBLE_EQ(Find(one.disk, "GeoTIFFs (8)")->bytes, cells * 8 * 4);
+
+  // No raster, no trajectory: no raster work and no trajectories.h5.
+  std::string lean = kScene;
+  lean.replace(lean.find("trajectories = true"), 19, "trajectories = false");
+  lean.replace(lean.find("rasters = ["), std::string::npos, "quicklook = false\n");
+  const ResourceEstimate bare = EstimateResources(Load(lean), 1);
+  EXPECT_EQ(Find(bare.memory, "raster"), nullptr);
+  EXPECT_EQ(Find(bare.memory, "values behind"), nullptr);
+  EXPECT_EQ(Find(bare.memory, "quick-look"), nullptr);
+  EXPECT_EQ(Find(bare.disk, "trajectories.h5"), nullptr);
+}
+
+// A run whose estimate exceeds what the machine has is refused with the estimate, what is
+// available and the knobs of the largest parts. The limits are injected: nothing is allocated.
+TEST(CheckResources, RefusesARunLargerThanTheMemoryOrDiskWithTheKnob) {
+  const ResourceEstimate e = EstimateResources(Load(kScene), 2);
+  const double unlimited = std::numeric_limits<double>::infinity();
+  EXPECT_EQ(CheckResources(e, {unlimited, unlimited}), "");
+  EXPECT_EQ(CheckResources(e, {e.run_bytes(), e.disk_bytes()}), "");  // just fits
+
+  const std::string memory = CheckResources(e, {e.run_bytes() - 1, unlimited});
+  EXPECT_HAS(memory, "the run needs about " + FormatBytes(e.run_bytes()) +
+                         " of memory besides the " + FormatBytes(e.loaded_bytes) +
+                         " of the loaded scene, but " + FormatBytes(e.run_bytes() - 1) +
+                         " is available (MemAvailable)");
+  EXPECT_HAS(memory, "largest parts: ");
+  EXPECT_HAS(memory, "(fewer rocks (--rocks)");
+  EXPECT_HAS(memory, "nothing was run");
+  EXPECT_EQ(memory.find('\n'), std::string::npos);
+
+  const std::string disk = CheckResources(e, {unlimited, 1e5});
+  EXPECT_HAS(disk, "the outputs need about " + FormatBytes(e.disk_bytes()) +
+                       " of disk, but 100 kB is free in the output directory");
+  EXPECT_HAS(disk,
+             "trajectories.h5 (202 samples per rock: 20 s every 0.1 s) (trajectories = false");
+}
+
+TEST(MeasureCapacity, ReadsMemAvailableAndTheFreeSpaceOfTheDirectory) {
+  const MachineCapacity c = MeasureCapacity(testing::FreshDir("out").string());
+  EXPECT_GT(c.memory_bytes, 0);
+  EXPECT_TRUE(std::isfinite(c.memory_bytes));  // Linux has /proc/meminfo
+  EXPECT_GT(c.disk_bytes, 0);
+  EXPECT_TRUE(std::isfinite(c.disk_bytes));
+  EXPECT_TRUE(std::isinf(MeasureCapacity("/no/such/directory").disk_bytes));
+}
+
+TEST(FormatBytes, DecimalUnits) {
+  EXPECT_EQ(FormatBytes(12), "12 B");
+  EXPECT_EQ(FormatBytes(820e3), "820 kB");
+  EXPECT_EQ(FormatBytes(1.54e9), "1.5 GB");
+  EXPECT_EQ(FormatBytes(std::numeric_limits<double>::infinity()), "an unknown amount");
+}
+
+}  // namespace
+}  // namespace talus::io
