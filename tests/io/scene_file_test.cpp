@@ -193,7 +193,7 @@ TEST(LoadScene, DragLayerPerCategoryWithBounds) {
   testing::WriteText(dir / "scene.toml", kPlaneScene);
   EXPECT_FALSE(LoadScene((dir / "scene.toml").string()).scene.ground.AnyDragLayer());  // off
   EXPECT_HAS(ErrorOf(std::string(kPlaneScene) + "[ground.medium]\ndrag_height_m = 500\n", dir),
-             "ground.medium: drag_height_m = 500 violates 0 <= drag_height_m <= 100 (m)");
+             "ground.medium.drag_height_m: drag_height_m = 500 violates 0 <= drag_height_m <= 100 (m)");
   EXPECT_HAS(ErrorOf(std::string(kPlaneScene) + "[ground.medium]\ndrag_rotational = -1\n", dir),
              "drag_rotational = -1 violates");
   EXPECT_HAS(ErrorOf(std::string(kPlaneScene) + "[ground.medium]\ndrag_hight_m = 5\n", dir),
