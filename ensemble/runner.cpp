@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <memory>
 #include <optional>
+#include <stdexcept>
 #include <thread>
 
 #include "ensemble/ordered_pool.hpp"
@@ -61,10 +62,24 @@ std::string EnsembleReport::BriefReport() const {
   return line;
 }
 
+void EnsembleReport::AddCounts(const EnsembleReport& other) {
+  rocks += other.rocks;
+  for (std::size_t k = 0; k < by_end.size(); ++k) by_end[k] += other.by_end[k];
+  raised += other.raised;
+  steps += other.steps;
+  unconverged_steps += other.unconverged_steps;
+}
+
 EnsembleReport RunEnsemble(const Scene& scene, const ReleaseSpec& release,
                            const EnsembleOptions& options, RockSink* sink) {
   const auto t0 = std::chrono::steady_clock::now();
-  const long total = release.total_rocks();
+  const long first = options.first_rock;
+  const long end = options.end_rock < 0 ? release.total_rocks() : options.end_rock;
+  if (first < 0 || end < first || end > release.total_rocks())
+    throw std::invalid_argument("RunEnsemble: rocks " + std::to_string(first) + ":" +
+                                std::to_string(end) + " are not within the ensemble's " +
+                                std::to_string(release.total_rocks()));
+  const long total = end - first;
   int threads =
       options.threads > 0 ? options.threads : static_cast<int>(std::thread::hardware_concurrency());
   threads = static_cast<int>(std::clamp<long>(threads, 1, std::max<long>(total, 1)));
@@ -73,7 +88,8 @@ EnsembleReport RunEnsemble(const Scene& scene, const ReleaseSpec& release,
   auto make_worker = [&]() -> std::function<RockOutcome(long)> {
     auto workspace = std::make_shared<SimulationWorkspace>();
     auto recorders = std::make_shared<RecorderSet>(MakeRecorders(scene, options));
-    return [&scene, &release, workspace, recorders](long rock) {
+    return [&scene, &release, workspace, recorders, first](long item) {
+      const long rock = first + item;
       RockOutcome out;
       out.rock = rock;
       out.release = release.ReleaseOf(rock);
@@ -109,7 +125,10 @@ EnsembleReport RunEnsemble(const Scene& scene, const ReleaseSpec& release,
   RunInOrder(total, pool, make_worker, merge);
 
   if (options.progress) options.progress(report.rocks, total);
-  if (rasters) report.rasters = rasters->Finish();
+  if (rasters && options.keep_raster_state)
+    report.raster_state = std::move(rasters);
+  else if (rasters)
+    report.rasters = rasters->Finish();
   report.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return report;
 }
