@@ -18,18 +18,18 @@ class ByteWriter {
   void Put(const T& value) {
     static_assert(std::is_trivially_copyable_v<T>);
     const auto* p = reinterpret_cast<const char*>(&value);
-    bytes_.insert(bytes_.end(), p, p + sizeof(T));
+    bytes_.append(p, sizeof(T));
   }
   template <class T>
   void PutVector(const std::vector<T>& values) {
     static_assert(std::is_trivially_copyable_v<T>);
     Put<std::uint64_t>(values.size());
     const auto* p = reinterpret_cast<const char*>(values.data());
-    bytes_.insert(bytes_.end(), p, p + values.size() * sizeof(T));
+    bytes_.append(p, values.size() * sizeof(T));
   }
   void PutString(const std::string& text) {
     Put<std::uint64_t>(text.size());
-    bytes_.insert(bytes_.end(), text.begin(), text.end());
+    bytes_.append(text);
   }
   const std::string& bytes() const { return bytes_; }
   std::string Take() { return std::move(bytes_); }
