@@ -18,13 +18,13 @@
 #include "app/commands.hpp"
 #include "app/interrupt.hpp"
 #include "app/run_outputs.hpp"
+#include "app/simulate.hpp"
 #include "common/atomic_file.hpp"
 #include "common/error.hpp"
 #include "ensemble/runner.hpp"
 #include "io/scene_file.hpp"
 
 namespace talus::app {
-namespace {
 
 // "rock <shape> (<mass> kg, <n> hull vertices); <k> releases x <n> rocks, seed <s>", or the runs
 // and blocks of a run table.
@@ -47,78 +47,48 @@ std::string DescribeRocks(const io::SceneFile& scene) {
   return line;
 }
 
-struct SimulateArgs {
-  std::string scene;
-  std::string out;
-  long rocks = 0;  // per release; 0: the scene's
-  int threads = 0;
-  std::optional<std::uint64_t> seed;
-  std::string rock_range;  // "A:B": write a partial result of rocks A .. B - 1
-};
-
-// "rocks done / total, rate, time left" on a terminal; nothing otherwise.
-class ProgressBar {
- public:
-  ProgressBar()
-      : enabled_(::isatty(STDERR_FILENO) != 0), start_(std::chrono::steady_clock::now()) {}
-  void operator()(long done, long total) {
-    if (!enabled_ || total <= 0) return;
-    const double elapsed =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-    const double rate = elapsed > 0 ? double(done) / elapsed : 0.0;
-    const double left = rate > 0 ? double(total - done) / rate : 0.0;
-    constexpr int kWidth = 30;
-    const int filled = static_cast<int>(kWidth * done / total);
-    std::fprintf(stderr, "\r[%-*.*s] %ld/%ld rocks  %.1f/s  %s left   ", kWidth, filled,
-                 "##############################", done, total, rate,
-                 done > 0 ? (std::to_string(static_cast<long>(left + 0.5)) + " s").c_str() : "?");
-    shown_ = done < total;
-    if (done == total) std::fprintf(stderr, "\n");
-    std::fflush(stderr);
-  }
-  // Ends a bar left unfinished, so that a message starts on a line of its own.
-  void Break() {
-    if (shown_) std::fprintf(stderr, "\n");
-    shown_ = false;
-  }
-
- private:
-  bool enabled_;
-  bool shown_ = false;
-  std::chrono::steady_clock::time_point start_;
-};
-
-int RunSimulate(const SimulateArgs& args) {
+int LoadForSimulate(const SimulateArgs& args, io::SceneFile* scene, std::pair<long, long>* range,
+                    std::string* message) {
   namespace fs = std::filesystem;
   if (std::error_code error; fs::is_directory(args.scene, error)) {
-    std::cerr << "talus simulate: " << args.scene << " is a directory, not a scene file";
+    *message = args.scene + " is a directory, not a scene file";
     if (fs::is_regular_file(fs::path(args.scene) / "scene.toml", error))
-      std::cerr << " (did you mean " << (fs::path(args.scene) / "scene.toml").string() << "?)";
-    std::cerr << "\n";
+      *message += " (did you mean " + (fs::path(args.scene) / "scene.toml").string() + "?)";
     return kExitBadInput;
   }
-  io::SceneFile scene;
-  std::pair<long, long> range;  // rocks [first, end) to run
   try {
-    scene = io::LoadScene(args.scene);
-    if (args.rocks > 0) scene.release.rocks_per_release = args.rocks;
-    if (args.seed) scene.release.seed = *args.seed;
+    *scene = io::LoadScene(args.scene);
+    if (args.rocks > 0) scene->release.rocks_per_release = args.rocks;
+    if (args.seed) scene->release.seed = *args.seed;
     // The scene was valid; only --rocks can break it now (too many rocks in all).
-    if (std::string why; !scene.release.IsValid(&why))
+    if (std::string why; !scene->release.IsValid(&why))
       throw InputError("--rocks " + std::to_string(args.rocks) + ": " + why);
-    range = {0, scene.release.total_rocks()};
+    *range = {0, scene->release.total_rocks()};
     if (!args.rock_range.empty()) {
-      range = ParseRockRange(args.rock_range);
-      if (range.second > scene.release.total_rocks())
+      *range = ParseRockRange(args.rock_range);
+      if (range->second > scene->release.total_rocks())
         throw InputError("--rock-range " + args.rock_range + ": the ensemble has rocks 0:" +
-                         std::to_string(scene.release.total_rocks()) + " only");
+                         std::to_string(scene->release.total_rocks()) + " only");
     }
   } catch (const InputError& e) {
-    std::cerr << "talus simulate: " << e.what() << "\n";
+    *message = e.what();
     return kExitBadInput;
   } catch (const std::exception& e) {  // e.g. out of memory while reading the inputs
-    std::cerr << "talus simulate: cannot load " << args.scene << ": " << e.what() << "\n";
+    *message = "cannot load " + args.scene + ": " + e.what();
     return kExitRunFailed;
+  }
+  return kExitOk;
+}
+
+namespace {
+
+int RunSimulate(const SimulateArgs& args) {
+  if (const int ranks = LaunchedRanks(); ranks > 1) return RunSimulateOnRanks(args);
+  io::SceneFile scene;
+  std::pair<long, long> range;  // rocks [first, end) to run
+  if (std::string message; const int code = LoadForSimulate(args, &scene, &range, &message)) {
+    std::cerr << "talus simulate: " << message << "\n";
+    return code;
   }
   if (const std::string why = PrepareOutputDirectory(args.out); !why.empty()) {
     std::cerr << "talus simulate: " << why << "\n";
