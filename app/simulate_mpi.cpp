@@ -4,6 +4,7 @@
 // code of `talus merge`. The ranks agree on success at every step (loading, running, sending), so
 // that a failure on any rank ends every rank with one message from rank 0 and no output.
 
+#include <chrono>
 #include <csignal>
 #include <cstdlib>
 #include <filesystem>
@@ -11,6 +12,7 @@
 #include <iostream>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "app/commands.hpp"
@@ -69,19 +71,56 @@ class MpiSession {
   int rank_ = 0, size_ = 1;
 };
 
+// Waits for a non-blocking operation without keeping a core busy: a rank that is done waits on a
+// node where other ranks (or other jobs) still work, and a blocking MPI call would spin.
+void Wait(MPI_Request request) {
+  int done = 0;
+  MPI_Test(&request, &done, MPI_STATUS_IGNORE);
+  while (!done) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    MPI_Test(&request, &done, MPI_STATUS_IGNORE);
+  }
+}
+
+void Gather(const void* mine, int count, MPI_Datatype type, void* all) {
+  MPI_Request request;
+  MPI_Igather(mine, count, type, all, count, type, 0, MPI_COMM_WORLD, &request);
+  Wait(request);
+}
+
+void Broadcast(void* data, int count, MPI_Datatype type) {
+  MPI_Request request;
+  MPI_Ibcast(data, count, type, 0, MPI_COMM_WORLD, &request);
+  Wait(request);
+}
+
+void Send(const void* data, int count, MPI_Datatype type) {
+  MPI_Request request;
+  MPI_Isend(data, count, type, 0, 0, MPI_COMM_WORLD, &request);
+  Wait(request);
+}
+
+void Receive(void* data, int count, MPI_Datatype type, int from) {
+  MPI_Request request;
+  MPI_Irecv(data, count, type, from, 0, MPI_COMM_WORLD, &request);
+  Wait(request);
+}
+
 // Every rank's text, on rank 0 (empty elsewhere).
 std::vector<std::string> GatherText(const MpiSession& mpi, const std::string& mine) {
   const int length = static_cast<int>(mine.size());
   std::vector<int> lengths(static_cast<std::size_t>(mpi.size())), offsets(lengths.size());
-  MPI_Gather(&length, 1, MPI_INT, lengths.data(), 1, MPI_INT, 0, MPI_COMM_WORLD);
+  Gather(&length, 1, MPI_INT, lengths.data());
   int total = 0;
   for (std::size_t r = 0; r < lengths.size(); ++r) {
     offsets[r] = total;
     total += lengths[r];
   }
   std::string all(mpi.rank() == 0 ? static_cast<std::size_t>(total) : 0, '\0');
-  MPI_Gatherv(mine.data(), length, MPI_CHAR, all.data(), lengths.data(), offsets.data(), MPI_CHAR,
-              0, MPI_COMM_WORLD);
+  MPI_Request request;
+  MPI_Igatherv(mine.data(), length, MPI_CHAR, all.data(), lengths.data(), offsets.data(), MPI_CHAR,
+               0, MPI_COMM_WORLD, &request);
+  Wait(request);
   std::vector<std::string> texts;
   if (mpi.rank() == 0)
     for (std::size_t r = 0; r < lengths.size(); ++r)
@@ -93,9 +132,9 @@ std::vector<std::string> GatherText(const MpiSession& mpi, const std::string& mi
 // Rank 0's text on every rank.
 std::string BroadcastText(const MpiSession& mpi, std::string text) {
   int length = static_cast<int>(text.size());
-  MPI_Bcast(&length, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  Broadcast(&length, 1, MPI_INT);
   if (mpi.rank() != 0) text.assign(static_cast<std::size_t>(length), '\0');
-  MPI_Bcast(text.data(), length, MPI_CHAR, 0, MPI_COMM_WORLD);
+  Broadcast(text.data(), length, MPI_CHAR);
   return text;
 }
 
@@ -103,7 +142,7 @@ std::string BroadcastText(const MpiSession& mpi, std::string text) {
 // did), the same on every rank; rank 0 prints that rank's message.
 int Agree(const MpiSession& mpi, int code, const std::string& message) {
   std::vector<int> codes(static_cast<std::size_t>(mpi.size()));
-  MPI_Gather(&code, 1, MPI_INT, codes.data(), 1, MPI_INT, 0, MPI_COMM_WORLD);
+  Gather(&code, 1, MPI_INT, codes.data());
   const std::vector<std::string> messages = GatherText(mpi, code != 0 ? message : "");
   int agreed = 0;
   if (mpi.rank() == 0) {
@@ -114,7 +153,7 @@ int Agree(const MpiSession& mpi, int code, const std::string& message) {
                 << messages[r] << "\n";
     }
   }
-  MPI_Bcast(&agreed, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  Broadcast(&agreed, 1, MPI_INT);
   return agreed;
 }
 
@@ -126,26 +165,26 @@ void SendPart(const fs::path& dir) {
   for (const auto& entry : fs::directory_iterator(dir))
     if (entry.is_regular_file()) files.push_back(entry.path());
   int count = static_cast<int>(files.size());
-  MPI_Send(&count, 1, MPI_INT, 0, 0, MPI_COMM_WORLD);
+  Send(&count, 1, MPI_INT);
   std::vector<char> buffer(kChunk);
   for (const fs::path& file : files) {
     const std::string name = file.filename().string();
     int length = static_cast<int>(name.size());
-    MPI_Send(&length, 1, MPI_INT, 0, 0, MPI_COMM_WORLD);
-    MPI_Send(name.data(), length, MPI_CHAR, 0, 0, MPI_COMM_WORLD);
+    Send(&length, 1, MPI_INT);
+    Send(name.data(), length, MPI_CHAR);
     std::uint64_t size = fs::file_size(file);
-    MPI_Send(&size, 1, MPI_UINT64_T, 0, 0, MPI_COMM_WORLD);
+    Send(&size, 1, MPI_UINT64_T);
     std::ifstream in(file, std::ios::binary);
     // A read that fails sends zeros of the right length; rank 0 is told below and merges nothing.
     bool ok = static_cast<bool>(in);
     for (std::uint64_t sent = 0; sent < size;) {
       const auto n = static_cast<std::size_t>(std::min<std::uint64_t>(kChunk, size - sent));
       if (ok && !in.read(buffer.data(), static_cast<std::streamsize>(n))) ok = false;
-      MPI_Send(buffer.data(), static_cast<int>(n), MPI_BYTE, 0, 0, MPI_COMM_WORLD);
+      Send(buffer.data(), static_cast<int>(n), MPI_BYTE);
       sent += n;
     }
     int status = ok ? 0 : 1;
-    MPI_Send(&status, 1, MPI_INT, 0, 0, MPI_COMM_WORLD);
+    Send(&status, 1, MPI_INT);
   }
 }
 
@@ -156,27 +195,26 @@ void ReceivePart(int from, const fs::path& dir) {
   std::error_code ignored;
   fs::create_directories(dir, ignored);
   int count = 0;
-  MPI_Recv(&count, 1, MPI_INT, from, 0, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+  Receive(&count, 1, MPI_INT, from);
   std::vector<char> buffer(kChunk);
   for (int k = 0; k < count; ++k) {
     int length = 0;
-    MPI_Recv(&length, 1, MPI_INT, from, 0, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+    Receive(&length, 1, MPI_INT, from);
     std::string name(static_cast<std::size_t>(length), '\0');
-    MPI_Recv(name.data(), length, MPI_CHAR, from, 0, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+    Receive(name.data(), length, MPI_CHAR, from);
     std::uint64_t size = 0;
-    MPI_Recv(&size, 1, MPI_UINT64_T, from, 0, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+    Receive(&size, 1, MPI_UINT64_T, from);
     const fs::path path = dir / name;
     std::ofstream out(path, std::ios::binary);
     for (std::uint64_t received = 0; received < size;) {
       const auto n = static_cast<std::size_t>(std::min<std::uint64_t>(kChunk, size - received));
-      MPI_Recv(buffer.data(), static_cast<int>(n), MPI_BYTE, from, 0, MPI_COMM_WORLD,
-               MPI_STATUS_IGNORE);
+      Receive(buffer.data(), static_cast<int>(n), MPI_BYTE, from);
       out.write(buffer.data(), static_cast<std::streamsize>(n));
       received += n;
     }
     out.close();
     int status = 0;
-    MPI_Recv(&status, 1, MPI_INT, from, 0, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+    Receive(&status, 1, MPI_INT, from);
     if (error.empty() && status != 0)
       error = "rank " + std::to_string(from) + " could not read its " + name;
     if (error.empty() && !out) error = "cannot write " + path.string();
