@@ -138,6 +138,47 @@ TEST(Rasters, P95OfARunIsWithinTheStatedBoundOfTheExactPercentile) {
   EXPECT_EQ(compared, 3 * static_cast<int>(sink.values.size()));
 }
 
+// The rocks of one run split between accumulators (as threads, ranks or parts would), merged in
+// another order and passed through their serialized state, give the same rasters to the bit.
+TEST(Rasters, AccumulatorsOfAnySplitMergeToTheSameRasters) {
+  Scene scene = testing::SmallPlane(35, 15, 15);
+  scene.rock = MakeRockShape(MakeIcosphere(0.2, 1), 2700);
+  scene.options.max_time_s = 6;
+  ReleaseSpec release = testing::PointRelease({{2, 0}, {2, 3}}, 6);
+  EnsembleOptions options;
+  options.rasters = {scene.terrain.heights().grid, true, true, true, true, true, true};
+  struct Keep : RockSink {
+    std::vector<Footprint> footprints;
+    void OnRock(const RockOutcome& rock) override { footprints.push_back(rock.footprint); }
+  } sink;
+  const EnsembleReport whole = RunEnsemble(scene, release, options, &sink);
+  ASSERT_EQ(sink.footprints.size(), 12u);
+  RasterAccumulator a(options.rasters), b(options.rasters), c(options.rasters);
+  for (std::size_t k = 0; k < 12; ++k) (k % 3 == 0 ? a : k % 3 == 1 ? b : c).Add(sink.footprints[k]);
+  ByteWriter out;
+  b.Serialize(out);
+  const std::string bytes = out.Take();
+  ByteReader in(bytes, "state of b");
+  RasterAccumulator merged = RasterAccumulator::Deserialize(options.rasters, in);
+  EXPECT_TRUE(in.at_end());
+  merged.Merge(c);
+  merged.Merge(a);
+  EXPECT_EQ(merged.rocks(), 12);
+  const std::vector<RasterLayer> layers = merged.Finish();
+  ASSERT_EQ(layers.size(), whole.rasters.size());
+  for (std::size_t l = 0; l < layers.size(); ++l)
+    EXPECT_TRUE(layers[l].values == whole.rasters[l].values) << layers[l].name;
+  // A state made for another grid or other rasters is refused.
+  RasterRequest other = options.rasters;
+  other.grid.nx += 1;
+  ByteReader again(bytes, "state of b");
+  EXPECT_THROW(RasterAccumulator::Deserialize(other, again), std::runtime_error);
+  other = options.rasters;
+  other.deposits = false;
+  ByteReader third(bytes, "state of b");
+  EXPECT_THROW(RasterAccumulator::Deserialize(other, third), std::runtime_error);
+}
+
 TEST(Rasters, P95IsTheNearestRankPercentile) {
   RasterRequest request;
   request.grid = {1, 1, 0, 0, 1, 1};
