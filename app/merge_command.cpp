@@ -31,7 +31,8 @@ int RunMerge(const MergeArgs& args) {
     for (const std::string& dir : args.parts) {
       std::error_code error;
       if (fs::equivalent(dir, args.out, error))
-        throw InputError("--out " + args.out + " is one of the parts; merge into another directory");
+        throw InputError("--out " + args.out +
+                         " is one of the parts; merge into another directory");
       parts.push_back(io::ReadPartialInfo(dir));
     }
     parts = io::CheckPartials(std::move(parts));
@@ -71,8 +72,8 @@ int RunMerge(const MergeArgs& args) {
     return kExitOk;
   } catch (const Interrupted& e) {
     staging.reset();
-    std::cerr << "talus merge: " << e.what() << "; removed this run's temporary files, "
-              << args.out << " is as it was before\n";
+    std::cerr << "talus merge: " << e.what() << "; removed this run's temporary files, " << args.out
+              << " is as it was before\n";
     return ExitCodeForSignal(e.signal());
   } catch (const std::exception& e) {
     const std::string message = staging ? staging->Describe(e.what()) : e.what();

@@ -105,9 +105,9 @@ void AppendCsv(const std::string& from, bool skip_header, const std::string& hea
 }  // namespace
 
 std::vector<std::string> TalusOutputNames() {
-  std::vector<std::string> names = {"rocks.csv",    "trajectories.h5", "summary.json",
-                                    "quicklook.png", "passages.tif",   "deposits.tif",
-                                    "reach_probability.tif", "partial.json", "partial.bin"};
+  std::vector<std::string> names = {
+      "rocks.csv",    "trajectories.h5",       "summary.json", "quicklook.png", "passages.tif",
+      "deposits.tif", "reach_probability.tif", "partial.json", "partial.bin"};
   for (const char* quantity : {"speed", "energy", "jump_height"})
     for (const char* statistic : {"max", "mean", "p95"})
       names.push_back(std::string(quantity) + "_" + statistic + ".tif");
@@ -180,8 +180,7 @@ std::vector<std::string> MergeIntoStaging(const io::SceneFile& scene,
     out.Commit();
     outputs.push_back("trajectories.h5");
   }
-  const ensemble::RasterRequest request =
-      scene.output.Request(scene.scene.terrain.heights().grid);
+  const ensemble::RasterRequest request = scene.output.Request(scene.scene.terrain.heights().grid);
   std::optional<ensemble::RasterAccumulator> rasters;
   std::vector<io::SamplePath> paths;
   for (const io::PartialInfo& part : parts) {

@@ -73,5 +73,4 @@ class ProgressBar {
   std::chrono::steady_clock::time_point start_;
 };
 
-
 }  // namespace talus::app

@@ -124,8 +124,8 @@ std::vector<std::string> GatherText(const MpiSession& mpi, const std::string& mi
   std::vector<std::string> texts;
   if (mpi.rank() == 0)
     for (std::size_t r = 0; r < lengths.size(); ++r)
-      texts.push_back(all.substr(static_cast<std::size_t>(offsets[r]),
-                                 static_cast<std::size_t>(lengths[r])));
+      texts.push_back(
+          all.substr(static_cast<std::size_t>(offsets[r]), static_cast<std::size_t>(lengths[r])));
   return texts;
 }
 
@@ -244,15 +244,16 @@ int RunSimulateOnRanks(const SimulateArgs& args) {
   int code = LoadForSimulate(args, &scene, &range, &message);
   if (code == kExitOk && !args.rock_range.empty()) {
     code = kExitBadInput;
-    message = "--rock-range is for runs of one process (e.g. a job array); under mpirun the ranks "
-              "share all rocks";
+    message =
+        "--rock-range is for runs of one process (e.g. a job array); under mpirun the ranks "
+        "share all rocks";
   }
   if (const int failed = Agree(mpi, code, message)) return failed;
   const std::string identity = EnsembleIdentity(args, scene);
   if (const std::string root_identity = BroadcastText(mpi, identity); identity != root_identity) {
     code = kExitBadInput;
-    message = "started with another ensemble than rank 0: " + identity + " instead of " +
-              root_identity;
+    message =
+        "started with another ensemble than rank 0: " + identity + " instead of " + root_identity;
   }
   if (code == kExitOk && root) {
     message = PrepareOutputDirectory(args.out);
@@ -280,7 +281,14 @@ int RunSimulateOnRanks(const SimulateArgs& args) {
   std::optional<StagingDirectory> staging, part;
   ensemble::EnsembleReport report;
   try {
-    staging.emplace(root ? args.out : fs::temp_directory_path().string());
+    // Ranks other than 0 stage in $TMPDIR/talus-ranks, where they also remove what ranks that
+    // died (SIGKILL, a lost node) left there, as rank 0 does in --out.
+    const fs::path dir = root ? fs::path(args.out) : fs::temp_directory_path() / "talus-ranks";
+    if (!root) {
+      fs::create_directories(dir);
+      RemoveStaleTemporaries(dir.string());
+    }
+    staging.emplace(dir.string());
     part.emplace(staging->staging_path());
     auto show_progress = [&progress, root](long done, long rocks) {
       ThrowIfInterrupted();
@@ -293,7 +301,8 @@ int RunSimulateOnRanks(const SimulateArgs& args) {
               " is as it was before the run";
   } catch (const std::exception& e) {
     code = kExitRunFailed;
-    message = (staging ? staging->Describe(e.what()) : std::string(e.what())) + " (no output written)";
+    message =
+        (staging ? staging->Describe(e.what()) : std::string(e.what())) + " (no output written)";
   }
   progress.Break();
   if (code != kExitOk) {  // remove the temporary files before waiting for the other ranks

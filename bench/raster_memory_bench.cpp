@@ -67,14 +67,15 @@ int main(int argc, char** argv) {
     // The replaced layout: per cell max (float), sum (double) and a std::vector<float> of values
     // for each of 3 quantities, plus 4 bytes per passage and quantity, plus the passage and
     // deposit grids.
-    const double replaced = cells * 3 * (4 + 8 + 24) + 3.0 * 4 * double(counter.passages) +
-                            cells * 2 * 4;
+    const double replaced =
+        cells * 3 * (4 + 8 + 24) + 3.0 * 4 * double(counter.passages) + cells * 2 * 4;
     std::printf("%8ld %9.2f %12ld %14.2f %16.2f %13.1f\n", report.rocks, wall, counter.passages,
                 double(report.raster_state->MemoryBytes()) / (1 << 20), replaced / (1 << 20),
                 PeakRssMiB());
     std::fflush(stdout);
   }
-  std::printf("(*) computed for the layout the summaries replaced (every passing rock's value per "
-              "cell), without std::vector's spare capacity\n");
+  std::printf(
+      "(*) computed for the layout the summaries replaced (every passing rock's value per "
+      "cell), without std::vector's spare capacity\n");
   return 0;
 }

@@ -10,8 +10,8 @@ namespace {
 __extension__ typedef unsigned __int128 UInt128;
 
 constexpr int kShift = 23 - ValueSummary::kMantissaBits;  // float mantissa bits dropped
-constexpr double kQuantum = 0x1p24;                        // fixed-point scale of the sum
-constexpr double kLargest = 0x1p64;                        // |v| beyond this is clamped in the sum
+constexpr double kQuantum = 0x1p24;                       // fixed-point scale of the sum
+constexpr double kLargest = 0x1p64;                       // |v| beyond this is clamped in the sum
 
 std::uint32_t BitsOf(float v) {
   std::uint32_t bits;
@@ -94,8 +94,7 @@ float ValueSummary::Quantile(double q) const {
   std::int64_t seen = 0;
   for (const Bin& bin : bins_) {
     seen += bin.count;
-    if (seen >= rank)
-      return std::clamp(static_cast<float>(Midpoint(bin.key)), min_, max_);
+    if (seen >= rank) return std::clamp(static_cast<float>(Midpoint(bin.key)), min_, max_);
   }
   return max_;
 }

@@ -132,9 +132,9 @@ std::vector<RasterLayer> RasterAccumulator::Finish() const {
   std::vector<RasterLayer> out;
   const std::size_t cells = static_cast<std::size_t>(request_.grid.nx) * request_.grid.ny;
   int quantity = 0;
-  for (auto [wanted, name, unit] : {std::tuple{request_.speed, "speed", "m/s"},
-                                    std::tuple{request_.energy, "energy", "J"},
-                                    std::tuple{request_.jump_height, "jump_height", "m"}}) {
+  for (auto [wanted, name, unit] :
+       {std::tuple{request_.speed, "speed", "m/s"}, std::tuple{request_.energy, "energy", "J"},
+        std::tuple{request_.jump_height, "jump_height", "m"}}) {
     if (!wanted) continue;
     const std::string prefix = name;
     RasterLayer max{prefix + "_max", unit, std::vector<float>(cells, RasterLayer::kNoData), true};
@@ -168,8 +168,9 @@ std::vector<RasterLayer> RasterAccumulator::Finish() const {
 }
 
 std::size_t RasterAccumulator::MemoryBytes() const {
-  std::size_t bytes = sizeof(int) * (passages_.capacity() + deposits_.capacity() + slot_.capacity()) +
-                      sizeof(ValueSummary) * summaries_.capacity();
+  std::size_t bytes =
+      sizeof(int) * (passages_.capacity() + deposits_.capacity() + slot_.capacity()) +
+      sizeof(ValueSummary) * summaries_.capacity();
   for (const ValueSummary& s : summaries_) bytes += 8 * s.bins();
   return bytes;
 }

@@ -22,7 +22,7 @@
 namespace talus::ensemble {
 
 struct EnsembleOptions {
-  int threads = 0;                      // worker threads; 0: all cores
+  int threads = 0;  // worker threads; 0: all cores
   // The rocks to run: [first_rock, end_rock) of the release; end_rock < 0: to the last one.
   long first_rock = 0;
   long end_rock = -1;
@@ -33,7 +33,7 @@ struct EnsembleOptions {
   // Keep the raster accumulator in the report (EnsembleReport::raster_state) for merging with other
   // runs' instead of finishing the rasters.
   bool keep_raster_state = false;
-  bool episodes = false;                // record every rock's contact episodes
+  bool episodes = false;  // record every rock's contact episodes
   EpisodeOptions episode_options;
   std::vector<RecorderFactory> extra_recorders;  // further per-thread recorders
   // Called on the calling thread with (rocks done, rocks in total), at most every 0.2 s and at the

@@ -25,7 +25,9 @@ std::string ReadWholeFile(const std::string& path) {
   return s.str();
 }
 
-std::string Range(long first, long end) { return std::to_string(first) + ":" + std::to_string(end); }
+std::string Range(long first, long end) {
+  return std::to_string(first) + ":" + std::to_string(end);
+}
 
 }  // namespace
 
@@ -134,8 +136,9 @@ std::vector<PartialInfo> CheckPartials(std::vector<PartialInfo> parts) {
     const PartialInfo& p = parts[k];
     if (p.first_rock > covered)
       throw InputError("rocks " + Range(covered, p.first_rock) + " of " +
-                       std::to_string(a.total_rocks) + " are in no partial result (the next part, " +
-                       p.dir + ", starts at rock " + std::to_string(p.first_rock) + ")");
+                       std::to_string(a.total_rocks) +
+                       " are in no partial result (the next part, " + p.dir + ", starts at rock " +
+                       std::to_string(p.first_rock) + ")");
     if (p.first_rock < covered)
       throw InputError("rocks " + Range(p.first_rock, p.end_rock) + " of " + p.dir +
                        " overlap rocks " + Range(parts[k - 1].first_rock, parts[k - 1].end_rock) +
@@ -159,7 +162,8 @@ void ReadPartialState(const PartialInfo& part, const ensemble::RasterRequest& re
   if (has_rasters != request.any()) in.Fail("holds other rasters than the scene asks for");
   if (has_rasters) {
     ensemble::RasterAccumulator acc = ensemble::RasterAccumulator::Deserialize(request, in);
-    if (acc.rocks() != part.counts.rocks) in.Fail("holds another number of rocks than partial.json");
+    if (acc.rocks() != part.counts.rocks)
+      in.Fail("holds another number of rocks than partial.json");
     if (rasters->has_value())
       (*rasters)->Merge(acc);
     else

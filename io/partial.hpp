@@ -20,10 +20,10 @@ namespace talus::io {
 
 // What partial.json says about a part.
 struct PartialInfo {
-  std::string dir;            // where it was read from
-  std::string version;        // of talus
-  std::string scene;          // the scene path as given to talus simulate
-  std::string scene_file;     // the same, absolute
+  std::string dir;                  // where it was read from
+  std::string version;              // of talus
+  std::string scene;                // the scene path as given to talus simulate
+  std::string scene_file;           // the same, absolute
   std::vector<std::string> inputs;  // SceneFile::inputs as given
   std::string inputs_hash;
   std::uint64_t seed = 0;

@@ -309,8 +309,8 @@ StoredTrajectory TrajectoryReader::Read(long rock) const {
   SilenceHdf5();
   const std::string name = "/rocks/" + std::to_string(rock);
   try {
-    const Handle group(Check(H5Gopen2(impl_->file.get(), name.c_str(), H5P_DEFAULT), "no such rock"),
-                       H5Gclose);
+    const Handle group(
+        Check(H5Gopen2(impl_->file.get(), name.c_str(), H5P_DEFAULT), "no such rock"), H5Gclose);
     const hid_t g = group.get();
     const hid_t d = H5T_NATIVE_DOUBLE;
     StoredTrajectory out;

@@ -52,7 +52,8 @@ std::map<std::string, std::string> Outputs(const fs::path& dir) {
   std::map<std::string, std::string> files;
   for (const auto& entry : fs::directory_iterator(dir)) {
     const std::string name = entry.path().filename().string();
-    files[name] = name == "summary.json" ? WithoutTimings(Slurp(entry.path())) : Slurp(entry.path());
+    files[name] =
+        name == "summary.json" ? WithoutTimings(Slurp(entry.path())) : Slurp(entry.path());
   }
   return files;
 }
@@ -60,8 +61,8 @@ std::map<std::string, std::string> Outputs(const fs::path& dir) {
 class MergeCommand : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = talus::app::testing::FreshDir("talus_merge_tests",
-                                         ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    dir_ = talus::app::testing::FreshDir(
+        "talus_merge_tests", ::testing::UnitTest::GetInstance()->current_test_info()->name());
     scene_ = dir_ / "scene.toml";
     talus::app::testing::Write(scene_, kScene);
   }
@@ -72,15 +73,16 @@ class MergeCommand : public ::testing::Test {
     const fs::path out = dir_ / name;
     std::string log;
     EXPECT_EQ(RunCommand(Talus("simulate " + scene_.string() + " --out " + out.string() +
-                               " --rock-range " + range + " --threads " +
-                               std::to_string(threads) + " " + extra),
+                               " --rock-range " + range + " --threads " + std::to_string(threads) +
+                               " " + extra),
                          &log),
               0)
         << log;
     return out;
   }
   // `talus merge parts... --out <dir>/merged`; its exit code, output in *log.
-  int Merge(const std::vector<fs::path>& parts, std::string* log, const std::string& out = "merged") {
+  int Merge(const std::vector<fs::path>& parts, std::string* log,
+            const std::string& out = "merged") {
     std::string command = "merge";
     for (const fs::path& p : parts) command.append(" ").append(p.string());
     return RunCommand(Talus(command + " --out " + (dir_ / out).string()), log);
@@ -90,8 +92,8 @@ class MergeCommand : public ::testing::Test {
 
 TEST_F(MergeCommand, AnySplitInAnyOrderGivesTheSingleRunsBytes) {
   std::string log;
-  ASSERT_EQ(RunCommand(Talus("simulate " + scene_.string() + " --out " + (dir_ / "single").string() +
-                             " --threads 2"),
+  ASSERT_EQ(RunCommand(Talus("simulate " + scene_.string() + " --out " +
+                             (dir_ / "single").string() + " --threads 2"),
                        &log),
             0)
       << log;
@@ -177,8 +179,8 @@ TEST_F(MergeCommand, ASceneChangedSinceThePartsRanIsRefused) {
 TEST_F(MergeCommand, BadRockRangesAreRefusedBeforeAnyWork) {
   for (const std::string range : {"5", "5:5", "7:3", "a:4", "0:11", "-1:3"}) {
     std::string log;
-    EXPECT_EQ(RunCommand(Talus("simulate " + scene_.string() + " --out " +
-                               (dir_ / "bad").string() + " --rock-range " + range),
+    EXPECT_EQ(RunCommand(Talus("simulate " + scene_.string() + " --out " + (dir_ / "bad").string() +
+                               " --rock-range " + range),
                          &log),
               2)
         << range;

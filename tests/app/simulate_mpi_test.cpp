@@ -38,7 +38,8 @@ std::map<std::string, std::string> Outputs(const fs::path& dir) {
   std::map<std::string, std::string> files;
   for (const auto& entry : fs::directory_iterator(dir)) {
     const std::string name = entry.path().filename().string();
-    files[name] = name == "summary.json" ? WithoutTimings(Slurp(entry.path())) : Slurp(entry.path());
+    files[name] =
+        name == "summary.json" ? WithoutTimings(Slurp(entry.path())) : Slurp(entry.path());
   }
   return files;
 }
@@ -77,15 +78,16 @@ TEST(SimulateMpi, ABadInputOnOneRankEndsTheRunWithOneMessage) {
   const fs::path dir = FreshDir("bad_rank");
   const fs::path out = dir / "out";
   std::string log;
-  const int code = RunCommand(MpiRun("-n 1 " + Talus() + " simulate " + kScene + " --out " +
-                                     out.string() + " : -n 1 " + Talus() + " simulate " +
-                                     (dir / "missing.toml").string() + " --out " + out.string()),
-                              &log);
+  const int code = RunCommand(
+      MpiRun("-n 1 " + Talus() + " simulate " + kScene + " --out " + out.string() + " : -n 1 " +
+             Talus() + " simulate " + (dir / "missing.toml").string() + " --out " + out.string()),
+      &log);
   EXPECT_EQ(code, 2) << log;
   const std::string message = "talus simulate: rank 1: " + (dir / "missing.toml").string();
   const std::size_t at = log.find(message);
   EXPECT_NE(at, std::string::npos) << log;
-  EXPECT_EQ(log.find("talus simulate:", at + 1), std::string::npos) << "more than one message: " << log;
+  EXPECT_EQ(log.find("talus simulate:", at + 1), std::string::npos)
+      << "more than one message: " << log;
   EXPECT_FALSE(fs::exists(out));
 }
 
@@ -95,9 +97,9 @@ TEST(SimulateMpi, RanksWithDifferentEnsemblesAreRefused) {
   const fs::path out = dir / "out";
   std::string log;
   const std::string run = " simulate " + kScene + " --rocks 4 --out " + out.string();
-  EXPECT_EQ(RunCommand(MpiRun("-n 1 " + Talus() + run + " : -n 1 " + Talus() + run + " --seed 3"),
-                       &log),
-            2)
+  EXPECT_EQ(
+      RunCommand(MpiRun("-n 1 " + Talus() + run + " : -n 1 " + Talus() + run + " --seed 3"), &log),
+      2)
       << log;
   EXPECT_NE(log.find("rank 1: started with another ensemble than rank 0"), std::string::npos)
       << log;
@@ -105,18 +107,27 @@ TEST(SimulateMpi, RanksWithDifferentEnsemblesAreRefused) {
 }
 
 // Rank 1 is killed (SIGKILL) in the middle of its rocks: the run ends within the time limit with a
-// failure, --out holds neither outputs nor temporary files.
+// failure, --out holds neither outputs nor temporary files; the next run removes what the killed
+// rank left in its $TMPDIR.
 TEST(SimulateMpi, ALostRankEndsTheRunWithoutOutputs) {
   const fs::path dir = FreshDir("lost_rank");
-  const fs::path out = dir / "out";
+  const fs::path out = dir / "out", tmp = dir / "tmp";
   fs::create_directories(out);
+  fs::create_directories(tmp);
   std::string log;
-  const std::string run = " simulate " + kScene + " --rocks 200 --threads 1 --out " + out.string();
-  const int code = RunCommand(
-      MpiRun("-n 1 " + Talus() + run + " : -n 1 timeout -s KILL 2 " + Talus() + run), &log);
+  const std::string run = " simulate " + kScene + " --threads 1 --out " + out.string();
+  const std::string env = "TMPDIR=" + tmp.string() + " ";
+  const int code =
+      RunCommand(env + MpiRun("-n 1 " + Talus() + run + " --rocks 200 : -n 1 timeout -s KILL 2 " +
+                              Talus() + run + " --rocks 200"),
+                 &log);
   EXPECT_NE(code, 0) << log;
   EXPECT_NE(code, -1) << log;  // ended by itself, not by the test's time limit
   EXPECT_TRUE(fs::is_empty(out)) << log;
+  ASSERT_FALSE(fs::is_empty(tmp / "talus-ranks"));  // the killed rank's staging directory
+  ASSERT_EQ(RunCommand(env + MpiRun("-n 2 " + Talus()) + run + " --rocks 2", &log), 0) << log;
+  EXPECT_TRUE(fs::is_empty(tmp / "talus-ranks")) << log;
+  EXPECT_TRUE(fs::exists(out / "summary.json"));
 }
 
 }  // namespace

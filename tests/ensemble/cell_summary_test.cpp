@@ -39,10 +39,18 @@ std::vector<float> Sample(int kind, int n, std::mt19937_64& rng) {
   std::uniform_int_distribution<int> few(1, 5);
   for (float& x : v) {
     switch (kind) {
-      case 0: x = static_cast<float>(uniform(rng)); break;
-      case 1: x = static_cast<float>(std::pow(10.0, decades(rng))); break;
-      case 2: x = static_cast<float>(normal(rng)); break;
-      default: x = static_cast<float>(few(rng)) * 0.1f; break;
+      case 0:
+        x = static_cast<float>(uniform(rng));
+        break;
+      case 1:
+        x = static_cast<float>(std::pow(10.0, decades(rng)));
+        break;
+      case 2:
+        x = static_cast<float>(normal(rng));
+        break;
+      default:
+        x = static_cast<float>(few(rng)) * 0.1f;
+        break;
     }
   }
   return v;
@@ -98,8 +106,8 @@ TEST(ValueSummary, NonFiniteValuesAreLeftOut) {
 
 // Bins follow the order of the values, negative and positive, across zero.
 TEST(ValueSummary, BinsAreOrderedAsTheValues) {
-  const std::vector<float> ordered = {-1e30f, -5.0f, -1e-3f, -1e-38f, 0.0f, 1e-38f, 1e-3f, 5.0f,
-                                      1e30f};
+  const std::vector<float> ordered = {-1e30f, -5.0f, -1e-3f, -1e-38f, 0.0f,
+                                      1e-38f, 1e-3f, 5.0f,   1e30f};
   for (std::size_t k = 1; k < ordered.size(); ++k)
     EXPECT_LT(ValueSummary::BinOf(ordered[k - 1]), ValueSummary::BinOf(ordered[k])) << k;
   EXPECT_EQ(ValueSummary::BinOf(-0.0f), ValueSummary::BinOf(0.0f));

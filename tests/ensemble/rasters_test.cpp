@@ -154,7 +154,8 @@ TEST(Rasters, AccumulatorsOfAnySplitMergeToTheSameRasters) {
   const EnsembleReport whole = RunEnsemble(scene, release, options, &sink);
   ASSERT_EQ(sink.footprints.size(), 12u);
   RasterAccumulator a(options.rasters), b(options.rasters), c(options.rasters);
-  for (std::size_t k = 0; k < 12; ++k) (k % 3 == 0 ? a : k % 3 == 1 ? b : c).Add(sink.footprints[k]);
+  for (std::size_t k = 0; k < 12; ++k)
+    (k % 3 == 0 ? a : k % 3 == 1 ? b : c).Add(sink.footprints[k]);
   ByteWriter out;
   b.Serialize(out);
   const std::string bytes = out.Take();

@@ -44,8 +44,7 @@ TEST(CheckPartials, AcceptsATilingInAnyOrderAndSortsIt) {
 }
 
 TEST(CheckPartials, NamesOverlapsAndMissingRocks) {
-  EXPECT_EQ(Message({Part("a", 0, 6), Part("b", 4, 10)}),
-            "rocks 4:10 of b overlap rocks 0:6 of a");
+  EXPECT_EQ(Message({Part("a", 0, 6), Part("b", 4, 10)}), "rocks 4:10 of b overlap rocks 0:6 of a");
   EXPECT_EQ(Message({Part("a", 0, 4), Part("b", 6, 10)}),
             "rocks 4:6 of 10 are in no partial result (the next part, b, starts at rock 6)");
   EXPECT_EQ(Message({Part("a", 0, 4)}), "rocks 4:10 of 10 are in no partial result");
