@@ -10,6 +10,8 @@
 // outputs of a single run.
 
 #include <Eigen/Core>
+#include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
