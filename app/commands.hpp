@@ -15,6 +15,7 @@ Runner AddRockCommand(CLI::App& app);
 Runner AddSimulateCommand(CLI::App& app);
 Runner AddValidateCommand(CLI::App& app);
 Runner AddCalibrateCommand(CLI::App& app);
+Runner AddMergeCommand(CLI::App& app);
 
 // Exit codes, the same for every verb (README.md, "Exit codes").
 constexpr int kExitOk = 0;

@@ -19,7 +19,7 @@ int main(int argc, char** argv) {
   const std::vector<talus::app::Runner> runners = {
       talus::app::AddDemoCommand(app),      talus::app::AddRockCommand(app),
       talus::app::AddSimulateCommand(app),  talus::app::AddValidateCommand(app),
-      talus::app::AddCalibrateCommand(app),
+      talus::app::AddCalibrateCommand(app), talus::app::AddMergeCommand(app),
   };
 
   try {

@@ -1,6 +1,5 @@
 // talus simulate: run a scene's ensemble and write rocks.csv, rasters, trajectories and a summary.
 
-#include <cpl_error.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -18,20 +17,15 @@
 
 #include "app/commands.hpp"
 #include "app/interrupt.hpp"
+#include "app/run_outputs.hpp"
+#include "app/simulate.hpp"
 #include "common/atomic_file.hpp"
 #include "common/error.hpp"
 #include "ensemble/runner.hpp"
-#include "io/quicklook.hpp"
-#include "io/raster.hpp"
 #include "io/resources.hpp"
-#include "io/rocks_csv.hpp"
 #include "io/scene_file.hpp"
-#include "io/summary.hpp"
-#include "io/trajectory_file.hpp"
-#include "talus/version.hpp"
 
 namespace talus::app {
-namespace {
 
 // "rock <shape> (<mass> kg, <n> hull vertices); <k> releases x <n> rocks, seed <s>", or the runs
 // and blocks of a run table.
@@ -54,116 +48,48 @@ std::string DescribeRocks(const io::SceneFile& scene) {
   return line;
 }
 
-struct SimulateArgs {
-  std::string scene;
-  std::string out;
-  long rocks = 0;  // per release; 0: the scene's
-  int threads = 0;
-  std::optional<std::uint64_t> seed;
-};
-
-// Streams each finished rock to rocks.csv and trajectories.h5.
-// Keeps the horizontal paths of the quick-look's sample rocks.
-class FileSink : public ensemble::RockSink {
- public:
-  FileSink(io::RocksCsvWriter& csv, io::TrajectoryWriter* trajectories, long sample)
-      : csv_(csv), trajectories_(trajectories), sample_(sample) {}
-  void OnRock(const ensemble::RockOutcome& rock) override {
-    ThrowIfInterrupted();
-    csv_.Write(rock);
-    if (trajectories_) trajectories_->Write(rock);
-    if (rock.rock < sample_) {
-      std::vector<Eigen::Vector2d>& path = paths.emplace_back();
-      for (const ensemble::TrajectorySample& s : rock.trajectory)
-        path.push_back(s.position_m.head<2>());
-    }
-  }
-  std::vector<std::vector<Eigen::Vector2d>> paths;
-
- private:
-  io::RocksCsvWriter& csv_;
-  io::TrajectoryWriter* trajectories_;
-  long sample_;
-};
-
-// Keeps GDAL's error messages off stderr while alive (on this thread); they stay readable through
-// CPLGetLastErrorMsg, which the raster writers put in their exceptions.
-class QuietGdal {
- public:
-  QuietGdal() { CPLPushErrorHandler(CPLQuietErrorHandler); }
-  ~QuietGdal() { CPLPopErrorHandler(); }
-  QuietGdal(const QuietGdal&) = delete;
-  QuietGdal& operator=(const QuietGdal&) = delete;
-};
-
-constexpr long kQuickLookPaths = 20;  // rocks drawn on the quick-look
-
-// "rocks done / total, rate, time left" on a terminal; nothing otherwise.
-class ProgressBar {
- public:
-  ProgressBar()
-      : enabled_(::isatty(STDERR_FILENO) != 0), start_(std::chrono::steady_clock::now()) {}
-  void operator()(long done, long total) {
-    if (!enabled_ || total <= 0) return;
-    const double elapsed =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-    const double rate = elapsed > 0 ? double(done) / elapsed : 0.0;
-    const double left = rate > 0 ? double(total - done) / rate : 0.0;
-    constexpr int kWidth = 30;
-    const int filled = static_cast<int>(kWidth * done / total);
-    std::fprintf(stderr, "\r[%-*.*s] %ld/%ld rocks  %.1f/s  %s left   ", kWidth, filled,
-                 "##############################", done, total, rate,
-                 done > 0 ? (std::to_string(static_cast<long>(left + 0.5)) + " s").c_str() : "?");
-    shown_ = done < total;
-    if (done == total) std::fprintf(stderr, "\n");
-    std::fflush(stderr);
-  }
-  // Ends a bar left unfinished, so that a message starts on a line of its own.
-  void Break() {
-    if (shown_) std::fprintf(stderr, "\n");
-    shown_ = false;
-  }
-
- private:
-  bool enabled_;
-  bool shown_ = false;
-  std::chrono::steady_clock::time_point start_;
-};
-
-// Every file name talus simulate may write into its output directory.
-std::vector<std::string> TalusOutputNames() {
-  std::vector<std::string> names = {
-      "rocks.csv",    "trajectories.h5", "summary.json",         "quicklook.png",
-      "passages.tif", "deposits.tif",    "reach_probability.tif"};
-  for (const char* quantity : {"speed", "energy", "jump_height"})
-    for (const char* statistic : {"max", "mean", "p95"})
-      names.push_back(std::string(quantity) + "_" + statistic + ".tif");
-  return names;
-}
-
-int RunSimulate(const SimulateArgs& args) {
+int LoadForSimulate(const SimulateArgs& args, io::SceneFile* scene, std::pair<long, long>* range,
+                    std::string* message) {
   namespace fs = std::filesystem;
   if (std::error_code error; fs::is_directory(args.scene, error)) {
-    std::cerr << "talus simulate: " << args.scene << " is a directory, not a scene file";
+    *message = args.scene + " is a directory, not a scene file";
     if (fs::is_regular_file(fs::path(args.scene) / "scene.toml", error))
-      std::cerr << " (did you mean " << (fs::path(args.scene) / "scene.toml").string() << "?)";
-    std::cerr << "\n";
+      *message += " (did you mean " + (fs::path(args.scene) / "scene.toml").string() + "?)";
     return kExitBadInput;
   }
-  io::SceneFile scene;
   try {
-    scene = io::LoadScene(args.scene);
-    if (args.rocks > 0) scene.release.rocks_per_release = args.rocks;
-    if (args.seed) scene.release.seed = *args.seed;
+    *scene = io::LoadScene(args.scene);
+    if (args.rocks > 0) scene->release.rocks_per_release = args.rocks;
+    if (args.seed) scene->release.seed = *args.seed;
     // The scene was valid; only --rocks can break it now (too many rocks in all).
-    if (std::string why; !scene.release.IsValid(&why))
+    if (std::string why; !scene->release.IsValid(&why))
       throw InputError("--rocks " + std::to_string(args.rocks) + ": " + why);
+    *range = {0, scene->release.total_rocks()};
+    if (!args.rock_range.empty()) {
+      *range = ParseRockRange(args.rock_range);
+      if (range->second > scene->release.total_rocks())
+        throw InputError("--rock-range " + args.rock_range + ": the ensemble has rocks 0:" +
+                         std::to_string(scene->release.total_rocks()) + " only");
+    }
   } catch (const InputError& e) {
-    std::cerr << "talus simulate: " << e.what() << "\n";
+    *message = e.what();
     return kExitBadInput;
   } catch (const std::exception& e) {  // e.g. out of memory while reading the inputs
-    std::cerr << "talus simulate: cannot load " << args.scene << ": " << e.what() << "\n";
+    *message = "cannot load " + args.scene + ": " + e.what();
     return kExitRunFailed;
+  }
+  return kExitOk;
+}
+
+namespace {
+
+int RunSimulate(const SimulateArgs& args) {
+  if (const int ranks = LaunchedRanks(); ranks > 1) return RunSimulateOnRanks(args);
+  io::SceneFile scene;
+  std::pair<long, long> range;  // rocks [first, end) to run
+  if (std::string message; const int code = LoadForSimulate(args, &scene, &range, &message)) {
+    std::cerr << "talus simulate: " << message << "\n";
+    return code;
   }
   if (const std::string why = PrepareOutputDirectory(args.out); !why.empty()) {
     std::cerr << "talus simulate: " << why << "\n";
@@ -197,64 +123,21 @@ int RunSimulate(const SimulateArgs& args) {
   ProgressBar progress;
   try {
     staging.emplace(args.out);
-    const auto out = [&](const std::string& name) { return staging->path(name); };
-    ensemble::EnsembleOptions options;
-    options.threads = args.threads;
-    options.trajectories = scene.output.trajectories;
-    options.trajectory_interval_s = scene.output.trajectory_interval_s;
-    options.sample_trajectories = scene.output.quicklook ? kQuickLookPaths : 0;
-    const GridGeometry& dem = scene.scene.terrain.heights().grid;
-    options.rasters = scene.output.Request(dem);
     // Thrown on the calling thread, Interrupted stops the workers and comes out of RunEnsemble.
-    options.progress = [&progress](long done, long total) {
+    auto show_progress = [&progress](long done, long total) {
       ThrowIfInterrupted();
       progress(done, total);
     };
-
-    std::vector<std::string> outputs = {"rocks.csv"};
-    io::RocksCsvWriter csv(out("rocks.csv"), scene.release);
-    std::unique_ptr<io::TrajectoryWriter> trajectories;
-    if (scene.output.trajectories) {
-      trajectories =
-          std::make_unique<io::TrajectoryWriter>(out("trajectories.h5"), scene.scene.rock);
-      outputs.push_back("trajectories.h5");
-    }
-    FileSink sink(csv, trajectories.get(), options.sample_trajectories);
-    const ensemble::EnsembleReport report =
-        ensemble::RunEnsemble(scene.scene, scene.release, options, &sink);
-    ThrowIfInterrupted();
-    csv.Commit();
-    if (trajectories) trajectories->Commit();
-    // GDAL would print every failed write of a full disk; the writers throw with its last message.
-    const QuietGdal quiet_gdal;
-    for (const ensemble::RasterLayer& layer : report.rasters) {
-      ThrowIfInterrupted();
-      io::WriteGeoTiff(out(layer.name + ".tif"), dem, scene.crs_wkt, layer.values, layer.has_nodata,
-                       ensemble::RasterLayer::kNoData, layer.name + " (" + layer.unit + ")");
-      outputs.push_back(layer.name + ".tif");
-    }
-    ThrowIfInterrupted();
-    if (scene.output.quicklook) {
-      io::WriteQuickLookPng(out("quicklook.png"), scene.scene.terrain.heights(),
-                            io::QuickLookLayer(report.rasters), sink.paths);
-      outputs.push_back("quicklook.png");
-    }
-    WriteFileAtomically(out("summary.json"), io::SummaryJson(scene, report, kVersion, outputs));
-    ThrowIfInterrupted();
-    std::vector<std::string> commit = outputs;
-    commit.push_back("summary.json");  // last: a summary.json is there only with its outputs
-    staging->Commit(commit);
-    // An earlier run's outputs that this run did not replace must not pass for this run's.
-    int stale = 0;
-    for (const std::string& name : TalusOutputNames()) {
-      if (std::find(commit.begin(), commit.end(), name) != commit.end()) continue;
-      std::error_code error;
-      stale += fs::remove(fs::path(args.out) / name, error) ? 1 : 0;
-    }
-    if (stale > 0)
-      std::printf("Removed %d outputs of an earlier run from %s\n", stale, args.out.c_str());
+    ensemble::EnsembleReport report;
+    const std::vector<std::string> files =
+        RunIntoStaging(scene, args.threads, range.first, range.second, !args.rock_range.empty(),
+                       *staging, show_progress, &report);
+    CommitOutputs(*staging, files, args.out);
     std::printf("%s\n", report.BriefReport().c_str());
-    std::printf("Wrote %zu files to %s\n", commit.size(), args.out.c_str());
+    if (!args.rock_range.empty())
+      std::printf("Wrote rocks %ld:%ld of %ld as a partial result (merge with talus merge)\n",
+                  range.first, range.second, scene.release.total_rocks());
+    std::printf("Wrote %zu files to %s\n", files.size(), args.out.c_str());
     if (report.count(EndReason::kFailed) > 0)
       std::fprintf(stderr,
                    "talus simulate: %ld rocks failed numerically (end = failed in rocks.csv)\n",
@@ -292,6 +175,8 @@ Runner AddSimulateCommand(CLI::App& app) {
          "--seed", [args](const std::uint64_t& seed) { args->seed = seed; },
          "Random seed (overrides the scene)")
       ->check(IntegerRange(0, std::numeric_limits<std::int64_t>::max()));
+  cmd->add_option("--rock-range", args->rock_range,
+                  "Run only rocks A .. B-1 (A:B) and write a partial result for talus merge");
   return [cmd, args]() { return *cmd ? RunSimulate(*args) : -1; };
 }
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <tuple>
 
 namespace talus::ensemble {
 
@@ -83,21 +84,20 @@ RasterAccumulator::RasterAccumulator(const RasterRequest& request) : request_(re
   const auto cells = static_cast<std::size_t>(request.grid.nx) * request.grid.ny;
   if (request.passages || request.reach_probability) passages_.assign(cells, 0);
   if (request.deposits) deposits_.assign(cells, 0);
-  for (auto [wanted, stat] :
-       {std::pair{request.speed, &speed_}, std::pair{request.energy, &energy_},
-        std::pair{request.jump_height, &jump_}}) {
-    if (!wanted) continue;
-    stat->max.assign(cells, 0.0f);
-    stat->sum.assign(cells, 0.0);
-    stat->values.assign(cells, {});
-  }
+  if (quantities() > 0) slot_.assign(cells, -1);
 }
 
-void RasterAccumulator::AddStat(Stat& stat, int cell, float value) {
-  const auto c = static_cast<std::size_t>(cell);
-  stat.max[c] = stat.values[c].empty() ? value : std::max(stat.max[c], value);
-  stat.sum[c] += value;
-  stat.values[c].push_back(value);
+int RasterAccumulator::quantities() const {
+  return int(request_.speed) + int(request_.energy) + int(request_.jump_height);
+}
+
+ValueSummary* RasterAccumulator::Summaries(int cell) {
+  int& slot = slot_[static_cast<std::size_t>(cell)];
+  if (slot < 0) {
+    slot = static_cast<int>(summaries_.size());
+    summaries_.resize(summaries_.size() + static_cast<std::size_t>(quantities()));
+  }
+  return &summaries_[static_cast<std::size_t>(slot)];
 }
 
 void RasterAccumulator::Add(const Footprint& footprint) {
@@ -105,42 +105,54 @@ void RasterAccumulator::Add(const Footprint& footprint) {
   for (std::size_t k = 0; k < footprint.cells.size(); ++k) {
     const int cell = footprint.cells[k];
     if (!passages_.empty()) ++passages_[static_cast<std::size_t>(cell)];
-    if (request_.speed) AddStat(speed_, cell, footprint.speed_m_s[k]);
-    if (request_.energy) AddStat(energy_, cell, footprint.energy_j[k]);
-    if (request_.jump_height) AddStat(jump_, cell, footprint.jump_height_m[k]);
+    if (slot_.empty()) continue;
+    ValueSummary* s = Summaries(cell);
+    if (request_.speed) (s++)->Add(footprint.speed_m_s[k]);
+    if (request_.energy) (s++)->Add(footprint.energy_j[k]);
+    if (request_.jump_height) s->Add(footprint.jump_height_m[k]);
   }
   if (!deposits_.empty() && footprint.deposit_cell >= 0)
     ++deposits_[static_cast<std::size_t>(footprint.deposit_cell)];
 }
 
-void RasterAccumulator::FinishStat(const Stat& stat, const std::string& name,
-                                   const std::string& unit, std::vector<RasterLayer>& out) const {
-  const std::size_t cells = stat.max.size();
-  RasterLayer max{name + "_max", unit, std::vector<float>(cells, RasterLayer::kNoData), true};
-  RasterLayer mean{name + "_mean", unit, std::vector<float>(cells, RasterLayer::kNoData), true};
-  RasterLayer p95{name + "_p95", unit, std::vector<float>(cells, RasterLayer::kNoData), true};
-  std::vector<float> sorted;
-  for (std::size_t c = 0; c < cells; ++c) {
-    const std::vector<float>& v = stat.values[c];
-    if (v.empty()) continue;
-    max.values[c] = stat.max[c];
-    mean.values[c] = static_cast<float>(stat.sum[c] / static_cast<double>(v.size()));
-    // Nearest-rank percentile: the smallest value with at least 95 % of the values at or below it.
-    sorted = v;
-    const auto rank = static_cast<std::size_t>(std::ceil(0.95 * static_cast<double>(v.size())));
-    std::nth_element(sorted.begin(), sorted.begin() + static_cast<long>(rank - 1), sorted.end());
-    p95.values[c] = sorted[rank - 1];
+void RasterAccumulator::Merge(const RasterAccumulator& other) {
+  const auto q = static_cast<std::size_t>(quantities());
+  rocks_ += other.rocks_;
+  for (std::size_t c = 0; c < passages_.size(); ++c) passages_[c] += other.passages_[c];
+  for (std::size_t c = 0; c < deposits_.size(); ++c) deposits_[c] += other.deposits_[c];
+  for (std::size_t c = 0; c < other.slot_.size(); ++c) {
+    if (other.slot_[c] < 0) continue;
+    ValueSummary* mine = Summaries(static_cast<int>(c));
+    const ValueSummary* theirs = &other.summaries_[static_cast<std::size_t>(other.slot_[c])];
+    for (std::size_t k = 0; k < q; ++k) mine[k].Merge(theirs[k]);
   }
-  out.push_back(std::move(max));
-  out.push_back(std::move(mean));
-  out.push_back(std::move(p95));
 }
 
 std::vector<RasterLayer> RasterAccumulator::Finish() const {
   std::vector<RasterLayer> out;
-  if (request_.speed) FinishStat(speed_, "speed", "m/s", out);
-  if (request_.energy) FinishStat(energy_, "energy", "J", out);
-  if (request_.jump_height) FinishStat(jump_, "jump_height", "m", out);
+  const std::size_t cells = static_cast<std::size_t>(request_.grid.nx) * request_.grid.ny;
+  int quantity = 0;
+  for (auto [wanted, name, unit] :
+       {std::tuple{request_.speed, "speed", "m/s"}, std::tuple{request_.energy, "energy", "J"},
+        std::tuple{request_.jump_height, "jump_height", "m"}}) {
+    if (!wanted) continue;
+    const std::string prefix = name;
+    RasterLayer max{prefix + "_max", unit, std::vector<float>(cells, RasterLayer::kNoData), true};
+    RasterLayer mean{prefix + "_mean", unit, std::vector<float>(cells, RasterLayer::kNoData), true};
+    RasterLayer p95{prefix + "_p95", unit, std::vector<float>(cells, RasterLayer::kNoData), true};
+    for (std::size_t c = 0; c < cells; ++c) {
+      if (slot_[c] < 0) continue;
+      const ValueSummary& s = summaries_[static_cast<std::size_t>(slot_[c] + quantity)];
+      if (s.count() == 0) continue;
+      max.values[c] = s.max();
+      mean.values[c] = static_cast<float>(s.mean());
+      p95.values[c] = s.Quantile(kPercentile);
+    }
+    out.push_back(std::move(max));
+    out.push_back(std::move(mean));
+    out.push_back(std::move(p95));
+    ++quantity;
+  }
   const auto to_float = [](const std::vector<int>& counts) {
     return std::vector<float>(counts.begin(), counts.end());
   };
@@ -153,6 +165,94 @@ std::vector<RasterLayer> RasterAccumulator::Finish() const {
     out.push_back(std::move(reach));
   }
   return out;
+}
+
+std::size_t RasterAccumulator::MemoryBytes() const {
+  std::size_t bytes =
+      sizeof(int) * (passages_.capacity() + deposits_.capacity() + slot_.capacity()) +
+      sizeof(ValueSummary) * summaries_.capacity();
+  for (const ValueSummary& s : summaries_) bytes += 8 * s.bins();
+  return bytes;
+}
+
+namespace {
+
+// Format of RasterAccumulator::Serialize; a change of layout changes the number.
+constexpr std::uint32_t kStateFormat = 1;
+
+std::uint32_t RequestBits(const RasterRequest& r) {
+  return std::uint32_t(r.speed) | std::uint32_t(r.energy) << 1 | std::uint32_t(r.jump_height) << 2 |
+         std::uint32_t(r.passages) << 3 | std::uint32_t(r.deposits) << 4 |
+         std::uint32_t(r.reach_probability) << 5;
+}
+
+// The cells with a non-zero count, and their counts.
+void PutCounts(ByteWriter& out, const std::vector<int>& counts) {
+  std::vector<std::int32_t> cells, values;
+  for (std::size_t c = 0; c < counts.size(); ++c)
+    if (counts[c] != 0) {
+      cells.push_back(static_cast<std::int32_t>(c));
+      values.push_back(counts[c]);
+    }
+  out.PutVector(cells);
+  out.PutVector(values);
+}
+
+void GetCounts(ByteReader& in, std::vector<int>& counts) {
+  const auto cells = in.GetVector<std::int32_t>();
+  const auto values = in.GetVector<std::int32_t>();
+  if (cells.size() != values.size()) in.Fail();
+  for (std::size_t k = 0; k < cells.size(); ++k) {
+    if (cells[k] < 0 || static_cast<std::size_t>(cells[k]) >= counts.size()) in.Fail();
+    counts[static_cast<std::size_t>(cells[k])] = values[k];
+  }
+}
+
+}  // namespace
+
+void RasterAccumulator::Serialize(ByteWriter& out) const {
+  out.Put(kStateFormat);
+  out.Put(RequestBits(request_));
+  out.Put(request_.grid);
+  out.Put<std::int64_t>(rocks_);
+  PutCounts(out, passages_);
+  PutCounts(out, deposits_);
+  std::vector<std::int32_t> passed;  // in cell order, so that the bytes do not depend on the order
+  for (std::size_t c = 0; c < slot_.size(); ++c)
+    if (slot_[c] >= 0) passed.push_back(static_cast<std::int32_t>(c));
+  out.PutVector(passed);
+  for (std::int32_t c : passed)
+    for (int k = 0; k < quantities(); ++k)
+      summaries_[static_cast<std::size_t>(slot_[static_cast<std::size_t>(c)] + k)].Serialize(out);
+}
+
+RasterAccumulator RasterAccumulator::Deserialize(const RasterRequest& request, ByteReader& in) {
+  if (in.Get<std::uint32_t>() != kStateFormat) in.Fail("was written by another version of talus");
+  if (in.Get<std::uint32_t>() != RequestBits(request))
+    in.Fail("holds other rasters than the scene asks for");
+  const auto grid = in.Get<GridGeometry>();
+  if (grid.nx != request.grid.nx || grid.ny != request.grid.ny || grid.x0_m != request.grid.x0_m ||
+      grid.y0_m != request.grid.y0_m || grid.dx_m != request.grid.dx_m ||
+      grid.dy_m != request.grid.dy_m)
+    in.Fail("is on another grid than the scene's DEM");
+  RasterAccumulator acc(request);
+  acc.rocks_ = static_cast<long>(in.Get<std::int64_t>());
+  std::vector<int> passages(static_cast<std::size_t>(grid.nx) * grid.ny, 0);
+  std::vector<int> deposits(passages.size(), 0);
+  GetCounts(in, passages);
+  GetCounts(in, deposits);
+  if (!acc.passages_.empty()) acc.passages_ = std::move(passages);
+  if (!acc.deposits_.empty()) acc.deposits_ = std::move(deposits);
+  const auto passed = in.GetVector<std::int32_t>();
+  if (!passed.empty() && acc.slot_.empty()) in.Fail();
+  for (std::int32_t c : passed) {
+    if (c < 0 || static_cast<std::size_t>(c) >= acc.slot_.size() ||
+        acc.slot_[static_cast<std::size_t>(c)] >= 0)
+      in.Fail();
+    ValueSummary* s = acc.Summaries(c);
+    for (int k = 0; k < acc.quantities(); ++k) s[k] = ValueSummary::Deserialize(in);
+  }
+  return acc;
 }
 
 }  // namespace talus::ensemble

@@ -1,11 +1,14 @@
 #pragma once
 // Raster statistics of an ensemble on the DEM grid: each rock leaves a footprint (the cells its
 // centre of mass passed, with its largest speed, energy and jump height in each), and footprints
-// are merged in rock order, so that the rasters do not depend on the number of threads.
+// are summarised per cell so that the rasters do not depend on the number of threads, ranks or
+// partial runs.
 
 #include <string>
 #include <vector>
 
+#include "common/bytes.hpp"
+#include "ensemble/cell_summary.hpp"
 #include "ensemble/outcome.hpp"
 #include "ensemble/recorders.hpp"
 #include "solver/simulate.hpp"
@@ -63,27 +66,42 @@ struct RasterLayer {
   static constexpr float kNoData = -9999.0f;
 };
 
-// Merges footprints; Add must be called in rock order for bit-identical results.
+// Merges footprints into per-cell summaries (cell_summary.hpp): counts, maxima, means and 95th
+// percentiles whose result does not depend on the order of the rocks or on how they were split
+// between accumulators (Merge), to the bit. Memory: 4 bytes per cell for each of the slot,
+// passage and deposit grids in use, plus, per passed cell and requested quantity, one
+// ValueSummary (64 bytes) and 8 bytes per histogram bin it holds; it does not grow with the
+// number of rocks beyond the bins (at most 64 per octave of the cell's values).
 class RasterAccumulator {
  public:
   explicit RasterAccumulator(const RasterRequest& request);
   void Add(const Footprint& footprint);
+  // Adds the rocks of `other`, which must have the same request.
+  void Merge(const RasterAccumulator& other);
   std::vector<RasterLayer> Finish() const;
+  long rocks() const { return rocks_; }
+  const RasterRequest& request() const { return request_; }
+  // Bytes held now (grids, summaries and their bins), for memory reports.
+  std::size_t MemoryBytes() const;
+
+  // The state, for merging in another process; Deserialize checks that it was made for the same
+  // request and grid, and throws std::runtime_error otherwise or when the bytes are damaged.
+  void Serialize(ByteWriter& out) const;
+  static RasterAccumulator Deserialize(const RasterRequest& request, ByteReader& in);
+
+  // The fraction whose quantile the *_p95 rasters show.
+  static constexpr double kPercentile = 0.95;
 
  private:
-  struct Stat {
-    std::vector<float> max;
-    std::vector<double> sum;
-    std::vector<std::vector<float>> values;  // every rock's value per cell, for the percentile
-  };
-  void AddStat(Stat& stat, int cell, float value);
-  void FinishStat(const Stat& stat, const std::string& name, const std::string& unit,
-                  std::vector<RasterLayer>& out) const;
+  // The summaries of a passed cell, created on its first passage.
+  ValueSummary* Summaries(int cell);
+  int quantities() const;
 
   RasterRequest request_;
   long rocks_ = 0;
   std::vector<int> passages_, deposits_;
-  Stat speed_, energy_, jump_;
+  std::vector<int> slot_;  // per cell: index of its first summary in summaries_, or -1
+  std::vector<ValueSummary> summaries_;  // per passed cell: speed, energy, jump height as requested
 };
 
 }  // namespace talus::ensemble

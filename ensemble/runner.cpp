@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <memory>
 #include <optional>
+#include <stdexcept>
 #include <thread>
 
 #include "ensemble/ordered_pool.hpp"
@@ -68,17 +69,33 @@ int WorkerThreads(int requested, long total_rocks) {
   return static_cast<int>(std::clamp<long>(threads, 1, std::max<long>(total_rocks, 1)));
 }
 
+void EnsembleReport::AddCounts(const EnsembleReport& other) {
+  rocks += other.rocks;
+  for (std::size_t k = 0; k < by_end.size(); ++k) by_end[k] += other.by_end[k];
+  raised += other.raised;
+  steps += other.steps;
+  stayed_at_release += other.stayed_at_release;
+  unconverged_steps += other.unconverged_steps;
+}
+
 EnsembleReport RunEnsemble(const Scene& scene, const ReleaseSpec& release,
                            const EnsembleOptions& options, RockSink* sink) {
   const auto t0 = std::chrono::steady_clock::now();
-  const long total = release.total_rocks();
+  const long first = options.first_rock;
+  const long end = options.end_rock < 0 ? release.total_rocks() : options.end_rock;
+  if (first < 0 || end < first || end > release.total_rocks())
+    throw std::invalid_argument("RunEnsemble: rocks " + std::to_string(first) + ":" +
+                                std::to_string(end) + " are not within the ensemble's " +
+                                std::to_string(release.total_rocks()));
+  const long total = end - first;
   const int threads = WorkerThreads(options.threads, total);
 
   // Worker side: release, run with the recorders, hand over the outcome.
   auto make_worker = [&]() -> std::function<RockOutcome(long)> {
     auto workspace = std::make_shared<SimulationWorkspace>();
     auto recorders = std::make_shared<RecorderSet>(MakeRecorders(scene, options));
-    return [&scene, &release, workspace, recorders](long rock) {
+    return [&scene, &release, workspace, recorders, first](long item) {
+      const long rock = first + item;
       RockOutcome out;
       out.rock = rock;
       out.release = release.ReleaseOf(rock);
@@ -115,7 +132,10 @@ EnsembleReport RunEnsemble(const Scene& scene, const ReleaseSpec& release,
   RunInOrder(total, pool, make_worker, merge);
 
   if (options.progress) options.progress(report.rocks, total);
-  if (rasters) report.rasters = rasters->Finish();
+  if (rasters && options.keep_raster_state)
+    report.raster_state = std::move(rasters);
+  else if (rasters)
+    report.rasters = rasters->Finish();
   report.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return report;
 }

@@ -9,6 +9,7 @@
 #include <Eigen/Geometry>
 #include <array>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -21,12 +22,18 @@
 namespace talus::ensemble {
 
 struct EnsembleOptions {
-  int threads = 0;                      // worker threads; 0: all cores
+  int threads = 0;  // worker threads; 0: all cores
+  // The rocks to run: [first_rock, end_rock) of the release; end_rock < 0: to the last one.
+  long first_rock = 0;
+  long end_rock = -1;
   bool trajectories = false;            // record every rock's trajectory
   long sample_trajectories = 0;         // record also the trajectories of rocks 0 .. n - 1
   double trajectory_interval_s = 0.01;  // samples at t = 0, every interval, and the end
   RasterRequest rasters;                // nothing requested: no raster work
-  bool episodes = false;                // record every rock's contact episodes
+  // Keep the raster accumulator in the report (EnsembleReport::raster_state) for merging with other
+  // runs' instead of finishing the rasters.
+  bool keep_raster_state = false;
+  bool episodes = false;  // record every rock's contact episodes
   EpisodeOptions episode_options;
   std::vector<RecorderFactory> extra_recorders;  // further per-thread recorders
   // Called on the calling thread with (rocks done, rocks in total), at most every 0.2 s and at the
@@ -54,6 +61,10 @@ struct EnsembleReport {
   int threads = 1;
   double wall_time_s = 0;
   std::vector<RasterLayer> rasters;
+  std::optional<RasterAccumulator> raster_state;  // with EnsembleOptions::keep_raster_state
+
+  // Adds the counts of another part of the same ensemble (rasters are merged by the caller).
+  void AddCounts(const EnsembleReport& other);
 
   double trajectories_per_s() const { return wall_time_s > 0 ? double(rocks) / wall_time_s : 0.0; }
   long count(EndReason end) const { return by_end[static_cast<std::size_t>(end)]; }
@@ -64,7 +75,8 @@ struct EnsembleReport {
 // core): never more than there are rocks, at least one.
 int WorkerThreads(int requested, long total_rocks);
 
-// Runs rocks 0 .. release.total_rocks() - 1. Requires scene.IsValid() and release.IsValid().
+// Runs rocks options.first_rock .. options.end_rock - 1 (all by default). Requires scene.IsValid(),
+// release.IsValid() and 0 <= first_rock <= end_rock <= release.total_rocks().
 // An exception thrown by the sink stops the workers and is rethrown.
 EnsembleReport RunEnsemble(const Scene& scene, const ReleaseSpec& release,
                            const EnsembleOptions& options, RockSink* sink = nullptr);

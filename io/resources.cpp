@@ -11,6 +11,7 @@
 #include <numeric>
 #include <sstream>
 
+#include "ensemble/cell_summary.hpp"
 #include "ensemble/ordered_pool.hpp"
 #include "ensemble/outcome.hpp"
 
@@ -31,6 +32,7 @@ constexpr double kGeoTiffBytesPerCell = 4;
 // spare capacity of a std::vector grown by push_back (capacity doubles: 1.5 on average).
 constexpr double kHeapBlockOverhead = 16;
 constexpr double kVectorGrowth = 1.5;
+constexpr double kHistogramBinBytes = 8;  // ValueSummary's bin: key and count
 
 // The quick-look image per pixel: an RGB triple of doubles, a byte band and GDAL's 3-band canvas.
 constexpr double kQuickLookBytesPerPixel = 3 * sizeof(double) + 1 + 3;
@@ -42,10 +44,16 @@ std::string Cells(const GridGeometry& g) {
 }  // namespace
 
 double PercentileStorageBytes(int stats, double cells, double passes) {
-  // RasterAccumulator::Stat::values: a std::vector<float> per cell with every rock's value.
+  // RasterAccumulator: a ValueSummary per passed cell and statistic (ensemble/cell_summary.hpp),
+  // with a histogram bin per distinct bin of its values: at most one per value, and at most 64 per
+  // octave of the cell's range (counted here as 16 octaves, far wider than any cell's spread),
+  // plus a slot per DEM cell pointing at the cell's summaries.
+  if (stats == 0) return 0;
   const double touched = std::min(cells, passes);  // cells with at least one value
-  return stats * (cells * sizeof(std::vector<float>) + touched * kHeapBlockOverhead +
-                  passes * sizeof(float) * kVectorGrowth);
+  const double bins = std::min(passes, touched * 64 * 16);
+  return cells * sizeof(int) +
+         stats * (touched * sizeof(ensemble::ValueSummary) * kVectorGrowth +
+                  bins * kHistogramBinBytes * kVectorGrowth + touched * kHeapBlockOverhead);
 }
 
 double ResourceEstimate::memory_bytes() const {
@@ -89,19 +97,17 @@ ResourceEstimate EstimateResources(const SceneFile& scene, int threads) {
     e.memory.push_back({"raster footprint grids of " + std::to_string(threads) + " threads",
                         double(threads) * cells * sizeof(int),
                         "fewer threads (--threads), or a coarser DEM"});
-    // RasterAccumulator: counters, and a maximum (float) and a sum (double) per statistic.
+    // RasterAccumulator: passage and deposit counters per DEM cell.
     const double counters =
         (rasters.passages || rasters.reach_probability ? 1 : 0) + (rasters.deposits ? 1 : 0);
-    e.memory.push_back({"raster accumulators",
-                        cells * (counters * sizeof(int) + stats * (sizeof(float) + sizeof(double))),
-                        fewer_rasters});
+    e.memory.push_back({"raster accumulators", cells * counters * sizeof(int), fewer_rasters});
     if (stats > 0)
       e.memory.push_back(
-          {"values behind the p95 rasters of speed, energy or jump_height (" +
+          {"per-cell summaries behind the speed, energy or jump_height rasters (" +
                std::to_string(stats) + " of them)",
            PercentileStorageBytes(stats, cells, rocks * footprint),
-           "fewer rocks (--rocks), or leave speed, energy and jump_height out of [output] "
-           "rasters"});
+           "fewer rocks (--rocks), a coarser DEM, or leave speed, energy and jump_height "
+           "out of [output] rasters"});
     const double layers =
         3 * stats + int(rasters.passages) + int(rasters.deposits) + int(rasters.reach_probability);
     e.memory.push_back({"output rasters", cells * layers * sizeof(float), fewer_rasters});

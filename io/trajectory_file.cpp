@@ -195,9 +195,23 @@ TrajectoryWriter::TrajectoryWriter(const std::string& path, const RockShape& roc
 TrajectoryWriter::~TrajectoryWriter() = default;
 
 void TrajectoryWriter::Write(const ensemble::RockOutcome& rock) {
+  StoredTrajectory stored;
+  // Each rock's own shape (runs with blocks, or a shape per rock), else the scene's rock.
+  if (rock.shape) {
+    stored.mass_kg = rock.shape->mass_kg;
+    stored.principal_inertia_kg_m2 = rock.shape->inertia_kg_m2;
+  } else if (impl_) {
+    stored.mass_kg = impl_->mass_kg;
+    stored.principal_inertia_kg_m2 = Eigen::Vector3d(impl_->inertia.data());
+  }
+  stored.samples = rock.trajectory;
+  Write(rock.rock, stored);
+}
+
+void TrajectoryWriter::Write(long rock, const StoredTrajectory& stored) {
   if (!impl_) throw std::logic_error("TrajectoryWriter::Write after a failure or Commit");
   SilenceHdf5();
-  const auto& samples = rock.trajectory;
+  const auto& samples = stored.samples;
   const hsize_t n = samples.size();
   std::vector<double> t, position, quaternion, velocity, angular, scar;
   std::vector<std::uint8_t> contact;
@@ -213,16 +227,10 @@ void TrajectoryWriter::Write(const ensemble::RockOutcome& rock) {
     scar.push_back(s.scar_m);
   }
   try {
-    Handle group = CreateGroup(impl_->rocks.get(), std::to_string(rock.rock).c_str());
-    // Each rock's own shape (runs with blocks, or a shape per rock), else the scene's rock.
-    if (rock.shape) {
-      const Eigen::Vector3d& inertia = rock.shape->inertia_kg_m2;
-      Attribute(group.get(), "mass_kg", {rock.shape->mass_kg});
-      Attribute(group.get(), "principal_inertia_kg_m2", {inertia.x(), inertia.y(), inertia.z()});
-    } else {
-      Attribute(group.get(), "mass_kg", {impl_->mass_kg});
-      Attribute(group.get(), "principal_inertia_kg_m2", impl_->inertia);
-    }
+    Handle group = CreateGroup(impl_->rocks.get(), std::to_string(rock).c_str());
+    const Eigen::Vector3d& inertia = stored.principal_inertia_kg_m2;
+    Attribute(group.get(), "mass_kg", {stored.mass_kg});
+    Attribute(group.get(), "principal_inertia_kg_m2", {inertia.x(), inertia.y(), inertia.z()});
     const hid_t d = H5T_NATIVE_DOUBLE;
     Dataset(group.get(), "t", d, t, n, 1);
     Dataset(group.get(), "position", d, position, n, 3);
@@ -235,7 +243,7 @@ void TrajectoryWriter::Write(const ensemble::RockOutcome& rock) {
   } catch (const Hdf5Failure& failure) {
     const std::string reason = failure.reason;
     impl_.reset();  // abandon the file: nothing more is written to it
-    throw std::runtime_error("cannot write rock " + std::to_string(rock.rock) + " to " +
+    throw std::runtime_error("cannot write rock " + std::to_string(rock) + " to " +
                              file_.final_path() + ": " + reason);
   }
 }
@@ -255,6 +263,96 @@ void TrajectoryWriter::Commit() {
   }
   impl_.reset();
   file_.Commit();
+}
+
+namespace {
+
+// Reads a whole attribute or dataset of doubles (or bytes) of `n` values.
+template <class T>
+std::vector<T> ReadValues(hid_t object, const char* name, hid_t type, bool attribute,
+                          hsize_t per_row, hsize_t* rows) {
+  Handle item = attribute ? Handle(Check(H5Aopen(object, name, H5P_DEFAULT), name), H5Aclose)
+                          : Handle(Check(H5Dopen2(object, name, H5P_DEFAULT), name), H5Dclose);
+  Handle space(Check(attribute ? H5Aget_space(item.get()) : H5Dget_space(item.get()), name),
+               H5Sclose);
+  const hssize_t n = H5Sget_simple_extent_npoints(space.get());
+  if (n < 0 || static_cast<hsize_t>(n) % per_row != 0) Fail(name);
+  if (rows) *rows = static_cast<hsize_t>(n) / per_row;
+  std::vector<T> values(static_cast<std::size_t>(n));
+  if (n > 0)
+    Check(attribute ? H5Aread(item.get(), type, values.data())
+                    : H5Dread(item.get(), type, H5S_ALL, H5S_ALL, H5P_DEFAULT, values.data()),
+          name);
+  return values;
+}
+
+}  // namespace
+
+struct TrajectoryReader::Impl {
+  Handle file;
+};
+
+TrajectoryReader::TrajectoryReader(const std::string& path) : path_(path) {
+  SilenceHdf5();
+  impl_ = std::make_unique<Impl>();
+  try {
+    impl_->file = Handle(Check(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), "open the file"),
+                         H5Fclose);
+  } catch (const Hdf5Failure& failure) {
+    throw std::runtime_error("cannot read " + path + ": " + failure.reason);
+  }
+}
+
+TrajectoryReader::~TrajectoryReader() = default;
+
+StoredTrajectory TrajectoryReader::Read(long rock) const {
+  SilenceHdf5();
+  const std::string name = "/rocks/" + std::to_string(rock);
+  try {
+    const Handle group(
+        Check(H5Gopen2(impl_->file.get(), name.c_str(), H5P_DEFAULT), "no such rock"), H5Gclose);
+    const hid_t g = group.get();
+    const hid_t d = H5T_NATIVE_DOUBLE;
+    StoredTrajectory out;
+    const auto mass = ReadValues<double>(g, "mass_kg", d, true, 1, nullptr);
+    const auto inertia = ReadValues<double>(g, "principal_inertia_kg_m2", d, true, 3, nullptr);
+    if (mass.size() != 1 || inertia.size() != 3) Fail("rock attributes");
+    out.mass_kg = mass[0];
+    out.principal_inertia_kg_m2 = Eigen::Vector3d(inertia.data());
+    hsize_t n = 0, rows = 0;
+    const auto t = ReadValues<double>(g, "t", d, false, 1, &n);
+    const auto check = [&](hsize_t r) {
+      if (r != n) Fail("datasets of different lengths");
+    };
+    const auto position = ReadValues<double>(g, "position", d, false, 3, &rows);
+    check(rows);
+    const auto quaternion = ReadValues<double>(g, "quaternion", d, false, 4, &rows);
+    check(rows);
+    const auto velocity = ReadValues<double>(g, "velocity", d, false, 3, &rows);
+    check(rows);
+    const auto angular = ReadValues<double>(g, "angular_velocity", d, false, 3, &rows);
+    check(rows);
+    const auto contact = ReadValues<std::uint8_t>(g, "contact", H5T_NATIVE_UINT8, false, 1, &rows);
+    check(rows);
+    const auto scar = ReadValues<double>(g, "scar", d, false, 1, &rows);
+    check(rows);
+    out.samples.resize(n);
+    for (std::size_t k = 0; k < n; ++k) {
+      ensemble::TrajectorySample& s = out.samples[k];
+      s.t_s = t[k];
+      s.position_m = Eigen::Vector3d(&position[3 * k]);
+      s.orientation = Eigen::Quaterniond(quaternion[4 * k], quaternion[4 * k + 1],
+                                         quaternion[4 * k + 2], quaternion[4 * k + 3]);
+      s.velocity_m_s = Eigen::Vector3d(&velocity[3 * k]);
+      s.angular_velocity_rad_s = Eigen::Vector3d(&angular[3 * k]);
+      s.contact = contact[k] != 0;
+      s.scar_m = scar[k];
+    }
+    return out;
+  } catch (const Hdf5Failure& failure) {
+    throw std::runtime_error("cannot read rock " + std::to_string(rock) + " from " + path_ + ": " +
+                             failure.reason);
+  }
 }
 
 }  // namespace talus::io

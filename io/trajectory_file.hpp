@@ -9,12 +9,20 @@
 
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "common/atomic_file.hpp"
 #include "ensemble/runner.hpp"
 #include "solver/polyhedron.hpp"
 
 namespace talus::io {
+
+// One rock's group of a trajectories.h5, as read back.
+struct StoredTrajectory {
+  double mass_kg = 0;
+  Eigen::Vector3d principal_inertia_kg_m2 = Eigen::Vector3d::Zero();
+  std::vector<ensemble::TrajectorySample> samples;
+};
 
 class TrajectoryWriter {
  public:
@@ -26,11 +34,30 @@ class TrajectoryWriter {
   TrajectoryWriter& operator=(const TrajectoryWriter&) = delete;
 
   void Write(const ensemble::RockOutcome& rock);
+  // Writes a rock read from another file: the same bytes as Write of the rock it came from.
+  void Write(long rock, const StoredTrajectory& trajectory);
   void Commit();  // closes and renames into place
 
  private:
   struct Impl;
   AtomicFile file_;
+  std::unique_ptr<Impl> impl_;
+};
+
+// Reads rocks back from a trajectories.h5 (for merging partial runs). Throws std::runtime_error
+// naming the file, the rock and the reason.
+class TrajectoryReader {
+ public:
+  explicit TrajectoryReader(const std::string& path);
+  ~TrajectoryReader();
+  TrajectoryReader(const TrajectoryReader&) = delete;
+  TrajectoryReader& operator=(const TrajectoryReader&) = delete;
+
+  StoredTrajectory Read(long rock) const;
+
+ private:
+  struct Impl;
+  std::string path_;
   std::unique_ptr<Impl> impl_;
 };
 

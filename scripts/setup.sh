@@ -19,6 +19,6 @@ if ((${#missing[@]})); then
 fi
 
 if [[ ! -f "$build/build.ninja" ]]; then
-  cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
+  cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DTALUS_WITH_MPI=ON >/dev/null
 fi
 cmake --build "$build" --parallel "$(nproc)"

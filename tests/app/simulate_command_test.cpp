@@ -409,7 +409,8 @@ TEST(TalusCommandLine, ThreadsAreCappedAtAFewPerCore) {
 // runs (exit 2, nothing written), with the estimate, what is available and the knob to turn.
 TEST(SimulateCommand, ARunTooLargeForTheMachineIsRefusedBeforeAnyRock) {
   const fs::path dir = FreshDir("too_large");
-  // 3500 x 1000 cells; 10^9 rocks, each assumed to cross the diagonal: ~65 TB of p95 values.
+  // 3500 x 1000 cells; 10^9 rocks, each assumed to cross the diagonal: a full histogram in every
+  // cell, about 130 GB of per-cell summaries.
   const std::string memory_scene = R"([terrain]
 plane = { slope_deg = 35, slope_length_m = 300, runout_m = 50, width_m = 100, cell_m = 0.1 }
 [rock]
@@ -426,7 +427,7 @@ rasters = ["speed", "energy", "jump_height"]
                      "trajectories = true\nquicklook = false\n");
   const std::vector<std::pair<std::string, std::vector<std::string>>> cases = {
       {memory_scene,
-       {"of memory besides the ", " is available (", "values behind the p95 rasters",
+       {"of memory besides the ", " is available (", "per-cell summaries behind the speed",
         "(fewer rocks (--rocks)", "nothing was run"}},
       {disk_scene,
        {"the outputs need about ", " TB of disk, but ", "trajectories.h5 (10002 samples per rock",

@@ -1,3 +1,4 @@
+#include "ensemble/cell_summary.hpp"
 #include "io/resources.hpp"
 
 #include <gtest/gtest.h>
@@ -43,12 +44,18 @@ const ResourceTerm* Find(const std::vector<ResourceTerm>& terms, const std::stri
 
 #define EXPECT_HAS(text, part) EXPECT_NE(std::string(text).find(part), std::string::npos) << (text)
 
-TEST(PercentileStorageBytes, AVectorPerCellAndEveryValue) {
-  // Per statistic: a std::vector<float> (24 bytes) per cell, a heap block (16 bytes) per cell
-  // with a value, 4 bytes per value with half again of spare capacity.
-  EXPECT_DOUBLE_EQ(PercentileStorageBytes(1, 100, 1000), 100 * 24 + 100 * 16 + 1000 * 4 * 1.5);
-  EXPECT_DOUBLE_EQ(PercentileStorageBytes(1, 100, 10), 100 * 24 + 10 * 16 + 10 * 4 * 1.5);
-  EXPECT_DOUBLE_EQ(PercentileStorageBytes(3, 100, 1000), 3 * PercentileStorageBytes(1, 100, 1000));
+TEST(PercentileStorageBytes, ASummaryPerPassedCellAndABinPerValueAtMost) {
+  // A slot (4 bytes) per DEM cell; per statistic and passed cell a ValueSummary with half again of
+  // spare capacity and a heap block (16 bytes), and an 8-byte histogram bin per value, at most
+  // 64 x 16 per cell, again with half of spare capacity.
+  const double summary = sizeof(ensemble::ValueSummary) * 1.5 + 16;
+  EXPECT_DOUBLE_EQ(PercentileStorageBytes(1, 100, 1000), 100 * 4 + 100 * summary + 1000 * 8 * 1.5);
+  EXPECT_DOUBLE_EQ(PercentileStorageBytes(1, 100, 10), 100 * 4 + 10 * summary + 10 * 8 * 1.5);
+  // However many rocks pass, a cell's histogram is bounded: 1e9 passes over 100 cells cost as
+  // much as 100 x 1024 values.
+  EXPECT_DOUBLE_EQ(PercentileStorageBytes(1, 100, 1e9), PercentileStorageBytes(1, 100, 102400));
+  EXPECT_DOUBLE_EQ(PercentileStorageBytes(3, 100, 1000) - 100 * 4,
+                   3 * (PercentileStorageBytes(1, 100, 1000) - 100 * 4));
   EXPECT_DOUBLE_EQ(PercentileStorageBytes(0, 100, 1000), 0);
 }
 
@@ -62,7 +69,8 @@ TEST(EstimateResources, CountsEachPartFromTheScene) {
   EXPECT_DOUBLE_EQ(one.loaded_bytes, cells * 8);  // no ground raster
   EXPECT_DOUBLE_EQ(one.run_bytes(), one.memory_bytes() - cells * 8);
   // Speed and energy: each rock assumed to cross the DEM's diagonal.
-  const ResourceTerm* p95 = Find(one.memory, "values behind the p95 rasters");
+  const ResourceTerm* p95 =
+      Find(one.memory, "per-cell summaries behind the speed, energy or jump_height rasters");
   ASSERT_NE(p95, nullptr);
   EXPECT_DOUBLE_EQ(p95->bytes, PercentileStorageBytes(2, cells, rocks * std::hypot(61.0, 31.0)));
   EXPECT_HAS(p95->knob, "fewer rocks (--rocks)");

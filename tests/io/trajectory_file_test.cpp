@@ -34,6 +34,43 @@ ensemble::RockOutcome Rock(long index, int samples) {
   return rock;
 }
 
+// Rocks read back and written again (as talus merge does) give the original file's bytes.
+TEST(TrajectoryReader, RocksReadBackAndWrittenAgainGiveTheSameBytes) {
+  const auto dir = testing::FreshDir("h5_read");
+  const auto first = (dir / "first.h5").string(), second = (dir / "second.h5").string();
+  const RockShape shape = MakeRockShape(MakeBox(1, 2, 3), 2000);
+  auto own = std::make_shared<RockShape>(MakeRockShape(MakeBox(1, 1, 1), 2500));
+  {
+    TrajectoryWriter writer(first, shape);
+    ensemble::RockOutcome a = Rock(3, 40), b = Rock(4, 0);
+    a.shape = own;
+    a.trajectory[5].orientation = Eigen::Quaterniond(0.5, -0.5, 0.5, 0.5);
+    writer.Write(a);
+    writer.Write(b);
+    writer.Commit();
+  }
+  {
+    const TrajectoryReader reader(first);
+    const StoredTrajectory a = reader.Read(3);
+    EXPECT_EQ(a.mass_kg, own->mass_kg);
+    ASSERT_EQ(a.samples.size(), 40u);
+    EXPECT_EQ(a.samples[5].orientation.x(), -0.5);
+    EXPECT_EQ(a.samples[7].position_m.y(), 14);
+    EXPECT_THROW(reader.Read(5), std::runtime_error);
+    TrajectoryWriter writer(second, shape);
+    writer.Write(3, a);
+    writer.Write(4, reader.Read(4));
+    writer.Commit();
+  }
+  const auto slurp = [](const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    std::ostringstream bytes;
+    bytes << in.rdbuf();
+    return bytes.str();
+  };
+  EXPECT_TRUE(slurp(first) == slurp(second));
+}
+
 TEST(TrajectoryWriter, GroupsPerRockChunkedAndCompressed) {
   const auto dir = testing::FreshDir("h5");
   const auto path = (dir / "trajectories.h5").string();

@@ -1,0 +1,98 @@
+// talus merge: combines the partial results of `talus simulate --rock-range` into the outputs of
+// one run of all rocks (io/partial.hpp, docs/cluster.md).
+
+#include <algorithm>
+#include <csignal>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "app/commands.hpp"
+#include "app/interrupt.hpp"
+#include "app/run_outputs.hpp"
+#include "common/error.hpp"
+
+namespace talus::app {
+namespace {
+
+struct MergeArgs {
+  std::vector<std::string> parts;
+  std::string out;
+};
+
+int RunMerge(const MergeArgs& args) {
+  namespace fs = std::filesystem;
+  std::vector<io::PartialInfo> parts;
+  io::SceneFile scene;
+  try {
+    for (const std::string& dir : args.parts) {
+      std::error_code error;
+      if (fs::equivalent(dir, args.out, error))
+        throw InputError("--out " + args.out +
+                         " is one of the parts; merge into another directory");
+      parts.push_back(io::ReadPartialInfo(dir));
+    }
+    parts = io::CheckPartials(std::move(parts));
+    scene = LoadSceneOfPart(parts.front());
+  } catch (const InputError& e) {
+    std::cerr << "talus merge: " << e.what() << "\n";
+    return kExitBadInput;
+  } catch (const std::exception& e) {
+    std::cerr << "talus merge: " << e.what() << "\n";
+    return kExitRunFailed;
+  }
+  if (const std::string why = PrepareOutputDirectory(args.out); !why.empty()) {
+    std::cerr << "talus merge: " << why << "\n";
+    return kExitBadInput;
+  }
+  const InterruptScope interrupts;
+  std::signal(SIGXFSZ, SIG_IGN);  // a file-size limit is a write error ("File too large")
+  RemoveStaleTemporaries(args.out);
+  std::optional<StagingDirectory> staging;
+  try {
+    staging.emplace(args.out);
+    // The threads and wall time of the parts, for the summary: the most threads any part used and
+    // the sum of the parts' wall times.
+    int threads = 1;
+    double wall_time_s = 0;
+    for (const io::PartialInfo& p : parts) {
+      threads = std::max(threads, p.counts.threads);
+      wall_time_s += p.counts.wall_time_s;
+    }
+    ensemble::EnsembleReport report;
+    const std::vector<std::string> files =
+        MergeIntoStaging(scene, parts, threads, wall_time_s, *staging, &report);
+    CommitOutputs(*staging, files, args.out);
+    std::printf("Merged %zu parts of %s: %s\n", parts.size(), scene.path.c_str(),
+                report.BriefReport().c_str());
+    std::printf("Wrote %zu files to %s\n", files.size(), args.out.c_str());
+    return kExitOk;
+  } catch (const Interrupted& e) {
+    staging.reset();
+    std::cerr << "talus merge: " << e.what() << "; removed this run's temporary files, " << args.out
+              << " is as it was before\n";
+    return ExitCodeForSignal(e.signal());
+  } catch (const std::exception& e) {
+    const std::string message = staging ? staging->Describe(e.what()) : e.what();
+    staging.reset();
+    std::cerr << "talus merge: " << message << " (no output written)\n";
+    return kExitRunFailed;
+  }
+}
+
+}  // namespace
+
+Runner AddMergeCommand(CLI::App& app) {
+  auto args = std::make_shared<MergeArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "merge", "Combine partial results of talus simulate --rock-range into one run's outputs");
+  cmd->add_option("parts", args->parts, "Directories of the partial results, in any order")
+      ->required();
+  cmd->add_option("--out", args->out, "Output directory")->required();
+  return [cmd, args]() { return *cmd ? RunMerge(*args) : -1; };
+}
+
+}  // namespace talus::app

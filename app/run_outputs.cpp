@@ -1,0 +1,243 @@
+#include "app/run_outputs.hpp"
+
+#include <cpl_error.h>
+
+#include <algorithm>
+#include <charconv>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include "app/interrupt.hpp"
+#include "common/error.hpp"
+#include "io/quicklook.hpp"
+#include "io/raster.hpp"
+#include "io/rocks_csv.hpp"
+#include "io/summary.hpp"
+#include "io/trajectory_file.hpp"
+#include "talus/version.hpp"
+
+namespace talus::app {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Streams each finished rock to rocks.csv and trajectories.h5.
+// Keeps the horizontal paths of the quick-look's sample rocks.
+class FileSink : public ensemble::RockSink {
+ public:
+  FileSink(io::RocksCsvWriter& csv, io::TrajectoryWriter* trajectories, long sample)
+      : csv_(csv), trajectories_(trajectories), sample_(sample) {}
+  void OnRock(const ensemble::RockOutcome& rock) override {
+    ThrowIfInterrupted();
+    csv_.Write(rock);
+    if (trajectories_) trajectories_->Write(rock);
+    if (rock.rock < sample_) {
+      io::SamplePath& path = paths.emplace_back();
+      path.rock = rock.rock;
+      for (const ensemble::TrajectorySample& s : rock.trajectory)
+        path.xy_m.push_back(s.position_m.head<2>());
+    }
+  }
+  std::vector<io::SamplePath> paths;
+
+ private:
+  io::RocksCsvWriter& csv_;
+  io::TrajectoryWriter* trajectories_;
+  long sample_;
+};
+
+// Keeps GDAL's error messages off stderr while alive (on this thread); they stay readable through
+// CPLGetLastErrorMsg, which the raster writers put in their exceptions.
+class QuietGdal {
+ public:
+  QuietGdal() { CPLPushErrorHandler(CPLQuietErrorHandler); }
+  ~QuietGdal() { CPLPopErrorHandler(); }
+  QuietGdal(const QuietGdal&) = delete;
+  QuietGdal& operator=(const QuietGdal&) = delete;
+};
+
+// Writes the rasters, the quick-look and summary.json of a whole ensemble after `outputs`;
+// returns all files in commit order (summary.json last: it is there only with its outputs).
+std::vector<std::string> WriteSummaryOutputs(const io::SceneFile& scene,
+                                             const ensemble::EnsembleReport& report,
+                                             const std::vector<ensemble::RasterLayer>& layers,
+                                             const std::vector<io::SamplePath>& paths,
+                                             const StagingDirectory& staging,
+                                             std::vector<std::string> outputs) {
+  const GridGeometry& dem = scene.scene.terrain.heights().grid;
+  // GDAL would print every failed write of a full disk; the writers throw with its last message.
+  const QuietGdal quiet_gdal;
+  for (const ensemble::RasterLayer& layer : layers) {
+    ThrowIfInterrupted();
+    io::WriteGeoTiff(staging.path(layer.name + ".tif"), dem, scene.crs_wkt, layer.values,
+                     layer.has_nodata, ensemble::RasterLayer::kNoData,
+                     layer.name + " (" + layer.unit + ")");
+    outputs.push_back(layer.name + ".tif");
+  }
+  ThrowIfInterrupted();
+  if (scene.output.quicklook) {
+    std::vector<std::vector<Eigen::Vector2d>> xy;
+    for (const io::SamplePath& p : paths) xy.push_back(p.xy_m);
+    io::WriteQuickLookPng(staging.path("quicklook.png"), scene.scene.terrain.heights(),
+                          io::QuickLookLayer(layers), xy);
+    outputs.push_back("quicklook.png");
+  }
+  WriteFileAtomically(staging.path("summary.json"),
+                      io::SummaryJson(scene, report, kVersion, outputs));
+  ThrowIfInterrupted();
+  outputs.push_back("summary.json");
+  return outputs;
+}
+
+// Copies `from` to `out`, without its first line when `skip_header`; that line must be `header`.
+void AppendCsv(const std::string& from, bool skip_header, const std::string& header,
+               std::ofstream& out) {
+  std::ifstream in(from, std::ios::binary);
+  std::string first;
+  if (!in || !std::getline(in, first)) throw std::runtime_error("cannot read " + from);
+  if (first != header) throw std::runtime_error(from + " does not start with the rocks.csv header");
+  if (!skip_header) out << first << '\n';
+  if (in.peek() != std::ifstream::traits_type::eof()) out << in.rdbuf();
+  if (in.bad()) throw std::runtime_error("cannot read " + from);
+}
+
+}  // namespace
+
+std::vector<std::string> TalusOutputNames() {
+  std::vector<std::string> names = {
+      "rocks.csv",    "trajectories.h5",       "summary.json", "quicklook.png", "passages.tif",
+      "deposits.tif", "reach_probability.tif", "partial.json", "partial.bin"};
+  for (const char* quantity : {"speed", "energy", "jump_height"})
+    for (const char* statistic : {"max", "mean", "p95"})
+      names.push_back(std::string(quantity) + "_" + statistic + ".tif");
+  return names;
+}
+
+std::vector<std::string> RunIntoStaging(const io::SceneFile& scene, int threads, long first_rock,
+                                        long end_rock, bool part, const StagingDirectory& staging,
+                                        std::function<void(long, long)> progress,
+                                        ensemble::EnsembleReport* report) {
+  ensemble::EnsembleOptions options;
+  options.threads = threads;
+  options.first_rock = first_rock;
+  options.end_rock = end_rock;
+  options.trajectories = scene.output.trajectories;
+  options.trajectory_interval_s = scene.output.trajectory_interval_s;
+  options.sample_trajectories = scene.output.quicklook ? kQuickLookPaths : 0;
+  options.rasters = scene.output.Request(scene.scene.terrain.heights().grid);
+  options.keep_raster_state = part;
+  options.progress = std::move(progress);
+
+  std::vector<std::string> outputs = {"rocks.csv"};
+  io::RocksCsvWriter csv(staging.path("rocks.csv"), scene.release);
+  std::unique_ptr<io::TrajectoryWriter> trajectories;
+  if (scene.output.trajectories) {
+    trajectories =
+        std::make_unique<io::TrajectoryWriter>(staging.path("trajectories.h5"), scene.scene.rock);
+    outputs.push_back("trajectories.h5");
+  }
+  FileSink sink(csv, trajectories.get(), options.sample_trajectories);
+  *report = ensemble::RunEnsemble(scene.scene, scene.release, options, &sink);
+  ThrowIfInterrupted();
+  csv.Commit();
+  if (trajectories) trajectories->Commit();
+  if (!part)
+    return WriteSummaryOutputs(scene, *report, report->rasters, sink.paths, staging, outputs);
+  WriteFileAtomically(staging.path("partial.bin"), io::PartialState(*report, sink.paths));
+  WriteFileAtomically(staging.path("partial.json"),
+                      io::PartialJson(scene, kVersion, first_rock, end_rock, *report));
+  outputs.push_back("partial.bin");
+  outputs.push_back("partial.json");  // last: a complete part is one with a partial.json
+  return outputs;
+}
+
+std::vector<std::string> MergeIntoStaging(const io::SceneFile& scene,
+                                          const std::vector<io::PartialInfo>& parts, int threads,
+                                          double wall_time_s, const StagingDirectory& staging,
+                                          ensemble::EnsembleReport* report) {
+  *report = ensemble::EnsembleReport{};
+  std::vector<std::string> outputs = {"rocks.csv"};
+  {
+    std::ofstream csv(staging.path("rocks.csv"), std::ios::binary);
+    for (std::size_t k = 0; k < parts.size(); ++k) {
+      ThrowIfInterrupted();
+      AppendCsv((fs::path(parts[k].dir) / "rocks.csv").string(), k > 0,
+                io::RocksCsvWriter::Header(), csv);
+    }
+    csv.close();
+    if (!csv) throw std::runtime_error("cannot write " + staging.path("rocks.csv"));
+  }
+  if (scene.output.trajectories) {
+    io::TrajectoryWriter out(staging.path("trajectories.h5"), scene.scene.rock);
+    for (const io::PartialInfo& part : parts) {
+      const io::TrajectoryReader in((fs::path(part.dir) / "trajectories.h5").string());
+      for (long rock = part.first_rock; rock < part.end_rock; ++rock) {
+        if ((rock & 255) == 0) ThrowIfInterrupted();
+        out.Write(rock, in.Read(rock));
+      }
+    }
+    out.Commit();
+    outputs.push_back("trajectories.h5");
+  }
+  const ensemble::RasterRequest request = scene.output.Request(scene.scene.terrain.heights().grid);
+  std::optional<ensemble::RasterAccumulator> rasters;
+  std::vector<io::SamplePath> paths;
+  for (const io::PartialInfo& part : parts) {
+    ThrowIfInterrupted();
+    io::ReadPartialState(part, request, &rasters, &paths);
+    report->AddCounts(part.counts);
+  }
+  report->threads = threads;
+  report->wall_time_s = wall_time_s;
+  const std::vector<ensemble::RasterLayer> layers =
+      rasters ? rasters->Finish() : std::vector<ensemble::RasterLayer>{};
+  return WriteSummaryOutputs(scene, *report, layers, paths, staging, outputs);
+}
+
+void CommitOutputs(StagingDirectory& staging, const std::vector<std::string>& files,
+                   const std::string& dir) {
+  staging.Commit(files);
+  // An earlier run's outputs that this run did not replace must not pass for this run's.
+  int stale = 0;
+  for (const std::string& name : TalusOutputNames()) {
+    if (std::find(files.begin(), files.end(), name) != files.end()) continue;
+    std::error_code error;
+    stale += fs::remove(fs::path(dir) / name, error) ? 1 : 0;
+  }
+  if (stale > 0) std::printf("Removed %d outputs of an earlier run from %s\n", stale, dir.c_str());
+}
+
+io::SceneFile LoadSceneOfPart(const io::PartialInfo& part) {
+  io::SceneFile scene = io::LoadScene(part.scene_file);
+  if (scene.inputs_hash != part.inputs_hash)
+    throw InputError(part.dir + ": the scene " + part.scene_file +
+                     " or its data files changed since this part was run (inputs hash " +
+                     scene.inputs_hash + ", was " + part.inputs_hash + ")");
+  scene.path = part.scene;
+  scene.inputs = part.inputs;
+  scene.release.rocks_per_release = part.rocks_per_release;
+  scene.release.seed = part.seed;
+  if (scene.release.total_rocks() != part.total_rocks)
+    throw InputError(part.dir + ": the scene gives " + std::to_string(scene.release.total_rocks()) +
+                     " rocks, the part " + std::to_string(part.total_rocks));
+  return scene;
+}
+
+std::pair<long, long> ParseRockRange(const std::string& text) {
+  const std::size_t colon = text.find(':');
+  long first = -1, end = -1;
+  const auto number = [](const std::string& s, long* value) {
+    const auto [at, error] = std::from_chars(s.data(), s.data() + s.size(), *value);
+    return !s.empty() && error == std::errc() && at == s.data() + s.size() && *value >= 0;
+  };
+  if (colon == std::string::npos || !number(text.substr(0, colon), &first) ||
+      !number(text.substr(colon + 1), &end))
+    throw InputError("--rock-range: expected A:B (rocks A .. B - 1, 0 <= A < B), got '" + text +
+                     "'");
+  if (end <= first)
+    throw InputError("--rock-range " + text + ": the range is empty (B must be greater than A)");
+  return {first, end};
+}
+
+}  // namespace talus::app

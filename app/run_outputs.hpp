@@ -1,0 +1,54 @@
+#pragma once
+// The outputs of a simulation run, shared by `talus simulate` (one process, a part of the rocks,
+// or MPI ranks) and `talus merge`: running rocks into a staging directory as a whole run or as a
+// part (io/partial.hpp), merging parts, and writing the rasters, quick-look and summary.json.
+
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "common/atomic_file.hpp"
+#include "ensemble/runner.hpp"
+#include "io/partial.hpp"
+#include "io/scene_file.hpp"
+
+namespace talus::app {
+
+// Rocks drawn on the quick-look (the first ones).
+inline constexpr long kQuickLookPaths = 20;
+
+// Every file name talus simulate and merge may write into an output directory.
+std::vector<std::string> TalusOutputNames();
+
+// Runs rocks [first_rock, end_rock) of the scene and writes them into `staging`: rocks.csv and
+// trajectories.h5 (when asked); then, as a `part`, partial.bin and partial.json, else (the whole
+// ensemble) the rasters, quick-look and summary.json. Returns the files written, in commit order.
+// `progress` is called on the calling thread (and may throw to stop the run).
+std::vector<std::string> RunIntoStaging(const io::SceneFile& scene, int threads, long first_rock,
+                                        long end_rock, bool part, const StagingDirectory& staging,
+                                        std::function<void(long, long)> progress,
+                                        ensemble::EnsembleReport* report);
+
+// Merges parts that CheckPartials accepted into `staging`: rocks.csv, trajectories.h5, rasters,
+// quick-look and summary.json, the same bytes as one run of all rocks (summary.json's threads and
+// timings aside: `threads` and `wall_time_s` are written there). Returns the files written, in
+// commit order; *report gets the merged counts.
+std::vector<std::string> MergeIntoStaging(const io::SceneFile& scene,
+                                          const std::vector<io::PartialInfo>& parts, int threads,
+                                          double wall_time_s, const StagingDirectory& staging,
+                                          ensemble::EnsembleReport* report);
+
+// Commits the staged files into `dir` and removes the outputs of an earlier run there that this one
+// did not replace (printing how many).
+void CommitOutputs(StagingDirectory& staging, const std::vector<std::string>& files,
+                   const std::string& dir);
+
+// The scene a part was run with, loaded again from its scene file (with the part's --rocks and
+// --seed, and its scene path as given). Throws InputError when the scene's inputs changed since.
+io::SceneFile LoadSceneOfPart(const io::PartialInfo& part);
+
+// Parses "A:B" (0 <= A < B) into [A, B); throws InputError naming --rock-range.
+std::pair<long, long> ParseRockRange(const std::string& text);
+
+}  // namespace talus::app

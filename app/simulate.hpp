@@ -1,0 +1,76 @@
+#pragma once
+// talus simulate, shared by its one-process run (simulate_command.cpp) and its MPI run
+// (simulate_mpi.cpp): the command-line arguments, loading and checking them, the messages.
+
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdint>
+#include <cstdio>
+#include <optional>
+#include <string>
+#include <utility>
+
+#include "io/scene_file.hpp"
+
+namespace talus::app {
+
+struct SimulateArgs {
+  std::string scene;
+  std::string out;
+  long rocks = 0;  // per release; 0: the scene's
+  int threads = 0;
+  std::optional<std::uint64_t> seed;
+  std::string rock_range;  // "A:B": write a partial result of rocks A .. B - 1
+};
+
+// Loads the scene with the overrides of `args` and the rocks to run ([0, total), or --rock-range).
+// Returns kExitOk, or the exit code with the reason in *message (bad input: kExitBadInput).
+int LoadForSimulate(const SimulateArgs& args, io::SceneFile* scene, std::pair<long, long>* range,
+                    std::string* message);
+
+// "rock <shape> (<mass> kg, <n> hull vertices); <k> releases x <n> rocks, seed <s>", or the runs
+// and blocks of a run table.
+std::string DescribeRocks(const io::SceneFile& scene);
+
+// How many processes an MPI launcher (mpirun, srun) started this one among; 1 without a launcher.
+int LaunchedRanks();
+
+// talus simulate across the ranks of an MPI run: the rocks are divided among the ranks, each
+// writes a part (io/partial.hpp) and rank 0 merges them into --out, byte for byte the outputs of
+// one process. Only rank 0 prints and writes --out; every rank returns the same exit code.
+int RunSimulateOnRanks(const SimulateArgs& args);
+
+// "rocks done / total, rate, time left" on a terminal; nothing otherwise.
+class ProgressBar {
+ public:
+  ProgressBar()
+      : enabled_(::isatty(STDERR_FILENO) != 0), start_(std::chrono::steady_clock::now()) {}
+  void operator()(long done, long total) {
+    if (!enabled_ || total <= 0) return;
+    const double elapsed =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+    const double rate = elapsed > 0 ? double(done) / elapsed : 0.0;
+    const double left = rate > 0 ? double(total - done) / rate : 0.0;
+    constexpr int kWidth = 30;
+    const int filled = static_cast<int>(kWidth * done / total);
+    std::fprintf(stderr, "\r[%-*.*s] %ld/%ld rocks  %.1f/s  %s left   ", kWidth, filled,
+                 "##############################", done, total, rate,
+                 done > 0 ? (std::to_string(static_cast<long>(left + 0.5)) + " s").c_str() : "?");
+    shown_ = done < total;
+    if (done == total) std::fprintf(stderr, "\n");
+    std::fflush(stderr);
+  }
+  // Ends a bar left unfinished, so that a message starts on a line of its own.
+  void Break() {
+    if (shown_) std::fprintf(stderr, "\n");
+    shown_ = false;
+  }
+
+ private:
+  bool enabled_;
+  bool shown_ = false;
+  std::chrono::steady_clock::time_point start_;
+};
+
+}  // namespace talus::app

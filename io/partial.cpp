@@ -1,0 +1,184 @@
+#include "io/partial.hpp"
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "common/bytes.hpp"
+#include "common/error.hpp"
+
+namespace talus::io {
+namespace {
+
+constexpr const char* kFormat = "talus partial result";
+constexpr int kFormatVersion = 1;
+constexpr const char* kStateMagic = "talus partial state 1";
+
+std::string ReadWholeFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error("cannot read " + path);
+  std::ostringstream s;
+  s << in.rdbuf();
+  if (in.bad()) throw std::runtime_error("cannot read " + path);
+  return s.str();
+}
+
+std::string Range(long first, long end) {
+  return std::to_string(first) + ":" + std::to_string(end);
+}
+
+}  // namespace
+
+std::string PartialJson(const SceneFile& scene, const std::string& version, long first_rock,
+                        long end_rock, const ensemble::EnsembleReport& report) {
+  nlohmann::ordered_json j;
+  j["format"] = kFormat;
+  j["format_version"] = kFormatVersion;
+  j["talus_version"] = version;
+  j["scene"] = scene.path;
+  j["scene_file"] = std::filesystem::absolute(scene.path).lexically_normal().string();
+  j["inputs"] = scene.inputs;
+  j["inputs_hash_fnv1a64"] = scene.inputs_hash;
+  j["seed"] = scene.release.seed;
+  j["rocks_per_release"] = scene.release.rocks_per_release;
+  j["total_rocks"] = scene.release.total_rocks();
+  j["first_rock"] = first_rock;
+  j["end_rock"] = end_rock;
+  j["trajectories"] = scene.output.trajectories;
+  j["rocks"] = report.rocks;
+  j["ends"] = report.by_end;
+  j["raised_at_release"] = report.raised;
+  j["stayed_at_release"] = report.stayed_at_release;
+  j["steps"] = report.steps;
+  j["unconverged_steps"] = report.unconverged_steps;
+  j["threads"] = report.threads;
+  j["wall_time_s"] = report.wall_time_s;
+  return j.dump(2) + "\n";
+}
+
+std::string PartialState(const ensemble::EnsembleReport& report,
+                         const std::vector<SamplePath>& paths) {
+  ByteWriter out;
+  out.PutString(kStateMagic);
+  out.Put<std::uint8_t>(report.raster_state ? 1 : 0);
+  if (report.raster_state) report.raster_state->Serialize(out);
+  out.Put<std::uint64_t>(paths.size());
+  for (const SamplePath& p : paths) {
+    out.Put<std::int64_t>(p.rock);
+    std::vector<double> xy;
+    for (const Eigen::Vector2d& v : p.xy_m) xy.insert(xy.end(), {v.x(), v.y()});
+    out.PutVector(xy);
+  }
+  return out.Take();
+}
+
+PartialInfo ReadPartialInfo(const std::string& dir) {
+  const std::string path = (std::filesystem::path(dir) / "partial.json").string();
+  if (!std::filesystem::is_regular_file(path))
+    throw InputError(dir + ": not a complete partial result of talus simulate --rock-range (no " +
+                     path + ")");
+  PartialInfo p;
+  p.dir = dir;
+  try {
+    const nlohmann::json j = nlohmann::json::parse(ReadWholeFile(path));
+    if (j.at("format") != kFormat || j.at("format_version") != kFormatVersion)
+      throw InputError(path + ": not a partial result of this version of talus (format " +
+                       j.at("format").dump() + " " + j.at("format_version").dump() + ")");
+    p.version = j.at("talus_version");
+    p.scene = j.at("scene");
+    p.scene_file = j.at("scene_file");
+    p.inputs = j.at("inputs").get<std::vector<std::string>>();
+    p.inputs_hash = j.at("inputs_hash_fnv1a64");
+    p.seed = j.at("seed");
+    p.rocks_per_release = j.at("rocks_per_release");
+    p.total_rocks = j.at("total_rocks");
+    p.first_rock = j.at("first_rock");
+    p.end_rock = j.at("end_rock");
+    p.trajectories = j.at("trajectories");
+    p.counts.rocks = j.at("rocks");
+    p.counts.by_end = j.at("ends").get<std::array<long, 4>>();
+    p.counts.raised = j.at("raised_at_release");
+    p.counts.stayed_at_release = j.at("stayed_at_release");
+    p.counts.steps = j.at("steps");
+    p.counts.unconverged_steps = j.at("unconverged_steps");
+    p.counts.threads = j.at("threads");
+    p.counts.wall_time_s = j.at("wall_time_s");
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(path + ": not a valid partial.json: " + e.what());
+  }
+  if (p.first_rock < 0 || p.end_rock < p.first_rock || p.end_rock > p.total_rocks ||
+      p.counts.rocks != p.end_rock - p.first_rock)
+    throw InputError(path + ": inconsistent rock range " + Range(p.first_rock, p.end_rock));
+  return p;
+}
+
+std::vector<PartialInfo> CheckPartials(std::vector<PartialInfo> parts) {
+  if (parts.empty()) throw InputError("no partial results to merge");
+  const PartialInfo& a = parts.front();
+  for (const PartialInfo& b : parts) {
+    const auto differ = [&](const std::string& what, const std::string& x, const std::string& y) {
+      throw InputError(a.dir + " and " + b.dir + " are parts of different runs: " + what + " " + x +
+                       " and " + y);
+    };
+    if (b.version != a.version) differ("talus versions", a.version, b.version);
+    if (b.inputs_hash != a.inputs_hash)
+      differ("scenes (inputs hash)", a.scene + " " + a.inputs_hash, b.scene + " " + b.inputs_hash);
+    if (b.scene_file != a.scene_file) differ("scene files", a.scene_file, b.scene_file);
+    if (b.seed != a.seed) differ("seeds", std::to_string(a.seed), std::to_string(b.seed));
+    if (b.rocks_per_release != a.rocks_per_release || b.total_rocks != a.total_rocks)
+      differ("rocks", std::to_string(a.total_rocks), std::to_string(b.total_rocks));
+  }
+  std::sort(parts.begin(), parts.end(), [](const PartialInfo& x, const PartialInfo& y) {
+    return x.first_rock != y.first_rock ? x.first_rock < y.first_rock : x.end_rock < y.end_rock;
+  });
+  long covered = 0;
+  for (std::size_t k = 0; k < parts.size(); ++k) {
+    const PartialInfo& p = parts[k];
+    if (p.first_rock > covered)
+      throw InputError("rocks " + Range(covered, p.first_rock) + " of " +
+                       std::to_string(a.total_rocks) +
+                       " are in no partial result (the next part, " + p.dir + ", starts at rock " +
+                       std::to_string(p.first_rock) + ")");
+    if (p.first_rock < covered)
+      throw InputError("rocks " + Range(p.first_rock, p.end_rock) + " of " + p.dir +
+                       " overlap rocks " + Range(parts[k - 1].first_rock, parts[k - 1].end_rock) +
+                       " of " + parts[k - 1].dir);
+    covered = p.end_rock;
+  }
+  if (covered < a.total_rocks)
+    throw InputError("rocks " + Range(covered, a.total_rocks) + " of " +
+                     std::to_string(a.total_rocks) + " are in no partial result");
+  return parts;
+}
+
+void ReadPartialState(const PartialInfo& part, const ensemble::RasterRequest& request,
+                      std::optional<ensemble::RasterAccumulator>* rasters,
+                      std::vector<SamplePath>* paths) {
+  const std::string path = (std::filesystem::path(part.dir) / "partial.bin").string();
+  const std::string bytes = ReadWholeFile(path);
+  ByteReader in(bytes, path);
+  if (in.GetString() != kStateMagic) in.Fail("is not a partial state of this version of talus");
+  const bool has_rasters = in.Get<std::uint8_t>() != 0;
+  if (has_rasters != request.any()) in.Fail("holds other rasters than the scene asks for");
+  if (has_rasters) {
+    ensemble::RasterAccumulator acc = ensemble::RasterAccumulator::Deserialize(request, in);
+    if (acc.rocks() != part.counts.rocks)
+      in.Fail("holds another number of rocks than partial.json");
+    if (rasters->has_value())
+      (*rasters)->Merge(acc);
+    else
+      rasters->emplace(std::move(acc));
+  }
+  const auto n = in.Get<std::uint64_t>();
+  for (std::uint64_t k = 0; k < n; ++k) {
+    SamplePath& p = paths->emplace_back();
+    p.rock = static_cast<long>(in.Get<std::int64_t>());
+    const auto xy = in.GetVector<double>();
+    for (std::size_t i = 0; i + 1 < xy.size(); i += 2) p.xy_m.emplace_back(xy[i], xy[i + 1]);
+  }
+  if (!in.at_end()) in.Fail();
+}
+
+}  // namespace talus::io

@@ -1,0 +1,192 @@
+// End to end through the talus program: `talus simulate --rock-range` parts merged by
+// `talus merge` give the single run's outputs byte for byte, for any split and order; parts that
+// overlap, leave rocks out or come from different runs are refused with a clear message.
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "run_talus.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using talus::app::testing::RunCommand;
+using talus::app::testing::Slurp;
+
+// A small slope with every output: 2 releases x 5 rocks.
+const char* kScene = R"([terrain]
+plane = { slope_deg = 35, slope_length_m = 20, runout_m = 10, width_m = 12, cell_m = 1 }
+default_ground = "medium_hard"
+[rock]
+shape = { box = [0.4, 0.4, 0.3] }
+[release]
+points = [[3, 0]]
+lines = [[[4, -2], [4, 2]]]
+rocks = 5
+[solver]
+max_time_s = 4
+[output]
+trajectories = true
+trajectory_interval_s = 0.05
+rasters = ["speed", "energy", "jump_height", "passages", "deposits", "reach_probability"]
+)";
+
+std::string Talus(const std::string& arguments) {
+  return std::string(TALUS_BINARY) + " " + arguments;
+}
+
+// summary.json without what depends on the machine and the split (threads and timings).
+std::string WithoutTimings(const std::string& summary) {
+  nlohmann::ordered_json j = nlohmann::ordered_json::parse(summary);
+  for (const char* key : {"threads", "wall_time_s", "trajectories_per_s"}) j.erase(key);
+  return j.dump(2);
+}
+
+// Every file of `dir` by name; summary.json without timings.
+std::map<std::string, std::string> Outputs(const fs::path& dir) {
+  std::map<std::string, std::string> files;
+  for (const auto& entry : fs::directory_iterator(dir)) {
+    const std::string name = entry.path().filename().string();
+    files[name] =
+        name == "summary.json" ? WithoutTimings(Slurp(entry.path())) : Slurp(entry.path());
+  }
+  return files;
+}
+
+class MergeCommand : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = talus::app::testing::FreshDir(
+        "talus_merge_tests", ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    scene_ = dir_ / "scene.toml";
+    talus::app::testing::Write(scene_, kScene);
+  }
+  // Runs rocks `range` ("A:B") into <dir>/part-A-B with `threads`; returns that directory.
+  fs::path Part(const std::string& range, int threads = 1, const std::string& extra = "") {
+    std::string name = "part-" + range;
+    name[name.find(':')] = '-';
+    const fs::path out = dir_ / name;
+    std::string log;
+    EXPECT_EQ(RunCommand(Talus("simulate " + scene_.string() + " --out " + out.string() +
+                               " --rock-range " + range + " --threads " + std::to_string(threads) +
+                               " " + extra),
+                         &log),
+              0)
+        << log;
+    return out;
+  }
+  // `talus merge parts... --out <dir>/merged`; its exit code, output in *log.
+  int Merge(const std::vector<fs::path>& parts, std::string* log,
+            const std::string& out = "merged") {
+    std::string command = "merge";
+    for (const fs::path& p : parts) command.append(" ").append(p.string());
+    return RunCommand(Talus(command + " --out " + (dir_ / out).string()), log);
+  }
+  fs::path dir_, scene_;
+};
+
+TEST_F(MergeCommand, AnySplitInAnyOrderGivesTheSingleRunsBytes) {
+  std::string log;
+  ASSERT_EQ(RunCommand(Talus("simulate " + scene_.string() + " --out " +
+                             (dir_ / "single").string() + " --threads 2"),
+                       &log),
+            0)
+      << log;
+  const auto single = Outputs(dir_ / "single");
+  ASSERT_EQ(single.size(), 16u);  // 12 statistics rasters + 4 files: every output is compared
+
+  const std::vector<std::vector<std::string>> splits = {
+      {"0:10"}, {"5:10", "0:5"}, {"9:10", "0:1", "4:9", "1:4"}};
+  int k = 0;
+  for (const auto& split : splits) {
+    std::vector<fs::path> parts;
+    for (const std::string& range : split) parts.push_back(Part(range, 1 + (k++ % 2)));
+    const std::string out = "merged-" + std::to_string(split.size());
+    ASSERT_EQ(Merge(parts, &log, out), 0) << log;
+    const auto merged = Outputs(dir_ / out);
+    ASSERT_EQ(merged.size(), single.size());
+    for (const auto& [name, bytes] : single)
+      EXPECT_TRUE(merged.at(name) == bytes) << name << " differs for a split into " << split.size();
+  }
+}
+
+TEST_F(MergeCommand, OverlappingPartsAreRefused) {
+  std::string log;
+  EXPECT_EQ(Merge({Part("0:6"), Part("4:10")}, &log), 2);
+  EXPECT_NE(log.find("rocks 4:10 of"), std::string::npos) << log;
+  EXPECT_NE(log.find("overlap rocks 0:6"), std::string::npos) << log;
+  EXPECT_FALSE(fs::exists(dir_ / "merged" / "summary.json"));
+}
+
+TEST_F(MergeCommand, MissingRocksAreRefused) {
+  std::string log;
+  EXPECT_EQ(Merge({Part("0:4"), Part("6:10")}, &log), 2);
+  EXPECT_NE(log.find("rocks 4:6 of 10 are in no partial result"), std::string::npos) << log;
+  EXPECT_EQ(Merge({Part("0:4")}, &log), 2);
+  EXPECT_NE(log.find("rocks 4:10 of 10 are in no partial result"), std::string::npos) << log;
+}
+
+TEST_F(MergeCommand, PartsOfDifferentRunsAreRefused) {
+  std::string log;
+  const fs::path a = Part("0:5");
+  // Another seed.
+  const fs::path b = dir_ / "other-seed";
+  ASSERT_EQ(RunCommand(Talus("simulate " + scene_.string() + " --out " + b.string() +
+                             " --rock-range 5:10 --seed 99"),
+                       &log),
+            0);
+  EXPECT_EQ(Merge({a, b}, &log), 2);
+  EXPECT_NE(log.find("parts of different runs: seeds 1 and 99"), std::string::npos) << log;
+  // Another scene (the same scene file, edited).
+  const fs::path c = dir_ / "other-scene";
+  std::string edited = kScene;
+  edited.replace(edited.find("max_time_s = 4"), 14, "max_time_s = 5");
+  const fs::path scene2 = dir_ / "scene2.toml";
+  talus::app::testing::Write(scene2, edited);
+  ASSERT_EQ(RunCommand(Talus("simulate " + scene2.string() + " --out " + c.string() +
+                             " --rock-range 5:10"),
+                       &log),
+            0);
+  EXPECT_EQ(Merge({a, c}, &log), 2);
+  EXPECT_NE(log.find("parts of different runs: scenes (inputs hash)"), std::string::npos) << log;
+  // A part whose version differs (its partial.json edited).
+  const fs::path d = Part("5:10");
+  std::string info = Slurp(d / "partial.json");
+  info.replace(info.find("\"talus_version\": \""), 18, "\"talus_version\": \"0.0.1-");
+  talus::app::testing::Write(d / "partial.json", info);
+  EXPECT_EQ(Merge({a, d}, &log), 2);
+  EXPECT_NE(log.find("parts of different runs: talus versions"), std::string::npos) << log;
+  // A directory that is not a complete part.
+  EXPECT_EQ(Merge({a, dir_}, &log), 2);
+  EXPECT_NE(log.find("not a complete partial result"), std::string::npos) << log;
+}
+
+TEST_F(MergeCommand, ASceneChangedSinceThePartsRanIsRefused) {
+  std::string log;
+  const fs::path a = Part("0:10");
+  std::string edited = kScene;
+  edited.replace(edited.find("max_time_s = 4"), 14, "max_time_s = 5");
+  talus::app::testing::Write(scene_, edited);
+  EXPECT_EQ(Merge({a}, &log), 2);
+  EXPECT_NE(log.find("changed since this part was run"), std::string::npos) << log;
+}
+
+TEST_F(MergeCommand, BadRockRangesAreRefusedBeforeAnyWork) {
+  for (const std::string range : {"5", "5:5", "7:3", "a:4", "0:11", "-1:3"}) {
+    std::string log;
+    EXPECT_EQ(RunCommand(Talus("simulate " + scene_.string() + " --out " + (dir_ / "bad").string() +
+                               " --rock-range " + range),
+                         &log),
+              2)
+        << range;
+    EXPECT_NE(log.find("--rock-range"), std::string::npos) << range << ": " << log;
+    EXPECT_FALSE(fs::exists(dir_ / "bad" / "partial.json"));
+  }
+}
+
+}  // namespace

@@ -1,0 +1,133 @@
+// End to end through mpirun: `mpirun -n R talus simulate` writes the bytes of a one-process run
+// (summary.json's threads and timings aside), and a rank that fails or is lost ends the whole run
+// with an error and no output, never a hang.
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "run_talus.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using talus::app::testing::RunCommand;
+using talus::app::testing::Slurp;
+
+const std::string kScene = std::string(TALUS_SOURCE_DIR) + "/cases/tirol/scene.toml";
+
+// mpirun as CI runs it: as root, more ranks than cores allowed, and a time limit so that a hang
+// fails the test instead of stalling it.
+std::string MpiRun(const std::string& ranks) {
+  return "timeout -s KILL 120 " + std::string(TALUS_MPIEXEC) +
+         " --oversubscribe --allow-run-as-root " + ranks;
+}
+
+std::string Talus() { return TALUS_BINARY; }
+
+std::string WithoutTimings(const std::string& summary) {
+  nlohmann::ordered_json j = nlohmann::ordered_json::parse(summary);
+  for (const char* key : {"threads", "wall_time_s", "trajectories_per_s"}) j.erase(key);
+  return j.dump(2);
+}
+
+std::map<std::string, std::string> Outputs(const fs::path& dir) {
+  std::map<std::string, std::string> files;
+  for (const auto& entry : fs::directory_iterator(dir)) {
+    const std::string name = entry.path().filename().string();
+    files[name] =
+        name == "summary.json" ? WithoutTimings(Slurp(entry.path())) : Slurp(entry.path());
+  }
+  return files;
+}
+
+fs::path FreshDir(const std::string& name) {
+  return talus::app::testing::FreshDir("talus_mpi_tests", name);
+}
+
+// The real Tirol DEM crop with its CRS, 12 rocks with trajectories and every raster.
+TEST(SimulateMpi, RanksTimesThreadsGiveTheOneProcessBytes) {
+  const fs::path dir = FreshDir("identity");
+  std::string log;
+  const std::string args = " simulate " + kScene + " --rocks 12 --out ";
+  ASSERT_EQ(RunCommand(Talus() + args + (dir / "single").string() + " --threads 1", &log), 0)
+      << log;
+  const auto single = Outputs(dir / "single");
+  ASSERT_EQ(single.size(), 16u);
+  for (const auto& [ranks, threads] : {std::pair{2, 1}, std::pair{2, 2}, std::pair{3, 1}}) {
+    const std::string name = "mpi-" + std::to_string(ranks) + "x" + std::to_string(threads);
+    ASSERT_EQ(RunCommand(MpiRun("-n " + std::to_string(ranks) + " " + Talus()) + args +
+                             (dir / name).string() + " --threads " + std::to_string(threads),
+                         &log),
+              0)
+        << log;
+    EXPECT_NE(log.find(std::to_string(ranks) + " ranks"), std::string::npos) << log;
+    const auto merged = Outputs(dir / name);
+    ASSERT_EQ(merged.size(), single.size()) << name;
+    for (const auto& [file, bytes] : single)
+      EXPECT_TRUE(merged.at(file) == bytes) << file << " differs for " << name;
+  }
+}
+
+// Rank 1 is given a scene file that does not exist: every rank stops before any work, rank 0 says
+// which rank failed and why, once, and nothing is written.
+TEST(SimulateMpi, ABadInputOnOneRankEndsTheRunWithOneMessage) {
+  const fs::path dir = FreshDir("bad_rank");
+  const fs::path out = dir / "out";
+  std::string log;
+  const int code = RunCommand(
+      MpiRun("-n 1 " + Talus() + " simulate " + kScene + " --out " + out.string() + " : -n 1 " +
+             Talus() + " simulate " + (dir / "missing.toml").string() + " --out " + out.string()),
+      &log);
+  EXPECT_EQ(code, 2) << log;
+  const std::string message = "talus simulate: rank 1: " + (dir / "missing.toml").string();
+  const std::size_t at = log.find(message);
+  EXPECT_NE(at, std::string::npos) << log;
+  EXPECT_EQ(log.find("talus simulate:", at + 1), std::string::npos)
+      << "more than one message: " << log;
+  EXPECT_FALSE(fs::exists(out));
+}
+
+// Rank 1 runs another ensemble (another seed): refused before any work.
+TEST(SimulateMpi, RanksWithDifferentEnsemblesAreRefused) {
+  const fs::path dir = FreshDir("other_seed");
+  const fs::path out = dir / "out";
+  std::string log;
+  const std::string run = " simulate " + kScene + " --rocks 4 --out " + out.string();
+  EXPECT_EQ(
+      RunCommand(MpiRun("-n 1 " + Talus() + run + " : -n 1 " + Talus() + run + " --seed 3"), &log),
+      2)
+      << log;
+  EXPECT_NE(log.find("rank 1: started with another ensemble than rank 0"), std::string::npos)
+      << log;
+  EXPECT_FALSE(fs::exists(out / "summary.json"));
+}
+
+// Rank 1 is killed (SIGKILL) in the middle of its rocks: the run ends within the time limit with a
+// failure, --out holds neither outputs nor temporary files; the next run removes what the killed
+// rank left in its $TMPDIR.
+TEST(SimulateMpi, ALostRankEndsTheRunWithoutOutputs) {
+  const fs::path dir = FreshDir("lost_rank");
+  const fs::path out = dir / "out", tmp = dir / "tmp";
+  fs::create_directories(out);
+  fs::create_directories(tmp);
+  std::string log;
+  const std::string run = " simulate " + kScene + " --threads 1 --out " + out.string();
+  const std::string env = "TMPDIR=" + tmp.string() + " ";
+  const int code =
+      RunCommand(env + MpiRun("-n 1 " + Talus() + run + " --rocks 200 : -n 1 timeout -s KILL 2 " +
+                              Talus() + run + " --rocks 200"),
+                 &log);
+  EXPECT_NE(code, 0) << log;
+  EXPECT_NE(code, -1) << log;  // ended by itself, not by the test's time limit
+  EXPECT_TRUE(fs::is_empty(out)) << log;
+  ASSERT_FALSE(fs::is_empty(tmp / "talus-ranks"));  // the killed rank's staging directory
+  ASSERT_EQ(RunCommand(env + MpiRun("-n 2 " + Talus()) + run + " --rocks 2", &log), 0) << log;
+  EXPECT_TRUE(fs::is_empty(tmp / "talus-ranks")) << log;
+  EXPECT_TRUE(fs::exists(out / "summary.json"));
+}
+
+}  // namespace
