@@ -124,7 +124,7 @@ std::string CalibrationJson(const CalibrationFile& file, const Objective& object
                       {"best", Vector(r.best_u)},
                       {"best_objective", Number(r.best_value)},
                       {"evaluations", r.evaluations},
-                      {"nlopt_result", r.nlopt_result}});
+                      {"result", r.result}});
   const ensemble::ReleaseSpec& release = objective.release();
   json j = {{"version", run.version},
             {"calibration_file", file.path},
