@@ -193,5 +193,65 @@ TEST(Calibrate, CeresRecoversMuMinAndItsUncertaintyCoversTheTruth) {
   EXPECT_GT(u.standard_error[0], data.se / 3);
 }
 
+// An interruption (here: on_evaluation throws after 3 evaluations, as talus calibrate does on
+// SIGINT) loses nothing: replaying the evaluations made so far (OptimizerOptions::replay, what
+// --resume reads from the checkpoint) retraces the optimiser's path without running a rock and
+// goes on to the result of an uninterrupted run, bit for bit, for NLopt and for Ceres.
+TEST(Calibrate, AnInterruptedCalibrationResumesToTheIdenticalResult) {
+  static const testing::SyntheticRunouts p(12, 3, kTruth);  // small: this tests bookkeeping
+  ObjectiveOptions objective_options;
+  objective_options.threads = 2;
+  const Objective objective(p.scene, p.release, p.observations,
+                            {Free(GroundField::kMuMin, 0.1, 0.9)}, objective_options);
+  struct Stop {};
+  for (const char* algorithm : {"bobyqa", "ceres"}) {
+    SCOPED_TRACE(algorithm);
+    OptimizerOptions options;
+    options.algorithm = algorithm;
+    options.max_evaluations = 6;
+    options.fd_step = 0.05;
+    options.start = Eigen::VectorXd::Constant(1, 0.125);
+    const Summary whole = Calibrate(objective, options);
+
+    std::vector<Evaluation> kept;
+    OptimizerOptions interrupted = options;
+    interrupted.on_evaluation = [&](const Evaluation& e, int index) {
+      kept.push_back(e);
+      if (index == 2) throw Stop{};
+    };
+    EXPECT_THROW(Calibrate(objective, interrupted), Stop);
+    ASSERT_EQ(kept.size(), 3u);
+    OptimizerOptions resumed = options;
+    resumed.replay = kept;
+    const Summary rest = Calibrate(objective, resumed);
+
+    EXPECT_EQ(rest.replayed, 3);
+    ASSERT_EQ(rest.evaluations(), whole.evaluations());
+    for (int k = 0; k < whole.evaluations(); ++k) {
+      EXPECT_EQ(rest.history[k].u, whole.history[k].u) << k;
+      EXPECT_EQ(rest.history[k].value, whole.history[k].value) << k;
+      EXPECT_EQ(rest.history[k].residuals, whole.history[k].residuals) << k;
+    }
+    EXPECT_EQ(rest.best.u, whole.best.u);
+    EXPECT_EQ(rest.best.value, whole.best.value);
+    EXPECT_EQ(rest.termination, whole.termination);
+  }
+}
+
+// A replay that does not belong to the calibration (another start) is refused.
+TEST(Calibrate, AReplayOfAnotherCalibrationIsRefused) {
+  const auto& p = Problem();
+  ObjectiveOptions objective_options;
+  objective_options.threads = 2;
+  const Objective objective(p.scene, p.release, p.observations,
+                            {Free(GroundField::kMuMin, 0.1, 0.9)}, objective_options);
+  OptimizerOptions options;
+  options.max_evaluations = 3;
+  Evaluation other;
+  other.u = Eigen::VectorXd::Constant(1, 0.9);
+  options.replay = {other};
+  EXPECT_THROW(Calibrate(objective, options), std::runtime_error);
+}
+
 }  // namespace
 }  // namespace talus::calibration
