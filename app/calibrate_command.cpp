@@ -32,6 +32,7 @@
 #include "io/calibration_checkpoint.hpp"
 #include "io/calibration_file.hpp"
 #include "io/calibration_outputs.hpp"
+#include "io/calibration_plots.hpp"
 #include "talus/version.hpp"
 
 namespace talus::app {
@@ -46,8 +47,6 @@ struct CalibrateArgs {
   bool resume = false;
 };
 
-const std::vector<std::string> kOutputs = {"ground_table.toml", "ground_table.csv", "history.csv",
-                                           "calibration.json"};
 const char* kCheckpoint = "checkpoint.json";
 
 // The held-out runs of --holdout: K runs drawn by the optimiser's seed, or the listed ids.
@@ -207,9 +206,10 @@ int RunCalibrate(const CalibrateArgs& args) {
       calibration::UncertaintyOptions options = file.uncertainty_options;
       if (!(options.fd_step > 0))
         options.fd_step = run.summary.fd_step > 0 ? run.summary.fd_step
-                          : run.roughness    ? run.roughness->fd_step
-                                             : 0.01;
+                          : run.roughness         ? run.roughness->fd_step
+                                                  : 0.01;
       options.noise = run.roughness ? run.roughness->level() : 0;
+      options.profiles = run.profiles;
       std::printf("Estimating the covariance at the optimum...\n");
       std::fflush(stdout);
       run.uncertainty =
@@ -217,13 +217,21 @@ int RunCalibrate(const CalibrateArgs& args) {
       std::printf("%s", run.uncertainty->Report().c_str());
     }
     const GroundTable fitted = objective->GroundOf(best.u);
+    // The fitted runs scored before and after, for the observed-vs-simulated plots.
+    std::printf("Scoring the observations before and after for the plots...\n");
+    std::fflush(stdout);
+    const calibration::HeldOutScores before =
+        calibration::ScoreRuns(event.scene.scene, fit, objective->GroundOf(run.summary.initial.u),
+                               nullptr, args.threads, objective->needs_episodes());
+    const calibration::HeldOutScores after = calibration::ScoreRuns(
+        event.scene.scene, fit, fitted, nullptr, args.threads, objective->needs_episodes());
     if (!holdout.empty()) {
       std::printf("Scoring the %zu held-out runs...\n", holdout.size());
       std::fflush(stdout);
       run.holdout = calibration::ScoreRuns(
           event.scene.scene,
-          calibration::SelectRuns(event.scene.release, event.observations, holdout, false),
-          fitted, reference ? &*reference : nullptr, args.threads, objective->needs_episodes());
+          calibration::SelectRuns(event.scene.release, event.observations, holdout, false), fitted,
+          reference ? &*reference : nullptr, args.threads, objective->needs_episodes());
       std::printf("%s", io::HeldOutReport(*run.holdout).c_str());
     }
     for (std::size_t f = 0; f < folds.size(); ++f) {
@@ -233,9 +241,8 @@ int RunCalibrate(const CalibrateArgs& args) {
       std::fflush(stdout);
       const calibration::RunSubset train = calibration::SelectRuns(
           fit.release, fit.observations, calibration::OtherRuns(fit.release, folds[f]), true);
-      const calibration::Objective fold_objective(event.scene.scene, train.release,
-                                                  train.observations, file.parameters,
-                                                  objective_options);
+      const calibration::Objective fold_objective(
+          event.scene.scene, train.release, train.observations, file.parameters, objective_options);
       io::FoldRun fold;
       fold.summary = optimise(fold_objective, stage);
       std::printf("%s\n", fold.summary.BriefReport().c_str());
@@ -268,10 +275,21 @@ int RunCalibrate(const CalibrateArgs& args) {
                         io::GroundTableToml(file, *objective, fitted));
     WriteFileAtomically(staging->path("ground_table.csv"), io::GroundTableCsv(*objective, fitted));
     WriteFileAtomically(staging->path("history.csv"), io::HistoryCsv(*objective, run.summary));
+    std::vector<std::string> outputs = {"ground_table.toml", "ground_table.csv", "history.csv",
+                                        "convergence.svg"};
+    WriteFileAtomically(staging->path("convergence.svg"), io::ConvergenceSvg(run.summary));
+    for (const std::string& kind : objective->kinds()) {
+      if (kind == "deposit") continue;
+      const std::string name = "observed_vs_simulated_" + kind + ".svg";
+      WriteFileAtomically(staging->path(name),
+                          io::ObservedSimulatedSvg(kind, before.observations, after.observations));
+      outputs.push_back(name);
+    }
+    outputs.push_back("calibration.json");
     WriteFileAtomically(staging->path("calibration.json"),
                         io::CalibrationJson(file, *objective, run));
     ThrowIfInterrupted();
-    staging->Commit(kOutputs);  // calibration.json last
+    staging->Commit(outputs);  // calibration.json last
     // The run is complete: its checkpoint is no longer needed, unless a budget ended a fit
     // (a later --resume with a larger budget goes on from it).
     bool budget = run.summary.termination == calibration::Termination::kMaxEvaluations ||
@@ -280,7 +298,7 @@ int RunCalibrate(const CalibrateArgs& args) {
       budget = budget || f.summary.termination == calibration::Termination::kMaxEvaluations ||
                f.summary.termination == calibration::Termination::kMaxTime;
     if (!budget) fs::remove(checkpoint_path);
-    std::printf("Wrote %zu files to %s in %.1f s%s\n", kOutputs.size(), args.out.c_str(),
+    std::printf("Wrote %zu files to %s in %.1f s%s\n", outputs.size(), args.out.c_str(),
                 run.wall_time_s,
                 budget ? " (a budget ended a fit: checkpoint.json kept for --resume)" : "");
     return kExitOk;

@@ -5,8 +5,7 @@
 
 namespace talus::calibration {
 
-Evaluator::Evaluator(const Objective& objective, const OptimizerOptions& options,
-                     Summary& summary)
+Evaluator::Evaluator(const Objective& objective, const OptimizerOptions& options, Summary& summary)
     : objective_(objective),
       options_(options),
       summary_(summary),

@@ -69,8 +69,7 @@ std::vector<std::string> OtherRuns(const ensemble::ReleaseSpec& release,
   return out;
 }
 
-std::vector<std::string> PickRuns(const ensemble::ReleaseSpec& release, int k,
-                                  std::uint64_t seed) {
+std::vector<std::string> PickRuns(const ensemble::ReleaseSpec& release, int k, std::uint64_t seed) {
   const std::size_t n = release.runs.size();
   if (k < 1 || static_cast<std::size_t>(k) >= n)
     throw InputError("cannot hold out " + std::to_string(k) + " of " + std::to_string(n) +

@@ -35,8 +35,7 @@ std::vector<std::string> OtherRuns(const ensemble::ReleaseSpec& release,
 
 // k runs drawn without replacement by a seeded shuffle (the same on every platform), in release
 // order. 1 <= k < number of runs.
-std::vector<std::string> PickRuns(const ensemble::ReleaseSpec& release, int k,
-                                  std::uint64_t seed);
+std::vector<std::string> PickRuns(const ensemble::ReleaseSpec& release, int k, std::uint64_t seed);
 // The runs dealt into k folds of (almost) equal size after a seeded shuffle, each in release
 // order. 2 <= k <= number of runs.
 std::vector<std::vector<std::string>> Folds(const ensemble::ReleaseSpec& release, int k,

@@ -119,7 +119,7 @@ Summary CalibrateLeastSquares(const Objective& objective, const OptimizerOptions
     solver.minimizer_type = ceres::TRUST_REGION;
     solver.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
     solver.linear_solver_type = ceres::DENSE_QR;
-    solver.num_threads = 1;  // the evaluations use the threads
+    solver.num_threads = 1;             // the evaluations use the threads
     solver.max_num_iterations = 10000;  // the evaluation budget stops it
     solver.function_tolerance = std::max(options.ftol_rel, 1e-16);
     solver.parameter_tolerance = std::max(options.xtol_abs, 1e-16);
@@ -218,8 +218,7 @@ Uncertainty EstimateUncertainty(const Objective& objective, const Eigen::VectorX
   const auto finish = [&](const std::string& note) {
     if (error) std::rethrow_exception(error);
     out.note = note;
-    out.wall_time_s =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    out.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return out;
   };
 
@@ -230,12 +229,14 @@ Uncertainty EstimateUncertainty(const Objective& objective, const Eigen::VectorX
   std::vector<double> residuals;
   ceres::CRSMatrix crs;
   if (!problem.Evaluate(ceres::Problem::EvaluateOptions(), &cost, &residuals, nullptr, &crs))
-    return finish("no covariance: the residuals or their differences could not be evaluated at "
-                  "the optimum (infeasible neighbours)");
+    return finish(
+        "no covariance: the residuals or their differences could not be evaluated at "
+        "the optimum (infeasible neighbours)");
   out.residuals = Eigen::Map<const Eigen::VectorXd>(residuals.data(), m);
   out.jacobian = Eigen::MatrixXd::Zero(m, n);
   for (int i = 0; i < crs.num_rows; ++i)
-    for (int k = crs.rows[i]; k < crs.rows[i + 1]; ++k) out.jacobian(i, crs.cols[k]) = crs.values[k];
+    for (int k = crs.rows[i]; k < crs.rows[i + 1]; ++k)
+      out.jacobian(i, crs.cols[k]) = crs.values[k];
 
   ceres::Covariance::Options covariance_options;
   covariance_options.algorithm_type = ceres::DENSE_SVD;
@@ -244,12 +245,23 @@ Uncertainty EstimateUncertainty(const Objective& objective, const Eigen::VectorX
   covariance_options.num_threads = 1;
   RowMajor inverse = RowMajor::Zero(n, n);  // (J^T J)^-1 of the identified coordinates
   bool ok = false;
-  {
+  std::vector<int> flat;  // coordinates whose given profile is flat
+  if (static_cast<int>(options.profiles.size()) == n) {
+    out.profiles = options.profiles;
+    for (int j = 0; j < n; ++j)
+      if (!options.profiles[static_cast<std::size_t>(j)].identified) {
+        out.identified[static_cast<std::size_t>(j)] = false;
+        flat.push_back(j);
+      }
+    if (!flat.empty() && static_cast<int>(flat.size()) < n)
+      problem.SetManifold(x.data(), new ceres::SubsetManifold(n, flat));
+  }
+  if (static_cast<int>(flat.size()) < n) {
     ceres::Covariance covariance(covariance_options);
     ok = covariance.Compute(std::vector<const double*>{x.data()}, &problem) &&
          covariance.GetCovarianceBlock(x.data(), x.data(), inverse.data());
   }
-  if (!ok) {
+  if (!ok && flat.empty()) {
     // Rank-deficient: the profiles decide which coordinates the observations see; the others are
     // held constant for the covariance of the rest.
     if (error) return finish("");
@@ -259,12 +271,12 @@ Uncertainty EstimateUncertainty(const Objective& objective, const Eigen::VectorX
     out.evaluations += n * std::max(2, options.profile.points);
     std::vector<int> constant;
     for (int j = 0; j < n; ++j) {
-      out.identified[static_cast<std::size_t>(j)] = out.profiles[static_cast<std::size_t>(j)].identified;
+      out.identified[static_cast<std::size_t>(j)] =
+          out.profiles[static_cast<std::size_t>(j)].identified;
       if (!out.identified[static_cast<std::size_t>(j)]) constant.push_back(j);
     }
     if (static_cast<int>(constant.size()) < n) {
-      if (!constant.empty())
-        problem.SetManifold(x.data(), new ceres::SubsetManifold(n, constant));
+      if (!constant.empty()) problem.SetManifold(x.data(), new ceres::SubsetManifold(n, constant));
       ceres::Covariance covariance(covariance_options);
       ok = covariance.Compute(std::vector<const double*>{x.data()}, &problem) &&
            covariance.GetCovarianceBlock(x.data(), x.data(), inverse.data());
@@ -283,13 +295,11 @@ Uncertainty EstimateUncertainty(const Objective& objective, const Eigen::VectorX
   std::string note;
   if (!unidentified.empty())
     note += "not constrained by the observations (flat profile): " + unidentified + ". ";
-  if (!ok) {
+  const auto none = std::count(out.identified.begin(), out.identified.end(), false);
+  if (!ok && none == n) return finish(note + "No covariance: no parameter is identified.");
+  if (!ok)
     return finish(note + "No covariance: J^T J is rank-deficient" +
-                  (out.rank_deficient && unidentified.size() < out.names.size()
-                       ? " even without the unconstrained parameters"
-                       : "") +
-                  ".");
-  }
+                  (none > 0 ? " even without the unconstrained parameters." : "."));
 
   // Sandwich: (J^T J)^-1 M (J^T J)^-1, M = sum over runs of (J_g^T r_g)(J_g^T r_g)^T.
   const auto& groups = objective.residual_groups();
@@ -298,18 +308,16 @@ Uncertainty EstimateUncertainty(const Objective& objective, const Eigen::VectorX
   Eigen::MatrixXd gradients = Eigen::MatrixXd::Zero(group_count, n);
   for (int i = 0; i < m; ++i)
     if (groups[static_cast<std::size_t>(i)] >= 0)
-      gradients.row(groups[static_cast<std::size_t>(i)]) +=
-          out.residuals[i] * out.jacobian.row(i);
+      gradients.row(groups[static_cast<std::size_t>(i)]) += out.residuals[i] * out.jacobian.row(i);
   for (int g = 0; g < group_count; ++g) out.groups += gradients.row(g).squaredNorm() > 0 ? 1 : 0;
-  const int free = n - static_cast<int>(std::count(out.identified.begin(), out.identified.end(),
-                                                   false));
+  const int free =
+      n - static_cast<int>(std::count(out.identified.begin(), out.identified.end(), false));
   if (out.groups <= free)
     return finish(note + "No covariance: " + std::to_string(out.groups) +
                   " runs with a score gradient for " + std::to_string(free) + " parameters.");
   const Eigen::MatrixXd bread = inverse;
   const Eigen::MatrixXd meat = gradients.transpose() * gradients;
-  out.covariance_unit =
-      bread * meat * bread * (double(out.groups) / double(out.groups - free));
+  out.covariance_unit = bread * meat * bread * (double(out.groups) / double(out.groups - free));
   out.computed = true;
 
   Eigen::VectorXd d(n);  // d value / d u
@@ -325,9 +333,8 @@ Uncertainty EstimateUncertainty(const Objective& objective, const Eigen::VectorX
     out.weak[static_cast<std::size_t>(j)] = out.standard_error_unit[j] > options.weak_fraction;
     for (int k = 0; k < n; ++k)
       if (out.identified[static_cast<std::size_t>(k)])
-        out.correlation(j, k) =
-            out.covariance_unit(j, k) /
-            std::sqrt(out.covariance_unit(j, j) * out.covariance_unit(k, k));
+        out.correlation(j, k) = out.covariance_unit(j, k) /
+                                std::sqrt(out.covariance_unit(j, j) * out.covariance_unit(k, k));
   }
   const std::string weak = list([&](int j) { return bool(out.weak[static_cast<std::size_t>(j)]); });
   if (!weak.empty()) {
@@ -341,8 +348,9 @@ Uncertainty EstimateUncertainty(const Objective& objective, const Eigen::VectorX
            (u[j] <= options.fd_step || u[j] >= 1 - options.fd_step);
   });
   if (!at_bound.empty())
-    note += "at a bound (the optimum may lie beyond it; the interval is not reliable): " +
-            at_bound + ". ";
+    note +=
+        "at a bound (the optimum may lie beyond it; the interval is not reliable): " + at_bound +
+        ". ";
   if (note.empty()) note = "every parameter is constrained by the observations.";
   while (!note.empty() && note.back() == ' ') note.pop_back();
   return finish(note);
@@ -360,7 +368,9 @@ std::string Uncertainty::Report() const {
     std::snprintf(line, sizeof line, "  %-28s %14s %14s %10s  %s\n", names[j].c_str(),
                   Num(values[k], "%.6g").c_str(), Num(standard_error[k]).c_str(),
                   Num(standard_error_unit[k], "%.3f").c_str(),
-                  !identified[j] ? "UNIDENTIFIED" : weak[j] ? "weak" : "");
+                  !identified[j] ? "UNIDENTIFIED"
+                  : weak[j]      ? "weak"
+                                 : "");
     out += line;
   }
   if (computed && names.size() > 1) {
@@ -368,9 +378,9 @@ std::string Uncertainty::Report() const {
     for (std::size_t j = 0; j < names.size(); ++j) {
       out += "    ";
       for (std::size_t k = 0; k < names.size(); ++k)
-        out += Num(correlation(static_cast<Eigen::Index>(j), static_cast<Eigen::Index>(k)),
-                   "%6.2f") +
-               " ";
+        out +=
+            Num(correlation(static_cast<Eigen::Index>(j), static_cast<Eigen::Index>(k)), "%6.2f") +
+            " ";
       out += "\n";
     }
   }

@@ -18,6 +18,8 @@
 // M = sum_g (J_g^T r_g)(J_g^T r_g)^T. Where J^T J is rank-deficient, Ceres refuses: each
 // parameter is then profiled (ProfileParameters) and those whose profile is flat are held
 // constant (a ceres::SubsetManifold) for the covariance of the others, and reported unidentified.
+// Profiles measured beforehand (UncertaintyOptions::profiles) are used the same way from the
+// start: a flat profile overrules a finite-difference Jacobian of noise.
 
 #include <Eigen/Core>
 #include <string>
@@ -47,27 +49,32 @@ struct UncertaintyOptions {
   // profiles' options.
   double noise = 0;
   ProfileOptions profile;
+  // Profiles already measured at this point (ProfileParameters, one per coordinate), or empty.
+  // A coordinate whose profile is flat is unidentified whatever J says -- on a rough objective
+  // the differences of a parameter that only reshuffles which way rocks turn are noise, which a
+  // covariance would read as information -- and is held constant like a rank-deficient one.
+  std::vector<ParameterProfile> profiles;
   bool IsValid(std::string* why) const;
 };
 
 struct Uncertainty {
-  bool computed = false;         // a covariance was computed (for the identified parameters)
-  bool rank_deficient = false;   // J^T J was rank-deficient: profiles decided what is identified
+  bool computed = false;        // a covariance was computed (for the identified parameters)
+  bool rank_deficient = false;  // J^T J was rank-deficient: profiles decided what is identified
   std::vector<std::string> names;
-  Eigen::VectorXd u;             // where (unit coordinates)
-  Eigen::VectorXd values;        // the parameters there
-  Eigen::MatrixXd jacobian;      // residuals x coordinates, unit coordinates
+  Eigen::VectorXd u;         // where (unit coordinates)
+  Eigen::VectorXd values;    // the parameters there
+  Eigen::MatrixXd jacobian;  // residuals x coordinates, unit coordinates
   Eigen::VectorXd residuals;
-  int groups = 0;                // independent groups (runs) in the sandwich
+  int groups = 0;                   // independent groups (runs) in the sandwich
   Eigen::MatrixXd covariance_unit;  // n x n, unit coordinates; rows of unidentified ones are 0
   Eigen::MatrixXd covariance;       // n x n, physical units (through the transforms' Jacobian)
   Eigen::VectorXd standard_error;   // physical units; NaN where unidentified
   Eigen::VectorXd standard_error_unit;
-  Eigen::MatrixXd correlation;      // NaN where unidentified
-  std::vector<bool> identified;     // per coordinate
-  std::vector<bool> weak;           // identified but standard_error_unit > weak_fraction
+  Eigen::MatrixXd correlation;             // NaN where unidentified
+  std::vector<bool> identified;            // per coordinate
+  std::vector<bool> weak;                  // identified but standard_error_unit > weak_fraction
   std::vector<ParameterProfile> profiles;  // when rank-deficient
-  std::string note;                 // the identifiability note, naming parameters
+  std::string note;                        // the identifiability note, naming parameters
   int evaluations = 0;
   double wall_time_s = 0;
   std::string Report() const;  // a few lines for people

@@ -230,9 +230,8 @@ Evaluation Objective::Run(const Eigen::VectorXd& u, const ensemble::ReleaseSpec&
         continue;
       }
       const fieldobs::ScalarObservation& o = observations_.scalars[static_cast<std::size_t>(i)];
-      const double spread =
-          std::min(s.score, fieldobs::CrpsEnsemble(samples.Values(o.quantity, o.run, o.zone),
-                                                   s.median));
+      const double spread = std::min(
+          s.score, fieldobs::CrpsEnsemble(samples.Values(o.quantity, o.run, o.zone), s.median));
       const double location = std::sqrt(c * (s.score - spread));
       e.residuals[i] = s.median < s.observed ? -location : location;
       e.residuals[m + i] = std::sqrt(c * spread);

@@ -16,7 +16,6 @@
 namespace talus::calibration {
 namespace {
 
-
 nlopt_algorithm AlgorithmOf(const std::string& name) {
   if (name == "bobyqa") return NLOPT_LN_BOBYQA;
   if (name == "sbplx") return NLOPT_LN_SBPLX;
@@ -50,7 +49,7 @@ std::string Num(double v, const char* format = "%.6g") {
 
 const std::vector<std::string>& AlgorithmNames() {
   static const std::vector<std::string> names = {"bobyqa",   "sbplx", "crs2_lm",
-                                                  "direct_l", "isres", "ceres"};
+                                                 "direct_l", "isres", "ceres"};
   return names;
 }
 
@@ -203,8 +202,8 @@ std::string Summary::BriefReport() const {
   char line[512];
   std::snprintf(line, sizeof line,
                 "%s %s: %s after %d evaluations in %.1f s; objective %s -> %s (%d starts)",
-                algorithm == "ceres" ? "Ceres" : "NLopt", algorithm.c_str(), ToString(termination), evaluations(), wall_time_s,
-                Num(initial.value).c_str(), Num(best.value).c_str(),
+                algorithm == "ceres" ? "Ceres" : "NLopt", algorithm.c_str(), ToString(termination),
+                evaluations(), wall_time_s, Num(initial.value).c_str(), Num(best.value).c_str(),
                 static_cast<int>(starts.size()));
   return line;
 }

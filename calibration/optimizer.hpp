@@ -83,8 +83,8 @@ struct Summary {
   std::vector<Evaluation> history;  // every evaluation, in order
   std::vector<int> history_start;   // per evaluation: which start (0 .. starts - 1)
   std::vector<StartRecord> starts;
-  int cache_hits = 0;  // points asked for twice (answered from the history, not re-run)
-  int replayed = 0;    // evaluations served from OptimizerOptions::replay
+  int cache_hits = 0;     // points asked for twice (answered from the history, not re-run)
+  int replayed = 0;       // evaluations served from OptimizerOptions::replay
   double fd_step = kNaN;  // Ceres: the central-difference step used (unit coordinates)
   double wall_time_s = 0;
 

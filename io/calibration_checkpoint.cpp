@@ -76,10 +76,8 @@ std::string CheckpointJson(const CalibrationCheckpoint& c) {
     for (const Evaluation& e : evaluations) list.push_back(ToJson(e));
     stages[name] = list;
   }
-  const json j = {{"path_hash", c.path_hash},
-                  {"holdout", c.holdout},
-                  {"folds", c.folds},
-                  {"stages", stages}};
+  const json j = {
+      {"path_hash", c.path_hash}, {"holdout", c.holdout}, {"folds", c.folds}, {"stages", stages}};
   return j.dump() + "\n";
 }
 

@@ -234,10 +234,9 @@ std::string Fnv1a(const std::string& text) {
 CalibrationFile LoadCalibration(const std::string& path) {
   const Context context(path);
   const toml::table root = ParseTomlFile(path, "calibration file");
-  const Section top(
-      context, &root, "",
-      {"event", "rocks", "seed", "parameters", "objective", "optimizer", "roughness",
-       "uncertainty"});
+  const Section top(context, &root, "",
+                    {"event", "rocks", "seed", "parameters", "objective", "optimizer", "roughness",
+                     "uncertainty"});
   CalibrationFile out;
   out.path = path;
   if (!top.Has("event"))

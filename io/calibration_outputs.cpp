@@ -206,8 +206,9 @@ std::string CalibrationJson(const CalibrationFile& file, const Objective& object
       identified.push_back(bool(u.identified[k]));
       weak.push_back(bool(u.weak[k]));
     }
-    j["uncertainty"] = {{"method", "sandwich covariance H^-1 V H^-1 over runs, (J^T J)^-1 from "
-                                   "ceres::Covariance (dense SVD)"},
+    j["uncertainty"] = {{"method",
+                         "sandwich covariance H^-1 V H^-1 over runs, (J^T J)^-1 from "
+                         "ceres::Covariance (dense SVD)"},
                         {"computed", u.computed},
                         {"rank_deficient", u.rank_deficient},
                         {"names", u.names},
@@ -223,8 +224,7 @@ std::string CalibrationJson(const CalibrationFile& file, const Objective& object
                         {"evaluations", u.evaluations},
                         {"wall_time_s", u.wall_time_s}};
     for (std::size_t k = 0; k < u.names.size() && k < j["parameters"].size(); ++k)
-      j["parameters"][k]["standard_error"] =
-          Number(u.standard_error[static_cast<Eigen::Index>(k)]);
+      j["parameters"][k]["standard_error"] = Number(u.standard_error[static_cast<Eigen::Index>(k)]);
   } else {
     j["uncertainty"] = nullptr;
   }
@@ -241,7 +241,8 @@ std::string CalibrationJson(const CalibrationFile& file, const Objective& object
       folds.push_back(fold);
       sets.push_back(f.scores);
     }
-    j["cross_validation"] = {{"folds", folds}, {"kinds", HeldOutKinds(calibration::PoolKinds(sets))}};
+    j["cross_validation"] = {{"folds", folds},
+                             {"kinds", HeldOutKinds(calibration::PoolKinds(sets))}};
   } else {
     j["cross_validation"] = nullptr;
   }

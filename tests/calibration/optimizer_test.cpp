@@ -133,15 +133,15 @@ TEST(Calibrate, BetaIsUnidentifiedWhereRocksBarelyFlyAndMuMinIsIdentified) {
   const Objective objective(
       p.scene, p.release, p.observations,
       {Free(GroundField::kMuMin, 0.1, 0.9), Free(GroundField::kBeta, 50, 400)}, objective_options);
-  Eigen::VectorXd u = objective.StartPoint();
-  u[0] = (kTruth - 0.1) / 0.8;
+  Eigen::VectorXd u0 = objective.StartPoint();
+  u0[0] = (kTruth - 0.1) / 0.8;
   RoughnessOptions roughness;
   roughness.steps = {1e-4};
   roughness.seeds = 3;
-  const RoughnessReport r = MeasureRoughness(objective, u, roughness);
+  const RoughnessReport r = MeasureRoughness(objective, u0, roughness);
   std::printf("%s", r.Report().c_str());
   const std::vector<ParameterProfile> profiles =
-      ProfileParameters(objective, u, r.value, r.level(), {4, 3, 1e-6});
+      ProfileParameters(objective, u0, r.value, r.level(), {4, 3, 1e-6});
   for (const ParameterProfile& profile : profiles)
     std::printf("%s: range %.4g, threshold %.4g, %s\n", profile.name.c_str(), profile.range,
                 profile.threshold, profile.identified ? "identified" : "unidentified");
@@ -150,6 +150,52 @@ TEST(Calibrate, BetaIsUnidentifiedWhereRocksBarelyFlyAndMuMinIsIdentified) {
   EXPECT_FALSE(profiles[1].identified);
   EXPECT_GT(r.level(), 0);
   EXPECT_GT(r.seed_sd, 0);
+
+  // The covariance with these profiles: beta is held constant and named in the note; mu_min
+  // gets a standard error.
+  UncertaintyOptions uncertainty_options;
+  uncertainty_options.fd_step = 0.05;
+  uncertainty_options.noise = r.level();
+  uncertainty_options.profiles = profiles;
+  const Uncertainty u = EstimateUncertainty(objective, u0, uncertainty_options);
+  std::printf("%s", u.Report().c_str());
+  ASSERT_TRUE(u.computed) << u.note;
+  EXPECT_TRUE(u.identified[0]);
+  EXPECT_FALSE(u.identified[1]);
+  EXPECT_GT(u.standard_error[0], 0);
+  EXPECT_TRUE(std::isnan(u.standard_error[1]));
+  EXPECT_NE(u.note.find("not constrained by the observations (flat profile): medium_hard.beta"),
+            std::string::npos)
+      << u.note;
+}
+
+// A parameter no rock ever feels (the friction of a category the plane does not have) leaves
+// J^T J rank-deficient: ceres::Covariance refuses, the profiles (measured then) find it flat, and
+// the covariance of the others is computed with it held constant.
+TEST(Calibrate, ARankDeficientCovarianceFallsBackToTheProfiles) {
+  const auto& p = Problem();
+  ObjectiveOptions objective_options;
+  objective_options.threads = 2;
+  ParameterSpec unseen = Free(GroundField::kMuMin, 0.1, 0.9);
+  unseen.category = "hard";
+  const Objective objective(p.scene, p.release, p.observations,
+                            {Free(GroundField::kMuMin, 0.1, 0.9), unseen}, objective_options);
+  Eigen::VectorXd u0 = objective.StartPoint();
+  u0[0] = (kTruth - 0.1) / 0.8;
+  UncertaintyOptions options;
+  options.fd_step = 0.05;
+  options.profile.points = 3;
+  const Uncertainty u = EstimateUncertainty(objective, u0, options);
+  std::printf("%s", u.Report().c_str());
+  EXPECT_TRUE(u.rank_deficient);
+  EXPECT_TRUE(u.jacobian.col(1).isZero(0));
+  ASSERT_EQ(u.profiles.size(), 2u);
+  EXPECT_EQ(u.profiles[1].range, 0);
+  ASSERT_TRUE(u.computed) << u.note;
+  EXPECT_TRUE(u.identified[0]);
+  EXPECT_FALSE(u.identified[1]);
+  EXPECT_GT(u.standard_error[0], 0);
+  EXPECT_NE(u.note.find("hard.mu_min"), std::string::npos) << u.note;
 }
 
 // Ceres from the same distant start: Levenberg-Marquardt on the residuals (signed location and
@@ -183,8 +229,8 @@ TEST(Calibrate, CeresRecoversMuMinAndItsUncertaintyCoversTheTruth) {
   std::printf("%s", u.Report().c_str());
   const DataError data = MeasuredDataError();
   const double fitted = summary.best.values[0];
-  std::printf("fitted mu_min %.4f (truth %.2f), stated standard error %.4f, data's %.4f\n",
-              fitted, kTruth, u.standard_error[0], data.se);
+  std::printf("fitted mu_min %.4f (truth %.2f), stated standard error %.4f, data's %.4f\n", fitted,
+              kTruth, u.standard_error[0], data.se);
   EXPECT_NEAR(fitted, kTruth, 3 * data.se + options.xtol_abs * 0.8);
   ASSERT_TRUE(u.computed) << u.note;
   EXPECT_TRUE(u.identified[0]);
