@@ -195,7 +195,10 @@ std::string CalibrationJson(const CalibrationFile& file, const Objective& object
             {"starts", starts},
             {"timings",
              {{"calibration_s", s.wall_time_s},
-              {"evaluations_per_s", s.wall_time_s > 0 ? s.evaluations() / s.wall_time_s : 0.0},
+              // Over the evaluations this run made (not those replayed from a checkpoint).
+              {"evaluations_per_s", s.wall_time_s > 0 && s.evaluations() > s.replayed
+                                        ? json((s.evaluations() - s.replayed) / s.wall_time_s)
+                                        : json(nullptr)},
               {"roughness_and_profiles_s",
                run.roughness ? json(run.roughness->wall_time_s) : json(nullptr)},
               {"total_s", run.wall_time_s}}}};
