@@ -74,6 +74,19 @@ class BudgetCallback final : public ceres::IterationCallback {
   const Evaluator& evaluate_;
 };
 
+// Ceres logs a rank-deficient covariance as an error on stderr; here it is an expected outcome,
+// reported in Uncertainty. Quiets glog below FATAL while alive (one thread computes it).
+class QuietCeresLog {
+ public:
+  QuietCeresLog() : level_(FLAGS_minloglevel) { FLAGS_minloglevel = google::GLOG_FATAL; }
+  ~QuietCeresLog() { FLAGS_minloglevel = level_; }
+  QuietCeresLog(const QuietCeresLog&) = delete;
+  QuietCeresLog& operator=(const QuietCeresLog&) = delete;
+
+ private:
+  int level_;
+};
+
 std::string Num(double v, const char* format = "%.4g") {
   if (std::isnan(v)) return "-";
   char b[64];
@@ -243,6 +256,7 @@ Uncertainty EstimateUncertainty(const Objective& objective, const Eigen::VectorX
   covariance_options.min_reciprocal_condition_number = options.min_reciprocal_condition_number;
   covariance_options.null_space_rank = 0;  // rank-deficient: refuse, and profile instead
   covariance_options.num_threads = 1;
+  const QuietCeresLog quiet;
   RowMajor inverse = RowMajor::Zero(n, n);  // (J^T J)^-1 of the identified coordinates
   bool ok = false;
   std::vector<int> flat;  // coordinates whose given profile is flat
