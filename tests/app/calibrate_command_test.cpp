@@ -85,8 +85,22 @@ TEST(CalibrateCommand, WritesTheGroundTableJsonAndHistory) {
   ASSERT_EQ(code, 0) << output;
   EXPECT_NE(output.find("Calibration report"), std::string::npos) << output;
   for (const char* name :
-       {"ground_table.toml", "ground_table.csv", "history.csv", "calibration.json"})
+       {"ground_table.toml", "ground_table.csv", "history.csv", "calibration.json",
+        "convergence.svg", "observed_vs_simulated_runout.svg"})
     EXPECT_TRUE(fs::exists(dir / "out" / name)) << name;
+  // The plots: one dot per feasible evaluation and the best-so-far line; one dot per run before
+  // and one after.
+  const std::string convergence = Slurp(dir / "out" / "convergence.svg");
+  const std::string scatter = Slurp(dir / "out" / "observed_vs_simulated_runout.svg");
+  const auto count = [](const std::string& text, const std::string& what) {
+    std::size_t n = 0;
+    for (std::size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1))
+      ++n;
+    return n;
+  };
+  EXPECT_EQ(convergence.rfind("<svg ", 0), 0u);
+  EXPECT_EQ(count(convergence, "<polyline"), 1u);
+  EXPECT_EQ(count(scatter, "<circle"), 8u);  // 4 runs, before and after
   const auto json = nlohmann::json::parse(Slurp(dir / "out" / "calibration.json"));
   EXPECT_EQ(json["parameters"][0]["name"], "medium_soft.mu_min");
   EXPECT_LE(json["objective"]["after"].get<double>(), json["objective"]["before"].get<double>());
