@@ -1,5 +1,6 @@
 #include "calibration/objective.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <sstream>
@@ -133,6 +134,21 @@ Objective::Objective(const Scene& scene, const ensemble::ReleaseSpec& release,
     prior_center_ = parameters_.UnitOf(*options_.prior_reference);
     *prior_center_ = prior_center_->cwiseMax(0.0).cwiseMin(1.0);
   }
+
+  // Residual groups: runs in order of first appearance; an observation of the whole scene alone.
+  std::vector<std::string> runs;
+  const auto group_of = [&](const std::string& run) {
+    if (!run.empty())
+      for (std::size_t g = 0; g < runs.size(); ++g)
+        if (runs[g] == run) return static_cast<int>(g);
+    runs.push_back(run);
+    return static_cast<int>(runs.size() - 1);
+  };
+  for (const auto& o : observations_.scalars) residual_groups_.push_back(group_of(o.run));
+  for (const auto& o : observations_.deposits) residual_groups_.push_back(group_of(o.run));
+  for (std::size_t i = 0; i < observations_.scalars.size(); ++i)
+    residual_groups_.push_back(residual_groups_[i]);
+  if (prior_center_) residual_groups_.insert(residual_groups_.end(), dimension(), -1);
 }
 
 GroundTable Objective::GroundOf(const Eigen::VectorXd& u) const {
@@ -157,7 +173,8 @@ Evaluation Objective::Run(const Eigen::VectorXd& u, const ensemble::ReleaseSpec&
   e.kind_scores.assign(kinds_.size(), kNaN);
   e.kind_scored.assign(kinds_.size(), 0);
   const long m = static_cast<long>(observations_.size());
-  e.residuals = Eigen::VectorXd::Zero(m + (prior_center_ ? dimension() : 0));
+  const long m_scalars = static_cast<long>(observations_.scalars.size());
+  e.residuals = Eigen::VectorXd::Zero(residual_count());
   const auto elapsed = [&] {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   };
@@ -205,9 +222,20 @@ Evaluation Objective::Run(const Eigen::VectorXd& u, const ensemble::ReleaseSpec&
   for (long i = 0; i < m; ++i) {
     const fieldobs::ObservationScore& s = scores.observations[static_cast<std::size_t>(i)];
     if (!s.scored) continue;
-    for (std::size_t k = 0; k < kinds_.size(); ++k)
-      if (s.kind == kinds_[k] && weights_[k] > 0)
-        e.residuals[i] = std::sqrt(weights_[k] / (e.kind_scored[k] * scales_[k]) * s.score);
+    for (std::size_t k = 0; k < kinds_.size(); ++k) {
+      if (s.kind != kinds_[k] || weights_[k] == 0) continue;
+      const double c = weights_[k] / (e.kind_scored[k] * scales_[k]);
+      if (i >= m_scalars) {
+        e.residuals[i] = std::sqrt(c * s.score);
+        continue;
+      }
+      const fieldobs::ScalarObservation& o = observations_.scalars[static_cast<std::size_t>(i)];
+      const double spread = std::min(
+          s.score, fieldobs::CrpsEnsemble(samples.Values(o.quantity, o.run, o.zone), s.median));
+      const double location = std::sqrt(c * (s.score - spread));
+      e.residuals[i] = s.median < s.observed ? -location : location;
+      e.residuals[m + i] = std::sqrt(c * spread);
+    }
   }
   if (prior_center_) {
     const Eigen::VectorXd d = u - *prior_center_;

@@ -68,9 +68,20 @@ struct Evaluation {
   // Per kind (in the order of ObjectiveKinds()): mean score in the kind's unit, and scored count.
   std::vector<double> kind_scores;
   std::vector<int> kind_scored;
-  // One per observation (scalars, then deposits): sqrt(weight / (n_kind * scale_kind) * score),
-  // so that the sum of squares is the data term; 0 for an observation that was not scored.
-  // Then one per coordinate for the prior: sqrt(prior_weight) (u - u_ref).
+  // The residual vector of least squares (least_squares.hpp), whose sum of squares is the
+  // objective. With c = weight / (n_kind * scale_kind) the factor of an observation's score:
+  //  - one per observation (scalars, then deposits): for a scalar the *location* residual
+  //      sign(median - observed) sqrt(c (CRPS - CRPS_at_median)),
+  //    the CRPS's excess over the CRPS the same ensemble would score had the observation been
+  //    its median (the smallest it can score, since the CRPS in the observation is smallest at
+  //    the ensemble's median); signed, and about sqrt(c f(median)) (median - observed) near zero
+  //    bias (f: the ensemble's density), so it crosses zero smoothly as the bias does.
+  //    For a deposit (a 2-D energy score has no sign): sqrt(c energy_score);
+  //  - then one per scalar observation, the *spread* residual sqrt(c CRPS_at_median): what the
+  //    ensemble's width costs even without bias;
+  //  - then one per coordinate for the prior: sqrt(prior_weight) (u - u_ref).
+  // So the sum of squares is the data term plus the prior term. 0 for an observation that was
+  // not scored. Objective::residual_groups() says which run each residual belongs to.
   Eigen::VectorXd residuals;
   long rocks = 0;
   long failed_rocks = 0;
@@ -107,6 +118,11 @@ class Objective {
   const Scene& scene() const { return scene_; }
   std::optional<Eigen::VectorXd> prior_center() const { return prior_center_; }
   bool needs_episodes() const { return episodes_; }
+  // Per residual (Evaluation::residuals): the group of observations it belongs to -- one group
+  // per run, one per observation of the whole scene --, and -1 for the prior's. Observations of
+  // one run share its rocks and are not independent; the groups are independent.
+  const std::vector<int>& residual_groups() const { return residual_groups_; }
+  int residual_count() const { return static_cast<int>(residual_groups_.size()); }
 
  private:
   Evaluation Run(const Eigen::VectorXd& u, const ensemble::ReleaseSpec& release) const;
@@ -120,6 +136,7 @@ class Objective {
   std::vector<std::string> kinds_;  // observation kinds in order of first appearance
   std::vector<double> weights_, scales_;
   std::optional<Eigen::VectorXd> prior_center_;
+  std::vector<int> residual_groups_;
 };
 
 }  // namespace talus::calibration

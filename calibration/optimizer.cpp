@@ -10,11 +10,11 @@
 #include <stdexcept>
 
 #include "calibration/designs.hpp"
+#include "calibration/evaluator.hpp"
+#include "calibration/least_squares.hpp"
 
 namespace talus::calibration {
 namespace {
-
-using Clock = std::chrono::steady_clock;
 
 nlopt_algorithm AlgorithmOf(const std::string& name) {
   if (name == "bobyqa") return NLOPT_LN_BOBYQA;
@@ -26,44 +26,16 @@ nlopt_algorithm AlgorithmOf(const std::string& name) {
 
 // The state the NLopt callback works on.
 struct Run {
-  const Objective& objective;
-  const OptimizerOptions& options;
-  Summary& summary;
-  Clock::time_point t0;
+  Evaluator& evaluate;
   nlopt_opt opt = nullptr;
-  int start = 0;
-  std::exception_ptr error;
-  bool out_of_time = false;
 };
 
 double Callback(unsigned n, const double* x, double* /*grad*/, void* data) {
   Run& run = *static_cast<Run*>(data);
-  try {
-    const Eigen::Map<const Eigen::VectorXd> u(x, n);
-    // The objective is deterministic: a point asked for again is answered from the history.
-    for (const Evaluation& e : run.summary.history)
-      if (e.u == u) {
-        ++run.summary.cache_hits;
-        return e.value;
-      }
-    Evaluation e = run.objective.Evaluate(u);
-    run.summary.history.push_back(e);
-    run.summary.history_start.push_back(run.start);
-    const int index = run.summary.evaluations() - 1;
-    if (e.feasible && (!run.summary.best.feasible || !(e.value >= run.summary.best.value)))
-      run.summary.best = e;
-    if (run.options.on_evaluation) run.options.on_evaluation(e, index);
-    if (run.options.max_time_s > 0 &&
-        std::chrono::duration<double>(Clock::now() - run.t0).count() >= run.options.max_time_s) {
-      run.out_of_time = true;
-      nlopt_force_stop(run.opt);
-    }
-    return e.value;
-  } catch (...) {
-    run.error = std::current_exception();
-    nlopt_force_stop(run.opt);
-    return HUGE_VAL;
-  }
+  const std::optional<Evaluation> e =
+      run.evaluate.TryEvaluate(Eigen::Map<const Eigen::VectorXd>(x, n));
+  if (!e || run.evaluate.stopped()) nlopt_force_stop(run.opt);
+  return e ? e->value : HUGE_VAL;
 }
 
 std::string Num(double v, const char* format = "%.6g") {
@@ -76,11 +48,14 @@ std::string Num(double v, const char* format = "%.6g") {
 }  // namespace
 
 const std::vector<std::string>& AlgorithmNames() {
-  static const std::vector<std::string> names = {"bobyqa", "sbplx", "crs2_lm", "direct_l", "isres"};
+  static const std::vector<std::string> names = {"bobyqa",   "sbplx", "crs2_lm",
+                                                 "direct_l", "isres", "ceres"};
   return names;
 }
 
-bool IsLocalAlgorithm(const std::string& name) { return name == "bobyqa" || name == "sbplx"; }
+bool IsLocalAlgorithm(const std::string& name) {
+  return name == "bobyqa" || name == "sbplx" || name == "ceres";
+}
 
 const char* ToString(Termination t) {
   switch (t) {
@@ -101,7 +76,7 @@ bool OptimizerOptions::IsValid(std::string* why) const {
   const auto& names = AlgorithmNames();
   if (std::find(names.begin(), names.end(), algorithm) == names.end())
     msg << "algorithm = '" << algorithm
-        << "' is not one of bobyqa, sbplx, crs2_lm, direct_l, isres";
+        << "' is not one of bobyqa, sbplx, crs2_lm, direct_l, isres, ceres";
   else if (max_evaluations < 1)
     msg << "max_evaluations = " << max_evaluations << " must be >= 1";
   else if (!(max_time_s >= 0) || !std::isfinite(max_time_s))
@@ -117,41 +92,44 @@ bool OptimizerOptions::IsValid(std::string* why) const {
     msg << "starts = " << starts << " must be in 1 .. max_evaluations = " << max_evaluations;
   else if (start_design != "sobol" && start_design != "lhs")
     msg << "start_design = '" << start_design << "' must be \"sobol\" or \"lhs\"";
+  else if (!(fd_step >= 0 && fd_step <= 0.25))
+    msg << "fd_step = " << fd_step << " must be in [0, 0.25] (0: measured)";
   if (msg.str().empty()) return true;
   if (why) *why = msg.str();
   return false;
 }
 
-Summary Calibrate(const Objective& objective, const OptimizerOptions& options) {
-  std::string why;
-  if (!options.IsValid(&why)) throw std::invalid_argument("Calibrate: " + why);
+std::vector<Eigen::VectorXd> StartPoints(const Objective& objective,
+                                         const OptimizerOptions& options) {
   const int n = objective.dimension();
   if (options.start_design == "sobol" && options.starts > 1 && n > kMaxSobolDimension)
     throw std::invalid_argument("Calibrate: Sobol starts for more than 16 parameters; use lhs");
-
-  Summary summary;
-  summary.algorithm = options.algorithm;
-  for (const Coordinate& c : objective.parameters().coordinates()) summary.names.push_back(c.name);
-  Run run{objective, options, summary, Clock::now(), nullptr, 0, nullptr, false};
-
-  // Start points: the given one (or the scene's table), then the design's.
   Eigen::VectorXd x0 = options.start ? *options.start : objective.StartPoint();
   if (x0.size() != n) throw std::invalid_argument("Calibrate: start has the wrong dimension");
-  x0 = x0.cwiseMax(0.0).cwiseMin(1.0);
-  std::vector<Eigen::VectorXd> starts = {x0};
+  std::vector<Eigen::VectorXd> starts = {x0.cwiseMax(0.0).cwiseMin(1.0)};
   if (options.starts > 1) {
     const Eigen::MatrixXd design = options.start_design == "sobol"
                                        ? Sobol(options.starts - 1, n, options.seed)
                                        : LatinHypercube(options.starts - 1, n, options.seed);
     for (int k = 0; k < design.rows(); ++k) starts.push_back(design.row(k).transpose());
   }
+  return starts;
+}
 
+Summary Calibrate(const Objective& objective, const OptimizerOptions& options) {
+  std::string why;
+  if (!options.IsValid(&why)) throw std::invalid_argument("Calibrate: " + why);
+  if (options.algorithm == "ceres") return CalibrateLeastSquares(objective, options);
+  const int n = objective.dimension();
+  const std::vector<Eigen::VectorXd> starts = StartPoints(objective, options);
+
+  Summary summary;
+  summary.algorithm = options.algorithm;
+  for (const Coordinate& c : objective.parameters().coordinates()) summary.names.push_back(c.name);
+  Evaluator evaluate(objective, options, summary);
+  Run run{evaluate, nullptr};
   // The initial point's evaluation is the first of the history (the optimiser reuses it).
-  summary.initial = objective.Evaluate(x0);
-  summary.history.push_back(summary.initial);
-  summary.history_start.push_back(0);
-  if (summary.initial.feasible) summary.best = summary.initial;
-  if (options.on_evaluation) options.on_evaluation(summary.initial, 0);
+  evaluate(starts.front());
 
   const std::vector<double> lower(static_cast<std::size_t>(n), 0.0);
   const std::vector<double> upper(static_cast<std::size_t>(n), 1.0);
@@ -159,12 +137,12 @@ Summary Calibrate(const Objective& objective, const OptimizerOptions& options) {
   const std::vector<double> xtol(static_cast<std::size_t>(n), options.xtol_abs);
   nlopt_result last = NLOPT_SUCCESS;
   for (std::size_t s = 0; s < starts.size(); ++s) {
-    const int used = summary.evaluations();
-    const int left = options.max_evaluations - used;
-    const double elapsed = std::chrono::duration<double>(Clock::now() - run.t0).count();
-    if (left <= 0 || run.out_of_time || (options.max_time_s > 0 && elapsed >= options.max_time_s))
+    const int left = options.max_evaluations - summary.evaluations();
+    const double elapsed = evaluate.elapsed_s();
+    if (left <= 0 || evaluate.out_of_time() ||
+        (options.max_time_s > 0 && elapsed >= options.max_time_s))
       break;
-    run.start = static_cast<int>(s);
+    evaluate.set_start(static_cast<int>(s));
     run.opt = nlopt_create(AlgorithmOf(options.algorithm), static_cast<unsigned>(n));
     if (!run.opt) throw std::runtime_error("Calibrate: NLopt could not create its optimiser");
     nlopt_set_min_objective(run.opt, Callback, &run);
@@ -173,7 +151,8 @@ Summary Calibrate(const Objective& objective, const OptimizerOptions& options) {
     // This start's share of the evaluations left (its first point may be answered by the cache).
     const int share = std::max(1, left / static_cast<int>(starts.size() - s));
     nlopt_set_maxeval(run.opt, share + (s == 0 ? 1 : 0));
-    if (options.max_time_s > 0) nlopt_set_maxtime(run.opt, options.max_time_s - elapsed);
+    // Time is watched by the evaluator (after each evaluation), not by NLopt's clock, so that
+    // the path does not depend on when NLopt looks at it.
     nlopt_set_ftol_rel(run.opt, options.ftol_rel);
     nlopt_set_ftol_abs(run.opt, options.ftol_abs);
     nlopt_set_xtol_abs(run.opt, xtol.data());
@@ -188,20 +167,20 @@ Summary Calibrate(const Objective& objective, const OptimizerOptions& options) {
     last = nlopt_optimize(run.opt, x.data(), &f);
     nlopt_destroy(run.opt);
     run.opt = nullptr;
-    if (run.error) std::rethrow_exception(run.error);
+    evaluate.Rethrow();
 
     StartRecord record;
     record.u0 = starts[s];
     record.best_u = Eigen::Map<const Eigen::VectorXd>(x.data(), n);
     record.best_value = f;
     record.evaluations = summary.evaluations() - before;
-    record.nlopt_result = nlopt_result_to_string(last);
+    record.result = nlopt_result_to_string(last);
     summary.starts.push_back(record);
   }
 
-  summary.wall_time_s = std::chrono::duration<double>(Clock::now() - run.t0).count();
+  summary.wall_time_s = evaluate.elapsed_s();
   std::ostringstream msg;
-  if (run.out_of_time || last == NLOPT_MAXTIME_REACHED) {
+  if (evaluate.out_of_time()) {
     summary.termination = Termination::kMaxTime;
     msg << "wall-time budget of " << options.max_time_s << " s spent";
   } else if (last == NLOPT_MAXEVAL_REACHED || summary.evaluations() >= options.max_evaluations) {
@@ -222,9 +201,9 @@ Summary Calibrate(const Objective& objective, const OptimizerOptions& options) {
 std::string Summary::BriefReport() const {
   char line[512];
   std::snprintf(line, sizeof line,
-                "NLopt %s: %s after %d evaluations in %.1f s; objective %s -> %s (%d starts)",
-                algorithm.c_str(), ToString(termination), evaluations(), wall_time_s,
-                Num(initial.value).c_str(), Num(best.value).c_str(),
+                "%s %s: %s after %d evaluations in %.1f s; objective %s -> %s (%d starts)",
+                algorithm == "ceres" ? "Ceres" : "NLopt", algorithm.c_str(), ToString(termination),
+                evaluations(), wall_time_s, Num(initial.value).c_str(), Num(best.value).c_str(),
                 static_cast<int>(starts.size()));
   return line;
 }
@@ -232,9 +211,10 @@ std::string Summary::BriefReport() const {
 std::string Summary::FullReport() const {
   std::string out = "\nCalibration report\n";
   char line[512];
-  std::snprintf(line, sizeof line, "  %-28s %s\n  %-28s %s\n  %-28s %d (%d asked again)\n",
+  std::snprintf(line, sizeof line,
+                "  %-28s %s\n  %-28s %s\n  %-28s %d (%d asked again, %d from a checkpoint)\n",
                 "Algorithm", algorithm.c_str(), "Termination", message.c_str(), "Evaluations",
-                evaluations(), cache_hits);
+                evaluations(), cache_hits, replayed);
   out += line;
   std::snprintf(line, sizeof line, "  %-28s %s\n  %-28s %s (data %s + prior %s)\n  %-28s %.2f s\n",
                 "Initial objective", Num(initial.value).c_str(), "Final objective",
@@ -252,10 +232,15 @@ std::string Summary::FullReport() const {
                   Num(best.u.size() > k ? best.u[k] : kNaN, "%.4f").c_str());
     out += line;
   }
-  out += "\n  start  evaluations  best objective  NLopt result\n";
+  if (!std::isnan(fd_step)) {
+    std::snprintf(line, sizeof line, "  %-28s %.3g (of each range)\n", "Finite-difference step",
+                  fd_step);
+    out += line;
+  }
+  out += "\n  start  evaluations  best objective  result\n";
   for (std::size_t s = 0; s < starts.size(); ++s) {
     std::snprintf(line, sizeof line, "  %5zu  %11d  %14s  %s\n", s, starts[s].evaluations,
-                  Num(starts[s].best_value).c_str(), starts[s].nlopt_result.c_str());
+                  Num(starts[s].best_value).c_str(), starts[s].result.c_str());
     out += line;
   }
   return out + BriefReport() + "\n";

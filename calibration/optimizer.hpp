@@ -1,8 +1,11 @@
 #pragma once
-// Calibration by NLopt's derivative-free methods on the objective (objective.hpp), in the unit
-// cube: local BOBYQA and Sbplx, global CRS2-LM, DIRECT-L and ISRES, chosen by name; optionally
-// from several starts (the given start, then Sobol or Latin-hypercube points). Every evaluation is
-// kept. The result is a Summary with a termination type, a brief and a full report (Ceres style).
+// Calibration on the objective (objective.hpp), in the unit cube, by NLopt's derivative-free
+// methods -- local BOBYQA and Sbplx, global CRS2-LM, DIRECT-L and ISRES -- or by Ceres Solver's
+// bounded nonlinear least squares on the residual vector ("ceres", least_squares.hpp), chosen by
+// name; optionally from several starts (the given start, then Sobol or Latin-hypercube points).
+// Every evaluation is kept, and a checkpoint's evaluations can be replayed so that an interrupted
+// calibration resumes to the identical result. The result is a Summary with a termination type, a
+// brief and a full report (Ceres style).
 //
 // Infeasible vectors (mu_min > mu_max where both are free; NLopt keeps to the box itself) run no
 // rock and get the finite penalty ObjectiveOptions::infeasible_value * (1 + violation), far above
@@ -21,7 +24,8 @@
 
 namespace talus::calibration {
 
-// The algorithms by name: "bobyqa", "sbplx" (local), "crs2_lm", "direct_l", "isres" (global).
+// The algorithms by name: "bobyqa", "sbplx" (local), "crs2_lm", "direct_l", "isres" (global),
+// "ceres" (local, least squares with numeric derivatives).
 const std::vector<std::string>& AlgorithmNames();
 bool IsLocalAlgorithm(const std::string& name);
 
@@ -38,6 +42,14 @@ struct OptimizerOptions {
   std::string start_design = "sobol";    // or "lhs"
   std::uint64_t seed = 1;                // designs and the stochastic methods (CRS2-LM, ISRES)
   std::optional<Eigen::VectorXd> start;  // unit coordinates; default: the scene's table, clamped
+  // Ceres: the central-difference step in unit coordinates (fraction of each range); 0: measured
+  // at the start point (MeasureRoughness's recommended step, above the objective's roughness).
+  double fd_step = 0;
+  // Evaluations of an earlier, interrupted run of the same calibration (a checkpoint), served in
+  // order instead of running rocks: the optimiser retraces its path bit for bit and goes on from
+  // where the checkpoint ends. An optimiser asking for another point than the next one recorded
+  // is an error (the checkpoint belongs to another calibration).
+  std::vector<Evaluation> replay;
   // Called after every evaluation (on the calling thread); may throw to stop (e.g. interrupted):
   // the optimiser stops and the exception comes out of Calibrate.
   std::function<void(const Evaluation&, int evaluation)> on_evaluation;
@@ -58,7 +70,7 @@ struct StartRecord {
   Eigen::VectorXd best_u;  // its best point
   double best_value = kNaN;
   int evaluations = 0;
-  std::string nlopt_result;  // e.g. "FTOL_REACHED"
+  std::string result;  // NLopt's result (e.g. "FTOL_REACHED") or Ceres' termination message
 };
 
 struct Summary {
@@ -71,7 +83,9 @@ struct Summary {
   std::vector<Evaluation> history;  // every evaluation, in order
   std::vector<int> history_start;   // per evaluation: which start (0 .. starts - 1)
   std::vector<StartRecord> starts;
-  int cache_hits = 0;  // points NLopt asked for twice (answered from the history, not re-run)
+  int cache_hits = 0;     // points asked for twice (answered from the history, not re-run)
+  int replayed = 0;       // evaluations served from OptimizerOptions::replay
+  double fd_step = kNaN;  // Ceres: the central-difference step used (unit coordinates)
   double wall_time_s = 0;
 
   int evaluations() const { return static_cast<int>(history.size()); }
@@ -79,6 +93,11 @@ struct Summary {
   std::string BriefReport() const;  // one line
   std::string FullReport() const;   // several lines, per parameter and per start
 };
+
+// The start points: options.start (or the scene's table), clamped to the unit cube, then the
+// starts - 1 points of the design.
+std::vector<Eigen::VectorXd> StartPoints(const Objective& objective,
+                                         const OptimizerOptions& options);
 
 // Minimises the objective. Throws what options.on_evaluation throws; std::invalid_argument for
 // invalid options (validate them first).

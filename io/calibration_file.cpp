@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 
 #include "calibration/designs.hpp"
 #include "common/error.hpp"
@@ -134,7 +135,7 @@ void LoadObjective(const Context& context, const toml::table* table, Calibration
 void LoadOptimizer(const Context& context, const toml::table* table, CalibrationFile& out) {
   const Section s(context, table, "optimizer",
                   {"algorithm", "max_evaluations", "max_time_s", "ftol_rel", "ftol_abs", "xtol_abs",
-                   "initial_step", "population", "starts", "start_design", "seed"});
+                   "initial_step", "population", "starts", "start_design", "seed", "fd_step"});
   calibration::OptimizerOptions& o = out.optimizer;
   o.algorithm = s.String("algorithm", o.algorithm);
   const auto& names = calibration::AlgorithmNames();
@@ -172,6 +173,11 @@ void LoadOptimizer(const Context& context, const toml::table* table, Calibration
   const long seed = s.Integer("seed", 1);
   if (seed < 0) s.Fail("seed", std::to_string(seed) + " must be >= 0");
   o.seed = static_cast<std::uint64_t>(seed);
+  o.fd_step = s.Checked(
+      "fd_step", 0.0, [](double v) { return v >= 0 && v <= 0.25; },
+      "must be in [0, 0.25] (a fraction of each range; 0: measured at the start)");
+  if (s.Has("fd_step") && o.algorithm != "ceres")
+    s.Fail("fd_step", "only algorithm = \"ceres\" takes derivatives");
   std::string why;
   if (!o.IsValid(&why)) s.FailCheck(why);
 }
@@ -195,14 +201,42 @@ void LoadRoughness(const Context& context, const toml::table* table, Calibration
   if (!out.roughness_options.IsValid(&why)) s.Fail("steps", why);
 }
 
+void LoadUncertainty(const Context& context, const toml::table* table, CalibrationFile& out) {
+  const Section s(context, table, "uncertainty",
+                  {"enabled", "fd_step", "min_reciprocal_condition_number", "weak_fraction"});
+  calibration::UncertaintyOptions& o = out.uncertainty_options;
+  out.uncertainty = s.Bool("enabled", true);
+  o.fd_step = s.Checked(
+      "fd_step", 0.0, [](double v) { return v >= 0 && v <= 0.25; },
+      "must be in [0, 0.25] (a fraction of each range; 0: the optimiser's or the roughness')");
+  o.min_reciprocal_condition_number = s.Checked(
+      "min_reciprocal_condition_number", o.min_reciprocal_condition_number,
+      [](double v) { return v > 0 && v < 1; }, "must be in (0, 1)");
+  o.weak_fraction = s.Checked(
+      "weak_fraction", o.weak_fraction, [](double v) { return v > 0; }, "must be > 0");
+  o.profile = out.profile_options;
+}
+
+// 64-bit FNV-1a of `text`, as 16 hex digits.
+std::string Fnv1a(const std::string& text) {
+  std::uint64_t h = 1469598103934665603ULL;
+  for (unsigned char c : text) {
+    h ^= c;
+    h *= 1099511628211ULL;
+  }
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
+  return hex;
+}
+
 }  // namespace
 
 CalibrationFile LoadCalibration(const std::string& path) {
   const Context context(path);
   const toml::table root = ParseTomlFile(path, "calibration file");
-  const Section top(
-      context, &root, "",
-      {"event", "rocks", "seed", "parameters", "objective", "optimizer", "roughness"});
+  const Section top(context, &root, "",
+                    {"event", "rocks", "seed", "parameters", "objective", "optimizer", "roughness",
+                     "uncertainty"});
   CalibrationFile out;
   out.path = path;
   if (!top.Has("event"))
@@ -229,22 +263,28 @@ CalibrationFile LoadCalibration(const std::string& path) {
   LoadObjective(context, SubTable(context, root, "objective"), out);
   LoadOptimizer(context, SubTable(context, root, "optimizer"), out);
   LoadRoughness(context, SubTable(context, root, "roughness"), out);
+  LoadUncertainty(context, SubTable(context, root, "uncertainty"), out);
 
   out.inputs.push_back(path);
   for (const std::string& input : out.event.inputs) out.inputs.push_back(input);
-  std::uint64_t h = 1469598103934665603ULL;
   std::ifstream in(path, std::ios::binary);
-  for (unsigned char c : std::string(std::istreambuf_iterator<char>(in), {})) {
-    h ^= c;
-    h *= 1099511628211ULL;
-  }
-  for (unsigned char c : out.event.inputs_hash) {
-    h ^= c;
-    h *= 1099511628211ULL;
-  }
-  char hex[17];
-  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
-  out.inputs_hash = hex;
+  out.inputs_hash =
+      Fnv1a(std::string(std::istreambuf_iterator<char>(in), {}) + out.event.inputs_hash);
+
+  std::ostringstream path_text;  // every number at full precision
+  path_text.precision(17);
+  path_text << out.event.inputs_hash << ' ' << release.rocks_per_release << ' ' << release.seed;
+  for (const ParameterSpec& p : out.parameters)
+    path_text << ' ' << p.Name() << ' ' << p.lower << ' ' << p.upper << ' ' << p.UsesLog() << ' '
+              << p.tie;
+  const calibration::ObjectiveOptions& ob = out.objective;
+  for (const auto& [kind, weight] : ob.weights) path_text << ' ' << kind << ' ' << weight;
+  path_text << ' ' << ob.normalise << ' ' << ob.prior_weight << ' ' << out.prior_reference;
+  const calibration::OptimizerOptions& o = out.optimizer;
+  path_text << ' ' << o.algorithm << ' ' << o.ftol_rel << ' ' << o.ftol_abs << ' ' << o.xtol_abs
+            << ' ' << o.initial_step << ' ' << o.population << ' ' << o.starts << ' '
+            << o.start_design << ' ' << o.seed << ' ' << o.fd_step;
+  out.path_hash = Fnv1a(path_text.str());
   return out;
 }
 

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "calibration/least_squares.hpp"
 #include "calibration/objective.hpp"
 #include "calibration/optimizer.hpp"
 #include "calibration/parameters.hpp"
@@ -25,8 +26,16 @@ struct CalibrationFile {
   bool roughness = true;  // measure roughness and profile every parameter at the optimum
   calibration::RoughnessOptions roughness_options;
   calibration::ProfileOptions profile_options;
+  // The covariance at the optimum (Ceres). fd_step 0 in uncertainty_options: the optimiser's
+  // step (Ceres), else the roughness measurement's recommendation, else 0.01.
+  bool uncertainty = true;
+  calibration::UncertaintyOptions uncertainty_options;
   std::vector<std::string> inputs;  // the calibration file and the event's inputs
   std::string inputs_hash;
+  // What decides an optimiser's path -- the event's inputs, rocks and seed, the parameters, the
+  // objective and the optimiser's options -- but not its budget (max_evaluations, max_time_s),
+  // nor the roughness and uncertainty sections: a checkpoint may be resumed with another budget.
+  std::string path_hash;
 };
 
 // Throws InputError "<file>:<line>: <key>: <reason>".

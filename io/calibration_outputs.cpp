@@ -57,7 +57,46 @@ json Kinds(const Objective& objective, const Evaluation& before, const Evaluatio
   return out;
 }
 
+json Matrix(const Eigen::MatrixXd& m) {
+  json out = json::array();
+  for (Eigen::Index r = 0; r < m.rows(); ++r) out.push_back(Vector(m.row(r).transpose()));
+  return out;
+}
+
+json HeldOutKinds(const std::vector<calibration::HeldOutKind>& kinds) {
+  json out = json::array();
+  for (const auto& k : kinds)
+    out.push_back({{"kind", k.kind},
+                   {"unit", k.unit},
+                   {"observations", k.observations},
+                   {"scored", k.scored},
+                   {"crps_fitted", Number(k.fitted)},
+                   {"crps_reference", Number(k.reference)}});
+  return out;
+}
+
+json HeldOut(const calibration::HeldOutScores& s) {
+  return {{"runs", s.runs},
+          {"kinds", HeldOutKinds(s.kinds)},
+          {"rocks", s.rocks},
+          {"wall_time_s", s.wall_time_s}};
+}
+
 }  // namespace
+
+std::string HeldOutReport(const calibration::HeldOutScores& scores) {
+  std::string out;
+  char line[256];
+  std::snprintf(line, sizeof line, "  %-24s %8s %14s %14s\n", "kind", "scored", "fitted",
+                "reference");
+  out += line;
+  for (const auto& k : scores.kinds) {
+    std::snprintf(line, sizeof line, "  %-24s %8d %11.4g %-2s %11.4g %-2s\n", k.kind.c_str(),
+                  k.scored, k.fitted, k.unit.c_str(), k.reference, k.unit.c_str());
+    out += line;
+  }
+  return out;
+}
 
 std::string GroundTableToml(const CalibrationFile& file, const Objective& objective,
                             const GroundTable& fitted) {
@@ -124,7 +163,7 @@ std::string CalibrationJson(const CalibrationFile& file, const Objective& object
                       {"best", Vector(r.best_u)},
                       {"best_objective", Number(r.best_value)},
                       {"evaluations", r.evaluations},
-                      {"nlopt_result", r.nlopt_result}});
+                      {"result", r.result}});
   const ensemble::ReleaseSpec& release = objective.release();
   json j = {{"version", run.version},
             {"calibration_file", file.path},
@@ -151,13 +190,65 @@ std::string CalibrationJson(const CalibrationFile& file, const Objective& object
             {"kinds", Kinds(objective, s.initial, s.best)},
             {"evaluations", s.evaluations()},
             {"cache_hits", s.cache_hits},
+            {"replayed_from_checkpoint", s.replayed},
+            {"finite_difference_step", Number(s.fd_step)},
             {"starts", starts},
             {"timings",
              {{"calibration_s", s.wall_time_s},
-              {"evaluations_per_s", s.wall_time_s > 0 ? s.evaluations() / s.wall_time_s : 0.0},
+              // Over the evaluations this run made (not those replayed from a checkpoint).
+              {"evaluations_per_s", s.wall_time_s > 0 && s.evaluations() > s.replayed
+                                        ? json((s.evaluations() - s.replayed) / s.wall_time_s)
+                                        : json(nullptr)},
               {"roughness_and_profiles_s",
                run.roughness ? json(run.roughness->wall_time_s) : json(nullptr)},
               {"total_s", run.wall_time_s}}}};
+  if (run.uncertainty) {
+    const auto& u = *run.uncertainty;
+    json identified = json::array(), weak = json::array();
+    for (std::size_t k = 0; k < u.identified.size(); ++k) {
+      identified.push_back(bool(u.identified[k]));
+      weak.push_back(bool(u.weak[k]));
+    }
+    j["uncertainty"] = {{"method",
+                         "sandwich covariance H^-1 V H^-1 over runs, (J^T J)^-1 from "
+                         "ceres::Covariance (dense SVD)"},
+                        {"computed", u.computed},
+                        {"rank_deficient", u.rank_deficient},
+                        {"names", u.names},
+                        {"values", Vector(u.values)},
+                        {"standard_error", Vector(u.standard_error)},
+                        {"standard_error_unit", Vector(u.standard_error_unit)},
+                        {"correlation", Matrix(u.correlation)},
+                        {"covariance", Matrix(u.covariance)},
+                        {"identified", identified},
+                        {"weak", weak},
+                        {"runs", u.groups},
+                        {"note", u.note},
+                        {"evaluations", u.evaluations},
+                        {"wall_time_s", u.wall_time_s}};
+    for (std::size_t k = 0; k < u.names.size() && k < j["parameters"].size(); ++k)
+      j["parameters"][k]["standard_error"] = Number(u.standard_error[static_cast<Eigen::Index>(k)]);
+  } else {
+    j["uncertainty"] = nullptr;
+  }
+  j["holdout"] = run.holdout ? HeldOut(*run.holdout) : json(nullptr);
+  if (!run.folds.empty()) {
+    json folds = json::array();
+    std::vector<calibration::HeldOutScores> sets;
+    for (const FoldRun& f : run.folds) {
+      json fold = HeldOut(f.scores);
+      fold["fitted"] = Vector(f.summary.best.values);
+      fold["objective"] = Number(f.summary.best.value);
+      fold["evaluations"] = f.summary.evaluations();
+      fold["termination"] = calibration::ToString(f.summary.termination);
+      folds.push_back(fold);
+      sets.push_back(f.scores);
+    }
+    j["cross_validation"] = {{"folds", folds},
+                             {"kinds", HeldOutKinds(calibration::PoolKinds(sets))}};
+  } else {
+    j["cross_validation"] = nullptr;
+  }
   if (run.roughness) {
     const auto& r = *run.roughness;
     j["roughness"] = {{"at_objective", Number(r.value)},

@@ -7,12 +7,20 @@
 #include <string>
 #include <vector>
 
+#include "calibration/holdout.hpp"
+#include "calibration/least_squares.hpp"
 #include "calibration/objective.hpp"
 #include "calibration/optimizer.hpp"
 #include "calibration/roughness.hpp"
 #include "io/calibration_file.hpp"
 
 namespace talus::io {
+
+// One fold of a cross-validation: the fit without it, and its runs' scores.
+struct FoldRun {
+  calibration::Summary summary;
+  calibration::HeldOutScores scores;
+};
 
 // Everything a calibration run gave, for calibration.json.
 struct CalibrationRun {
@@ -22,7 +30,13 @@ struct CalibrationRun {
   calibration::Summary summary;
   std::optional<calibration::RoughnessReport> roughness;
   std::vector<calibration::ParameterProfile> profiles;
+  std::optional<calibration::Uncertainty> uncertainty;
+  std::optional<calibration::HeldOutScores> holdout;
+  std::vector<FoldRun> folds;
 };
+
+// Held-out scores per kind, fitted against reference, as a few lines for people.
+std::string HeldOutReport(const calibration::HeldOutScores& scores);
 
 // The categories the calibration touched, with every field, as [ground.<name>] blocks.
 std::string GroundTableToml(const CalibrationFile& file, const calibration::Objective& objective,

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdio>
 #include <filesystem>
@@ -28,8 +29,8 @@ using talus::app::testing::Slurp;
 
 using talus::app::testing::Write;
 
-// Four runs of a block on a short 35 degree slope with observed run-outs.
-fs::path MakeEvent(const std::string& name) {
+// Four (or seven) runs of a block on a short 35 degree slope with observed run-outs.
+fs::path MakeEvent(const std::string& name, bool seven = false) {
   const fs::path dir = FreshDir(name);
   Write(dir / "scene.toml", R"([terrain]
 plane = { slope_deg = 35, slope_length_m = 20, runout_m = 10, width_m = 12, cell_m = 1 }
@@ -44,8 +45,10 @@ seed = 3
 max_time_s = 3
 )");
   Write(dir / "runs.csv",
-        "trajectory_id,x_m,y_m,height_m,vx_mps\nr1,3,0,1,1\nr2,3,2,1,2\nr3,4,-2,1,0\nr4,4,3,1,1\n");
-  Write(dir / "observed.csv", "trajectory_id,observed_runout_m\nr1,17\nr2,19\nr3,14\nr4,16\n");
+        "trajectory_id,x_m,y_m,height_m,vx_mps\nr1,3,0,1,1\nr2,3,2,1,2\nr3,4,-2,1,0\nr4,4,3,1,1\n" +
+            std::string(seven ? "r5,3,-4,1,1\nr6,4,1,1,2\nr7,3,4,1,0\n" : ""));
+  Write(dir / "observed.csv", "trajectory_id,observed_runout_m\nr1,17\nr2,19\nr3,14\nr4,16\n" +
+                                  std::string(seven ? "r5,18\nr6,15\nr7,13\n" : ""));
   Write(dir / "event.toml", R"(scene = "scene.toml"
 [[observations]]
 kind = "runout"
@@ -82,8 +85,22 @@ TEST(CalibrateCommand, WritesTheGroundTableJsonAndHistory) {
   ASSERT_EQ(code, 0) << output;
   EXPECT_NE(output.find("Calibration report"), std::string::npos) << output;
   for (const char* name :
-       {"ground_table.toml", "ground_table.csv", "history.csv", "calibration.json"})
+       {"ground_table.toml", "ground_table.csv", "history.csv", "calibration.json",
+        "convergence.svg", "observed_vs_simulated_runout.svg"})
     EXPECT_TRUE(fs::exists(dir / "out" / name)) << name;
+  // The plots: one dot per feasible evaluation and the best-so-far line; one dot per run before
+  // and one after.
+  const std::string convergence = Slurp(dir / "out" / "convergence.svg");
+  const std::string scatter = Slurp(dir / "out" / "observed_vs_simulated_runout.svg");
+  const auto count = [](const std::string& text, const std::string& what) {
+    std::size_t n = 0;
+    for (std::size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1))
+      ++n;
+    return n;
+  };
+  EXPECT_EQ(convergence.rfind("<svg ", 0), 0u);
+  EXPECT_EQ(count(convergence, "<polyline"), 1u);
+  EXPECT_EQ(count(scatter, "<circle"), 8u);  // 4 runs, before and after
   const auto json = nlohmann::json::parse(Slurp(dir / "out" / "calibration.json"));
   EXPECT_EQ(json["parameters"][0]["name"], "medium_soft.mu_min");
   EXPECT_LE(json["objective"]["after"].get<double>(), json["objective"]["before"].get<double>());
@@ -130,7 +147,7 @@ TEST(CalibrateCommand, BadFilesAreRefusedBeforeAnyRun) {
              "hard, extra_hard, snow"},
       {"algorithm = \"bobyqa\"", "algorithm = \"bobyqua\"",
        cal + ":8: optimizer.algorithm: unknown algorithm 'bobyqua' (did you mean 'bobyqa'?); "
-             "known: bobyqa, sbplx, crs2_lm, direct_l, isres"},
+             "known: bobyqa, sbplx, crs2_lm, direct_l, isres, ceres"},
       {"[optimizer]", "[objective]\nweights = { scar_length = 1 }\n[optimizer]",
        cal + ":8: objective.weights.scar_length: no observation of this kind; the event "
              "observes runout"},
@@ -152,6 +169,103 @@ TEST(CalibrateCommand, BadFilesAreRefusedBeforeAnyRun) {
     EXPECT_EQ(output, "talus calibrate: " + c.expected + "\n");
     EXPECT_FALSE(fs::exists(dir / "out"));
   }
+}
+
+std::string Calibrate(const fs::path& dir, const std::string& options, std::string* output) {
+  return std::to_string(RunCommand(std::string(TALUS_BINARY) + " calibrate " +
+                                       (dir / "cal.toml").string() + " --out " +
+                                       (dir / "out").string() + " --threads 2 " + options,
+                                   output));
+}
+
+// Ceres with one run held out (--holdout r2) and 2-fold cross-validation of the other six: the
+// held-out run is scored with the fitted and the reference (Table 1) parameters, each fold's runs
+// by the fit without them, the folds split the six runs, and the covariance is reported.
+TEST(CalibrateCommand, CeresWithAHeldOutRunAndCrossValidation) {
+  const fs::path dir = MakeEvent("ceres", true);
+  std::string cal = kGood;
+  cal.replace(cal.find("bobyqa"), 6, "ceres");
+  cal.replace(cal.find("max_evaluations = 6"), 19, "max_evaluations = 6\nfd_step = 0.05");
+  Write(dir / "cal.toml", cal);
+  std::string output;
+  ASSERT_EQ(Calibrate(dir, "--holdout r2 --folds 2", &output), "0") << output;
+  const auto json = nlohmann::json::parse(Slurp(dir / "out" / "calibration.json"));
+  EXPECT_EQ(json["algorithm"], "ceres");
+  EXPECT_EQ(json["runs"], 6);
+  EXPECT_EQ(json["holdout"]["runs"], nlohmann::json::array({"r2"}));
+  ASSERT_EQ(json["holdout"]["kinds"].size(), 1u);
+  EXPECT_EQ(json["holdout"]["kinds"][0]["kind"], "runout");
+  EXPECT_EQ(json["holdout"]["kinds"][0]["scored"], 1);
+  EXPECT_TRUE(json["holdout"]["kinds"][0]["crps_fitted"].is_number());
+  EXPECT_TRUE(json["holdout"]["kinds"][0]["crps_reference"].is_number());
+  const auto& folds = json["cross_validation"]["folds"];
+  ASSERT_EQ(folds.size(), 2u);
+  std::vector<std::string> runs;
+  for (const auto& fold : folds) {
+    EXPECT_EQ(fold["runs"].size(), 3u);
+    for (const auto& r : fold["runs"]) runs.push_back(r.get<std::string>());
+  }
+  std::sort(runs.begin(), runs.end());
+  EXPECT_EQ(runs, (std::vector<std::string>{"r1", "r3", "r4", "r5", "r6", "r7"}));
+  EXPECT_EQ(json["cross_validation"]["kinds"][0]["scored"], 6);
+  EXPECT_TRUE(json["uncertainty"].is_object());
+  EXPECT_TRUE(json["uncertainty"]["note"].is_string());
+  EXPECT_GT(json["finite_difference_step"].get<double>(), 0);
+  // When a budget ended a fit (the main one or a fold's), the checkpoint stays for --resume.
+  const auto budget = [](const nlohmann::json& t) {
+    return t == "max_evaluations" || t == "max_time";
+  };
+  bool any_budget = budget(json["termination"]);
+  for (const auto& fold : folds) any_budget = any_budget || budget(fold["termination"]);
+  EXPECT_EQ(fs::exists(dir / "out" / "checkpoint.json"), any_budget);
+  // Unknown held-out runs and a second run over a checkpoint are refused before any rock runs.
+  EXPECT_EQ(Calibrate(dir, "--holdout r9", &output), "2") << output;
+  EXPECT_NE(output.find("--holdout: 'r9' is not a run of the event's scene"), std::string::npos)
+      << output;
+}
+
+// A calibration stopped by its budget (5 evaluations) and resumed from its checkpoint with a
+// budget of 10 ends exactly where an uninterrupted run with 10 does: the same evaluations, bit
+// for bit (history.csv without its wall times), the same fitted table.
+TEST(CalibrateCommand, ResumedCalibrationEqualsAnUninterruptedOne) {
+  const auto without_times = [](const std::string& csv) {
+    std::string out;
+    std::stringstream in(csv);
+    for (std::string line; std::getline(in, line);) {
+      const std::size_t note = line.rfind(',');
+      const std::size_t time = line.rfind(',', note - 1);
+      out += line.substr(0, time) + "\n";
+    }
+    return out;
+  };
+  std::string cal = kGood;
+  cal.replace(cal.find("max_evaluations = 6"), 19, "max_evaluations = 10\nxtol_abs = 0");
+  const fs::path whole = MakeEvent("whole");
+  Write(whole / "cal.toml", cal);
+  std::string output;
+  ASSERT_EQ(Calibrate(whole, "", &output), "0") << output;
+
+  const fs::path parts = MakeEvent("parts");
+  std::string first = cal;
+  first.replace(first.find("max_evaluations = 10"), 20, "max_evaluations = 5");
+  Write(parts / "cal.toml", first);
+  ASSERT_EQ(Calibrate(parts, "", &output), "0") << output;
+  ASSERT_TRUE(fs::exists(parts / "out" / "checkpoint.json")) << output;
+  EXPECT_EQ(Calibrate(parts, "", &output), "2") << output;  // not without --resume
+  EXPECT_NE(output.find("resume it with --resume"), std::string::npos) << output;
+  Write(parts / "cal.toml", cal);
+  ASSERT_EQ(Calibrate(parts, "--resume", &output), "0") << output;
+  EXPECT_NE(output.find("5 from a checkpoint"), std::string::npos) << output;
+
+  const auto a = nlohmann::json::parse(Slurp(whole / "out" / "calibration.json"));
+  const auto b = nlohmann::json::parse(Slurp(parts / "out" / "calibration.json"));
+  EXPECT_EQ(a["evaluations"], 10);
+  EXPECT_EQ(a["parameters"], b["parameters"]);
+  EXPECT_EQ(a["objective"], b["objective"]);
+  EXPECT_EQ(a["evaluations"], b["evaluations"]);
+  EXPECT_EQ(Slurp(whole / "out" / "ground_table.csv"), Slurp(parts / "out" / "ground_table.csv"));
+  EXPECT_EQ(without_times(Slurp(whole / "out" / "history.csv")),
+            without_times(Slurp(parts / "out" / "history.csv")));
 }
 
 }  // namespace

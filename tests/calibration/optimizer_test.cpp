@@ -1,6 +1,8 @@
 // Calibration end to end on observations Talus generated itself from known parameters: BOBYQA
-// gives the truth back from a distant start, within a tolerance derived from the data's own
-// sampling error; a parameter the data cannot see has a flat profile and is reported unidentified.
+// and Ceres give the truth back from a distant start, within a tolerance derived from the data's
+// own sampling error, and Ceres' covariance states an uncertainty that covers the truth; a
+// parameter the data cannot see has a flat profile and is reported unidentified; an interrupted
+// calibration resumed from its evaluations ends bit for bit where an uninterrupted one does.
 
 #include "calibration/optimizer.hpp"
 
@@ -9,6 +11,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "calibration/least_squares.hpp"
 #include "calibration/roughness.hpp"
 #include "tests/calibration/fixtures.hpp"
 
@@ -58,6 +61,28 @@ Moments RunoutMoments(double mu) {
   return m;
 }
 
+// The standard error of mu_min the data allow: one observation per run is one draw of a runout
+// whose within-run sd is sigma; the mean runout moves by dm/dmu per unit mu_min; so N runs locate
+// mu_min to about sigma / (|dm/dmu| sqrt(N)), and the model's own ensemble of R rocks per run adds
+// a factor sqrt(1 + 1/R). sigma and dm/dmu are measured (central difference over +-0.05 around
+// the truth), not assumed.
+struct DataError {
+  double sd = 0, slope = 0, se = 0;
+};
+DataError MeasuredDataError() {
+  static const DataError error = [] {
+    const Moments lo = RunoutMoments(kTruth - 0.05), hi = RunoutMoments(kTruth + 0.05),
+                  at = RunoutMoments(kTruth);
+    DataError e;
+    e.sd = at.sd;
+    e.slope = (hi.mean - lo.mean) / 0.1;
+    e.se = at.sd / (std::abs(e.slope) * std::sqrt(double(kRuns))) *
+           std::sqrt(1 + 1.0 / double(kRocks));
+    return e;
+  }();
+  return error;
+}
+
 // mu_min from 0.2 (Table 1 is 0.40, the truth 0.50) with BOBYQA on the normalised mean CRPS of 24
 // run-outs. Tolerance, from the data: one observation per run is one draw of a runout whose
 // within-run sd is sigma; the mean runout moves by dm/dmu per unit mu_min; so N runs locate
@@ -81,17 +106,14 @@ TEST(Calibrate, BobyqaRecoversMuMinFromADistantStart) {
   std::printf("%s", summary.FullReport().c_str());
   ASSERT_TRUE(summary.IsSolutionUsable());
 
-  const Moments lo = RunoutMoments(kTruth - 0.05), hi = RunoutMoments(kTruth + 0.05),
-                at = RunoutMoments(kTruth);
-  const double slope = (hi.mean - lo.mean) / 0.1;
-  const double se =
-      at.sd / (std::abs(slope) * std::sqrt(double(kRuns))) * std::sqrt(1 + 1.0 / double(kRocks));
+  const DataError data = MeasuredDataError();
+  const double se = data.se;
   const double tolerance = 3 * se + options.xtol_abs * 0.8;
   const double fitted = summary.best.values[0];
   std::printf(
       "fitted mu_min %.4f (truth %.2f); within-run sd %.2f m, dm/dmu %.1f m, "
       "standard error %.4f, tolerance %.4f\n",
-      fitted, kTruth, at.sd, slope, se, tolerance);
+      fitted, kTruth, data.sd, data.slope, se, tolerance);
   EXPECT_NEAR(fitted, kTruth, tolerance);
   EXPECT_GT(std::abs(0.2 - kTruth), tolerance);  // the start lies outside the accepted band
   EXPECT_LT(summary.best.value, summary.initial.value);
@@ -111,15 +133,15 @@ TEST(Calibrate, BetaIsUnidentifiedWhereRocksBarelyFlyAndMuMinIsIdentified) {
   const Objective objective(
       p.scene, p.release, p.observations,
       {Free(GroundField::kMuMin, 0.1, 0.9), Free(GroundField::kBeta, 50, 400)}, objective_options);
-  Eigen::VectorXd u = objective.StartPoint();
-  u[0] = (kTruth - 0.1) / 0.8;
+  Eigen::VectorXd u0 = objective.StartPoint();
+  u0[0] = (kTruth - 0.1) / 0.8;
   RoughnessOptions roughness;
   roughness.steps = {1e-4};
   roughness.seeds = 3;
-  const RoughnessReport r = MeasureRoughness(objective, u, roughness);
+  const RoughnessReport r = MeasureRoughness(objective, u0, roughness);
   std::printf("%s", r.Report().c_str());
   const std::vector<ParameterProfile> profiles =
-      ProfileParameters(objective, u, r.value, r.level(), {4, 3, 1e-6});
+      ProfileParameters(objective, u0, r.value, r.level(), {4, 3, 1e-6});
   for (const ParameterProfile& profile : profiles)
     std::printf("%s: range %.4g, threshold %.4g, %s\n", profile.name.c_str(), profile.range,
                 profile.threshold, profile.identified ? "identified" : "unidentified");
@@ -128,6 +150,153 @@ TEST(Calibrate, BetaIsUnidentifiedWhereRocksBarelyFlyAndMuMinIsIdentified) {
   EXPECT_FALSE(profiles[1].identified);
   EXPECT_GT(r.level(), 0);
   EXPECT_GT(r.seed_sd, 0);
+
+  // The covariance with these profiles: beta is held constant and named in the note; mu_min
+  // gets a standard error.
+  UncertaintyOptions uncertainty_options;
+  uncertainty_options.fd_step = 0.05;
+  uncertainty_options.noise = r.level();
+  uncertainty_options.profiles = profiles;
+  const Uncertainty u = EstimateUncertainty(objective, u0, uncertainty_options);
+  std::printf("%s", u.Report().c_str());
+  ASSERT_TRUE(u.computed) << u.note;
+  EXPECT_TRUE(u.identified[0]);
+  EXPECT_FALSE(u.identified[1]);
+  EXPECT_GT(u.standard_error[0], 0);
+  EXPECT_TRUE(std::isnan(u.standard_error[1]));
+  EXPECT_NE(u.note.find("not constrained by the observations (flat profile): medium_hard.beta"),
+            std::string::npos)
+      << u.note;
+}
+
+// A parameter no rock ever feels (the friction of a category the plane does not have) leaves
+// J^T J rank-deficient: ceres::Covariance refuses, the profiles (measured then) find it flat, and
+// the covariance of the others is computed with it held constant.
+TEST(Calibrate, ARankDeficientCovarianceFallsBackToTheProfiles) {
+  const auto& p = Problem();
+  ObjectiveOptions objective_options;
+  objective_options.threads = 2;
+  ParameterSpec unseen = Free(GroundField::kMuMin, 0.1, 0.9);
+  unseen.category = "hard";
+  const Objective objective(p.scene, p.release, p.observations,
+                            {Free(GroundField::kMuMin, 0.1, 0.9), unseen}, objective_options);
+  Eigen::VectorXd u0 = objective.StartPoint();
+  u0[0] = (kTruth - 0.1) / 0.8;
+  UncertaintyOptions options;
+  options.fd_step = 0.05;
+  options.profile.points = 3;
+  const Uncertainty u = EstimateUncertainty(objective, u0, options);
+  std::printf("%s", u.Report().c_str());
+  EXPECT_TRUE(u.rank_deficient);
+  EXPECT_TRUE(u.jacobian.col(1).isZero(0));
+  ASSERT_EQ(u.profiles.size(), 2u);
+  EXPECT_EQ(u.profiles[1].range, 0);
+  ASSERT_TRUE(u.computed) << u.note;
+  EXPECT_TRUE(u.identified[0]);
+  EXPECT_FALSE(u.identified[1]);
+  EXPECT_GT(u.standard_error[0], 0);
+  EXPECT_NE(u.note.find("hard.mu_min"), std::string::npos) << u.note;
+}
+
+// Ceres from the same distant start: Levenberg-Marquardt on the residuals (signed location and
+// spread parts of each run-out's CRPS) with central differences at the step measured above the
+// roughness, then the sandwich covariance at the optimum. The fitted mu_min must lie within the
+// tolerance of the BOBYQA test (3 data standard errors plus xtol), and the stated uncertainty
+// must cover the truth: |fitted - truth| <= 2 standard errors (a 95 % interval). The stated
+// standard error must also agree with the data's (MeasuredDataError, an independent estimate from
+// the run-outs' spread and sensitivity) within a factor of 3.
+TEST(Calibrate, CeresRecoversMuMinAndItsUncertaintyCoversTheTruth) {
+  const auto& p = Problem();
+  ObjectiveOptions objective_options;
+  objective_options.threads = 2;
+  const Objective objective(p.scene, p.release, p.observations,
+                            {Free(GroundField::kMuMin, 0.1, 0.9)}, objective_options);
+  OptimizerOptions options;
+  options.algorithm = "ceres";
+  options.max_evaluations = 40;
+  options.start = Eigen::VectorXd::Constant(1, (0.2 - 0.1) / 0.8);
+  const Summary summary = Calibrate(objective, options);
+  std::printf("%s", summary.FullReport().c_str());
+  ASSERT_TRUE(summary.IsSolutionUsable());
+  EXPECT_GT(summary.fd_step, 0);
+  EXPECT_LE(summary.evaluations(), options.max_evaluations);
+  EXPECT_LT(summary.best.value, summary.initial.value);
+
+  UncertaintyOptions uncertainty_options;
+  uncertainty_options.fd_step = summary.fd_step;
+  const Uncertainty u =
+      EstimateUncertainty(objective, summary.best.u, uncertainty_options, summary.history);
+  std::printf("%s", u.Report().c_str());
+  const DataError data = MeasuredDataError();
+  const double fitted = summary.best.values[0];
+  std::printf("fitted mu_min %.4f (truth %.2f), stated standard error %.4f, data's %.4f\n", fitted,
+              kTruth, u.standard_error[0], data.se);
+  EXPECT_NEAR(fitted, kTruth, 3 * data.se + options.xtol_abs * 0.8);
+  ASSERT_TRUE(u.computed) << u.note;
+  EXPECT_TRUE(u.identified[0]);
+  EXPECT_LE(std::abs(fitted - kTruth), 2 * u.standard_error[0]);
+  EXPECT_LT(u.standard_error[0], 3 * data.se);
+  EXPECT_GT(u.standard_error[0], data.se / 3);
+}
+
+// An interruption (here: on_evaluation throws after 3 evaluations, as talus calibrate does on
+// SIGINT) loses nothing: replaying the evaluations made so far (OptimizerOptions::replay, what
+// --resume reads from the checkpoint) retraces the optimiser's path without running a rock and
+// goes on to the result of an uninterrupted run, bit for bit, for NLopt and for Ceres.
+TEST(Calibrate, AnInterruptedCalibrationResumesToTheIdenticalResult) {
+  static const testing::SyntheticRunouts p(12, 3, kTruth);  // small: this tests bookkeeping
+  ObjectiveOptions objective_options;
+  objective_options.threads = 2;
+  const Objective objective(p.scene, p.release, p.observations,
+                            {Free(GroundField::kMuMin, 0.1, 0.9)}, objective_options);
+  struct Stop {};
+  for (const char* algorithm : {"bobyqa", "ceres"}) {
+    SCOPED_TRACE(algorithm);
+    OptimizerOptions options;
+    options.algorithm = algorithm;
+    options.max_evaluations = 6;
+    options.fd_step = 0.05;
+    options.start = Eigen::VectorXd::Constant(1, 0.125);
+    const Summary whole = Calibrate(objective, options);
+
+    std::vector<Evaluation> kept;
+    OptimizerOptions interrupted = options;
+    interrupted.on_evaluation = [&](const Evaluation& e, int index) {
+      kept.push_back(e);
+      if (index == 2) throw Stop{};
+    };
+    EXPECT_THROW(Calibrate(objective, interrupted), Stop);
+    ASSERT_EQ(kept.size(), 3u);
+    OptimizerOptions resumed = options;
+    resumed.replay = kept;
+    const Summary rest = Calibrate(objective, resumed);
+
+    EXPECT_EQ(rest.replayed, 3);
+    ASSERT_EQ(rest.evaluations(), whole.evaluations());
+    for (int k = 0; k < whole.evaluations(); ++k) {
+      EXPECT_EQ(rest.history[k].u, whole.history[k].u) << k;
+      EXPECT_EQ(rest.history[k].value, whole.history[k].value) << k;
+      EXPECT_EQ(rest.history[k].residuals, whole.history[k].residuals) << k;
+    }
+    EXPECT_EQ(rest.best.u, whole.best.u);
+    EXPECT_EQ(rest.best.value, whole.best.value);
+    EXPECT_EQ(rest.termination, whole.termination);
+  }
+}
+
+// A replay that does not belong to the calibration (another start) is refused.
+TEST(Calibrate, AReplayOfAnotherCalibrationIsRefused) {
+  const auto& p = Problem();
+  ObjectiveOptions objective_options;
+  objective_options.threads = 2;
+  const Objective objective(p.scene, p.release, p.observations,
+                            {Free(GroundField::kMuMin, 0.1, 0.9)}, objective_options);
+  OptimizerOptions options;
+  options.max_evaluations = 3;
+  Evaluation other;
+  other.u = Eigen::VectorXd::Constant(1, 0.9);
+  options.replay = {other};
+  EXPECT_THROW(Calibrate(objective, options), std::runtime_error);
 }
 
 }  // namespace

@@ -5,10 +5,12 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <vector>
 
 #include "ensemble/runner.hpp"
+#include "io/calibration_file.hpp"
 #include "io/event_file.hpp"
 #include "io/scene_file.hpp"
 
@@ -17,14 +19,28 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::vector<fs::path> CaseScenes() {
-  std::vector<fs::path> scenes;
-  for (const auto& entry : fs::recursive_directory_iterator(fs::path(TALUS_SOURCE_DIR) / "cases"))
-    if (entry.path().extension() == ".toml" && entry.path().stem() != "event")
-      scenes.push_back(entry.path());
-  std::sort(scenes.begin(), scenes.end());
-  return scenes;
+// The cases' TOML files of one kind, told apart by their first key: an event names its `scene`,
+// a calibration file its `event`; every other TOML file is a scene.
+enum class Kind { kScene, kEvent, kCalibration };
+Kind KindOf(const fs::path& path) {
+  std::ifstream in(path);
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind("scene =", 0) == 0) return Kind::kEvent;
+    if (line.rfind("event =", 0) == 0) return Kind::kCalibration;
+  }
+  return Kind::kScene;
 }
+
+std::vector<fs::path> CaseFiles(Kind kind) {
+  std::vector<fs::path> files;
+  for (const auto& entry : fs::recursive_directory_iterator(fs::path(TALUS_SOURCE_DIR) / "cases"))
+    if (entry.path().extension() == ".toml" && KindOf(entry.path()) == kind)
+      files.push_back(entry.path());
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+std::vector<fs::path> CaseScenes() { return CaseFiles(Kind::kScene); }
 
 TEST(Cases, EverySceneLoadsAndItsFirstRocksRun) {
   const std::vector<fs::path> scenes = CaseScenes();
@@ -45,17 +61,28 @@ TEST(Cases, EverySceneLoadsAndItsFirstRocksRun) {
   }
 }
 
-// Every case's event file (event.toml) loads: its scene, its observation tables, its runs.
+// Every case's event file loads: its scene, its observation tables, its runs.
 TEST(Cases, EveryEventLoads) {
   int events = 0;
-  for (const auto& entry : fs::recursive_directory_iterator(fs::path(TALUS_SOURCE_DIR) / "cases"))
-    if (entry.path().filename() == "event.toml") {
-      SCOPED_TRACE(entry.path().string());
-      const io::EventFile event = io::LoadEvent(entry.path().string());
-      EXPECT_GT(event.observations.size(), 0u);
-      ++events;
-    }
-  EXPECT_GE(events, 2);  // tschamut2014, chant_sura
+  for (const fs::path& path : CaseFiles(Kind::kEvent)) {
+    SCOPED_TRACE(path.string());
+    const io::EventFile event = io::LoadEvent(path.string());
+    EXPECT_GT(event.observations.size(), 0u);
+    ++events;
+  }
+  EXPECT_GE(events, 3);  // tschamut2014 (2), chant_sura
+}
+
+// Every case's calibration file loads and is checked (event, parameters, optimiser).
+TEST(Cases, EveryCalibrationFileLoads) {
+  int files = 0;
+  for (const fs::path& path : CaseFiles(Kind::kCalibration)) {
+    SCOPED_TRACE(path.string());
+    const io::CalibrationFile file = io::LoadCalibration(path.string());
+    EXPECT_FALSE(file.parameters.empty());
+    ++files;
+  }
+  EXPECT_GE(files, 1);  // tschamut2014
 }
 
 }  // namespace

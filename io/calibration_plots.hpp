@@ -1,0 +1,24 @@
+#pragma once
+// The plots of `talus calibrate` as small, deterministic SVG files (docs/calibration.md): the
+// convergence of the objective over the evaluations, and the observed against the simulated
+// median of each scalar observation kind before and after the fit.
+
+#include <string>
+#include <vector>
+
+#include "calibration/optimizer.hpp"
+#include "fieldobs/validation.hpp"
+
+namespace talus::io {
+
+// Every feasible evaluation's objective (dots) and the best so far (line), against the evaluation.
+std::string ConvergenceSvg(const calibration::Summary& summary);
+
+// For the scored observations of `kind` (a scalar kind): observed (x) against the simulated
+// median (y), before (grey) and after (blue) the fit, with the 1:1 line. `before` and `after` are
+// the same observations scored with the initial and the fitted parameters.
+std::string ObservedSimulatedSvg(const std::string& kind,
+                                 const std::vector<fieldobs::ObservationScore>& before,
+                                 const std::vector<fieldobs::ObservationScore>& after);
+
+}  // namespace talus::io
