@@ -17,10 +17,16 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// Event files are event.toml and event_<what>.toml; every other .toml under cases/ is a scene.
+bool IsEventFile(const fs::path& path) {
+  const std::string stem = path.stem().string();
+  return path.extension() == ".toml" && (stem == "event" || stem.rfind("event_", 0) == 0);
+}
+
 std::vector<fs::path> CaseScenes() {
   std::vector<fs::path> scenes;
   for (const auto& entry : fs::recursive_directory_iterator(fs::path(TALUS_SOURCE_DIR) / "cases"))
-    if (entry.path().extension() == ".toml" && entry.path().stem() != "event")
+    if (entry.path().extension() == ".toml" && !IsEventFile(entry.path()))
       scenes.push_back(entry.path());
   std::sort(scenes.begin(), scenes.end());
   return scenes;
@@ -45,17 +51,18 @@ TEST(Cases, EverySceneLoadsAndItsFirstRocksRun) {
   }
 }
 
-// Every case's event file (event.toml) loads: its scene, its observation tables, its runs.
+// Every case's event file (event.toml, event_<what>.toml) loads: its scene, its observation
+// tables, its runs.
 TEST(Cases, EveryEventLoads) {
   int events = 0;
   for (const auto& entry : fs::recursive_directory_iterator(fs::path(TALUS_SOURCE_DIR) / "cases"))
-    if (entry.path().filename() == "event.toml") {
+    if (IsEventFile(entry.path())) {
       SCOPED_TRACE(entry.path().string());
       const io::EventFile event = io::LoadEvent(entry.path().string());
       EXPECT_GT(event.observations.size(), 0u);
       ++events;
     }
-  EXPECT_GE(events, 2);  // tschamut2014, chant_sura
+  EXPECT_GE(events, 3);  // tschamut2014, chant_sura (impacts, segments)
 }
 
 }  // namespace
