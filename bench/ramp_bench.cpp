@@ -1,7 +1,8 @@
 // Benchmark: single-rock trajectories of the EOTA221 block down the 40 degree ramp, one core.
 // Prints the machine, trajectories per second (median of repeats), steps per second, contact-solver
 // sweeps per contact step, the ramp statistics that Leine et al. 2021 (Table 2) report for
-// RAMMS::ROCKFALL, and a per-stage time profile.
+// RAMMS::ROCKFALL, per rock and pooled per raster cell (RAMMS's statistic mode), and a per-stage
+// time profile.
 
 #include <sys/utsname.h>
 
@@ -12,11 +13,13 @@
 #include <cstdio>
 #include <fstream>
 #include <map>
+#include <memory>
 #include <numbers>
 #include <string>
 #include <thread>
 #include <vector>
 
+#include "ensemble/rasters.hpp"
 #include "scenes/scenes.hpp"
 #include "solver/simulate.hpp"
 
@@ -33,7 +36,8 @@ struct Batch {
   double wall_s = 0;
   long steps = 0, contact_steps = 0, iterations = 0, unconverged = 0;
   double time_sum_s = 0;
-  std::vector<double> runouts_m, max_speeds_m_s, rotation_rates_1_s, jump_heights_m, travel_times_s;
+  std::vector<double> runouts_m, max_speeds_m_s, rotation_rates_1_s, jump_heights_m, travel_times_s,
+      kinetic_energies_kj;
   int stopped_within_5_m = 0;
   std::map<std::string, int> endings;
 };
@@ -55,6 +59,7 @@ Batch RunBatch(const talus::Scene& scene, int rocks, std::uint64_t seed, talus::
     batch.rotation_rates_1_s.push_back(r.max_angular_speed_rad_s / (2 * std::numbers::pi));
     batch.jump_heights_m.push_back(r.max_jump_height_m);
     batch.travel_times_s.push_back(r.travel_time_s);
+    batch.kinetic_energies_kj.push_back(r.max_kinetic_energy_j / 1000);
     batch.stopped_within_5_m += r.end == talus::EndReason::kRest && r.runout_m < 5;
     batch.time_sum_s += r.travel_time_s;
     ++batch.endings[talus::ToString(r.end)];
@@ -88,6 +93,85 @@ std::pair<double, double> MeanAndError(const std::vector<double>& v) {
   return {mean, std::sqrt(var / v.size())};
 }
 
+// RAMMS's statistic mode, pooled: for each rock and each raster cell its centre of mass passed,
+// that rock's maximum of a quantity in that cell; the values of all rocks and cells together.
+struct CellValues {
+  std::vector<double> speeds_m_s, rotation_rates_1_s, jump_heights_m, kinetic_energies_kj;
+};
+
+// Records each rock's per-cell maxima with the recorder of `talus simulate`'s rasters
+// (ensemble::FootprintRecorder: same cells, same marking of the cells a long step crosses). Its
+// footprint has no angular speed, so a second recorder sees each state with the angular velocity
+// in place of the velocity: the "speed" it records per cell is the angular speed.
+class CellMaxima : public talus::StepObserver {
+ public:
+  CellMaxima(const talus::Scene& scene, CellValues* out)
+      : motion_request_(Request(scene, true)),
+        spin_request_(Request(scene, false)),
+        motion_(motion_request_, scene.terrain),
+        spin_(spin_request_, scene.terrain),
+        shape_(std::make_shared<const talus::RockShape>(scene.rock)),
+        out_(out) {}
+
+  void Begin(const talus::RockState& start) {
+    talus::ensemble::RockOutcome outcome;
+    outcome.shape = shape_;
+    outcome.start = start;
+    motion_.Begin(outcome);
+    outcome.start = WithSpinAsVelocity(start);
+    spin_.Begin(outcome);
+  }
+  void OnStep(const talus::RockState& state, const talus::StepReport& step,
+              const talus::TerrainSample& ground) override {
+    motion_.OnStep(state, step, ground);
+    spin_.OnStep(WithSpinAsVelocity(state), step, ground);
+  }
+  void Finish(const talus::RockResult& result) {
+    talus::ensemble::RockOutcome motion, spin;
+    motion.result = spin.result = result;
+    motion_.Finish(motion);
+    spin_.Finish(spin);
+    const talus::ensemble::Footprint& m = motion.footprint;
+    for (std::size_t k = 0; k < m.cells.size(); ++k) {
+      out_->speeds_m_s.push_back(m.speed_m_s[k]);
+      out_->jump_heights_m.push_back(m.jump_height_m[k]);
+      out_->kinetic_energies_kj.push_back(m.energy_j[k] / 1000);
+    }
+    for (float w : spin.footprint.speed_m_s)
+      out_->rotation_rates_1_s.push_back(w / (2 * std::numbers::pi));
+  }
+
+ private:
+  static talus::ensemble::RasterRequest Request(const talus::Scene& scene, bool motion) {
+    talus::ensemble::RasterRequest request;
+    request.grid = scene.terrain.heights().grid;
+    request.speed = true;
+    request.energy = request.jump_height = motion;
+    return request;
+  }
+  static talus::RockState WithSpinAsVelocity(talus::RockState state) {
+    state.velocity_m_s = state.angular_velocity_rad_s;
+    return state;
+  }
+
+  talus::ensemble::RasterRequest motion_request_, spin_request_;
+  talus::ensemble::FootprintRecorder motion_, spin_;
+  std::shared_ptr<const talus::RockShape> shape_;
+  CellValues* out_;
+};
+
+CellValues RunCellStatistics(const talus::Scene& scene, int rocks, std::uint64_t seed) {
+  CellValues values;
+  CellMaxima recorder(scene, &values);
+  talus::SimulationWorkspace workspace;
+  for (int k = 0; k < rocks; ++k) {
+    const talus::RockState start = talus::scenes::Ramp40Release(scene, seed, k);
+    recorder.Begin(start);
+    recorder.Finish(talus::SimulateRock(scene, start, workspace, &recorder));
+  }
+  return values;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -113,10 +197,11 @@ int main(int argc, char** argv) {
   app.add_option("--contact-solve", contact_solve,
                  "Two-contact steps: gauss_seidel sweeps or one block solve")
       ->check(CLI::IsMember({"gauss_seidel", "block"}));
-  bool no_profile = false;
-  app.add_flag(
-      "--no-profile", no_profile,
-      "Skip the stage profile run (for instruction counts of exactly --rocks trajectories)");
+  bool no_profile = false, no_cells = false;
+  app.add_flag("--no-profile", no_profile,
+               "Skip the stage profile and the per-cell statistics runs (for instruction counts "
+               "of exactly --rocks trajectories)");
+  app.add_flag("--no-cells", no_cells, "Skip the per-cell statistics run");
   CLI11_PARSE(app, argc, argv);
 
   talus::Scene scene = talus::scenes::Ramp40();
@@ -179,18 +264,22 @@ int main(int argc, char** argv) {
   const auto [jump_mean, jump_sd] = MeanAndSd(last.jump_heights_m);
   const auto [time_mean, time_sd] = MeanAndSd(last.travel_times_s);
   const auto [runout_mean, runout_sd] = MeanAndSd(last.runouts_m);
+  const auto [energy_mean, energy_sd] = MeanAndSd(last.kinetic_energies_kj);
   int slow = 0;
   for (double v : last.max_speeds_m_s) slow += v < 5;
   std::printf(
       "ramp statistics per rock (mean +- sd; Leine et al. 2021, Table 2, RAMMS::ROCKFALL: max "
       "speed "
-      "17.75 +- 7.7 m/s, rotation 4.77 +- 1.9 rot/s, jump height 1.40 +- 1.1 m):\n"
+      "17.75 +- 7.7 m/s, rotation 4.77 +- 1.9 rot/s, jump height 1.40 +- 1.1 m, kinetic energy "
+      "188.03 +- 131.7 kJ):\n"
       "  max speed %.2f +- %.2f m/s (median %.2f); rotation rate (max angular speed / 2 pi) "
       "%.2f +- %.2f rot/s (median %.2f); max jump height %.2f +- %.2f m (median %.2f)\n"
+      "  max kinetic energy (translational + rotational) %.1f +- %.1f kJ (median %.1f)\n"
       "  runout %.1f +- %.1f m (median %.1f); travel time %.1f +- %.1f s (median %.1f); "
       "stopped within 5 m %.1f %%; max speed below 5 m/s %.1f %%\n",
       speed_mean, speed_sd, Median(last.max_speeds_m_s), rotation_mean, rotation_sd,
-      Median(last.rotation_rates_1_s), jump_mean, jump_sd, Median(last.jump_heights_m), runout_mean,
+      Median(last.rotation_rates_1_s), jump_mean, jump_sd, Median(last.jump_heights_m),
+      energy_mean, energy_sd, Median(last.kinetic_energies_kj), runout_mean,
       runout_sd, Median(last.runouts_m), time_mean, time_sd, Median(last.travel_times_s),
       100.0 * last.stopped_within_5_m / rocks, 100.0 * slow / rocks);
   std::printf("endings:");
@@ -200,6 +289,23 @@ int main(int argc, char** argv) {
       "(Leine et al. 2021, Table 1)\n");
 
   if (no_profile) return 0;
+  if (!no_cells) {
+    // The same rocks again, with the per-cell recorder (a separate run: it is not timed).
+    const CellValues cells = RunCellStatistics(scene, rocks, seed);
+    std::printf(
+        "\nramp statistics pooled per cell (RAMMS's statistic mode: each rock's maximum in each "
+        "%.0f m cell its centre of mass passed, %zu values of %d rocks; mean +- sd (median)):\n",
+        scene.terrain.heights().grid.dx_m, cells.speeds_m_s.size(), rocks);
+    const std::pair<const char*, const std::vector<double>*> pooled[] = {
+        {"speed, m/s", &cells.speeds_m_s},
+        {"rotation rate, rot/s", &cells.rotation_rates_1_s},
+        {"jump height, m", &cells.jump_heights_m},
+        {"kinetic energy, kJ", &cells.kinetic_energies_kj}};
+    for (const auto& [name, values] : pooled) {
+      const auto [mean, sd] = MeanAndSd(*values);
+      std::printf("  %-22s %8.2f +- %7.2f (%.2f)\n", name, mean, sd, Median(*values));
+    }
+  }
   // Stage profile in a separate run (the clock calls cost time of their own).
   talus::StageTimes times;
   const Batch profiled = RunBatch(scene, std::max(1, rocks / 4), seed, &times);

@@ -266,7 +266,7 @@ void ReadTrajectories(const CsvTable& t, const TableColumns& c, const Terrain& t
     if (r.size() < 2)
       throw InputError(where + ": run '" + runs[k] + "' has a single trajectory sample");
     double max_speed = 0, omega_sum = 0, max_jump = -1e300;
-    bool jump = false;
+    bool jump = false, every_omega = omega;
     double previous_t = -1e300;
     for (int row : r) {
       const double time = t.Number(row, "time_s");
@@ -279,7 +279,10 @@ void ReadTrajectories(const CsvTable& t, const TableColumns& c, const Terrain& t
                                                  t.Number(row, "vz_mps"))
                                      .norm();
       max_speed = std::max(max_speed, speed);
-      if (omega)
+      if (omega && (t.Empty(row, "omega_x_radps") || t.Empty(row, "omega_y_radps") ||
+                    t.Empty(row, "omega_z_radps")))
+        every_omega = false;
+      else if (omega)
         omega_sum += Eigen::Vector3d(t.Number(row, "omega_x_radps"), t.Number(row, "omega_y_radps"),
                                      t.Number(row, "omega_z_radps"))
                          .norm();
@@ -292,7 +295,7 @@ void ReadTrajectories(const CsvTable& t, const TableColumns& c, const Terrain& t
     }
     const double window = t.Number(r.back(), "time_s") - t.Number(r.front(), "time_s");
     out.scalars.push_back({Quantity::kSegmentMaxSpeed, runs[k], max_speed, where, window});
-    if (omega)
+    if (every_omega)
       out.scalars.push_back({Quantity::kSegmentMeanAngularSpeed, runs[k],
                              omega_sum / double(r.size()), where, window});
     if (jump)

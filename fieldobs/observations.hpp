@@ -117,7 +117,9 @@ void ReadZoneObservations(const CsvTable& table, const TableColumns& columns, Ob
 // grouped by run, each run's samples from its start. Each run gives its segment's largest speed,
 // mean angular speed (when given) and largest jump height over `terrain` (centre of mass above the
 // terrain along its normal, samples over the DEM only), with the segment's duration as the window.
-// A run needs at least 2 samples, in increasing time.
+// A run needs at least 2 samples, in increasing time. A run any of whose samples has no angular
+// velocity (empty or NaN cells) gives no angular-speed observation: its mean would not cover the
+// segment.
 void ReadTrajectories(const CsvTable& table, const TableColumns& columns, const Terrain& terrain,
                       ObservationSet& out);
 

@@ -1,23 +1,38 @@
 #!/bin/sh
-# The validation table of README.md: `talus validate` of event.toml for each ground category that
-# could describe the slope and each reading of the viscous term, with 30 rocks per run.
-# Usage: cases/chant_sura/validate_table.sh [TALUS] [OUT] [ROCKS] [SEED]
-#   (defaults: build/app/talus, out/chant_sura, 30, 1). Needs jq and awk.
+# The validation tables of README.md: `talus validate` of an event of this case for each ground
+# category that could describe the slope and each reading of the viscous term, with 30 rocks per run.
+# Usage: cases/chant_sura/validate_table.sh [TALUS] [OUT] [ROCKS] [SEED] [EVENT]
+#   (defaults: build/app/talus, out/chant_sura, 30, 1, event.toml). Needs jq and awk.
+#   EVENT: event.toml (the impacts) or event_segments.toml (the flight segments).
 # Each variant is the case's scene with only `default_ground` and `[solver] viscous` changed,
-# written with absolute data paths into OUT/<category>-<reading>/, and an event naming it.
+# written with absolute data paths into OUT/<category>-<reading>/ (segments:
+# OUT/segments-<category>-<reading>/), and the event naming it.
 set -eu
 case_dir=$(cd "$(dirname "$0")" && pwd)
 talus=${1:-build/app/talus}
 out=${2:-out/chant_sura}
 rocks=${3:-30}
 seed=${4:-1}
+event=${5:-event.toml}
+case $event in
+  event.toml)
+    prefix=
+    kinds="impact_energy_ratio impact_speed_out impact_angular_speed_out"
+    printf '| ground | viscous | CRPS energy ratio | skill_c | in 90%% | CRPS speed out (m/s) | skill_c | in 90%% | CRPS angular speed out (rad/s) | skill_c | in 90%% | median energy ratio sim / obs | scored |\n'
+    printf '|---|---|---|---|---|---|---|---|---|---|---|---|---|\n' ;;
+  event_segments.toml)
+    prefix=segments-
+    kinds="segment_max_speed segment_mean_angular_speed segment_max_jump_height"
+    printf '| ground | viscous | CRPS max speed (m/s) | skill_c | in 90%% | CRPS mean angular speed (rad/s) | skill_c | in 90%% | CRPS max jump height (m) | skill_c | in 90%% | mean bias: speed / angular speed / jump height | scored |\n'
+    printf '|---|---|---|---|---|---|---|---|---|---|---|---|---|\n' ;;
+  *) echo "validate_table.sh: EVENT must be event.toml or event_segments.toml, not '$event'" >&2
+     exit 2 ;;
+esac
 mkdir -p "$out"
 out=$(cd "$out" && pwd)
-printf '| ground | viscous | CRPS energy ratio | skill_c | in 90%% | CRPS speed out (m/s) | skill_c | in 90%% | CRPS angular speed out (rad/s) | skill_c | in 90%% | median energy ratio sim / obs | scored |\n'
-printf '|---|---|---|---|---|---|---|---|---|---|---|---|---|\n'
 for ground in hard medium_hard medium; do
   for viscous in centre_of_mass contact_friction; do
-    dir="$out/$ground-$viscous"
+    dir="$out/$prefix$ground-$viscous"
     mkdir -p "$dir"
     sed -e "s|^default_ground = \"[a-z_]*\"|default_ground = \"$ground\"|" \
         -e "s|^\[solver\]|[solver]\nviscous = \"$viscous\"|" \
@@ -26,25 +41,32 @@ for ground in hard medium_hard medium; do
         "$case_dir/scene.toml" > "$dir/scene.toml"
     sed -e "s|\"contact_events.csv\"|\"$case_dir/contact_events.csv\"|" \
         -e "s|\"observed_trajectories.csv\"|\"$case_dir/observed_trajectories.csv\"|" \
-        "$case_dir/event.toml" > "$dir/event.toml"
+        "$case_dir/$event" > "$dir/event.toml"
     "$talus" validate "$dir/event.toml" --out "$dir/out" --rocks "$rocks" --seed "$seed" \
       > "$dir/validate.log"
     kind() {  # mean CRPS, skill vs climatology, fraction inside the 90 % band
       jq -r --arg k "$1" '.kinds[$k] | if . == null then "-|-|-" else
         "\(.mean_score*1000|round/1000)|\(.skill_vs_climatology*100|round/100)|\(.inside_90_fraction*100|round/100)" end' \
-        "$dir/out/scores.json"
+        "$dir/out/scores.json" | sed 's/|/ | /g'
     }
-    # Medians over the scored energy-ratio observations: of the ensembles' medians, of the observed.
-    medians=$(awk -F, '$1 == "impact_energy_ratio" && $7 == 1 { print $12, $4 }' "$dir/out/observations.csv" |
-      awk '{ s[NR] = $1; o[NR] = $2 } END {
-        n = NR; for (i = 1; i <= n; i++) for (j = i + 1; j <= n; j++) {
-          if (s[j] < s[i]) { t = s[i]; s[i] = s[j]; s[j] = t }
-          if (o[j] < o[i]) { t = o[i]; o[i] = o[j]; o[j] = t } }
-        m = int((n + 1) / 2); ms = (n % 2) ? s[m] : (s[m] + s[m + 1]) / 2; mo = (n % 2) ? o[m] : (o[m] + o[m + 1]) / 2
-        printf "%.2f / %.2f", ms, mo }')
+    columns=
+    for k in $kinds; do columns="$columns$(kind "$k") | "; done
+    if [ "$event" = event.toml ]; then
+      # Medians over the scored energy-ratio observations: of the ensembles' medians, of the observed.
+      extra=$(awk -F, '$1 == "impact_energy_ratio" && $7 == 1 { print $12, $4 }' "$dir/out/observations.csv" |
+        awk '{ s[NR] = $1; o[NR] = $2 } END {
+          n = NR; for (i = 1; i <= n; i++) for (j = i + 1; j <= n; j++) {
+            if (s[j] < s[i]) { t = s[i]; s[i] = s[j]; s[j] = t }
+            if (o[j] < o[i]) { t = o[i]; o[i] = o[j]; o[j] = t } }
+          m = int((n + 1) / 2); ms = (n % 2) ? s[m] : (s[m] + s[m + 1]) / 2; mo = (n % 2) ? o[m] : (o[m] + o[m + 1]) / 2
+          printf "%.2f / %.2f", ms, mo }')
+    else
+      # Mean bias (ensemble mean - observed) of each segment quantity.
+      extra=$(jq -r '[.kinds.segment_max_speed, .kinds.segment_mean_angular_speed,
+          .kinds.segment_max_jump_height] | map(if . == null then "-" else .mean_bias*100|round/100 end) |
+          join(" / ")' "$dir/out/scores.json")
+    fi
     scored=$(jq -r '.observations_scored' "$dir/out/scores.json")
-    printf '| %s | %s | %s | %s | %s | %s | %s |\n' "$ground" "$viscous" \
-      "$(kind impact_energy_ratio | sed 's/|/ | /g')" "$(kind impact_speed_out | sed 's/|/ | /g')" \
-      "$(kind impact_angular_speed_out | sed 's/|/ | /g')" "$medians" "$scored"
+    printf '| %s | %s | %s%s | %s |\n' "$ground" "$viscous" "$columns" "$extra" "$scored"
   done
 done

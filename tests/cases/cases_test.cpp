@@ -70,7 +70,7 @@ TEST(Cases, EveryEventLoads) {
     EXPECT_GT(event.observations.size(), 0u);
     ++events;
   }
-  EXPECT_GE(events, 3);  // tschamut2014 (2), chant_sura
+  EXPECT_GE(events, 4);  // tschamut2014 (2), chant_sura (impacts, segments)
 }
 
 // Every case's calibration file loads and is checked (event, parameters, optimiser).

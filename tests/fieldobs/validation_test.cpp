@@ -283,6 +283,36 @@ TEST(Observations, TrajectorySegmentsNeedIncreasingTimesAndTwoSamples) {
             std::string::npos);
   EXPECT_NE(error("trajectory_id,time_s,x_m,y_m,z_m\na,0,1,1,1\n").find("missing column 'vx_mps'"),
             std::string::npos);
+  EXPECT_NE(error("trajectory_id,time_s,x_m,y_m,z_m,speed_mps,omega_x_radps,omega_y_radps,"
+                  "omega_z_radps\na,0,1,1,1,2,1,0,0\na,1,1,1,1,2,1,x,0\n")
+                .find("t.csv:3: column 'omega_y_radps': 'x' is not a finite number"),
+            std::string::npos);
+}
+
+// Segments whose samples lack angular velocity (the Chant Sura EOTA111 block: NaN) keep their
+// speed and jump height; the angular mean is only over segments every sample of which has it.
+TEST(Observations, TrajectorySegmentsWithoutAngularVelocityGiveNoAngularSpeed) {
+  const Terrain flat(MakePlaneHeightfield(PlaneSpec{0, 0.0, 10, 10, 1}), 0);
+  ObservationSet set;
+  ReadTrajectories(
+      CsvTable::Parse("trajectory_id,time_s,x_m,y_m,z_m,speed_mps,omega_x_radps,omega_y_radps,"
+                      "omega_z_radps\n"
+                      "full,0,1,1,1,2,3,4,0\nfull,1,1,1,1,2,0,0,1\n"
+                      "none,0,1,1,1,3,NaN,NaN,NaN\nnone,1,1,1,1,3,NaN,NaN,NaN\n"
+                      "part,0,1,1,1,4,1,0,0\npart,1,1,1,1,4,,,\n",
+                      "t.csv"),
+      TableColumns{}, flat, set);
+  std::vector<std::string> angular_runs;
+  int speeds = 0;
+  for (const ScalarObservation& o : set.scalars) {
+    if (o.quantity == Quantity::kSegmentMeanAngularSpeed) {
+      angular_runs.push_back(o.run);
+      EXPECT_NEAR(o.value, 3.0, 1e-15);  // (|(3,4,0)| + |(0,0,1)|) / 2
+    }
+    speeds += o.quantity == Quantity::kSegmentMaxSpeed;
+  }
+  EXPECT_EQ(angular_runs, std::vector<std::string>{"full"});
+  EXPECT_EQ(speeds, 3);
 }
 
 }  // namespace
