@@ -15,6 +15,7 @@
 #include <stdexcept>
 
 #include "calibration/evaluator.hpp"
+#include "calibration/report_text.hpp"
 
 namespace talus::calibration {
 namespace {
@@ -86,13 +87,6 @@ class QuietCeresLog {
  private:
   int level_;
 };
-
-std::string Num(double v, const char* format = "%.4g") {
-  if (std::isnan(v)) return "-";
-  char b[64];
-  std::snprintf(b, sizeof b, format, v);
-  return b;
-}
 
 }  // namespace
 
@@ -380,7 +374,7 @@ std::string Uncertainty::Report() const {
   for (std::size_t j = 0; j < names.size(); ++j) {
     const auto k = static_cast<Eigen::Index>(j);
     std::snprintf(line, sizeof line, "  %-28s %14s %14s %10s  %s\n", names[j].c_str(),
-                  Num(values[k], "%.6g").c_str(), Num(standard_error[k]).c_str(),
+                  Num(values[k], "%.6g").c_str(), Num(standard_error[k], "%.4g").c_str(),
                   Num(standard_error_unit[k], "%.3f").c_str(),
                   !identified[j] ? "UNIDENTIFIED"
                   : weak[j]      ? "weak"

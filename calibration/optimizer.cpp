@@ -12,6 +12,7 @@
 #include "calibration/designs.hpp"
 #include "calibration/evaluator.hpp"
 #include "calibration/least_squares.hpp"
+#include "calibration/report_text.hpp"
 
 namespace talus::calibration {
 namespace {
@@ -36,13 +37,6 @@ double Callback(unsigned n, const double* x, double* /*grad*/, void* data) {
       run.evaluate.TryEvaluate(Eigen::Map<const Eigen::VectorXd>(x, n));
   if (!e || run.evaluate.stopped()) nlopt_force_stop(run.opt);
   return e ? e->value : HUGE_VAL;
-}
-
-std::string Num(double v, const char* format = "%.6g") {
-  if (std::isnan(v)) return "-";
-  char b[64];
-  std::snprintf(b, sizeof b, format, v);
-  return b;
 }
 
 }  // namespace
