@@ -3,6 +3,47 @@
 #include <nlohmann/json.hpp>
 
 namespace talus::io {
+namespace {
+
+// Every solver option, by the names of the scene's [solver] table.
+nlohmann::ordered_json SolverJson(const SolverOptions& o) {
+  return {{"dt_s", o.dt_s},
+          {"max_time_s", o.max_time_s},
+          {"gravity_m_s2", o.gravity_m_s2},
+          {"normal_restitution", o.normal_restitution},
+          {"tangential_restitution", o.tangential_restitution},
+          {"viscous", ToString(o.viscous)},
+          {"contact_solve", ToString(o.contact_solve)},
+          {"tolerance_m_s", o.tolerance_m_s},
+          {"max_iterations", o.max_iterations},
+          {"prox_alpha", o.prox_alpha},
+          {"penetration_tolerance", o.penetration_tolerance},
+          {"rest_speed_m_s", o.rest_speed_m_s},
+          {"rest_angular_speed_rad_s", o.rest_angular_speed_rad_s},
+          {"rest_hold_s", o.rest_hold_s}};
+}
+
+// The ground table the run used, by the keys of the scene's [ground.<name>] tables; the drag
+// layer's keys only for a category that has one.
+nlohmann::ordered_json GroundJson(const GroundTable& table) {
+  nlohmann::ordered_json out = nlohmann::ordered_json::object();
+  for (int i = 0; i < table.size(); ++i) {
+    const GroundCategory& c = table.category(i);
+    const GroundParams& p = c.params;
+    nlohmann::ordered_json g = {{"code", c.code},           {"mu_min", p.mu_min},
+                                {"mu_max", p.mu_max},       {"beta", p.beta_1_s},
+                                {"kappa", p.kappa_1_m},     {"nu", p.nu_1_s}};
+    if (p.HasDragLayer()) {
+      g["drag_height_m"] = p.drag_height_m;
+      g["drag_translational"] = p.drag_translational_1_s;
+      g["drag_rotational"] = p.drag_rotational_1_s;
+    }
+    out[c.name] = g;
+  }
+  return out;
+}
+
+}  // namespace
 
 std::string SummaryJson(const SceneFile& scene, const ensemble::EnsembleReport& report,
                         const std::string& version, const std::vector<std::string>& outputs) {
@@ -41,6 +82,10 @@ std::string SummaryJson(const SceneFile& scene, const ensemble::EnsembleReport& 
   j["steps"] = report.steps;
   j["unconverged_steps"] = report.unconverged_steps;
   j["dt_s"] = scene.scene.options.dt_s;
+  // What the run used, whatever the scene file left to the defaults: a run can be repeated from
+  // summary.json alone (with the inputs of the same hash).
+  j["solver"] = SolverJson(scene.scene.options);
+  j["ground"] = GroundJson(scene.scene.ground);
   j["threads"] = report.threads;
   j["wall_time_s"] = report.wall_time_s;
   j["trajectories_per_s"] = report.trajectories_per_s();

@@ -29,6 +29,15 @@ TEST(SummaryJson, CarriesHashVersionCountsAndRate) {
   EXPECT_EQ(j["ends"]["max_time"], 1);
   EXPECT_EQ(j["raised_at_release"], 3);
   EXPECT_EQ(j["stayed_at_release"], 4);
+  // The options and ground table actually used, defaults included.
+  EXPECT_EQ(j["solver"]["viscous"], "contact_friction");
+  EXPECT_DOUBLE_EQ(j["solver"]["dt_s"].get<double>(), 0.002);
+  EXPECT_DOUBLE_EQ(j["solver"]["tolerance_m_s"].get<double>(), 1e-7);
+  EXPECT_EQ(j["ground"].size(), 8u);  // Table 1
+  EXPECT_EQ(j["ground"]["medium"]["code"], 4);
+  EXPECT_DOUBLE_EQ(j["ground"]["medium"]["mu_min"].get<double>(), 0.35);
+  EXPECT_DOUBLE_EQ(j["ground"]["snow"]["mu_max"].get<double>(), 0.35);
+  EXPECT_FALSE(j["ground"]["medium"].contains("drag_height_m"));  // no layer
   EXPECT_DOUBLE_EQ(j["trajectories_per_s"].get<double>(), 5.0);
   EXPECT_DOUBLE_EQ(j["wall_time_s"].get<double>(), 2.0);
 }
