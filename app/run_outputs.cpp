@@ -130,7 +130,7 @@ std::vector<std::string> RunIntoStaging(const io::SceneFile& scene, int threads,
   options.progress = std::move(progress);
 
   std::vector<std::string> outputs = {"rocks.csv"};
-  io::RocksCsvWriter csv(staging.path("rocks.csv"), scene.release);
+  io::RocksCsvWriter csv(staging.path("rocks.csv"), scene.scene, scene.release);
   std::unique_ptr<io::TrajectoryWriter> trajectories;
   if (scene.output.trajectories) {
     trajectories =

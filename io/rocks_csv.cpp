@@ -1,5 +1,7 @@
 #include "io/rocks_csv.hpp"
 
+#include <cmath>
+#include <numbers>
 #include <stdexcept>
 
 namespace talus::io {
@@ -18,11 +20,12 @@ std::string CsvField(const std::string& text) {
 const char* RocksCsvWriter::Header() {
   return "rock,release,run,seed,end,x_end,y_end,z_end,runout_m,path_length_m,travel_time_s,"
          "max_speed_m_s,max_kinetic_energy_j,max_jump_height_m,max_angular_speed_rad_s,max_scar_m,"
-         "block,mass_kg";
+         "block,mass_kg,x_start,y_start,z_start,travel_angle_deg,end_ground";
 }
 
-RocksCsvWriter::RocksCsvWriter(const std::string& path, const ensemble::ReleaseSpec& release)
-    : file_(path), release_(release) {
+RocksCsvWriter::RocksCsvWriter(const std::string& path, const Scene& scene,
+                               const ensemble::ReleaseSpec& release)
+    : file_(path), scene_(scene), release_(release) {
   out_ = std::fopen(file_.temp_path().c_str(), "w");
   if (!out_) throw std::runtime_error("cannot create " + file_.temp_path());
   std::fprintf(out_, "%s\n", Header());
@@ -39,15 +42,22 @@ void RocksCsvWriter::Write(const ensemble::RockOutcome& rock) {
       release_.runs.empty() ? nullptr : &release_.runs[static_cast<std::size_t>(rock.release)];
   const std::string block =
       run && run->block >= 0 ? release_.blocks[static_cast<std::size_t>(run->block)].id : "";
+  const Eigen::Vector3d& start = rock.start.position_m;
+  // Travel angle (Fahrboeschung) of the centre of mass, release to end.
+  const double travel_angle_deg =
+      std::atan2(start.z() - end.z(), r.runout_m) * 180.0 / std::numbers::pi;
+  const std::string& end_ground =
+      scene_.ground.category(scene_.terrain.GroundAt(end.x(), end.y())).name;
   std::fprintf(
       out_,
       "%ld,%d,%s,%llu,%s,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,"
-      "%s,%.10g\n",
+      "%s,%.10g,%.10g,%.10g,%.10g,%.10g,%s\n",
       rock.rock, rock.release, CsvField(release_.ReleaseName(rock.release)).c_str(),
       static_cast<unsigned long long>(release_.seed), ToString(r.end), end.x(), end.y(), end.z(),
       r.runout_m, r.path_length_m, r.travel_time_s, r.max_speed_m_s, r.max_kinetic_energy_j,
       r.max_jump_height_m, r.max_angular_speed_rad_s, r.max_scar_m, CsvField(block).c_str(),
-      rock.shape ? rock.shape->mass_kg : 0.0);
+      rock.shape ? rock.shape->mass_kg : 0.0, start.x(), start.y(), start.z(), travel_angle_deg,
+      CsvField(end_ground).c_str());
 }
 
 void RocksCsvWriter::Commit() {

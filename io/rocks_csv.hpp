@@ -7,14 +7,16 @@
 
 #include "common/atomic_file.hpp"
 #include "ensemble/runner.hpp"
+#include "solver/scene.hpp"
 
 namespace talus::io {
 
 class RocksCsvWriter {
  public:
   // Opens a temporary file next to `path` and writes the header. Throws std::runtime_error.
-  // `release` names each rock's run and block; it must outlive the writer.
-  RocksCsvWriter(const std::string& path, const ensemble::ReleaseSpec& release);
+  // `release` names each rock's run and block, `scene` the ground category where it ended; both
+  // must outlive the writer.
+  RocksCsvWriter(const std::string& path, const Scene& scene, const ensemble::ReleaseSpec& release);
   ~RocksCsvWriter();
   RocksCsvWriter(const RocksCsvWriter&) = delete;
   RocksCsvWriter& operator=(const RocksCsvWriter&) = delete;
@@ -27,6 +29,7 @@ class RocksCsvWriter {
  private:
   AtomicFile file_;
   std::FILE* out_ = nullptr;
+  const Scene& scene_;
   const ensemble::ReleaseSpec& release_;
 };
 
