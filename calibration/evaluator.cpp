@@ -65,4 +65,25 @@ std::optional<Evaluation> Evaluator::TryEvaluate(const Eigen::VectorXd& u) {
   }
 }
 
+void Evaluator::Finish(bool evaluations_spent, bool converged, const std::string& reason,
+                       const std::string& failure) const {
+  summary_.wall_time_s = elapsed_s();
+  std::ostringstream msg;
+  if (out_of_time_) {
+    summary_.termination = Termination::kMaxTime;
+    msg << "wall-time budget of " << options_.max_time_s << " s spent";
+  } else if (evaluations_spent) {
+    summary_.termination = Termination::kMaxEvaluations;
+    msg << "evaluation budget of " << options_.max_evaluations << " spent";
+  } else if (converged) {
+    summary_.termination = Termination::kConvergence;
+    msg << "converged (" << reason << ")";
+  } else {
+    summary_.termination = Termination::kFailure;
+    msg << failure;
+  }
+  if (!summary_.IsSolutionUsable()) msg << "; no feasible evaluation";
+  summary_.message = msg.str();
+}
+
 }  // namespace talus::calibration

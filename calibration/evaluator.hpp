@@ -9,6 +9,7 @@
 #include <chrono>
 #include <exception>
 #include <optional>
+#include <string>
 
 #include "calibration/optimizer.hpp"
 
@@ -34,6 +35,12 @@ class Evaluator {
   void Rethrow() const {
     if (error_) std::rethrow_exception(error_);
   }
+  // Closes the record when the optimiser has returned: the wall time, and the termination with its
+  // message -- the time budget first, then the evaluation budget (`evaluations_spent`, as the
+  // optimiser counts it), then convergence (`converged`, because of `reason`), else a failure
+  // (`failure` says how the optimiser stopped).
+  void Finish(bool evaluations_spent, bool converged, const std::string& reason,
+              const std::string& failure) const;
 
  private:
   const Objective& objective_;

@@ -149,23 +149,9 @@ Summary CalibrateLeastSquares(const Objective& objective, const OptimizerOptions
     summary.starts.push_back(record);
   }
 
-  summary.wall_time_s = evaluate.elapsed_s();
-  std::ostringstream msg;
-  if (evaluate.out_of_time()) {
-    summary.termination = Termination::kMaxTime;
-    msg << "wall-time budget of " << options.max_time_s << " s spent";
-  } else if (evaluate.out_of_evaluations()) {
-    summary.termination = Termination::kMaxEvaluations;
-    msg << "evaluation budget of " << options.max_evaluations << " spent";
-  } else if (last == ceres::CONVERGENCE || last == ceres::USER_SUCCESS) {
-    summary.termination = Termination::kConvergence;
-    msg << "converged (" << last_message << ")";
-  } else {
-    summary.termination = Termination::kFailure;
-    msg << "Ceres stopped: " << last_message;
-  }
-  if (!summary.IsSolutionUsable()) msg << "; no feasible evaluation";
-  summary.message = msg.str();
+  evaluate.Finish(evaluate.out_of_evaluations(),
+                  last == ceres::CONVERGENCE || last == ceres::USER_SUCCESS, last_message,
+                  "Ceres stopped: " + last_message);
   return summary;
 }
 

@@ -172,23 +172,9 @@ Summary Calibrate(const Objective& objective, const OptimizerOptions& options) {
     summary.starts.push_back(record);
   }
 
-  summary.wall_time_s = evaluate.elapsed_s();
-  std::ostringstream msg;
-  if (evaluate.out_of_time()) {
-    summary.termination = Termination::kMaxTime;
-    msg << "wall-time budget of " << options.max_time_s << " s spent";
-  } else if (last == NLOPT_MAXEVAL_REACHED || summary.evaluations() >= options.max_evaluations) {
-    summary.termination = Termination::kMaxEvaluations;
-    msg << "evaluation budget of " << options.max_evaluations << " spent";
-  } else if (last > 0) {
-    summary.termination = Termination::kConvergence;
-    msg << "converged (" << nlopt_result_to_string(last) << ")";
-  } else {
-    summary.termination = Termination::kFailure;
-    msg << "NLopt stopped with " << nlopt_result_to_string(last);
-  }
-  if (!summary.IsSolutionUsable()) msg << "; no feasible evaluation";
-  summary.message = msg.str();
+  evaluate.Finish(last == NLOPT_MAXEVAL_REACHED || summary.evaluations() >= options.max_evaluations,
+                  last > 0, nlopt_result_to_string(last),
+                  std::string("NLopt stopped with ") + nlopt_result_to_string(last));
   return summary;
 }
 
