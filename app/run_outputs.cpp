@@ -26,13 +26,14 @@ namespace fs = std::filesystem;
 // Keeps the horizontal paths of the quick-look's sample rocks.
 class FileSink : public ensemble::RockSink {
  public:
-  FileSink(io::RocksCsvWriter& csv, io::TrajectoryWriter* trajectories, long sample)
-      : csv_(csv), trajectories_(trajectories), sample_(sample) {}
+  FileSink(io::RocksCsvWriter& csv, io::TrajectoryWriter* trajectories,
+           std::function<bool(long)> sample)
+      : csv_(csv), trajectories_(trajectories), sample_(std::move(sample)) {}
   void OnRock(const ensemble::RockOutcome& rock) override {
     ThrowIfInterrupted();
     csv_.Write(rock);
     if (trajectories_) trajectories_->Write(rock);
-    if (rock.rock < sample_) {
+    if (sample_ && sample_(rock.rock)) {
       io::SamplePath& path = paths.emplace_back();
       path.rock = rock.rock;
       for (const ensemble::TrajectorySample& s : rock.trajectory)
@@ -44,7 +45,7 @@ class FileSink : public ensemble::RockSink {
  private:
   io::RocksCsvWriter& csv_;
   io::TrajectoryWriter* trajectories_;
-  long sample_;
+  std::function<bool(long)> sample_;
 };
 
 // Keeps GDAL's error messages off stderr while alive (on this thread); they stay readable through
@@ -104,6 +105,17 @@ void AppendCsv(const std::string& from, bool skip_header, const std::string& hea
 
 }  // namespace
 
+bool QuickLookSample(const ensemble::ReleaseSpec& release, long rock) {
+  constexpr long kPaths = 40, kReleases = 100;
+  const long releases = release.release_count();
+  const long stride = (releases + kReleases - 1) / kReleases;  // draw every stride-th release
+  const long drawn = (releases + stride - 1) / stride;
+  const long per_release =
+      std::clamp<long>((kPaths + drawn - 1) / drawn, 1, release.rocks_per_release);
+  const long which = release.ReleaseOf(rock);
+  return which % stride == 0 && rock - which * release.rocks_per_release < per_release;
+}
+
 std::vector<std::string> TalusOutputNames() {
   std::vector<std::string> names = {
       "rocks.csv",    "trajectories.h5",       "summary.json", "quicklook.png", "passages.tif",
@@ -124,7 +136,10 @@ std::vector<std::string> RunIntoStaging(const io::SceneFile& scene, int threads,
   options.end_rock = end_rock;
   options.trajectories = scene.output.trajectories;
   options.trajectory_interval_s = scene.output.trajectory_interval_s;
-  options.sample_trajectories = scene.output.quicklook ? kQuickLookPaths : 0;
+  if (scene.output.quicklook) {
+    const ensemble::ReleaseSpec& release = scene.release;
+    options.sample_trajectories = [&release](long rock) { return QuickLookSample(release, rock); };
+  }
   options.rasters = scene.output.Request(scene.scene.terrain.heights().grid);
   options.keep_raster_state = part;
   options.progress = std::move(progress);

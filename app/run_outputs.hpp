@@ -15,8 +15,9 @@
 
 namespace talus::app {
 
-// Rocks drawn on the quick-look (the first ones).
-inline constexpr long kQuickLookPaths = 20;
+// The rocks whose paths the quick-look draws: the first rocks of every release (of every k-th
+// release when there are more than 100), about 40 in all and at least one per release drawn.
+bool QuickLookSample(const ensemble::ReleaseSpec& release, long rock);
 
 // Every file name talus simulate and merge may write into an output directory.
 std::vector<std::string> TalusOutputNames();

@@ -38,11 +38,11 @@ RecorderSet MakeRecorders(const Scene& scene, const EnsembleOptions& options) {
   RecorderSet set;
   if (options.rasters.any())
     set.Add(std::make_unique<FootprintRecorder>(options.rasters, scene.terrain));
-  if (options.trajectories || options.sample_trajectories > 0) {
+  if (options.trajectories || options.sample_trajectories) {
     const bool all = options.trajectories;
-    const long sample = options.sample_trajectories;
+    const std::function<bool(long)> sample = options.sample_trajectories;
     set.Add(MakeTrajectoryRecorder(options.trajectory_interval_s, scene.options.dt_s,
-                                   [all, sample](long rock) { return all || rock < sample; }));
+                                   [all, sample](long rock) { return all || sample(rock); }));
   }
   if (options.episodes) set.Add(MakeEpisodeRecorder(scene.terrain, options.episode_options));
   for (const RecorderFactory& make : options.extra_recorders) set.Add(make());

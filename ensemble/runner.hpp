@@ -27,7 +27,8 @@ struct EnsembleOptions {
   long first_rock = 0;
   long end_rock = -1;
   bool trajectories = false;            // record every rock's trajectory
-  long sample_trajectories = 0;         // record also the trajectories of rocks 0 .. n - 1
+  // Record also the trajectories of the rocks this accepts (e.g. a sample for a picture); empty: none.
+  std::function<bool(long rock)> sample_trajectories;
   double trajectory_interval_s = 0.01;  // samples at t = 0, every interval, and the end
   RasterRequest rasters;                // nothing requested: no raster work
   // Keep the raster accumulator in the report (EnsembleReport::raster_state) for merging with other

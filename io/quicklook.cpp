@@ -1,66 +1,105 @@
 #include "io/quicklook.hpp"
 
-#include <gdal_priv.h>
+#include <cairo.h>
 
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <memory>
 #include <numbers>
 #include <stdexcept>
 
 #include "common/atomic_file.hpp"
-#include "io/raster.hpp"
 
 namespace talus::io {
 namespace {
 
 using Rgb = std::array<double, 3>;
 
+constexpr int kPanelWidth = 250;   // legend panel, pixels
+constexpr int kMinHeight = 380;    // the legend needs this much height
+constexpr int kMapPixels = 900;    // the map's longer side, at most
+
 // Yellow (low) through orange to dark red (high), t in [0, 1].
-Rgb Ramp(double t) {
+std::array<unsigned char, 3> Ramp(double t) {
   t = std::clamp(t, 0.0, 1.0);
   const Rgb stops[] = {{255, 255, 150}, {253, 141, 60}, {189, 0, 38}, {90, 0, 20}};
   const double s = t * 3;
   const int k = std::min(2, static_cast<int>(s));
   const double f = s - k;
-  return {stops[k][0] + f * (stops[k + 1][0] - stops[k][0]),
-          stops[k][1] + f * (stops[k + 1][1] - stops[k][1]),
-          stops[k][2] + f * (stops[k + 1][2] - stops[k][2])};
+  std::array<unsigned char, 3> rgb{};
+  for (int c = 0; c < 3; ++c)
+    rgb[c] = static_cast<unsigned char>(std::lround(stops[k][c] + f * (stops[k + 1][c] - stops[k][c])));
+  return rgb;
 }
 
-}  // namespace
-
-const ensemble::RasterLayer* QuickLookLayer(const std::vector<ensemble::RasterLayer>& layers) {
-  for (const char* name : {"reach_probability", "energy_max", "speed_max", "passages"})
-    for (const ensemble::RasterLayer& l : layers)
-      if (l.name == name) return &l;
-  return nullptr;
+// Classes with the given lower bounds and labels, coloured evenly along the ramp.
+std::vector<ColourClass> Classes(const std::vector<double>& lower,
+                                 const std::vector<std::string>& labels) {
+  std::vector<ColourClass> classes;
+  for (std::size_t k = 0; k < lower.size(); ++k)
+    classes.push_back(
+        {lower[k], labels[k], Ramp(lower.size() == 1 ? 1.0 : double(k) / (lower.size() - 1))});
+  return classes;
 }
 
-void WriteQuickLookPng(const std::string& path, const Heightfield& dem,
-                       const ensemble::RasterLayer* layer,
-                       const std::vector<std::vector<Eigen::Vector2d>>& paths,
-                       const std::vector<MapMarker>& markers) {
+std::string Number(double value) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.3g", value);
+  return text;
+}
+
+bool StartsWith(const std::string& s, const char* prefix) { return s.rfind(prefix, 0) == 0; }
+
+// The statistic of a layer name such as "speed_p95", for the legend's title.
+std::string StatisticOf(const std::string& name) {
+  const std::size_t underscore = name.rfind('_');
+  const std::string statistic = underscore == std::string::npos ? "" : name.substr(underscore + 1);
+  if (statistic == "max") return "largest";
+  if (statistic == "mean") return "mean";
+  if (statistic.size() > 1 && statistic[0] == 'p') return statistic.substr(1) + "th percentile of";
+  return statistic;
+}
+
+void SetColour(cairo_t* cr, const std::array<unsigned char, 3>& rgb, double alpha = 1) {
+  cairo_set_source_rgba(cr, rgb[0] / 255.0, rgb[1] / 255.0, rgb[2] / 255.0, alpha);
+}
+
+void Text(cairo_t* cr, double x, double y, double size, const std::string& text,
+          bool bold = false) {
+  cairo_select_font_face(cr, "DejaVu Sans", CAIRO_FONT_SLANT_NORMAL,
+                         bold ? CAIRO_FONT_WEIGHT_BOLD : CAIRO_FONT_WEIGHT_NORMAL);
+  cairo_set_font_size(cr, size);
+  cairo_move_to(cr, x, y);
+  cairo_show_text(cr, text.c_str());
+}
+
+double TextWidth(cairo_t* cr, double size, const std::string& text) {
+  cairo_select_font_face(cr, "DejaVu Sans", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_NORMAL);
+  cairo_set_font_size(cr, size);
+  cairo_text_extents_t extents;
+  cairo_text_extents(cr, text.c_str(), &extents);
+  return extents.x_advance;
+}
+
+// The hillshade of the DEM (sun from the north-west, 45° up) with the layer's classes on top,
+// one colour per cell, into the image surface's pixels.
+void PaintMap(cairo_surface_t* surface, const Heightfield& dem, const ensemble::RasterLayer* layer,
+              const QuickLookLegend& legend, int scale) {
   const GridGeometry& g = dem.grid;
-  const int scale = std::max(1, 900 / std::max(g.nx, g.ny));  // pixels per cell
-  const int w = g.nx * scale, h = g.ny * scale;
-  std::vector<Rgb> image(static_cast<std::size_t>(w) * h);
   auto z = [&](int i, int j) {
     i = std::clamp(i, 0, g.nx - 1);
     j = std::clamp(j, 0, g.ny - 1);
     return dem.z_m[static_cast<std::size_t>(j) * g.nx + i];
   };
-  // Overlay scaling: [0, largest value] (energy on a log scale).
-  double top = 0;
-  const bool log_scale = layer && layer->name.rfind("energy", 0) == 0;
-  if (layer) {
-    for (float v : layer->values)
-      if (v != ensemble::RasterLayer::kNoData) top = std::max(top, double(v));
-  }
-  // Hillshade: sun from the north-west, 45 degrees up.
   const double azimuth = 315 * std::numbers::pi / 180, altitude = 45 * std::numbers::pi / 180;
   const Eigen::Vector3d sun(std::sin(azimuth) * std::cos(altitude),
                             std::cos(azimuth) * std::cos(altitude), std::sin(altitude));
+  cairo_surface_flush(surface);
+  unsigned char* data = cairo_image_surface_get_data(surface);
+  const int stride = cairo_image_surface_get_stride(surface);
   for (int j = 0; j < g.ny; ++j)
     for (int i = 0; i < g.nx; ++i) {
       const double here = z(i, j);
@@ -74,70 +113,247 @@ void WriteQuickLookPng(const std::string& path, const Heightfield& dem,
         const double grey = 60 + 180 * shade;
         colour = {grey, grey, grey};
         const std::size_t c = static_cast<std::size_t>(j) * g.nx + i;
-        if (layer && layer->values[c] != ensemble::RasterLayer::kNoData && layer->values[c] > 0 &&
-            top > 0) {
-          const double v = layer->values[c];
-          const double t = log_scale ? std::log1p(v) / std::log1p(top) : v / top;
-          const Rgb ramp = Ramp(t);
-          for (int k = 0; k < 3; ++k) colour[k] = 0.25 * colour[k] + 0.75 * ramp[k];
-        }
+        const int k = layer && layer->values[c] != ensemble::RasterLayer::kNoData
+                          ? legend.ClassOf(layer->values[c])
+                          : -1;
+        if (k >= 0)
+          for (int b = 0; b < 3; ++b) colour[b] = 0.25 * colour[b] + 0.75 * legend.classes[k].rgb[b];
       }
-      for (int dy = 0; dy < scale; ++dy)
-        for (int dx = 0; dx < scale; ++dx)
-          image[static_cast<std::size_t>((g.ny - 1 - j) * scale + dy) * w + i * scale + dx] =
-              colour;
-    }
-  // Paths: translucent blue lines (one dot per half pixel, blended once per dot).
-  auto pixel = [&](const Eigen::Vector2d& p) {
-    return Eigen::Vector2d((p.x() - g.x0_m + 0.5 * g.dx_m) / g.dx_m * scale,
-                           (g.y_max_m() + 0.5 * g.dy_m - p.y()) / g.dy_m * scale);
-  };
-  for (const auto& line : paths)
-    for (std::size_t k = 1; k < line.size(); ++k) {
-      const Eigen::Vector2d a = pixel(line[k - 1]), b = pixel(line[k]);
-      const int n = std::max(1, static_cast<int>(2 * (b - a).norm()));
-      for (int s = 0; s <= n; ++s) {
-        const Eigen::Vector2d p = a + (double(s) / n) * (b - a);
-        const int x = static_cast<int>(p.x()), y = static_cast<int>(p.y());
-        if (x < 0 || y < 0 || x >= w || y >= h) continue;
-        Rgb& c = image[static_cast<std::size_t>(y) * w + x];
-        c = {0.5 * c[0] + 0.5 * 20, 0.5 * c[1] + 0.5 * 60, 0.5 * c[2] + 0.5 * 200};
+      // CAIRO_FORMAT_RGB24: one 32-bit word per pixel, 0x00RRGGBB in native byte order.
+      const std::uint32_t word = (static_cast<std::uint32_t>(std::lround(colour[0])) << 16) |
+                                 (static_cast<std::uint32_t>(std::lround(colour[1])) << 8) |
+                                 static_cast<std::uint32_t>(std::lround(colour[2]));
+      for (int dy = 0; dy < scale; ++dy) {
+        auto* row = reinterpret_cast<std::uint32_t*>(
+            data + static_cast<std::size_t>((g.ny - 1 - j) * scale + dy) * stride);
+        for (int dx = 0; dx < scale; ++dx) row[i * scale + dx] = word;
       }
     }
+  cairo_surface_mark_dirty(surface);
+}
 
+// Scale bar at the map's bottom left: four black and white quarters and the length.
+void DrawScaleBar(cairo_t* cr, const GridGeometry& g, const QuickLookLayout& layout) {
+  const double metres_per_pixel = g.dx_m / layout.scale;
+  const double length_m = ScaleBarLength(0.25 * layout.map_width * metres_per_pixel);
+  const double length_px = length_m / metres_per_pixel;
+  const std::string label = length_m >= 1000 ? Number(length_m / 1000) + " km" : Number(length_m) + " m";
+  const double x = 10, y = layout.map_height - 14;
+  cairo_set_source_rgba(cr, 1, 1, 1, 0.8);
+  cairo_rectangle(cr, x - 6, y - 22, length_px + 12 + TextWidth(cr, 12, label) + 8, 32);
+  cairo_fill(cr);
+  for (int q = 0; q < 4; ++q) {
+    cairo_rectangle(cr, x + q * length_px / 4, y - 4, length_px / 4, 6);
+    if (q % 2 == 0)
+      cairo_set_source_rgb(cr, 0, 0, 0);
+    else
+      cairo_set_source_rgb(cr, 1, 1, 1);
+    cairo_fill_preserve(cr);
+    cairo_set_source_rgb(cr, 0, 0, 0);
+    cairo_set_line_width(cr, 1);
+    cairo_stroke(cr);
+  }
+  cairo_set_source_rgb(cr, 0, 0, 0);
+  Text(cr, x, y - 9, 12, "0");
+  Text(cr, x + length_px + 6, y + 2, 12, label);
+}
+
+// North arrow at the map's top right (the DEM is north up).
+void DrawNorthArrow(cairo_t* cr, const QuickLookLayout& layout) {
+  const double cx = layout.map_width - 24, top = 10;
+  cairo_set_source_rgba(cr, 1, 1, 1, 0.8);
+  cairo_rectangle(cr, cx - 14, top - 2, 28, 50);
+  cairo_fill(cr);
+  cairo_set_source_rgb(cr, 0, 0, 0);
+  cairo_move_to(cr, cx, top + 2);
+  cairo_line_to(cr, cx + 8, top + 26);
+  cairo_line_to(cr, cx, top + 20);
+  cairo_line_to(cr, cx - 8, top + 26);
+  cairo_close_path(cr);
+  cairo_fill(cr);
+  Text(cr, cx - 5, top + 44, 14, "N", true);
+}
+
+void DrawLegend(cairo_t* cr, const ensemble::RasterLayer* layer, const QuickLookLegend& legend,
+                std::size_t paths, const std::vector<MapMarker>& markers,
+                const QuickLookLayout& layout) {
+  const double x = layout.map_width + 16;
+  double y = 28;
+  cairo_set_source_rgb(cr, 0.97, 0.97, 0.97);
+  cairo_rectangle(cr, layout.map_width, 0, layout.width - layout.map_width, layout.height);
+  cairo_fill(cr);
+  cairo_set_source_rgb(cr, 0, 0, 0);
+  if (layer) {
+    Text(cr, x, y, 14, legend.title, true);
+    y += 12;
+    for (auto it = legend.classes.rbegin(); it != legend.classes.rend(); ++it) {
+      SetColour(cr, it->rgb);
+      cairo_rectangle(cr, x, y + 4, 24, 16);
+      cairo_fill_preserve(cr);
+      cairo_set_source_rgb(cr, 0.3, 0.3, 0.3);
+      cairo_set_line_width(cr, 1);
+      cairo_stroke(cr);
+      cairo_set_source_rgb(cr, 0, 0, 0);
+      Text(cr, x + 32, y + 17, 12, it->label);
+      y += 22;
+    }
+    Text(cr, x, y + 16, 11, "no colour: no rock passed");
+    y += 34;
+  }
+  if (paths > 0) {
+    cairo_set_source_rgba(cr, 20 / 255.0, 60 / 255.0, 200 / 255.0, 0.8);
+    cairo_set_line_width(cr, 2);
+    cairo_move_to(cr, x, y + 8);
+    cairo_line_to(cr, x + 24, y + 8);
+    cairo_stroke(cr);
+    cairo_set_source_rgb(cr, 0, 0, 0);
+    Text(cr, x + 32, y + 12, 12,
+         "paths of " + std::to_string(paths) + (paths == 1 ? " rock" : " rocks"));
+    y += 22;
+  }
+  std::vector<std::string> listed;
+  for (const MapMarker& m : markers) {
+    if (m.label.empty() || std::find(listed.begin(), listed.end(), m.label) != listed.end()) continue;
+    listed.push_back(m.label);
+    SetColour(cr, m.rgb);
+    cairo_arc(cr, x + 12, y + 8, std::max(3, m.radius_px), 0, 2 * std::numbers::pi);
+    cairo_fill(cr);
+    cairo_set_source_rgb(cr, 0, 0, 0);
+    Text(cr, x + 32, y + 12, 12, m.label);
+    y += 22;
+  }
+  cairo_set_source_rgb(cr, 0.35, 0.35, 0.35);
+  Text(cr, x, layout.height - 12, 11, "hillshade: sun from the north-west");
+}
+
+}  // namespace
+
+int QuickLookLegend::ClassOf(double value) const {
+  if (!(value > 0) || classes.empty()) return -1;
+  int k = 0;
+  // Rasters hold floats: compare in float, so that 1 rock in 100 (0.01f, just below 0.01) is 1 %.
+  while (k + 1 < static_cast<int>(classes.size()) &&
+         static_cast<float>(value) >= static_cast<float>(classes[k + 1].lower))
+    ++k;
+  return k;
+}
+
+QuickLookLegend LegendOf(const ensemble::RasterLayer& layer) {
+  const std::string& name = layer.name;
+  if (name == "reach_probability")
+    return {"Reach probability",
+            Classes({0, 0.01, 0.1, 0.3}, {"below 1 %", "1 - 10 %", "10 - 30 %", "30 - 100 %"})};
+  if (StartsWith(name, "energy"))
+    return {"Energy, " + StatisticOf(name) + " (kJ)",
+            Classes({0, 30e3, 300e3, 1000e3, 3000e3},
+                    {"below 30 kJ", "30 - 300 kJ", "300 - 1000 kJ", "1000 - 3000 kJ", "3000 kJ and more"})};
+  if (StartsWith(name, "speed"))
+    return {"Speed, " + StatisticOf(name) + " (m/s)",
+            Classes({0, 5, 10, 20, 30},
+                    {"below 5 m/s", "5 - 10 m/s", "10 - 20 m/s", "20 - 30 m/s", "30 m/s and more"})};
+  if (StartsWith(name, "jump_height"))
+    return {"Jump height, " + StatisticOf(name) + " (m)",
+            Classes({0, 1, 2, 5, 10}, {"below 1 m", "1 - 2 m", "2 - 5 m", "5 - 10 m", "10 m and more"})};
+  if (name == "passages" || name == "deposits")
+    return {name == "passages" ? "Rocks that passed" : "Rocks at rest",
+            Classes({0, 1.5, 10.5, 100.5, 1000.5},
+                    {"1 rock", "2 - 10 rocks", "11 - 100 rocks", "101 - 1000 rocks", "more than 1000"})};
+  // Anything else: five equal classes up to the largest value.
+  double top = 0;
+  for (float v : layer.values)
+    if (v != ensemble::RasterLayer::kNoData) top = std::max(top, double(v));
+  std::vector<double> lower;
+  std::vector<std::string> labels;
+  for (int k = 0; k < 5; ++k) {
+    lower.push_back(k * top / 5);
+    labels.push_back(Number(k * top / 5) + " - " + Number((k + 1) * top / 5) + " " + layer.unit);
+  }
+  return {name + " (" + layer.unit + ")", Classes(lower, labels)};
+}
+
+const ensemble::RasterLayer* QuickLookLayer(const std::vector<ensemble::RasterLayer>& layers) {
+  for (const char* name : {"reach_probability", "energy_max", "speed_max", "passages"})
+    for (const ensemble::RasterLayer& l : layers)
+      if (l.name == name) return &l;
+  return nullptr;
+}
+
+QuickLookLayout QuickLookLayoutOf(const GridGeometry& grid) {
+  QuickLookLayout layout;
+  layout.scale = std::max(1, kMapPixels / std::max(grid.nx, grid.ny));
+  layout.map_width = grid.nx * layout.scale;
+  layout.map_height = grid.ny * layout.scale;
+  layout.width = layout.map_width + kPanelWidth;
+  layout.height = std::max(layout.map_height, kMinHeight);
+  return layout;
+}
+
+double ScaleBarLength(double at_most_m) {
+  if (!(at_most_m > 0)) return 0;
+  double decade = std::pow(10.0, std::floor(std::log10(at_most_m)));
+  if (decade > at_most_m) decade /= 10;  // guards log10 rounding at exact powers of ten
+  for (double step : {5.0, 2.0, 1.0})
+    if (step * decade <= at_most_m) return step * decade;
+  return decade;
+}
+
+void WriteQuickLookPng(const std::string& path, const Heightfield& dem,
+                       const ensemble::RasterLayer* layer,
+                       const std::vector<std::vector<Eigen::Vector2d>>& paths,
+                       const std::vector<MapMarker>& markers) {
+  const GridGeometry& g = dem.grid;
+  const QuickLookLayout layout = QuickLookLayoutOf(g);
+  const QuickLookLegend legend = layer ? LegendOf(*layer) : QuickLookLegend{};
+  const std::unique_ptr<cairo_surface_t, decltype(&cairo_surface_destroy)> surface(
+      cairo_image_surface_create(CAIRO_FORMAT_RGB24, layout.width, layout.height),
+      cairo_surface_destroy);
+  if (cairo_surface_status(surface.get()) != CAIRO_STATUS_SUCCESS)
+    throw std::runtime_error("cannot draw " + path + ": " +
+                             cairo_status_to_string(cairo_surface_status(surface.get())));
+  const std::unique_ptr<cairo_t, decltype(&cairo_destroy)> context(cairo_create(surface.get()),
+                                                                   cairo_destroy);
+  cairo_t* cr = context.get();
+  cairo_set_source_rgb(cr, 1, 1, 1);
+  cairo_paint(cr);
+  PaintMap(surface.get(), dem, layer, legend, layout.scale);
+
+  // Paths: translucent blue lines.
+  auto pixel = [&](const Eigen::Vector2d& p) {
+    return Eigen::Vector2d((p.x() - g.x0_m + 0.5 * g.dx_m) / g.dx_m * layout.scale,
+                           (g.y_max_m() + 0.5 * g.dy_m - p.y()) / g.dy_m * layout.scale);
+  };
+  cairo_rectangle(cr, 0, 0, layout.map_width, layout.map_height);
+  cairo_clip(cr);
+  cairo_set_source_rgba(cr, 20 / 255.0, 60 / 255.0, 200 / 255.0, 0.6);
+  cairo_set_line_width(cr, 1.5);
+  cairo_set_line_join(cr, CAIRO_LINE_JOIN_ROUND);
+  for (const auto& line : paths) {
+    if (line.size() < 2) continue;
+    for (std::size_t k = 0; k < line.size(); ++k) {
+      const Eigen::Vector2d p = pixel(line[k]);
+      if (k == 0)
+        cairo_move_to(cr, p.x(), p.y());
+      else
+        cairo_line_to(cr, p.x(), p.y());
+    }
+    cairo_stroke(cr);
+  }
   for (const MapMarker& m : markers) {
     const Eigen::Vector2d centre = pixel(m.xy_m);
-    for (int dy = -m.radius_px; dy <= m.radius_px; ++dy)
-      for (int dx = -m.radius_px; dx <= m.radius_px; ++dx) {
-        if (dx * dx + dy * dy > m.radius_px * m.radius_px) continue;
-        const int x = static_cast<int>(centre.x()) + dx, y = static_cast<int>(centre.y()) + dy;
-        if (x < 0 || y < 0 || x >= w || y >= h) continue;
-        image[static_cast<std::size_t>(y) * w + x] = {double(m.rgb[0]), double(m.rgb[1]),
-                                                      double(m.rgb[2])};
-      }
+    SetColour(cr, m.rgb);
+    cairo_arc(cr, centre.x(), centre.y(), m.radius_px, 0, 2 * std::numbers::pi);
+    cairo_fill(cr);
   }
+  DrawScaleBar(cr, g, layout);
+  DrawNorthArrow(cr, layout);
+  cairo_reset_clip(cr);
+  DrawLegend(cr, layer, legend, paths.size(), markers, layout);
 
-  RegisterGdal();
-  GDALDriver* mem = GetGDALDriverManager()->GetDriverByName("MEM");
-  GDALDriver* png = GetGDALDriverManager()->GetDriverByName("PNG");
-  if (!mem || !png) throw std::runtime_error("GDAL lacks the MEM or PNG driver");
-  GDALDataset* canvas = mem->Create("", w, h, 3, GDT_Byte, nullptr);
-  std::vector<unsigned char> band(image.size());
-  for (int k = 0; k < 3; ++k) {
-    for (std::size_t p = 0; p < image.size(); ++p)
-      band[p] = static_cast<unsigned char>(std::lround(std::clamp(image[p][k], 0.0, 255.0)));
-    if (canvas->GetRasterBand(k + 1)->RasterIO(GF_Write, 0, 0, w, h, band.data(), w, h, GDT_Byte, 0,
-                                               0) != CE_None) {
-      GDALClose(canvas);
-      throw std::runtime_error("cannot draw " + path);
-    }
-  }
+  cairo_surface_flush(surface.get());
   AtomicFile file(path);
-  GDALDataset* written =
-      png->CreateCopy(file.temp_path().c_str(), canvas, FALSE, nullptr, nullptr, nullptr);
-  GDALClose(canvas);
-  if (!written) throw std::runtime_error("cannot write " + path + ": " + CPLGetLastErrorMsg());
-  GDALClose(written);
+  const cairo_status_t written = cairo_surface_write_to_png(surface.get(), file.temp_path().c_str());
+  if (written != CAIRO_STATUS_SUCCESS)
+    throw std::runtime_error("cannot write " + path + ": " + cairo_status_to_string(written));
   file.Commit();
 }
 

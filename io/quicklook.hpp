@@ -1,8 +1,11 @@
 #pragma once
 // quicklook.png: a picture of a run for people who would rather look than read. The DEM's
-// hillshade (north up), one raster on top (reach probability, else the maximum energy, speed or
-// passages; yellow = low, dark red = the largest value in the raster, transparent where no rock
-// passed; energy on a log scale) and the paths of a sample of rocks in blue.
+// hillshade (north up), one raster on top in fixed classes (reach probability, else the largest
+// energy, speed or passages; transparent where no rock passed), the paths of sampled rocks in
+// blue, and beside the map a legend with the classes and their units, a scale bar and a north
+// arrow. The classes are absolute (the same value has the same colour in every run), so pictures
+// of different runs can be compared; for energy they include the 30 kJ and 300 kJ limits of the
+// intensity classes used in Swiss rockfall hazard zoning.
 
 #include <Eigen/Core>
 #include <array>
@@ -18,18 +21,52 @@ namespace talus::io {
 // in `layers`, or nullptr.
 const ensemble::RasterLayer* QuickLookLayer(const std::vector<ensemble::RasterLayer>& layers);
 
-// A filled disc drawn on the map (e.g. observed and simulated rest positions).
+// One colour class of the quick-look's legend: the values in [lower, next class's lower), in the
+// raster's own unit; `label` in the unit the legend shows (e.g. kJ for an energy in J).
+struct ColourClass {
+  double lower = 0;
+  std::string label;
+  std::array<unsigned char, 3> rgb{};
+};
+
+// The legend of a layer: its title (with the unit shown) and its classes, lowest first. A value
+// that is zero or below, or nodata, is not coloured. Known layers: reach_probability, energy_*,
+// speed_*, jump_height_*, passages, deposits; others get five classes up to the layer's largest
+// value.
+struct QuickLookLegend {
+  std::string title;
+  std::vector<ColourClass> classes;
+  // Index of the class of `value`, or -1 when the value is not coloured.
+  int ClassOf(double value) const;
+};
+QuickLookLegend LegendOf(const ensemble::RasterLayer& layer);
+
+// A filled disc drawn on the map (e.g. observed and simulated rest positions); markers with a
+// label are listed in the legend (once per label).
 struct MapMarker {
   Eigen::Vector2d xy_m;                // map coordinates
   std::array<unsigned char, 3> rgb{};  // colour
   int radius_px = 3;
+  std::string label;
 };
 
-// Writes the PNG atomically (GDAL's PNG driver). paths: horizontal positions, map coordinates;
-// markers are drawn last, in order.
+// The picture's layout in pixels: the map is `scale` pixels per DEM cell, north up, at the top
+// left; the legend panel is to its right.
+struct QuickLookLayout {
+  int scale = 1;
+  int map_width = 0, map_height = 0;
+  int width = 0, height = 0;
+};
+QuickLookLayout QuickLookLayoutOf(const GridGeometry& grid);
+
+// Writes the PNG atomically (cairo). paths: horizontal positions, map coordinates; markers are
+// drawn last, in order. The same inputs give the same bytes.
 void WriteQuickLookPng(const std::string& path, const Heightfield& dem,
                        const ensemble::RasterLayer* layer,
                        const std::vector<std::vector<Eigen::Vector2d>>& paths,
                        const std::vector<MapMarker>& markers = {});
+
+// A "nice" length for a scale bar at most `at_most_m` long: 1, 2 or 5 × 10^k m.
+double ScaleBarLength(double at_most_m);
 
 }  // namespace talus::io

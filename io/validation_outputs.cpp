@@ -237,9 +237,9 @@ void WriteDepositsPng(const std::string& path, const EventFile& event,
                       const fieldobs::EnsembleSamples& simulated) {
   std::vector<MapMarker> markers;
   for (const Eigen::Vector2d& end : simulated.EndPositions(""))
-    markers.push_back({end, {40, 90, 220}, 1});
+    markers.push_back({end, {40, 90, 220}, 1, "simulated rest position"});
   for (const fieldobs::DepositObservation& d : event.observations.deposits)
-    markers.push_back({d.xy_m, {215, 25, 28}, 3});
+    markers.push_back({d.xy_m, {215, 25, 28}, 3, "observed rest position"});
   WriteQuickLookPng(path, event.scene.scene.terrain.heights(), nullptr, {}, markers);
 }
 

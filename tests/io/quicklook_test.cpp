@@ -19,7 +19,15 @@ TEST(QuickLook, PicksTheLayerInOrderOfPreference) {
   EXPECT_EQ(QuickLookLayer({}), nullptr);
 }
 
-TEST(QuickLook, WritesAnRgbPngNorthUp) {
+// Reads one pixel of band 1..3 of an open PNG.
+unsigned char Pixel(GDALDataset* png, int band, int x, int y) {
+  unsigned char value = 0;
+  EXPECT_EQ(png->GetRasterBand(band)->RasterIO(GF_Read, x, y, 1, 1, &value, 1, 1, GDT_Byte, 0, 0),
+            CE_None);
+  return value;
+}
+
+TEST(QuickLook, WritesAnRgbPngNorthUpWithALegendBesideTheMap) {
   const auto dir = testing::FreshDir("png");
   const Heightfield dem = MakePlaneHeightfield({30, 20, 10, 20, 1});
   ensemble::RasterLayer reach{"reach_probability", "1", std::vector<float>(dem.z_m.size(), 0.0f),
@@ -31,17 +39,57 @@ TEST(QuickLook, WritesAnRgbPngNorthUp) {
   GDALDataset* png = static_cast<GDALDataset*>(GDALOpen(path.c_str(), GA_ReadOnly));
   ASSERT_NE(png, nullptr);
   EXPECT_EQ(png->GetRasterCount(), 3);
-  const int scale = png->GetRasterXSize() / dem.grid.nx;
-  EXPECT_EQ(png->GetRasterYSize(), dem.grid.ny * scale);
-  // The south-west cell is at the bottom left, in the ramp's dark red (red well above blue).
-  unsigned char red = 0, blue = 0;
-  const int y = png->GetRasterYSize() - 1;
-  EXPECT_EQ(png->GetRasterBand(1)->RasterIO(GF_Read, 0, y, 1, 1, &red, 1, 1, GDT_Byte, 0, 0),
-            CE_None);
-  EXPECT_EQ(png->GetRasterBand(3)->RasterIO(GF_Read, 0, y, 1, 1, &blue, 1, 1, GDT_Byte, 0, 0),
-            CE_None);
-  EXPECT_GT(red, blue + 40);
+  const QuickLookLayout layout = QuickLookLayoutOf(dem.grid);
+  EXPECT_EQ(png->GetRasterXSize(), layout.width);
+  EXPECT_EQ(png->GetRasterYSize(), layout.height);
+  EXPECT_GT(layout.width, layout.map_width + 200);  // room for the legend
+  // The south-west cell is at the map's bottom left, in the class 30 - 100 % (dark red: red well
+  // above blue).
+  const int y = layout.map_height - 1;
+  EXPECT_GT(Pixel(png, 1, 0, y), Pixel(png, 3, 0, y) + 40);
+  // Cells no rock passed keep the grey hillshade (red == blue).
+  EXPECT_EQ(Pixel(png, 1, layout.map_width / 2, layout.map_height / 2),
+            Pixel(png, 3, layout.map_width / 2, layout.map_height / 2));
+  // The legend panel holds text and swatches: many dark and many coloured pixels, which a blank
+  // panel would not.
+  int dark = 0, coloured = 0;
+  for (int yy = 0; yy < layout.height; ++yy)
+    for (int xx = layout.map_width; xx < layout.width; xx += 2) {
+      const int r = Pixel(png, 1, xx, yy), b = Pixel(png, 3, xx, yy);
+      dark += r < 100 && b < 100;
+      coloured += r > b + 60;
+    }
+  EXPECT_GT(dark, 200);
+  EXPECT_GT(coloured, 200);
   GDALClose(png);
+}
+
+TEST(QuickLook, EnergyClassesAreAbsoluteWithTheHazardLimitsAt30And300Kilojoules) {
+  const ensemble::RasterLayer energy{"energy_max", "J", {}, true};
+  const QuickLookLegend legend = LegendOf(energy);
+  EXPECT_EQ(legend.ClassOf(0), -1);      // no rock: not coloured
+  EXPECT_EQ(legend.ClassOf(29.9e3), 0);  // below 30 kJ
+  EXPECT_EQ(legend.ClassOf(30e3), 1);
+  EXPECT_EQ(legend.ClassOf(299e3), 1);
+  EXPECT_EQ(legend.ClassOf(300e3), 2);
+  EXPECT_EQ(legend.ClassOf(1e9), static_cast<int>(legend.classes.size()) - 1);
+  EXPECT_NE(legend.title.find("kJ"), std::string::npos);
+  EXPECT_NE(legend.title.find("largest"), std::string::npos);
+  // One rock in a hundred is 1 %, although the float raster holds 0.01f < 0.01.
+  const ensemble::RasterLayer reach{"reach_probability", "1", {}, false};
+  EXPECT_EQ(LegendOf(reach).ClassOf(1.0f / 100.0f), 1);
+  // The same value has the same class whatever else the raster holds.
+  const ensemble::RasterLayer speed{"speed_p95", "m/s", {1, 50}, true};
+  EXPECT_EQ(LegendOf(speed).ClassOf(12), 2);  // 10 - 20 m/s
+  EXPECT_NE(LegendOf(speed).title.find("95th percentile"), std::string::npos);
+}
+
+TEST(QuickLook, ScaleBarLengthsAreOneTwoOrFiveTimesAPowerOfTen) {
+  EXPECT_DOUBLE_EQ(ScaleBarLength(240), 200);
+  EXPECT_DOUBLE_EQ(ScaleBarLength(1000), 1000);
+  EXPECT_DOUBLE_EQ(ScaleBarLength(999), 500);
+  EXPECT_DOUBLE_EQ(ScaleBarLength(0.7), 0.5);
+  EXPECT_DOUBLE_EQ(ScaleBarLength(0), 0);
 }
 
 }  // namespace
