@@ -12,6 +12,7 @@
 #include "common/error.hpp"
 #include "io/quicklook.hpp"
 #include "io/raster.hpp"
+#include "io/report_html.hpp"
 #include "io/rocks_csv.hpp"
 #include "io/summary.hpp"
 #include "io/trajectory_file.hpp"
@@ -77,15 +78,26 @@ std::vector<std::string> WriteSummaryOutputs(const io::SceneFile& scene,
     outputs.push_back(layer.name + ".tif");
   }
   ThrowIfInterrupted();
+  std::vector<std::vector<Eigen::Vector2d>> xy;
+  for (const io::SamplePath& p : paths) xy.push_back(p.xy_m);
   if (scene.output.quicklook) {
-    std::vector<std::vector<Eigen::Vector2d>> xy;
-    for (const io::SamplePath& p : paths) xy.push_back(p.xy_m);
     io::WriteQuickLookPng(staging.path("quicklook.png"), scene.scene.terrain.heights(),
                           io::QuickLookLayer(layers), xy);
     outputs.push_back("quicklook.png");
   }
-  WriteFileAtomically(staging.path("summary.json"),
-                      io::SummaryJson(scene, report, kVersion, outputs));
+  if (scene.output.report) outputs.push_back("report.html");
+  const std::string summary = io::SummaryJson(scene, report, kVersion, outputs);
+  if (scene.output.report) {
+    ThrowIfInterrupted();
+    io::RunReportInput page;
+    page.summary_json = summary;
+    page.dem = &scene.scene.terrain.heights();
+    page.layers = &layers;
+    page.paths = std::move(xy);
+    page.rocks = io::ReadRockColumns(staging.path("rocks.csv"));
+    WriteFileAtomically(staging.path("report.html"), io::RunReportHtml(page));
+  }
+  WriteFileAtomically(staging.path("summary.json"), summary);
   ThrowIfInterrupted();
   outputs.push_back("summary.json");
   return outputs;
@@ -119,7 +131,7 @@ bool QuickLookSample(const ensemble::ReleaseSpec& release, long rock) {
 std::vector<std::string> TalusOutputNames() {
   std::vector<std::string> names = {
       "rocks.csv",    "trajectories.h5",       "summary.json", "quicklook.png", "passages.tif",
-      "deposits.tif", "reach_probability.tif", "partial.json", "partial.bin"};
+      "deposits.tif", "reach_probability.tif", "partial.json", "partial.bin",  "report.html"};
   for (const char* quantity : {"speed", "energy", "jump_height"})
     for (const char* statistic : {"max", "mean", "p95"})
       names.push_back(std::string(quantity) + "_" + statistic + ".tif");
@@ -136,7 +148,7 @@ std::vector<std::string> RunIntoStaging(const io::SceneFile& scene, int threads,
   options.end_rock = end_rock;
   options.trajectories = scene.output.trajectories;
   options.trajectory_interval_s = scene.output.trajectory_interval_s;
-  if (scene.output.quicklook) {
+  if (scene.output.quicklook || scene.output.report) {
     const ensemble::ReleaseSpec& release = scene.release;
     options.sample_trajectories = [&release](long rock) { return QuickLookSample(release, rock); };
   }

@@ -4,74 +4,22 @@
 #include <cmath>
 #include <cstdio>
 
+#include "io/svg_plot.hpp"
+
 namespace talus::io {
-namespace {
 
-constexpr double kWidth = 480, kHeight = 360;
-constexpr double kLeft = 64, kRight = 16, kTop = 32, kBottom = 48;
+using svg::Add;
+using svg::Axis;
+using svg::F;
+using svg::Frame;
+using svg::kBottom;
+using svg::kHeight;
+using svg::kLeft;
+using svg::kRight;
+using svg::kTop;
+using svg::kWidth;
+using svg::Pad;
 
-// Appends the parts one by one (GCC 12 warns wrongly about chains of std::string operator+).
-template <class... Parts>
-void Add(std::string& out, const Parts&... parts) {
-  (out.append(parts), ...);
-}
-
-std::string F(double v) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.2f", v);
-  return b;
-}
-
-std::string Label(double v) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.4g", v);
-  return b;
-}
-
-// A linear axis from lo to hi onto pixels a .. b.
-struct Axis {
-  double lo, hi, a, b;
-  double operator()(double v) const { return a + (v - lo) / (hi - lo) * (b - a); }
-};
-
-// lo and hi widened to at least a small range, and by 5 % on each side.
-void Pad(double& lo, double& hi) {
-  if (!(hi > lo)) {
-    const double d = std::max(std::abs(lo) * 0.1, 1e-9);
-    lo -= d;
-    hi += d;
-  }
-  const double d = 0.05 * (hi - lo);
-  lo -= d;
-  hi += d;
-}
-
-std::string Frame(const std::string& title, const std::string& x_label, const std::string& y_label,
-                  const Axis& x, const Axis& y) {
-  std::string out;
-  Add(out, "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"", F(kWidth), "\" height=\"",
-      F(kHeight), "\" font-family=\"sans-serif\" font-size=\"11\">\n");
-  Add(out, "<rect x=\"0\" y=\"0\" width=\"", F(kWidth), "\" height=\"", F(kHeight),
-      "\" fill=\"white\"/>\n");
-  Add(out, "<text x=\"", F(kWidth / 2), "\" y=\"18\" text-anchor=\"middle\" font-size=\"13\">",
-      title, "</text>\n");
-  Add(out, "<rect x=\"", F(kLeft), "\" y=\"", F(kTop), "\" width=\"", F(kWidth - kLeft - kRight),
-      "\" height=\"", F(kHeight - kTop - kBottom), "\" fill=\"none\" stroke=\"black\"/>\n");
-  for (int k = 0; k <= 4; ++k) {
-    const double vx = x.lo + (x.hi - x.lo) * k / 4, vy = y.lo + (y.hi - y.lo) * k / 4;
-    Add(out, "<text x=\"", F(x(vx)), "\" y=\"", F(kHeight - kBottom + 14),
-        "\" text-anchor=\"middle\">", Label(vx), "</text>\n");
-    Add(out, "<text x=\"", F(kLeft - 4), "\" y=\"", F(y(vy) + 4), "\" text-anchor=\"end\">",
-        Label(vy), "</text>\n");
-  }
-  Add(out, "<text x=\"", F(kLeft + (kWidth - kLeft - kRight) / 2), "\" y=\"", F(kHeight - 10),
-      "\" text-anchor=\"middle\">", x_label, "</text>\n");
-  Add(out, "<text transform=\"translate(14,", F(kTop + (kHeight - kTop - kBottom) / 2),
-      ") rotate(-90)\" text-anchor=\"middle\">", y_label, "</text>\n");
-  return out;
-}
-
-}  // namespace
 
 std::string ConvergenceSvg(const calibration::Summary& summary) {
   double lo = INFINITY, hi = -INFINITY;

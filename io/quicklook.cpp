@@ -297,10 +297,9 @@ double ScaleBarLength(double at_most_m) {
   return decade;
 }
 
-void WriteQuickLookPng(const std::string& path, const Heightfield& dem,
-                       const ensemble::RasterLayer* layer,
-                       const std::vector<std::vector<Eigen::Vector2d>>& paths,
-                       const std::vector<MapMarker>& markers) {
+std::string QuickLookPng(const Heightfield& dem, const ensemble::RasterLayer* layer,
+                         const std::vector<std::vector<Eigen::Vector2d>>& paths,
+                         const std::vector<MapMarker>& markers) {
   const GridGeometry& g = dem.grid;
   const QuickLookLayout layout = QuickLookLayoutOf(g);
   const QuickLookLegend legend = layer ? LegendOf(*layer) : QuickLookLegend{};
@@ -308,7 +307,7 @@ void WriteQuickLookPng(const std::string& path, const Heightfield& dem,
       cairo_image_surface_create(CAIRO_FORMAT_RGB24, layout.width, layout.height),
       cairo_surface_destroy);
   if (cairo_surface_status(surface.get()) != CAIRO_STATUS_SUCCESS)
-    throw std::runtime_error("cannot draw " + path + ": " +
+    throw std::runtime_error(std::string("cannot draw the quick-look: ") +
                              cairo_status_to_string(cairo_surface_status(surface.get())));
   const std::unique_ptr<cairo_t, decltype(&cairo_destroy)> context(cairo_create(surface.get()),
                                                                    cairo_destroy);
@@ -350,11 +349,25 @@ void WriteQuickLookPng(const std::string& path, const Heightfield& dem,
   DrawLegend(cr, layer, legend, paths.size(), markers, layout);
 
   cairo_surface_flush(surface.get());
-  AtomicFile file(path);
-  const cairo_status_t written = cairo_surface_write_to_png(surface.get(), file.temp_path().c_str());
-  if (written != CAIRO_STATUS_SUCCESS)
-    throw std::runtime_error("cannot write " + path + ": " + cairo_status_to_string(written));
-  file.Commit();
+  std::string png;
+  const cairo_status_t encoded = cairo_surface_write_to_png_stream(
+      surface.get(),
+      [](void* closure, const unsigned char* data, unsigned int length) {
+        static_cast<std::string*>(closure)->append(reinterpret_cast<const char*>(data), length);
+        return CAIRO_STATUS_SUCCESS;
+      },
+      &png);
+  if (encoded != CAIRO_STATUS_SUCCESS)
+    throw std::runtime_error(std::string("cannot encode the quick-look: ") +
+                             cairo_status_to_string(encoded));
+  return png;
+}
+
+void WriteQuickLookPng(const std::string& path, const Heightfield& dem,
+                       const ensemble::RasterLayer* layer,
+                       const std::vector<std::vector<Eigen::Vector2d>>& paths,
+                       const std::vector<MapMarker>& markers) {
+  WriteFileAtomically(path, QuickLookPng(dem, layer, paths, markers));
 }
 
 }  // namespace talus::io

@@ -59,8 +59,11 @@ struct QuickLookLayout {
 };
 QuickLookLayout QuickLookLayoutOf(const GridGeometry& grid);
 
-// Writes the PNG atomically (cairo). paths: horizontal positions, map coordinates; markers are
+// The picture as PNG bytes (cairo), and written atomically to `path`. paths: horizontal positions, map coordinates; markers are
 // drawn last, in order. The same inputs give the same bytes.
+std::string QuickLookPng(const Heightfield& dem, const ensemble::RasterLayer* layer,
+                         const std::vector<std::vector<Eigen::Vector2d>>& paths,
+                         const std::vector<MapMarker>& markers = {});
 void WriteQuickLookPng(const std::string& path, const Heightfield& dem,
                        const ensemble::RasterLayer* layer,
                        const std::vector<std::vector<Eigen::Vector2d>>& paths,

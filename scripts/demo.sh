@@ -12,3 +12,4 @@ if command -v column >/dev/null; then head -n 6 "$out/rocks.csv" | column -s, -t
 echo
 echo "Rasters (GeoTIFF, EPSG:31287, on the DEM grid): $(cd "$out" && ls ./*.tif | tr '\n' ' ')"
 echo "Quick look: $out/quicklook.png   Summary: $out/summary.json"
+echo "Report for a browser (maps with legends, histograms, tables): $out/report.html"

@@ -269,7 +269,7 @@ void InterruptARun(int signal, const std::string& name) {
       0)
       << log;
   const auto earlier = Snapshot(out);
-  ASSERT_EQ(earlier.size(), 16u);
+  ASSERT_EQ(earlier.size(), 17u);
 
   const pid_t pid = StartTalus(
       {"simulate", (dir / "slow.toml").string(), "--out", out.string(), "--threads", "2"},

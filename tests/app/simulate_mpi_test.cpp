@@ -56,7 +56,7 @@ TEST(SimulateMpi, RanksTimesThreadsGiveTheOneProcessBytes) {
   ASSERT_EQ(RunCommand(Talus() + args + (dir / "single").string() + " --threads 1", &log), 0)
       << log;
   const auto single = Outputs(dir / "single");
-  ASSERT_EQ(single.size(), 16u);
+  ASSERT_EQ(single.size(), 17u);
   for (const auto& [ranks, threads] : {std::pair{2, 1}, std::pair{2, 2}, std::pair{3, 1}}) {
     const std::string name = "mpi-" + std::to_string(ranks) + "x" + std::to_string(threads);
     ASSERT_EQ(RunCommand(MpiRun("-n " + std::to_string(ranks) + " " + Talus()) + args +

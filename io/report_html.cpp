@@ -1,0 +1,325 @@
+#include "io/report_html.hpp"
+
+#include <cpl_conv.h>
+#include <cpl_string.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <stdexcept>
+
+#include "common/error.hpp"
+#include "io/quicklook.hpp"
+#include "io/svg_plot.hpp"
+
+namespace talus::io {
+namespace {
+
+using Json = nlohmann::ordered_json;
+using svg::Add;
+using svg::Escape;
+
+// Splits one CSV record (RFC 4180 quoting, as rocks.csv writes text fields).
+std::vector<std::string> SplitRecord(const std::string& record) {
+  std::vector<std::string> fields(1);
+  bool quoted = false;
+  for (std::size_t k = 0; k < record.size(); ++k) {
+    const char c = record[k];
+    if (quoted) {
+      if (c == '"' && k + 1 < record.size() && record[k + 1] == '"') {
+        fields.back() += '"';
+        ++k;
+      } else if (c == '"') {
+        quoted = false;
+      } else {
+        fields.back() += c;
+      }
+    } else if (c == '"') {
+      quoted = true;
+    } else if (c == ',') {
+      fields.emplace_back();
+    } else {
+      fields.back() += c;
+    }
+  }
+  return fields;
+}
+
+// A value for a table cell: numbers with up to 6 significant digits, text escaped.
+std::string Cell(const Json& value) {
+  if (value.is_number_float()) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.6g", value.get<double>());
+    return text;
+  }
+  if (value.is_string()) return Escape(value.get<std::string>());
+  if (value.is_array()) {
+    std::string out;
+    for (const Json& v : value) Add(out, out.empty() ? "" : ", ", Cell(v));
+    return out;
+  }
+  return Escape(value.dump());
+}
+
+std::string Number(double v, const char* format = "%.4g") {
+  if (!std::isfinite(v)) return "&ndash;";
+  char text[32];
+  std::snprintf(text, sizeof text, format, v);
+  return text;
+}
+
+// A two-column table of the scalar members of `object` (nested objects left out).
+std::string KeyValueTable(const Json& object, const std::vector<std::string>& skip = {}) {
+  std::string out = "<table>\n";
+  for (const auto& [key, value] : object.items()) {
+    if (value.is_object() || std::find(skip.begin(), skip.end(), key) != skip.end()) continue;
+    Add(out, "<tr><th>", Escape(key), "</th><td>", Cell(value), "</td></tr>\n");
+  }
+  return out + "</table>\n";
+}
+
+// One row per member of `object` (each an object), one column per key any of them has.
+std::string RowsTable(const Json& object, const std::string& first_column) {
+  std::vector<std::string> columns;
+  for (const auto& [name, row] : object.items())
+    for (const auto& [key, value] : row.items())
+      if (std::find(columns.begin(), columns.end(), key) == columns.end()) columns.push_back(key);
+  std::string out = "<table>\n<tr><th>" + Escape(first_column) + "</th>";
+  for (const std::string& c : columns) Add(out, "<th>", Escape(c), "</th>");
+  out += "</tr>\n";
+  for (const auto& [name, row] : object.items()) {
+    Add(out, "<tr><th>", Escape(name), "</th>");
+    for (const std::string& c : columns)
+      Add(out, "<td>", row.contains(c) ? Cell(row[c]) : "", "</td>");
+    out += "</tr>\n";
+  }
+  return out + "</table>\n";
+}
+
+std::string Base64(const std::string& bytes) {
+  char* encoded = CPLBase64Encode(static_cast<int>(bytes.size()),
+                                  reinterpret_cast<const GByte*>(bytes.data()));
+  std::string out = encoded ? encoded : "";
+  CPLFree(encoded);
+  return out;
+}
+
+double Mean(const std::vector<double>& values) {
+  if (values.empty()) return std::numeric_limits<double>::quiet_NaN();
+  double sum = 0;
+  for (double v : values) sum += v;
+  return sum / static_cast<double>(values.size());
+}
+
+constexpr const char* kStyle = R"(body{font-family:sans-serif;max-width:1100px;margin:2em auto;color:#222}
+h1{font-size:1.5em}h2{font-size:1.2em;border-bottom:1px solid #ccc;padding-bottom:.2em;margin-top:1.6em}
+table{border-collapse:collapse;margin:.5em 0}th,td{border:1px solid #ccc;padding:.2em .6em;text-align:left}
+td{font-variant-numeric:tabular-nums}figure{display:inline-block;margin:.5em 1em .5em 0;vertical-align:top}
+figure img{width:520px;max-width:100%;border:1px solid #ccc}figure{max-width:520px}figcaption{font-size:.9em;color:#555}
+.plots svg{margin:.3em;border:1px solid #ddd}.note{color:#555;font-size:.9em})";
+
+}  // namespace
+
+RockColumns ReadRockColumns(const std::string& rocks_csv) {
+  std::ifstream in(rocks_csv, std::ios::binary);
+  if (!in) throw InputError(rocks_csv + ": cannot be read");
+  std::string header;
+  if (!std::getline(in, header)) throw InputError(rocks_csv + ": no header");
+  const std::vector<std::string> names = SplitRecord(header);
+  const auto column = [&](const char* name) {
+    const auto at = std::find(names.begin(), names.end(), name);
+    if (at == names.end()) throw InputError(rocks_csv + ": no column '" + name + "'");
+    return static_cast<std::size_t>(at - names.begin());
+  };
+  const std::size_t runout = column("runout_m"), energy = column("max_kinetic_energy_j"),
+                    jump = column("max_jump_height_m"), speed = column("max_speed_m_s"),
+                    angle = column("travel_angle_deg");
+  RockColumns out;
+  std::string record, line;
+  long number = 1;
+  while (std::getline(in, line)) {
+    ++number;
+    record = line;
+    // A quoted field may hold a line break: read on until the quotes balance.
+    while (std::count(record.begin(), record.end(), '"') % 2 == 1 && std::getline(in, line)) {
+      ++number;
+      record += "\n" + line;
+    }
+    if (record.empty()) continue;
+    const std::vector<std::string> fields = SplitRecord(record);
+    if (fields.size() != names.size())
+      throw InputError(rocks_csv + ":" + std::to_string(number) + ": " +
+                       std::to_string(fields.size()) + " fields, the header has " +
+                       std::to_string(names.size()));
+    const auto value = [&](std::size_t c) {
+      const std::string& text = fields[c];
+      if (text.empty()) return std::numeric_limits<double>::quiet_NaN();
+      std::size_t used = 0;
+      double v = 0;
+      try {
+        v = std::stod(text, &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (used != text.size())
+        throw InputError(rocks_csv + ":" + std::to_string(number) + ": column '" + names[c] +
+                         "': '" + text + "' is not a number");
+      return v;
+    };
+    out.runout_m.push_back(value(runout));
+    out.max_kinetic_energy_j.push_back(value(energy));
+    out.max_jump_height_m.push_back(value(jump));
+    out.max_speed_m_s.push_back(value(speed));
+    out.travel_angle_deg.push_back(value(angle));
+  }
+  if (in.bad()) throw InputError(rocks_csv + ": cannot be read");
+  return out;
+}
+
+double NearestRankPercentile(std::vector<double> values, double p) {
+  values.erase(std::remove_if(values.begin(), values.end(), [](double v) { return !std::isfinite(v); }),
+               values.end());
+  if (values.empty()) return std::numeric_limits<double>::quiet_NaN();
+  const auto n = static_cast<double>(values.size());
+  const auto rank = static_cast<std::size_t>(std::max(1.0, std::ceil(p / 100 * n)));
+  std::nth_element(values.begin(), values.begin() + static_cast<long>(rank - 1), values.end());
+  return values[rank - 1];
+}
+
+std::string HistogramSvg(const std::string& title, const std::string& x_label,
+                         const std::vector<double>& values, int bins) {
+  std::vector<double> finite;
+  for (double v : values)
+    if (std::isfinite(v)) finite.push_back(v);
+  double lo = 0, hi = 0;
+  for (double v : finite) {
+    lo = std::min(lo, v);
+    hi = std::max(hi, v);
+  }
+  if (!(hi > lo)) hi = lo + 1;
+  std::vector<long> count(static_cast<std::size_t>(bins), 0);
+  for (double v : finite) {
+    const int b = std::min(bins - 1, static_cast<int>((v - lo) / (hi - lo) * bins));
+    ++count[static_cast<std::size_t>(b)];
+  }
+  const long top = std::max<long>(1, *std::max_element(count.begin(), count.end()));
+  const svg::Axis x{lo, hi, svg::kLeft, svg::kWidth - svg::kRight};
+  const svg::Axis y{0, static_cast<double>(top) * 1.1, svg::kHeight - svg::kBottom, svg::kTop};
+  std::string out = svg::Frame(Escape(title), Escape(x_label), "rocks", x, y);
+  for (int b = 0; b < bins; ++b) {
+    const double left = lo + (hi - lo) * b / bins, right = lo + (hi - lo) * (b + 1) / bins;
+    const double h = static_cast<double>(count[static_cast<std::size_t>(b)]);
+    Add(out, "<rect x=\"", svg::F(x(left)), "\" y=\"", svg::F(y(h)), "\" width=\"",
+        svg::F(x(right) - x(left)), "\" height=\"", svg::F(y(0) - y(h)),
+        "\" fill=\"#1f5fbf\" fill-opacity=\"0.75\" stroke=\"white\"/>\n");
+  }
+  const std::string stats = "n = " + std::to_string(finite.size()) +
+                            ", median " + Number(NearestRankPercentile(finite, 50)) + ", 95 % " +
+                            Number(NearestRankPercentile(finite, 95)) + ", largest " +
+                            Number(finite.empty() ? NAN : hi);
+  Add(out, "<text x=\"", svg::F(svg::kWidth - svg::kRight - 6), "\" y=\"", svg::F(svg::kTop + 14),
+      "\" text-anchor=\"end\">", stats, "</text>\n");
+  return out + "</svg>\n";
+}
+
+std::string RunReportHtml(const RunReportInput& input) {
+  const Json summary = Json::parse(input.summary_json);
+  const auto get = [&](const char* key) { return summary.contains(key) ? summary[key] : Json(); };
+  std::string html = "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n";
+  Add(html, "<title>Talus run: ", Cell(get("scene")), "</title>\n<style>\n", kStyle,
+      "\n</style>\n</head>\n<body>\n");
+  Add(html, "<h1>Talus run: ", Cell(get("scene")), "</h1>\n");
+  Add(html, "<p class=\"note\">Talus ", Cell(get("talus_version")), ", inputs hash (FNV-1a 64) ",
+      Cell(get("inputs_hash_fnv1a64")), ". Everything here is also in summary.json, rocks.csv and "
+      "the GeoTIFFs next to this file.</p>\n");
+
+  html += "<h2>What ran</h2>\n";
+  html += KeyValueTable(summary, {"ends", "raised_at_release", "stayed_at_release", "steps",
+                                  "unconverged_steps", "threads", "wall_time_s",
+                                  "trajectories_per_s", "outputs", "blocks", "talus_version",
+                                  "inputs_hash_fnv1a64"});
+  if (summary.contains("rock") && summary["rock"].is_object()) {
+    html += "<h3>Rock</h3>\n";
+    html += KeyValueTable(summary["rock"]);
+  }
+
+  html += "<h2>How the rocks ended</h2>\n<table>\n";
+  const long rocks = get("rocks").is_number() ? get("rocks").get<long>() : 0;
+  const auto count_row = [&](const std::string& label, const Json& value) {
+    const double n = value.is_number() ? value.get<double>() : 0;
+    Add(html, "<tr><th>", label, "</th><td>", Cell(value), "</td><td>",
+        rocks > 0 ? Number(100 * n / rocks, "%.1f") + " %" : "", "</td></tr>\n");
+  };
+  if (summary.contains("ends"))
+    for (const auto& [ending, n] : summary["ends"].items()) count_row(Escape(ending), n);
+  count_row("raised at release", get("raised_at_release"));
+  count_row("stayed at release", get("stayed_at_release"));
+  html += "</table>\n";
+  Add(html, "<p class=\"note\">", Cell(get("steps")), " steps, ", Cell(get("unconverged_steps")),
+      " of them with a contact solve that did not converge.</p>\n");
+
+  // Maps with their legends.
+  std::vector<const ensemble::RasterLayer*> maps;
+  if (input.layers && input.dem) {
+    for (const char* name : {"reach_probability", "energy_max", "speed_max", "jump_height_max"})
+      for (const ensemble::RasterLayer& layer : *input.layers)
+        if (layer.name == name) maps.push_back(&layer);
+    if (maps.empty())
+      if (const ensemble::RasterLayer* layer = QuickLookLayer(*input.layers)) maps.push_back(layer);
+  }
+  if (!maps.empty()) {
+    html += "<h2>Maps</h2>\n";
+    for (const ensemble::RasterLayer* layer : maps) {
+      const std::string png = QuickLookPng(*input.dem, layer, input.paths);
+      Add(html, "<figure><img alt=\"", Escape(layer->name), "\" src=\"data:image/png;base64,",
+          Base64(png), "\"><figcaption>", Escape(LegendOf(*layer).title), " (",
+          Escape(layer->name), ".tif)</figcaption></figure>\n");
+    }
+  }
+
+  // Distributions over the rocks.
+  const RockColumns& r = input.rocks;
+  std::vector<double> energy_kj;
+  for (double e : r.max_kinetic_energy_j) energy_kj.push_back(e / 1000);
+  html += "<h2>Distributions over the rocks</h2>\n<div class=\"plots\">\n";
+  html += HistogramSvg("Runout", "runout (m)", r.runout_m);
+  html += HistogramSvg("Largest kinetic energy", "energy (kJ)", energy_kj);
+  html += HistogramSvg("Largest jump height", "jump height of the centre of mass (m)",
+                       r.max_jump_height_m);
+  html += "</div>\n<table>\n<tr><th></th><th>mean</th><th>median</th><th>90 %</th><th>95 %</th>"
+          "<th>99 %</th><th>largest</th></tr>\n";
+  const auto stats_row = [&](const char* label, const std::vector<double>& values) {
+    Add(html, "<tr><th>", label, "</th><td>", Number(Mean(values)), "</td>");
+    for (double p : {50.0, 90.0, 95.0, 99.0, 100.0})
+      Add(html, "<td>", Number(NearestRankPercentile(values, p)), "</td>");
+    html += "</tr>\n";
+  };
+  stats_row("runout (m)", r.runout_m);
+  stats_row("largest speed (m/s)", r.max_speed_m_s);
+  stats_row("largest kinetic energy (kJ)", energy_kj);
+  stats_row("largest jump height (m)", r.max_jump_height_m);
+  stats_row("travel angle (&deg;)", r.travel_angle_deg);
+  html += "</table>\n<p class=\"note\">Percentiles are nearest-rank, over the rocks (one value per "
+          "rock).</p>\n";
+
+  if (summary.contains("ground")) {
+    html += "<h2>Ground table</h2>\n";
+    html += RowsTable(summary["ground"], "category");
+  }
+  if (summary.contains("solver")) {
+    html += "<h2>Solver options</h2>\n";
+    html += KeyValueTable(summary["solver"]);
+  }
+  if (summary.contains("outputs")) {
+    html += "<h2>Files</h2>\n<p>";
+    html += Cell(summary["outputs"]);
+    html += "</p>\n";
+  }
+  html += "</body>\n</html>\n";
+  return html;
+}
+
+}  // namespace talus::io

@@ -1,0 +1,96 @@
+#include "io/report_html.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <nlohmann/json.hpp>
+
+#include "common/error.hpp"
+#include "io/rocks_csv.hpp"
+#include "test_files.hpp"
+
+namespace talus::io {
+namespace {
+
+// A rocks.csv with the real header and the given runout values (other columns made up).
+std::string RocksCsv(const std::vector<std::string>& runouts) {
+  std::string text = std::string(RocksCsvWriter::Header()) + "\n";
+  int rock = 0;
+  for (const std::string& runout : runouts) {
+    text += std::to_string(rock) + ",0,\"run, " + std::to_string(rock) +
+            "\",1,rest,0,0,0," + runout + ",1,2,3.5,4000,0.5,6,0,\"a \"\"block\"\"\",100,0,0,0,30,hard\n";
+    ++rock;
+  }
+  return text;
+}
+
+TEST(ReportHtml, ReadsTheRockColumnsByNameThroughQuotedFields) {
+  const auto dir = testing::FreshDir("csv");
+  testing::WriteText(dir / "rocks.csv", RocksCsv({"10", "20.5", "30"}));
+  const RockColumns columns = ReadRockColumns((dir / "rocks.csv").string());
+  ASSERT_EQ(columns.runout_m.size(), 3u);
+  EXPECT_DOUBLE_EQ(columns.runout_m[1], 20.5);
+  EXPECT_DOUBLE_EQ(columns.max_kinetic_energy_j[0], 4000);
+  EXPECT_DOUBLE_EQ(columns.max_speed_m_s[2], 3.5);
+  EXPECT_DOUBLE_EQ(columns.max_jump_height_m[0], 0.5);
+  EXPECT_DOUBLE_EQ(columns.travel_angle_deg[0], 30);
+}
+
+TEST(ReportHtml, ABrokenRocksCsvIsAnErrorNamingTheLine) {
+  const auto dir = testing::FreshDir("bad");
+  testing::WriteText(dir / "rocks.csv", RocksCsv({"10", "abc"}));
+  try {
+    ReadRockColumns((dir / "rocks.csv").string());
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("rocks.csv:3: column 'runout_m': 'abc'"),
+              std::string::npos)
+        << e.what();
+  }
+  EXPECT_THROW(ReadRockColumns((dir / "missing.csv").string()), InputError);
+}
+
+TEST(ReportHtml, NearestRankPercentiles) {
+  // Nearest rank: the ceil(p/100 · n)-th smallest value (Hyndman & Fan 1996, definition 1).
+  const std::vector<double> values = {5, 1, 4, 2, 3, 6, 8, 7, 10, 9};
+  EXPECT_EQ(NearestRankPercentile(values, 50), 5);
+  EXPECT_EQ(NearestRankPercentile(values, 95), 10);
+  EXPECT_EQ(NearestRankPercentile(values, 90), 9);
+  EXPECT_EQ(NearestRankPercentile(values, 1), 1);
+  EXPECT_TRUE(std::isnan(NearestRankPercentile({}, 50)));
+  EXPECT_EQ(NearestRankPercentile({NAN, 2}, 100), 2);  // NaN (no value) is left out
+}
+
+TEST(ReportHtml, HistogramCountsEveryValueOnce) {
+  const std::string plot = HistogramSvg("Runout", "runout (m)", {1, 2, 2, 3, 10}, 10);
+  EXPECT_NE(plot.find("<svg"), std::string::npos);
+  EXPECT_NE(plot.find("n = 5, median 2, 95 % 10, largest 10"), std::string::npos) << plot;
+  // Ten bars (one per bin) besides the frame's two rectangles.
+  std::size_t rects = 0;
+  for (std::size_t at = plot.find("<rect"); at != std::string::npos; at = plot.find("<rect", at + 1))
+    ++rects;
+  EXPECT_EQ(rects, 12u);
+}
+
+TEST(ReportHtml, ShowsTheSummaryWithoutTimingsAndEscapesText) {
+  RunReportInput input;
+  input.summary_json = R"({"talus_version": "9.9", "scene": "a<b>.toml", "rocks": 4,
+      "ends": {"rest": 3, "left_domain": 1}, "raised_at_release": 0, "stayed_at_release": 1,
+      "ground": {"hard": {"code": 6, "mu_min": 0.55}}, "solver": {"dt_s": 0.002},
+      "threads": 7, "wall_time_s": 123.456, "trajectories_per_s": 0.0324})";
+  input.rocks.runout_m = {1, 2, 3, 4};
+  const std::string html = RunReportHtml(input);
+  EXPECT_EQ(html.rfind("<!DOCTYPE html>", 0), 0u);
+  EXPECT_NE(html.find("a&lt;b&gt;.toml"), std::string::npos);
+  EXPECT_EQ(html.find("a<b>"), std::string::npos);
+  EXPECT_NE(html.find("75.0 %"), std::string::npos);  // 3 of 4 at rest
+  EXPECT_NE(html.find("<th>hard</th><td>6</td><td>0.55</td>"), std::string::npos);
+  // Nothing that differs between a run and the same run split into parts.
+  EXPECT_EQ(html.find("123.456"), std::string::npos);
+  EXPECT_EQ(html.find("wall_time"), std::string::npos);
+  EXPECT_EQ(html.find("threads"), std::string::npos);
+  EXPECT_EQ(html.find("<script"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace talus::io
