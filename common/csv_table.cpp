@@ -1,5 +1,6 @@
 #include "common/csv_table.hpp"
 
+#include <algorithm>
 #include <cerrno>
 #include <charconv>
 #include <cmath>
@@ -148,6 +149,71 @@ double CsvTable::Number(int row, const std::string& column) const {
 std::optional<double> CsvTable::OptionalNumber(int row, const std::string& column) const {
   if (Empty(row, column)) return std::nullopt;
   return Number(row, column);
+}
+
+namespace {
+
+// Splits one record (RFC 4180 quoting; the record may hold line breaks inside quotes).
+std::vector<std::string> SplitRecord(const std::string& record) {
+  std::vector<std::string> fields(1);
+  bool quoted = false;
+  for (std::size_t k = 0; k < record.size(); ++k) {
+    const char c = record[k];
+    if (quoted && c == '"' && k + 1 < record.size() && record[k + 1] == '"') {
+      fields.back() += '"';
+      ++k;
+    } else if (c == '"') {
+      quoted = !quoted;
+    } else if (c == ',' && !quoted) {
+      fields.emplace_back();
+    } else {
+      fields.back() += c;
+    }
+  }
+  return fields;
+}
+
+}  // namespace
+
+CsvReader::CsvReader(const std::string& path) : path_(path), in_(path, std::ios::binary) {
+  if (!in_) throw InputError(path + ": cannot open (" + std::strerror(errno) + ")");
+  if (!ReadRecord(&header_)) throw InputError(path + ": no header");
+  if (!header_.empty() && header_[0].compare(0, 3, "\xEF\xBB\xBF") == 0)
+    header_[0].erase(0, 3);
+}
+
+std::size_t CsvReader::Column(const std::string& name) const {
+  for (std::size_t c = 0; c < header_.size(); ++c)
+    if (header_[c] == name) return c;
+  throw InputError(path_ + ": no column '" + name + "'");
+}
+
+bool CsvReader::ReadRecord(std::vector<std::string>* fields) {
+  std::string record, text;
+  do {
+    if (!std::getline(in_, text)) {
+      if (in_.bad()) throw InputError(path_ + ": read error");
+      return false;
+    }
+    line_ = next_line_++;
+  } while (text.empty() || text == "\r");
+  record = text;
+  // A quoted field may hold a line break: read on until the quotes balance.
+  while (std::count(record.begin(), record.end(), '"') % 2 == 1 && std::getline(in_, text)) {
+    ++next_line_;
+    record += "\n" + text;
+  }
+  if (!record.empty() && record.back() == '\r') record.pop_back();
+  *fields = SplitRecord(record);
+  return true;
+}
+
+bool CsvReader::Next(std::vector<std::string>* fields) {
+  if (!ReadRecord(fields)) return false;
+  if (fields->size() != header_.size())
+    throw InputError(path_ + ":" + std::to_string(line_) + ": " + std::to_string(fields->size()) +
+                     " fields, the header has " + std::to_string(header_.size()));
+  return true;
 }
 
 }  // namespace talus

@@ -4,6 +4,7 @@
 // RFC 4180 quoting ("a, b" and "" inside quotes); a UTF-8 byte-order mark is skipped; blank lines
 // and lines starting with '#' are skipped.
 
+#include <fstream>
 #include <optional>
 #include <string>
 #include <vector>
@@ -46,6 +47,30 @@ class CsvTable {
   std::vector<std::string> header_;
   std::vector<std::vector<std::string>> cells_;
   std::vector<int> lines_;
+};
+
+// Reads a large CSV file (rocks.csv of a big run) record by record instead of whole, with the same
+// quoting rules; fields are not trimmed.
+class CsvReader {
+ public:
+  // Opens the file and reads the header; throws InputError naming the file.
+  explicit CsvReader(const std::string& path);
+  const std::vector<std::string>& header() const { return header_; }
+  // Index of a header column; throws InputError naming the file and the column when absent.
+  std::size_t Column(const std::string& name) const;
+  // The next record into *fields (as many as the header has); false at the end. Throws InputError
+  // "<path>:<line>: ..." for a record with another number of fields, or a read error.
+  bool Next(std::vector<std::string>* fields);
+  int line() const { return line_; }  // 1-based line where the last record started
+  const std::string& path() const { return path_; }
+
+ private:
+  bool ReadRecord(std::vector<std::string>* fields);
+
+  std::string path_;
+  std::ifstream in_;
+  std::vector<std::string> header_;
+  int line_ = 0, next_line_ = 1;
 };
 
 }  // namespace talus

@@ -6,11 +6,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <limits>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
+#include "common/csv_table.hpp"
 #include "common/error.hpp"
 #include "io/quicklook.hpp"
 #include "io/svg_plot.hpp"
@@ -21,32 +21,6 @@ namespace {
 using Json = nlohmann::ordered_json;
 using svg::Add;
 using svg::Escape;
-
-// Splits one CSV record (RFC 4180 quoting, as rocks.csv writes text fields).
-std::vector<std::string> SplitRecord(const std::string& record) {
-  std::vector<std::string> fields(1);
-  bool quoted = false;
-  for (std::size_t k = 0; k < record.size(); ++k) {
-    const char c = record[k];
-    if (quoted) {
-      if (c == '"' && k + 1 < record.size() && record[k + 1] == '"') {
-        fields.back() += '"';
-        ++k;
-      } else if (c == '"') {
-        quoted = false;
-      } else {
-        fields.back() += c;
-      }
-    } else if (c == '"') {
-      quoted = true;
-    } else if (c == ',') {
-      fields.emplace_back();
-    } else {
-      fields.back() += c;
-    }
-  }
-  return fields;
-}
 
 // A value for a table cell: numbers with up to 6 significant digits, text escaped.
 std::string Cell(const Json& value) {
@@ -124,36 +98,13 @@ figure img{width:520px;max-width:100%;border:1px solid #ccc}figure{max-width:520
 }  // namespace
 
 RockColumns ReadRockColumns(const std::string& rocks_csv) {
-  std::ifstream in(rocks_csv, std::ios::binary);
-  if (!in) throw InputError(rocks_csv + ": cannot be read");
-  std::string header;
-  if (!std::getline(in, header)) throw InputError(rocks_csv + ": no header");
-  const std::vector<std::string> names = SplitRecord(header);
-  const auto column = [&](const char* name) {
-    const auto at = std::find(names.begin(), names.end(), name);
-    if (at == names.end()) throw InputError(rocks_csv + ": no column '" + name + "'");
-    return static_cast<std::size_t>(at - names.begin());
-  };
-  const std::size_t runout = column("runout_m"), energy = column("max_kinetic_energy_j"),
-                    jump = column("max_jump_height_m"), speed = column("max_speed_m_s"),
-                    angle = column("travel_angle_deg");
+  CsvReader in(rocks_csv);
+  const std::size_t runout = in.Column("runout_m"), energy = in.Column("max_kinetic_energy_j"),
+                    jump = in.Column("max_jump_height_m"), speed = in.Column("max_speed_m_s"),
+                    angle = in.Column("travel_angle_deg");
   RockColumns out;
-  std::string record, line;
-  long number = 1;
-  while (std::getline(in, line)) {
-    ++number;
-    record = line;
-    // A quoted field may hold a line break: read on until the quotes balance.
-    while (std::count(record.begin(), record.end(), '"') % 2 == 1 && std::getline(in, line)) {
-      ++number;
-      record += "\n" + line;
-    }
-    if (record.empty()) continue;
-    const std::vector<std::string> fields = SplitRecord(record);
-    if (fields.size() != names.size())
-      throw InputError(rocks_csv + ":" + std::to_string(number) + ": " +
-                       std::to_string(fields.size()) + " fields, the header has " +
-                       std::to_string(names.size()));
+  std::vector<std::string> fields;
+  while (in.Next(&fields)) {
     const auto value = [&](std::size_t c) {
       const std::string& text = fields[c];
       if (text.empty()) return std::numeric_limits<double>::quiet_NaN();
@@ -165,8 +116,8 @@ RockColumns ReadRockColumns(const std::string& rocks_csv) {
         used = 0;
       }
       if (used != text.size())
-        throw InputError(rocks_csv + ":" + std::to_string(number) + ": column '" + names[c] +
-                         "': '" + text + "' is not a number");
+        throw InputError(rocks_csv + ":" + std::to_string(in.line()) + ": column '" +
+                         in.header()[c] + "': '" + text + "' is not a number");
       return v;
     };
     out.runout_m.push_back(value(runout));
@@ -175,7 +126,6 @@ RockColumns ReadRockColumns(const std::string& rocks_csv) {
     out.max_speed_m_s.push_back(value(speed));
     out.travel_angle_deg.push_back(value(angle));
   }
-  if (in.bad()) throw InputError(rocks_csv + ": cannot be read");
   return out;
 }
 
