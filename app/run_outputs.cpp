@@ -10,6 +10,7 @@
 
 #include "app/interrupt.hpp"
 #include "common/error.hpp"
+#include "io/geopackage.hpp"
 #include "io/quicklook.hpp"
 #include "io/raster.hpp"
 #include "io/report_html.hpp"
@@ -85,6 +86,13 @@ std::vector<std::string> WriteSummaryOutputs(const io::SceneFile& scene,
                           io::QuickLookLayer(layers), xy);
     outputs.push_back("quicklook.png");
   }
+  if (scene.output.geopackage) {
+    ThrowIfInterrupted();
+    io::WriteRocksGeoPackage(
+        staging.path("rocks.gpkg"), staging.path("rocks.csv"),
+        scene.output.trajectories ? staging.path("trajectories.h5") : std::string(), scene.crs_wkt);
+    outputs.push_back("rocks.gpkg");
+  }
   if (scene.output.report) outputs.push_back("report.html");
   const std::string summary = io::SummaryJson(scene, report, kVersion, outputs);
   if (scene.output.report) {
@@ -131,7 +139,7 @@ bool QuickLookSample(const ensemble::ReleaseSpec& release, long rock) {
 std::vector<std::string> TalusOutputNames() {
   std::vector<std::string> names = {
       "rocks.csv",    "trajectories.h5",       "summary.json", "quicklook.png", "passages.tif",
-      "deposits.tif", "reach_probability.tif", "partial.json", "partial.bin",  "report.html"};
+      "deposits.tif", "reach_probability.tif", "partial.json", "partial.bin",  "report.html",  "rocks.gpkg"};
   for (const char* quantity : {"speed", "energy", "jump_height"})
     for (const char* statistic : {"max", "mean", "p95"})
       names.push_back(std::string(quantity) + "_" + statistic + ".tif");

@@ -735,6 +735,7 @@ void LoadOutput(const Section& s, OutputSpec& o) {
       s.Checked("trajectory_interval_s", o.trajectory_interval_s, kPositive, "must be > 0");
   o.quicklook = s.Bool("quicklook", o.quicklook);
   o.report = s.Bool("report", o.report);
+  o.geopackage = s.Bool("geopackage", o.geopackage);
   if (const toml::node* node = s.Node("rasters")) {
     const toml::array* array = node->as_array();
     if (!array) s.Fail("rasters", "expected a list of raster names");
@@ -829,7 +830,7 @@ SceneFile LoadScene(const std::string& path) {
                "rest_speed_m_s", "rest_angular_speed_rad_s", "rest_hold_s"}),
       out.scene.options);
   LoadOutput(Section(context, SubTable(context, root, "output"), "output",
-                     {"trajectories", "trajectory_interval_s", "rasters", "quicklook", "report"}),
+                     {"trajectories", "trajectory_interval_s", "rasters", "quicklook", "report", "geopackage"}),
              out.output);
   if (!out.release.blocks.empty() && out.release.runs.empty())
     context.Fail(root.get("blocks"), "blocks",

@@ -20,6 +20,7 @@ struct OutputSpec {
   std::vector<std::string> rasters;
   bool quicklook =
       true;  // quicklook.png: hillshade, reach probability or energy, sample trajectories
+  bool geopackage = false;  // rocks.gpkg: end points and (with trajectories) paths as GIS layers
   bool report = true;  // report.html: one page with what ran, endings, maps and histograms
 
   // The raster request on `grid` (nothing when no raster is listed).

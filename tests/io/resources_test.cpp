@@ -96,6 +96,16 @@ TEST(EstimateResources, CountsEachPartFromTheScene) {
   EXPECT_EQ(Find(bare.memory, "values behind"), nullptr);
   EXPECT_EQ(Find(bare.memory, "quick-look"), nullptr);
   EXPECT_EQ(Find(bare.disk, "trajectories.h5"), nullptr);
+  EXPECT_EQ(Find(bare.disk, "rocks.gpkg"), nullptr);  // off by default
+
+  // rocks.gpkg: a row per rock and, with trajectories, a vertex per sample.
+  std::string gis = kScene;
+  gis.replace(gis.find("trajectories = true"), 19, "trajectories = true\ngeopackage = true");
+  const ResourceEstimate with_gpkg = EstimateResources(Load(gis), 1);
+  const ResourceTerm* gpkg = Find(with_gpkg.disk, "rocks.gpkg");
+  ASSERT_NE(gpkg, nullptr);
+  EXPECT_DOUBLE_EQ(gpkg->bytes, rocks * (700 + 202 * 24));
+  EXPECT_HAS(gpkg->knob, "geopackage = false");
 }
 
 // A run whose estimate exceeds what the machine has is refused with the estimate, what is

@@ -1,0 +1,179 @@
+#include "io/geopackage.hpp"
+
+#include <gdal_priv.h>
+#include <ogr_feature.h>
+#include <ogr_geometry.h>
+#include <ogrsf_frmts.h>
+
+#include <algorithm>
+#include <memory>
+#include <stdexcept>
+#include <vector>
+
+#include "common/atomic_file.hpp"
+#include "common/csv_table.hpp"
+#include "common/error.hpp"
+#include "io/raster.hpp"
+#include "io/trajectory_file.hpp"
+
+namespace talus::io {
+namespace {
+
+constexpr int kFeaturesPerTransaction = 20000;
+
+// The field type of a rocks.csv column: counts and indices as integers, names as text, the rest
+// (coordinates, distances, speeds, energies, masses) as reals.
+OGRFieldType FieldType(const std::string& column) {
+  static const char* const integers[] = {"rock", "release", "seed"};
+  static const char* const texts[] = {"run", "end", "block", "end_ground"};
+  for (const char* name : integers)
+    if (column == name) return OFTInteger64;
+  for (const char* name : texts)
+    if (column == name) return OFTString;
+  return OFTReal;
+}
+
+// Sets GDAL's clock for the GeoPackage's last_change while alive (this thread only).
+class FixedGpkgDate {
+ public:
+  FixedGpkgDate() { CPLSetThreadLocalConfigOption("OGR_CURRENT_DATE", "2000-01-01T00:00:00.000Z"); }
+  ~FixedGpkgDate() { CPLSetThreadLocalConfigOption("OGR_CURRENT_DATE", nullptr); }
+  FixedGpkgDate(const FixedGpkgDate&) = delete;
+  FixedGpkgDate& operator=(const FixedGpkgDate&) = delete;
+};
+
+struct DatasetCloser {
+  void operator()(GDALDataset* dataset) const { GDALClose(dataset); }
+};
+
+class Writer {
+ public:
+  Writer(const std::string& path, const std::string& temp_path, const std::string& crs_wkt)
+      : path_(path) {
+    RegisterGdal();
+    GDALDriver* driver = GetGDALDriverManager()->GetDriverByName("GPKG");
+    if (!driver) throw std::runtime_error("GDAL lacks the GPKG driver: cannot write " + path);
+    dataset_.reset(driver->Create(temp_path.c_str(), 0, 0, 0, GDT_Unknown, nullptr));
+    if (!dataset_) Fail("cannot create");
+    srs_ = std::make_unique<OGRSpatialReference>();
+    srs_->SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+    if (crs_wkt.empty()) {
+      // Local coordinates in metres (the analytic plane): an engineering CRS, so that no GIS
+      // takes them for longitude and latitude (GDAL's default for a layer without CRS).
+      srs_->SetLocalCS("Talus local coordinates (m)");
+      srs_->SetLinearUnits(SRS_UL_METER, 1.0);
+    } else if (srs_->importFromWkt(crs_wkt.c_str()) != OGRERR_NONE) {
+      Fail("cannot read the DEM's CRS");
+    }
+  }
+
+  OGRLayer* Layer(const char* name, OGRwkbGeometryType type) {
+    OGRLayer* layer = dataset_->CreateLayer(name, srs_.get(), type, nullptr);
+    if (!layer) Fail(std::string("cannot create the layer ") + name);
+    return layer;
+  }
+  void Field(OGRLayer* layer, const std::string& name, OGRFieldType type) {
+    OGRFieldDefn field(name.c_str(), type);
+    if (layer->CreateField(&field) != OGRERR_NONE) Fail("cannot create the field " + name);
+  }
+  // Adds a feature inside a transaction that is committed every kFeaturesPerTransaction.
+  void Add(OGRLayer* layer, OGRFeature& feature) {
+    if (pending_ == 0 && dataset_->StartTransaction() != OGRERR_NONE) Fail("cannot write");
+    if (layer->CreateFeature(&feature) != OGRERR_NONE) Fail("cannot write a feature");
+    if (++pending_ == kFeaturesPerTransaction) Flush();
+  }
+  void Flush() {
+    if (pending_ > 0 && dataset_->CommitTransaction() != OGRERR_NONE) Fail("cannot write");
+    pending_ = 0;
+  }
+  void Close() {
+    Flush();
+    CPLErrorReset();
+    GDALClose(dataset_.release());  // GDAL 3.6: no status; a failure leaves its error
+    if (CPLGetLastErrorType() >= CE_Failure) Fail("cannot write");
+  }
+
+ private:
+  [[noreturn]] void Fail(const std::string& what) const {
+    throw std::runtime_error(what + " " + path_ + ": " + CPLGetLastErrorMsg());
+  }
+
+  std::string path_;
+  std::unique_ptr<GDALDataset, DatasetCloser> dataset_;
+  std::unique_ptr<OGRSpatialReference> srs_;
+  int pending_ = 0;
+};
+
+}  // namespace
+
+void WriteRocksGeoPackage(const std::string& path, const std::string& rocks_csv,
+                          const std::string& trajectories_h5, const std::string& crs_wkt) {
+  const FixedGpkgDate fixed_date;
+  AtomicFile file(path);
+  Writer out(path, file.temp_path(), crs_wkt);
+
+  CsvReader rocks(rocks_csv);
+  const std::vector<std::string>& columns = rocks.header();
+  const std::size_t x = rocks.Column("x_end"), y = rocks.Column("y_end"), z = rocks.Column("z_end");
+  const std::size_t rock_column = rocks.Column("rock"), run_column = rocks.Column("run"),
+                    end_column = rocks.Column("end");
+  OGRLayer* ends = out.Layer("end_points", wkbPoint25D);
+  for (const std::string& c : columns) out.Field(ends, c, FieldType(c));
+  std::vector<std::string> fields;
+  const auto number = [&](std::size_t c) {
+    try {
+      std::size_t used = 0;
+      const double v = std::stod(fields[c], &used);
+      if (used == fields[c].size()) return v;
+    } catch (const std::exception&) {
+    }
+    throw InputError(rocks_csv + ":" + std::to_string(rocks.line()) + ": column '" + columns[c] +
+                     "': '" + fields[c] + "' is not a number");
+  };
+  while (rocks.Next(&fields)) {
+    OGRFeature feature(ends->GetLayerDefn());
+    for (std::size_t c = 0; c < columns.size(); ++c) {
+      if (fields[c].empty()) continue;  // null
+      const OGRFieldType type = FieldType(columns[c]);
+      if (type == OFTString)
+        feature.SetField(static_cast<int>(c), fields[c].c_str());
+      else if (type == OFTInteger64)
+        feature.SetField(static_cast<int>(c), static_cast<GIntBig>(std::stoll(fields[c])));
+      else
+        feature.SetField(static_cast<int>(c), number(c));
+    }
+    OGRPoint point(number(x), number(y), number(z));
+    feature.SetGeometry(&point);
+    out.Add(ends, feature);
+  }
+  out.Flush();
+
+  if (!trajectories_h5.empty()) {
+    const TrajectoryReader trajectories(trajectories_h5);
+    OGRLayer* lines = out.Layer("paths", wkbLineString25D);
+    out.Field(lines, "rock", OFTInteger64);
+    out.Field(lines, "run", OFTString);
+    out.Field(lines, "end", OFTString);
+    CsvReader again(rocks_csv);  // a second pass: nothing per rock is kept in memory
+    while (again.Next(&fields)) {
+      const long rock = std::stol(fields[rock_column]);
+      const StoredTrajectory t = trajectories.Read(rock);
+      OGRLineString line;
+      line.setNumPoints(static_cast<int>(t.samples.size()));
+      for (std::size_t k = 0; k < t.samples.size(); ++k) {
+        const Eigen::Vector3d& q = t.samples[k].position_m;
+        line.setPoint(static_cast<int>(k), q.x(), q.y(), q.z());
+      }
+      OGRFeature feature(lines->GetLayerDefn());
+      feature.SetField(0, static_cast<GIntBig>(rock));
+      feature.SetField(1, fields[run_column].c_str());
+      feature.SetField(2, fields[end_column].c_str());
+      feature.SetGeometry(&line);
+      out.Add(lines, feature);
+    }
+  }
+  out.Close();
+  file.Commit();
+}
+
+}  // namespace talus::io

@@ -1,0 +1,19 @@
+#pragma once
+// rocks.gpkg (docs/scenes.md): the rocks of a run as GIS layers QGIS opens directly, in the DEM's
+// CRS: `end_points` (one 3-D point per rock at its end, with every column of rocks.csv as a field)
+// and, when trajectories.h5 was written, `paths` (one 3-D line per rock through its trajectory
+// samples, with the rock, its run and how it ended). Built from rocks.csv and trajectories.h5 after
+// they are complete, so a run split into parts gives the same file; the GeoPackage's timestamps are
+// fixed (2000-01-01T00:00:00Z), so the same rocks give the same bytes.
+
+#include <string>
+
+namespace talus::io {
+
+// Writes the GeoPackage atomically. `trajectories_h5` empty: no `paths` layer. `crs_wkt` empty: local
+// coordinates in metres (the analytic plane), an engineering CRS. Throws std::runtime_error naming the file and the reason, and
+// InputError for a rocks.csv it cannot read.
+void WriteRocksGeoPackage(const std::string& path, const std::string& rocks_csv,
+                          const std::string& trajectories_h5, const std::string& crs_wkt);
+
+}  // namespace talus::io

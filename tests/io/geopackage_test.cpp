@@ -1,0 +1,137 @@
+#include "io/geopackage.hpp"
+
+#include <gdal_priv.h>
+#include <gtest/gtest.h>
+#include <ogrsf_frmts.h>
+
+#include <algorithm>
+#include <fstream>
+#include <iterator>
+
+#include "common/error.hpp"
+#include "io/rocks_csv.hpp"
+#include "io/trajectory_file.hpp"
+#include "solver/shapes.hpp"
+#include "test_files.hpp"
+
+namespace talus::io {
+namespace {
+
+// rocks.csv with the real header: rock k ends at (100 + k, 200 + k, 300 + k).
+std::string RocksCsv(int rocks) {
+  std::string text = std::string(RocksCsvWriter::Header()) + "\n";
+  for (int k = 0; k < rocks; ++k) {
+    const std::string c = std::to_string(k);
+    text += c + ",0,\"run, " + c + "\",7," + (k == 0 ? "rest" : "left_domain") + ",10" + c +
+            ",20" + c + ",30" + c + ",12.5,13,2,3.5,4000,0.5,6,0,,100,0,0,0,30,hard\n";
+  }
+  return text;
+}
+
+struct Dataset {
+  explicit Dataset(const std::string& path)
+      : d(static_cast<GDALDataset*>(GDALOpenEx(path.c_str(), GDAL_OF_VECTOR, nullptr, nullptr,
+                                               nullptr))) {}
+  ~Dataset() {
+    if (d) GDALClose(d);
+  }
+  GDALDataset* d;
+};
+
+TEST(RocksGeoPackage, EndPointsWithEveryColumnAndPathsInTheDemsCrs) {
+  const auto dir = testing::FreshDir("gpkg");
+  testing::WriteText(dir / "rocks.csv", RocksCsv(3));
+  {
+    TrajectoryWriter writer((dir / "t.h5").string(), MakeRockShape(MakeBox(1, 1, 1), 2000));
+    for (long rock = 0; rock < 3; ++rock) {
+      StoredTrajectory t;
+      t.mass_kg = 2000;
+      for (int k = 0; k <= rock + 1; ++k) {
+        ensemble::TrajectorySample s;
+        s.position_m = Eigen::Vector3d(k, 10.0 * rock, -k);
+        s.orientation = Eigen::Quaterniond::Identity();
+        s.velocity_m_s.setZero();
+        s.angular_velocity_rad_s.setZero();
+        t.samples.push_back(s);
+      }
+      writer.Write(rock, t);
+    }
+    writer.Commit();
+  }
+  const std::string path = (dir / "rocks.gpkg").string();
+  WriteRocksGeoPackage(path, (dir / "rocks.csv").string(), (dir / "t.h5").string(),
+                       testing::Wkt(2056));
+  RegisterGdal();
+  Dataset gpkg(path);
+  ASSERT_NE(gpkg.d, nullptr);
+  OGRLayer* ends = gpkg.d->GetLayerByName("end_points");
+  ASSERT_NE(ends, nullptr);
+  EXPECT_EQ(ends->GetFeatureCount(), 3);
+  ASSERT_NE(ends->GetSpatialRef(), nullptr);
+  EXPECT_STREQ(ends->GetSpatialRef()->GetAuthorityCode(nullptr), "2056");
+  // One field per column of rocks.csv.
+  const std::string header = RocksCsvWriter::Header();
+  EXPECT_EQ(ends->GetLayerDefn()->GetFieldCount(),
+            static_cast<int>(std::count(header.begin(), header.end(), ',') + 1));
+  ends->ResetReading();
+  std::unique_ptr<OGRFeature> second;
+  for (int k = 0; k < 2; ++k) second.reset(ends->GetNextFeature());
+  ASSERT_NE(second, nullptr);
+  const auto* point = second->GetGeometryRef()->toPoint();
+  EXPECT_EQ(point->getX(), 101);
+  EXPECT_EQ(point->getY(), 201);
+  EXPECT_EQ(point->getZ(), 301);
+  EXPECT_EQ(second->GetFieldAsInteger64("rock"), 1);
+  EXPECT_STREQ(second->GetFieldAsString("run"), "run, 1");
+  EXPECT_STREQ(second->GetFieldAsString("end"), "left_domain");
+  EXPECT_DOUBLE_EQ(second->GetFieldAsDouble("max_kinetic_energy_j"), 4000);
+  EXPECT_TRUE(second->IsFieldNull(second->GetFieldIndex("block")));  // empty: null
+
+  OGRLayer* paths = gpkg.d->GetLayerByName("paths");
+  ASSERT_NE(paths, nullptr);
+  EXPECT_EQ(paths->GetFeatureCount(), 3);
+  paths->ResetReading();
+  std::unique_ptr<OGRFeature> line;
+  for (int k = 0; k < 3; ++k) line.reset(paths->GetNextFeature());
+  const auto* string = line->GetGeometryRef()->toLineString();
+  ASSERT_EQ(string->getNumPoints(), 4);  // rock 2: samples k = 0 .. 3
+  EXPECT_EQ(string->getX(3), 3);
+  EXPECT_EQ(string->getY(3), 20);
+  EXPECT_EQ(string->getZ(3), -3);
+  EXPECT_EQ(line->GetFieldAsInteger64("rock"), 2);
+}
+
+TEST(RocksGeoPackage, SameRocksSameBytesAndLocalMetresForThePlane) {
+  const auto dir = testing::FreshDir("bytes");
+  testing::WriteText(dir / "rocks.csv", RocksCsv(4));
+  const std::string a = (dir / "a.gpkg").string(), b = (dir / "b.gpkg").string();
+  WriteRocksGeoPackage(a, (dir / "rocks.csv").string(), "", "");
+  WriteRocksGeoPackage(b, (dir / "rocks.csv").string(), "", "");
+  std::ifstream fa(a, std::ios::binary), fb(b, std::ios::binary);
+  const std::string bytes_a((std::istreambuf_iterator<char>(fa)), {});
+  const std::string bytes_b((std::istreambuf_iterator<char>(fb)), {});
+  EXPECT_FALSE(bytes_a.empty());
+  EXPECT_EQ(bytes_a, bytes_b);
+  Dataset gpkg(a);
+  ASSERT_NE(gpkg.d, nullptr);
+  EXPECT_EQ(gpkg.d->GetLayerByName("paths"), nullptr);  // no trajectories: no paths
+  // Local metres: an engineering CRS, not taken for longitude and latitude.
+  const OGRSpatialReference* srs = gpkg.d->GetLayerByName("end_points")->GetSpatialRef();
+  ASSERT_NE(srs, nullptr);
+  EXPECT_TRUE(srs->IsLocal());
+  EXPECT_FALSE(srs->IsGeographic());
+  EXPECT_EQ(srs->GetLinearUnits(nullptr), 1.0);
+}
+
+TEST(RocksGeoPackage, ABadRocksCsvIsAnErrorAndLeavesNoFile) {
+  const auto dir = testing::FreshDir("bad");
+  std::string text = RocksCsv(2);
+  text.replace(text.rfind(",101,"), 5, ",1o1,");
+  testing::WriteText(dir / "rocks.csv", text);
+  const std::string path = (dir / "rocks.gpkg").string();
+  EXPECT_THROW(WriteRocksGeoPackage(path, (dir / "rocks.csv").string(), "", ""), InputError);
+  EXPECT_FALSE(std::filesystem::exists(path));
+}
+
+}  // namespace
+}  // namespace talus::io
