@@ -10,9 +10,13 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <functional>
 #include <filesystem>
 #include <iostream>
 #include <limits>
@@ -22,6 +26,8 @@
 
 #include "app/commands.hpp"
 #include "app/interrupt.hpp"
+#include "app/mpi_session.hpp"
+#include "app/simulate.hpp"
 #include "calibration/holdout.hpp"
 #include "calibration/least_squares.hpp"
 #include "calibration/objective.hpp"
@@ -80,9 +86,31 @@ std::string Join(const std::vector<std::string>& items) {
   return out;
 }
 
-int RunCalibrate(const CalibrateArgs& args) {
+// The processes a calibration runs on: this one alone, or the ranks of an MPI run. Under MPI every
+// rank runs the same optimiser; each evaluation's rocks are divided among the ranks and their
+// samples joined in rock order on every rank (calibration::EnsembleRunner), so every rank computes
+// the same objective, bit for bit, and takes the same steps. Rank 0 alone prints and writes.
+struct Processes {
+  int rank = 0, size = 1;
+  // Agrees on how a step went (every rank calls it at the same steps): the exit code of the first
+  // rank that failed, on every rank, with its message printed once. Empty: one process, which
+  // prints its own message.
+  std::function<int(int code, const std::string& message)> agree;
+  calibration::EnsembleRunner runner;  // empty: the rocks run here
+  std::function<std::string(const std::string&)> broadcast;  // rank 0's text on every rank
+  bool root() const { return rank == 0; }
+  bool mpi() const { return static_cast<bool>(agree); }
+  int Step(int code, const std::string& message) const {
+    if (agree) return agree(code, message);
+    if (code != 0) std::cerr << "talus calibrate: " << message << "\n";
+    return code;
+  }
+};
+
+int RunCalibrate(const CalibrateArgs& args, const Processes& processes) {
   namespace fs = std::filesystem;
   const auto t0 = std::chrono::steady_clock::now();
+  const bool root = processes.root();
   io::CalibrationFile file;
   std::unique_ptr<calibration::Objective> objective;
   calibration::ObjectiveOptions objective_options;
@@ -91,11 +119,14 @@ int RunCalibrate(const CalibrateArgs& args) {
   std::vector<std::vector<std::string>> folds;
   io::CalibrationCheckpoint checkpoint;
   const std::string checkpoint_path = (fs::path(args.out) / kCheckpoint).string();
+  int code = kExitOk;
+  std::string message;
   try {
     file = io::LoadCalibration(args.file);
     objective_options = file.objective;
     objective_options.threads = args.threads;
     objective_options.progress = [](long, long) { ThrowIfInterrupted(); };
+    objective_options.run_ensemble = processes.runner;
     const io::EventFile& event = file.event;
     holdout = HoldoutRuns(args.holdout, event.scene.release, file.optimizer.seed);
     fit = calibration::SelectRuns(event.scene.release, event.observations,
@@ -126,25 +157,42 @@ int RunCalibrate(const CalibrateArgs& args) {
                        "--resume, or remove it");
     }
   } catch (const InputError& e) {
-    std::cerr << "talus calibrate: " << e.what() << "\n";
-    return kExitBadInput;
+    code = kExitBadInput;
+    message = e.what();
   } catch (const std::exception& e) {
-    std::cerr << "talus calibrate: cannot load " << args.file << ": " << e.what() << "\n";
-    return kExitRunFailed;
+    code = kExitRunFailed;
+    message = "cannot load " + args.file + ": " + e.what();
   }
-  if (const std::string why = PrepareOutputDirectory(args.out); !why.empty()) {
-    std::cerr << "talus calibrate: " << why << "\n";
-    return kExitBadInput;
+  if (const int failed = processes.Step(code, message)) return failed;
+  if (processes.mpi()) {
+    // Every rank must run the same calibration as rank 0 (same files, options and splits).
+    const std::string identity = "calibration " + fs::absolute(args.file).lexically_normal().string() +
+                                 " (inputs hash " + file.inputs_hash + "), --holdout '" +
+                                 args.holdout + "', --folds " + std::to_string(args.folds) +
+                                 ", --out " + fs::absolute(args.out).lexically_normal().string();
+    if (const std::string of_root = processes.broadcast(identity); of_root != identity) {
+      code = kExitBadInput;
+      message = "started with another calibration than rank 0: " + identity + " instead of " +
+                of_root;
+    }
   }
+  if (const int failed = processes.Step(code, message)) return failed;
+  if (root) {
+    message = PrepareOutputDirectory(args.out);
+    code = message.empty() ? kExitOk : kExitBadInput;
+  }
+  if (const int failed = processes.Step(code, message)) return failed;
   const InterruptScope interrupts;
   std::signal(SIGXFSZ, SIG_IGN);
-  RemoveStaleTemporaries(args.out);
+  if (root) RemoveStaleTemporaries(args.out);
 
   const io::EventFile& event = file.event;
   const ensemble::ReleaseSpec& release = objective->release();
-  std::printf("Calibration %s: %d parameters, %zu observations of %ld runs x %ld rocks, %s\n",
+  std::printf("Calibration %s: %d parameters, %zu observations of %ld runs x %ld rocks, %s%s\n",
               args.file.c_str(), objective->dimension(), fit.observations.size(),
-              release.release_count(), release.rocks_per_release, file.optimizer.algorithm.c_str());
+              release.release_count(), release.rocks_per_release, file.optimizer.algorithm.c_str(),
+              processes.mpi() ? (", " + std::to_string(processes.size) + " MPI ranks").c_str()
+                              : "");
   if (!holdout.empty())
     std::printf("Holding out %zu runs: %s\n", holdout.size(), Join(holdout).c_str());
   if (!checkpoint.stages.empty()) std::printf("Resuming from %s\n", checkpoint_path.c_str());
@@ -158,9 +206,10 @@ int RunCalibrate(const CalibrateArgs& args) {
       std::vector<calibration::Evaluation>& kept = checkpoint.stages[stage];
       if (index >= static_cast<int>(kept.size())) {
         kept.push_back(e);
-        WriteFileAtomically(checkpoint_path, io::CheckpointJson(checkpoint));
+        if (root) WriteFileAtomically(checkpoint_path, io::CheckpointJson(checkpoint));
       }
-      ThrowIfInterrupted();
+      // Under MPI the ranks stop together, inside an evaluation (the runner agrees on it).
+      if (!processes.mpi()) ThrowIfInterrupted();
       std::printf("%s  %s evaluation %4d  objective %-12.6g %s%s", terminal ? "\r" : "",
                   stage.c_str(), index, e.value, e.feasible ? "" : "(infeasible)",
                   terminal ? "   " : "\n");
@@ -181,10 +230,7 @@ int RunCalibrate(const CalibrateArgs& args) {
     run.version = kVersion;
     run.summary = optimise(*objective, "fit");
     std::printf("%s", run.summary.FullReport().c_str());
-    if (!run.summary.IsSolutionUsable()) {
-      std::cerr << "talus calibrate: " << run.summary.message << " (no output written)\n";
-      return kExitRunFailed;
-    }
+    if (!run.summary.IsSolutionUsable()) throw std::runtime_error(run.summary.message);
     const calibration::Evaluation& best = run.summary.best;
     if (file.roughness) {
       std::printf("Measuring the roughness and the profiles at the optimum...\n");
@@ -222,16 +268,18 @@ int RunCalibrate(const CalibrateArgs& args) {
     std::fflush(stdout);
     const calibration::HeldOutScores before =
         calibration::ScoreRuns(event.scene.scene, fit, objective->GroundOf(run.summary.initial.u),
-                               nullptr, args.threads, objective->needs_episodes());
-    const calibration::HeldOutScores after = calibration::ScoreRuns(
-        event.scene.scene, fit, fitted, nullptr, args.threads, objective->needs_episodes());
+                               nullptr, args.threads, objective->needs_episodes(), processes.runner);
+    const calibration::HeldOutScores after =
+        calibration::ScoreRuns(event.scene.scene, fit, fitted, nullptr, args.threads,
+                               objective->needs_episodes(), processes.runner);
     if (!holdout.empty()) {
       std::printf("Scoring the %zu held-out runs...\n", holdout.size());
       std::fflush(stdout);
       run.holdout = calibration::ScoreRuns(
           event.scene.scene,
           calibration::SelectRuns(event.scene.release, event.observations, holdout, false), fitted,
-          reference ? &*reference : nullptr, args.threads, objective->needs_episodes());
+          reference ? &*reference : nullptr, args.threads, objective->needs_episodes(),
+          processes.runner);
       std::printf("%s", io::HeldOutReport(*run.holdout).c_str());
     }
     for (std::size_t f = 0; f < folds.size(); ++f) {
@@ -246,16 +294,13 @@ int RunCalibrate(const CalibrateArgs& args) {
       io::FoldRun fold;
       fold.summary = optimise(fold_objective, stage);
       std::printf("%s\n", fold.summary.BriefReport().c_str());
-      if (!fold.summary.IsSolutionUsable()) {
-        std::cerr << "talus calibrate: fold " << f + 1 << ": " << fold.summary.message
-                  << " (no output written)\n";
-        return kExitRunFailed;
-      }
+      if (!fold.summary.IsSolutionUsable())
+        throw std::runtime_error("fold " + std::to_string(f + 1) + ": " + fold.summary.message);
       fold.scores = calibration::ScoreRuns(
           event.scene.scene,
           calibration::SelectRuns(fit.release, fit.observations, folds[f], false),
           fold_objective.GroundOf(fold.summary.best.u), reference ? &*reference : nullptr,
-          args.threads, objective->needs_episodes());
+          args.threads, objective->needs_episodes(), processes.runner);
       run.folds.push_back(std::move(fold));
     }
     if (!run.folds.empty()) {
@@ -269,51 +314,144 @@ int RunCalibrate(const CalibrateArgs& args) {
     run.threads = args.threads;
     run.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
-    ThrowIfInterrupted();
-    staging.emplace(args.out);
-    WriteFileAtomically(staging->path("ground_table.toml"),
-                        io::GroundTableToml(file, *objective, fitted));
-    WriteFileAtomically(staging->path("ground_table.csv"), io::GroundTableCsv(*objective, fitted));
-    WriteFileAtomically(staging->path("history.csv"), io::HistoryCsv(*objective, run.summary));
-    std::vector<std::string> outputs = {"ground_table.toml", "ground_table.csv", "history.csv",
-                                        "convergence.svg"};
-    WriteFileAtomically(staging->path("convergence.svg"), io::ConvergenceSvg(run.summary));
-    for (const std::string& kind : objective->kinds()) {
-      if (kind == "deposit") continue;
-      const std::string name = "observed_vs_simulated_" + kind + ".svg";
-      WriteFileAtomically(staging->path(name),
-                          io::ObservedSimulatedSvg(kind, before.observations, after.observations));
-      outputs.push_back(name);
+    // Rank 0 writes; the other ranks only agree on how it went (below).
+    if (root) {
+      ThrowIfInterrupted();
+      staging.emplace(args.out);
+      WriteFileAtomically(staging->path("ground_table.toml"),
+                          io::GroundTableToml(file, *objective, fitted));
+      WriteFileAtomically(staging->path("ground_table.csv"), io::GroundTableCsv(*objective, fitted));
+      WriteFileAtomically(staging->path("history.csv"), io::HistoryCsv(*objective, run.summary));
+      std::vector<std::string> outputs = {"ground_table.toml", "ground_table.csv", "history.csv",
+                                          "convergence.svg"};
+      WriteFileAtomically(staging->path("convergence.svg"), io::ConvergenceSvg(run.summary));
+      for (const std::string& kind : objective->kinds()) {
+        if (kind == "deposit") continue;
+        const std::string name = "observed_vs_simulated_" + kind + ".svg";
+        WriteFileAtomically(staging->path(name),
+                            io::ObservedSimulatedSvg(kind, before.observations, after.observations));
+        outputs.push_back(name);
+      }
+      outputs.push_back("calibration.json");
+      WriteFileAtomically(staging->path("calibration.json"),
+                          io::CalibrationJson(file, *objective, run));
+      ThrowIfInterrupted();
+      staging->Commit(outputs);  // calibration.json last
+      // The run is complete: its checkpoint is no longer needed, unless a budget ended a fit
+      // (a later --resume with a larger budget goes on from it).
+      bool budget = run.summary.termination == calibration::Termination::kMaxEvaluations ||
+                    run.summary.termination == calibration::Termination::kMaxTime;
+      for (const io::FoldRun& f : run.folds)
+        budget = budget || f.summary.termination == calibration::Termination::kMaxEvaluations ||
+                 f.summary.termination == calibration::Termination::kMaxTime;
+      if (!budget) fs::remove(checkpoint_path);
+      std::printf("Wrote %zu files to %s in %.1f s%s\n", outputs.size(), args.out.c_str(),
+                  run.wall_time_s,
+                  budget ? " (a budget ended a fit: checkpoint.json kept for --resume)" : "");
     }
-    outputs.push_back("calibration.json");
-    WriteFileAtomically(staging->path("calibration.json"),
-                        io::CalibrationJson(file, *objective, run));
-    ThrowIfInterrupted();
-    staging->Commit(outputs);  // calibration.json last
-    // The run is complete: its checkpoint is no longer needed, unless a budget ended a fit
-    // (a later --resume with a larger budget goes on from it).
-    bool budget = run.summary.termination == calibration::Termination::kMaxEvaluations ||
-                  run.summary.termination == calibration::Termination::kMaxTime;
-    for (const io::FoldRun& f : run.folds)
-      budget = budget || f.summary.termination == calibration::Termination::kMaxEvaluations ||
-               f.summary.termination == calibration::Termination::kMaxTime;
-    if (!budget) fs::remove(checkpoint_path);
-    std::printf("Wrote %zu files to %s in %.1f s%s\n", outputs.size(), args.out.c_str(),
-                run.wall_time_s,
-                budget ? " (a budget ended a fit: checkpoint.json kept for --resume)" : "");
-    return kExitOk;
   } catch (const Interrupted& e) {
     staging.reset();
-    std::cerr << "\ntalus calibrate: " << e.what() << "; no output written, " << args.out
-              << " is as it was before the run but for " << kCheckpoint
-              << " (resume with --resume)\n";
-    return ExitCodeForSignal(e.signal());
+    code = ExitCodeForSignal(e.signal());
+    message = std::string(e.what()) + "; no output written, " + args.out +
+              " is as it was before the run but for " + kCheckpoint + " (resume with --resume)";
+    if (root) std::printf("\n");
   } catch (const std::exception& e) {
-    const std::string message = staging ? staging->Describe(e.what()) : e.what();
+    code = kExitRunFailed;
+    message = (staging ? staging->Describe(e.what()) : std::string(e.what())) +
+              " (no output written)";
     staging.reset();
-    std::cerr << "talus calibrate: " << message << " (no output written)\n";
-    return kExitRunFailed;
   }
+  return processes.Step(code, message);
+}
+
+#if TALUS_HAVE_MPI
+
+// Counts of an ensemble report as bytes, and back.
+std::string CountsBytes(const ensemble::EnsembleReport& r) {
+  const std::array<long, 9> counts = {r.rocks,  r.by_end[0], r.by_end[1],
+                                      r.by_end[2], r.by_end[3], r.raised,
+                                      r.stayed_at_release, r.steps, r.unconverged_steps};
+  return std::string(reinterpret_cast<const char*>(counts.data()), sizeof counts);
+}
+ensemble::EnsembleReport ReportOfCounts(const std::string& bytes) {
+  std::array<long, 9> c{};
+  std::memcpy(c.data(), bytes.data(), sizeof c);
+  ensemble::EnsembleReport r;
+  r.rocks = c[0];
+  r.by_end = {c[1], c[2], c[3], c[4]};
+  r.raised = c[5];
+  r.stayed_at_release = c[6];
+  r.steps = c[7];
+  r.unconverged_steps = c[8];
+  return r;
+}
+
+// An evaluation's rocks divided among the ranks: rank r runs [r N / R, (r + 1) N / R) with its
+// threads, and every rank receives every rank's samples, joined in rock order. The ranks agree on
+// failures inside: an interrupt or an error on any rank is thrown on every rank.
+calibration::EnsembleRunner RanksRunner(const MpiSession& mpi) {
+  return [&mpi](const Scene& scene, const ensemble::ReleaseSpec& release,
+                const ensemble::EnsembleOptions& options, fieldobs::EnsembleSamples* samples) {
+    const long total = release.total_rocks();
+    ensemble::EnsembleOptions mine = options;
+    mine.first_rock = total * mpi.rank() / mpi.size();
+    mine.end_rock = total * (mpi.rank() + 1) / mpi.size();
+    std::string payload;
+    ensemble::EnsembleReport report;
+    try {
+      fieldobs::EnsembleSamples part(release);
+      report = ensemble::RunEnsemble(scene, release, mine, &part);
+      payload = "0" + CountsBytes(report) + part.Serialize();
+    } catch (const Interrupted& e) {
+      payload = "I" + std::to_string(e.signal());
+    } catch (const std::exception& e) {
+      payload = std::string("E") + e.what();
+    }
+    const std::vector<std::string> parts = AllGatherText(mpi, payload);
+    for (const std::string& p : parts)
+      if (p[0] == 'I') throw Interrupted(std::stoi(p.substr(1)));
+    for (std::size_t r = 0; r < parts.size(); ++r)
+      if (parts[r][0] == 'E')
+        throw std::runtime_error("rank " + std::to_string(r) + ": " + parts[r].substr(1));
+    ensemble::EnsembleReport all;
+    const std::size_t counts = CountsBytes(all).size();
+    for (const std::string& p : parts) {
+      all.AddCounts(ReportOfCounts(p.substr(1, counts)));
+      samples->Append(p.substr(1 + counts));
+    }
+    all.threads = report.threads;
+    all.wall_time_s = report.wall_time_s;
+    return all;
+  };
+}
+
+#endif
+
+// One process, or every rank of an MPI launch (mpirun / srun).
+int RunCalibrateOnProcesses(const CalibrateArgs& args) {
+  if (LaunchedRanks() <= 1) return RunCalibrate(args, Processes{});
+#if !TALUS_HAVE_MPI
+  const char* rank = std::getenv("OMPI_COMM_WORLD_RANK");
+  if (!rank || std::atoi(rank) == 0)
+    std::cerr << "talus calibrate: started as " << LaunchedRanks()
+              << " MPI processes, but this talus was built without MPI (configure with "
+                 "-DTALUS_WITH_MPI=ON, or run one process)\n";
+  return kExitBadInput;
+#else
+  const MpiSession mpi;
+  Processes processes;
+  processes.rank = mpi.rank();
+  processes.size = mpi.size();
+  processes.agree = [&mpi](int code, const std::string& message) {
+    return Agree(mpi, code, message, "talus calibrate");
+  };
+  processes.runner = RanksRunner(mpi);
+  processes.broadcast = [&mpi](const std::string& text) { return BroadcastText(mpi, text); };
+  // Rank 0 tells the story; the others would tell it again.
+  if (mpi.rank() != 0 && !std::freopen("/dev/null", "w", stdout))
+    std::cerr << "talus calibrate: rank " << mpi.rank() << " cannot silence its output\n";
+  return RunCalibrate(args, processes);
+#endif
 }
 
 }  // namespace
@@ -336,7 +474,7 @@ Runner AddCalibrateCommand(CLI::App& app) {
       ->check(IntegerRange(2, std::numeric_limits<int>::max()));
   cmd->add_flag("--resume", args->resume,
                 "Go on from the checkpoint an interrupted calibration left in --out");
-  return [cmd, args]() { return *cmd ? RunCalibrate(*args) : -1; };
+  return [cmd, args]() { return *cmd ? RunCalibrateOnProcesses(*args) : -1; };
 }
 
 }  // namespace talus::app

@@ -17,6 +17,7 @@
 
 #include "app/commands.hpp"
 #include "app/interrupt.hpp"
+#include "app/mpi_session.hpp"
 #include "app/run_outputs.hpp"
 #include "app/simulate.hpp"
 #include "common/error.hpp"
@@ -52,110 +53,6 @@ int RunSimulateOnRanks(const SimulateArgs&) {
 namespace {
 
 namespace fs = std::filesystem;
-
-// MPI for the length of a run: initialised, and finalised on every way out.
-class MpiSession {
- public:
-  MpiSession() {
-    MPI_Init(nullptr, nullptr);
-    MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
-    MPI_Comm_size(MPI_COMM_WORLD, &size_);
-  }
-  ~MpiSession() { MPI_Finalize(); }
-  MpiSession(const MpiSession&) = delete;
-  MpiSession& operator=(const MpiSession&) = delete;
-  int rank() const { return rank_; }
-  int size() const { return size_; }
-
- private:
-  int rank_ = 0, size_ = 1;
-};
-
-// Waits for a non-blocking operation without keeping a core busy: a rank that is done waits on a
-// node where other ranks (or other jobs) still work, and a blocking MPI call would spin.
-void Wait(MPI_Request request) {
-  int done = 0;
-  MPI_Test(&request, &done, MPI_STATUS_IGNORE);
-  while (!done) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(2));
-    MPI_Test(&request, &done, MPI_STATUS_IGNORE);
-  }
-}
-
-void Gather(const void* mine, int count, MPI_Datatype type, void* all) {
-  MPI_Request request;
-  MPI_Igather(mine, count, type, all, count, type, 0, MPI_COMM_WORLD, &request);
-  Wait(request);
-}
-
-void Broadcast(void* data, int count, MPI_Datatype type) {
-  MPI_Request request;
-  MPI_Ibcast(data, count, type, 0, MPI_COMM_WORLD, &request);
-  Wait(request);
-}
-
-void Send(const void* data, int count, MPI_Datatype type) {
-  MPI_Request request;
-  MPI_Isend(data, count, type, 0, 0, MPI_COMM_WORLD, &request);
-  Wait(request);
-}
-
-void Receive(void* data, int count, MPI_Datatype type, int from) {
-  MPI_Request request;
-  MPI_Irecv(data, count, type, from, 0, MPI_COMM_WORLD, &request);
-  Wait(request);
-}
-
-// Every rank's text, on rank 0 (empty elsewhere).
-std::vector<std::string> GatherText(const MpiSession& mpi, const std::string& mine) {
-  const int length = static_cast<int>(mine.size());
-  std::vector<int> lengths(static_cast<std::size_t>(mpi.size())), offsets(lengths.size());
-  Gather(&length, 1, MPI_INT, lengths.data());
-  int total = 0;
-  for (std::size_t r = 0; r < lengths.size(); ++r) {
-    offsets[r] = total;
-    total += lengths[r];
-  }
-  std::string all(mpi.rank() == 0 ? static_cast<std::size_t>(total) : 0, '\0');
-  MPI_Request request;
-  MPI_Igatherv(mine.data(), length, MPI_CHAR, all.data(), lengths.data(), offsets.data(), MPI_CHAR,
-               0, MPI_COMM_WORLD, &request);
-  Wait(request);
-  std::vector<std::string> texts;
-  if (mpi.rank() == 0)
-    for (std::size_t r = 0; r < lengths.size(); ++r)
-      texts.push_back(
-          all.substr(static_cast<std::size_t>(offsets[r]), static_cast<std::size_t>(lengths[r])));
-  return texts;
-}
-
-// Rank 0's text on every rank.
-std::string BroadcastText(const MpiSession& mpi, std::string text) {
-  int length = static_cast<int>(text.size());
-  Broadcast(&length, 1, MPI_INT);
-  if (mpi.rank() != 0) text.assign(static_cast<std::size_t>(length), '\0');
-  Broadcast(text.data(), length, MPI_CHAR);
-  return text;
-}
-
-// The ranks agree on how a step went: the exit code of the first rank that failed (0 when none
-// did), the same on every rank; rank 0 prints that rank's message.
-int Agree(const MpiSession& mpi, int code, const std::string& message) {
-  std::vector<int> codes(static_cast<std::size_t>(mpi.size()));
-  Gather(&code, 1, MPI_INT, codes.data());
-  const std::vector<std::string> messages = GatherText(mpi, code != 0 ? message : "");
-  int agreed = 0;
-  if (mpi.rank() == 0) {
-    for (std::size_t r = 0; r < codes.size() && agreed == 0; ++r) {
-      if (codes[r] == 0) continue;
-      agreed = codes[r];
-      std::cerr << "talus simulate: " << (r > 0 ? "rank " + std::to_string(r) + ": " : "")
-                << messages[r] << "\n";
-    }
-  }
-  Broadcast(&agreed, 1, MPI_INT);
-  return agreed;
-}
 
 constexpr std::size_t kChunk = std::size_t{1} << 26;  // bytes per message (64 MiB)
 
@@ -248,7 +145,7 @@ int RunSimulateOnRanks(const SimulateArgs& args) {
         "--rock-range is for runs of one process (e.g. a job array); under mpirun the ranks "
         "share all rocks";
   }
-  if (const int failed = Agree(mpi, code, message)) return failed;
+  if (const int failed = Agree(mpi, code, message, "talus simulate")) return failed;
   const std::string identity = EnsembleIdentity(args, scene);
   if (const std::string root_identity = BroadcastText(mpi, identity); identity != root_identity) {
     code = kExitBadInput;
@@ -259,7 +156,7 @@ int RunSimulateOnRanks(const SimulateArgs& args) {
     message = PrepareOutputDirectory(args.out);
     code = message.empty() ? kExitOk : kExitBadInput;
   }
-  if (const int failed = Agree(mpi, code, message)) return failed;
+  if (const int failed = Agree(mpi, code, message, "talus simulate")) return failed;
 
   const InterruptScope interrupts;
   std::signal(SIGXFSZ, SIG_IGN);  // a file-size limit is a write error ("File too large")
@@ -309,7 +206,7 @@ int RunSimulateOnRanks(const SimulateArgs& args) {
     part.reset();
     staging.reset();
   }
-  if (const int failed = Agree(mpi, code, message)) return failed;
+  if (const int failed = Agree(mpi, code, message, "talus simulate")) return failed;
 
   // Sending the parts to rank 0, rank by rank; then rank 0 merges them into --out.
   std::vector<fs::path> dirs = {part->staging_path()};
@@ -351,7 +248,7 @@ int RunSimulateOnRanks(const SimulateArgs& args) {
   }
   part.reset();
   staging.reset();
-  return Agree(mpi, code, message);
+  return Agree(mpi, code, message, "talus simulate");
 }
 
 #endif

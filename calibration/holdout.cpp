@@ -94,7 +94,8 @@ std::vector<std::vector<std::string>> Folds(const ensemble::ReleaseSpec& release
 }
 
 HeldOutScores ScoreRuns(const Scene& scene, const RunSubset& subset, const GroundTable& fitted,
-                        const GroundTable* reference, int threads, bool episodes) {
+                        const GroundTable* reference, int threads, bool episodes,
+                        const EnsembleRunner& runner) {
   const auto t0 = std::chrono::steady_clock::now();
   HeldOutScores out;
   for (const ensemble::ReleaseRun& r : subset.release.runs) out.runs.push_back(r.id);
@@ -104,7 +105,7 @@ HeldOutScores ScoreRuns(const Scene& scene, const RunSubset& subset, const Groun
   const auto run = [&](const GroundTable& table, fieldobs::EnsembleSamples* samples) {
     Scene edited = scene;  // shares terrain and shapes; only the ground table differs
     edited.ground = table;
-    out.rocks += ensemble::RunEnsemble(edited, subset.release, options, samples).rocks;
+    out.rocks += RunWith(runner, edited, subset.release, options, samples).rocks;
   };
   fieldobs::EnsembleSamples with_fitted(subset.release), with_reference(subset.release);
   run(fitted, &with_fitted);

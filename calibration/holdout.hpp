@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "calibration/objective.hpp"
 #include "ensemble/release.hpp"
 #include "fieldobs/observations.hpp"
 #include "fieldobs/validation.hpp"
@@ -60,9 +61,10 @@ struct HeldOutScores {
 
 // Runs `subset` on `scene` with the ground table `fitted`, and with `reference` when given, and
 // scores its observations. threads 0: all cores; episodes: record contact episodes (impact and
-// scar observations need them).
+// scar observations need them); runner: how the rocks run (objective.hpp; empty: here).
 HeldOutScores ScoreRuns(const Scene& scene, const RunSubset& subset, const GroundTable& fitted,
-                        const GroundTable* reference, int threads, bool episodes);
+                        const GroundTable* reference, int threads, bool episodes,
+                        const EnsembleRunner& runner = {});
 
 // Per kind, the means over every observation of several held-out sets (the folds of a
 // cross-validation), fitted and reference.

@@ -157,6 +157,14 @@ GroundTable Objective::GroundOf(const Eigen::VectorXd& u) const {
   return table;
 }
 
+ensemble::EnsembleReport RunWith(const EnsembleRunner& runner, const Scene& scene,
+                                 const ensemble::ReleaseSpec& release,
+                                 const ensemble::EnsembleOptions& options,
+                                 fieldobs::EnsembleSamples* samples) {
+  return runner ? runner(scene, release, options, samples)
+                : ensemble::RunEnsemble(scene, release, options, samples);
+}
+
 Evaluation Objective::Evaluate(const Eigen::VectorXd& u) const { return Run(u, release_); }
 
 Evaluation Objective::EvaluateWithSeed(const Eigen::VectorXd& u, std::uint64_t seed) const {
@@ -199,7 +207,8 @@ Evaluation Objective::Run(const Eigen::VectorXd& u, const ensemble::ReleaseSpec&
   options.episodes = episodes_;
   options.progress = options_.progress;
   fieldobs::EnsembleSamples samples(release);
-  const ensemble::EnsembleReport report = ensemble::RunEnsemble(scene, release, options, &samples);
+  const ensemble::EnsembleReport report =
+      RunWith(options_.run_ensemble, scene, release, options, &samples);
   e.rocks = report.rocks;
   e.failed_rocks = report.count(EndReason::kFailed);
   fieldobs::ValidationOptions validation;

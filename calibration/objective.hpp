@@ -29,6 +29,8 @@
 
 #include "calibration/parameters.hpp"
 #include "ensemble/release.hpp"
+#include "ensemble/runner.hpp"
+#include "fieldobs/samples.hpp"
 #include "fieldobs/observations.hpp"
 #include "fieldobs/validation.hpp"
 #include "solver/scene.hpp"
@@ -36,6 +38,20 @@
 namespace talus::calibration {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// Runs every rock of `release` into `samples`, in rock order, and returns the counts of all of
+// them. Empty (the default): ensemble::RunEnsemble in this process. A caller may divide the rocks
+// among processes (MPI ranks): each runs a range and the samples are joined in rock order
+// (fieldobs::EnsembleSamples::Append), so the objective is the same bits.
+using EnsembleRunner = std::function<ensemble::EnsembleReport(
+    const Scene& scene, const ensemble::ReleaseSpec& release,
+    const ensemble::EnsembleOptions& options, fieldobs::EnsembleSamples* samples)>;
+
+// Runs with `runner`, or in this process when it is empty.
+ensemble::EnsembleReport RunWith(const EnsembleRunner& runner, const Scene& scene,
+                                 const ensemble::ReleaseSpec& release,
+                                 const ensemble::EnsembleOptions& options,
+                                 fieldobs::EnsembleSamples* samples);
 
 struct ObjectiveOptions {
   // Weight per observation kind ("runout", "deposit", "impact_speed_out", ... as in
@@ -52,6 +68,7 @@ struct ObjectiveOptions {
   double infeasible_value = 1e3;
   // Called on the calling thread while rocks run (rocks done, total); may throw to stop.
   std::function<void(long, long)> progress;
+  EnsembleRunner run_ensemble;  // how an evaluation's rocks run; empty: in this process
 
   bool IsValid(std::string* why) const;
 };

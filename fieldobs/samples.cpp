@@ -1,9 +1,12 @@
 #include "fieldobs/samples.hpp"
 
 #include <algorithm>
+#include <cstdint>
+#include <cstring>
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <stdexcept>
 
 namespace talus::fieldobs {
 
@@ -276,6 +279,87 @@ std::optional<Eigen::Vector2d> EnsembleSamples::StartOf(const std::string& run) 
     if (!start) start = r.start_m;
   });
   return start;
+}
+
+namespace {
+
+template <class T>
+void Put(std::string& out, const T& value) {
+  out.append(reinterpret_cast<const char*>(&value), sizeof value);
+}
+
+void PutOptional(std::string& out, const std::optional<double>& value) {
+  Put<std::uint8_t>(out, value ? 1 : 0);
+  if (value) Put(out, *value);
+}
+
+class Reader {
+ public:
+  explicit Reader(const std::string& bytes) : bytes_(bytes) {}
+  template <class T>
+  T Get() {
+    if (bytes_.size() - at_ < sizeof(T))
+      throw std::runtime_error("ensemble samples: the record ends early");
+    T value;
+    std::memcpy(&value, bytes_.data() + at_, sizeof value);
+    at_ += sizeof value;
+    return value;
+  }
+  std::optional<double> GetOptional() {
+    if (Get<std::uint8_t>() == 0) return std::nullopt;
+    return Get<double>();
+  }
+  bool done() const { return at_ == bytes_.size(); }
+
+ private:
+  const std::string& bytes_;
+  std::size_t at_ = 0;
+};
+
+}  // namespace
+
+std::string EnsembleSamples::Serialize() const {
+  std::string out;
+  Put<std::uint64_t>(out, rocks_.size());
+  for (const Rock& r : rocks_) {
+    Put<std::int32_t>(out, r.release);
+    Put(out, r.runout_m);
+    for (double v : {r.end_m.x(), r.end_m.y(), r.start_m.x(), r.start_m.y()}) Put(out, v);
+    for (const auto* v : {&r.speed_out_m_s, &r.energy_ratio, &r.angular_speed_out_rad_s,
+                          &r.duration_s, &r.scar_m, &r.segment_max_speed_m_s,
+                          &r.segment_mean_angular_speed_rad_s, &r.segment_max_jump_m})
+      PutOptional(out, *v);
+    Put<std::uint64_t>(out, r.zones.size());
+    for (double v : r.zones) Put(out, v);
+  }
+  return out;
+}
+
+void EnsembleSamples::Append(const std::string& bytes) {
+  Reader in(bytes);
+  const auto n = in.Get<std::uint64_t>();
+  for (std::uint64_t k = 0; k < n; ++k) {
+    Rock r;
+    r.release = in.Get<std::int32_t>();
+    if (r.release < 0 || r.release >= release_.release_count())
+      throw std::runtime_error("ensemble samples: a rock of release " + std::to_string(r.release) +
+                               ", which this ensemble does not have");
+    r.runout_m = in.Get<double>();
+    r.end_m.x() = in.Get<double>();
+    r.end_m.y() = in.Get<double>();
+    r.start_m.x() = in.Get<double>();
+    r.start_m.y() = in.Get<double>();
+    for (auto* v : {&r.speed_out_m_s, &r.energy_ratio, &r.angular_speed_out_rad_s, &r.duration_s,
+                    &r.scar_m, &r.segment_max_speed_m_s, &r.segment_mean_angular_speed_rad_s,
+                    &r.segment_max_jump_m})
+      *v = in.GetOptional();
+    const auto zones = in.Get<std::uint64_t>();
+    if (zones > (std::uint64_t{1} << 32))
+      throw std::runtime_error("ensemble samples: a rock with " + std::to_string(zones) + " zones");
+    for (std::uint64_t z = 0; z < zones; ++z) r.zones.push_back(in.Get<double>());
+    rocks_.push_back(std::move(r));
+  }
+  if (!in.done()) throw std::runtime_error("ensemble samples: bytes after the last rock");
 }
 
 }  // namespace talus::fieldobs

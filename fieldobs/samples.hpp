@@ -49,6 +49,13 @@ class EnsembleSamples : public ensemble::RockSink {
   std::optional<Eigen::Vector2d> StartOf(const std::string& run) const;
   long rocks() const { return static_cast<long>(rocks_.size()); }
 
+  // The rocks received so far as bytes (exact: every double bit for bit), and the rocks of such
+  // bytes appended after those here: samples of rocks [a, b) and [b, c) of one release, appended
+  // in that order, equal the samples of [a, c). For dividing an ensemble among processes (MPI).
+  // Append throws std::runtime_error when the bytes are not such a record.
+  std::string Serialize() const;
+  void Append(const std::string& bytes);
+
  private:
   struct Rock {
     int release = 0;

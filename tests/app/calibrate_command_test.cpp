@@ -268,4 +268,87 @@ TEST(CalibrateCommand, ResumedCalibrationEqualsAnUninterruptedOne) {
             without_times(Slurp(parts / "out" / "history.csv")));
 }
 
+#ifdef TALUS_MPIEXEC
+
+std::string MpiRun(const std::string& ranks) {
+  return "timeout -s KILL 120 " + std::string(TALUS_MPIEXEC) +
+         " --oversubscribe --allow-run-as-root " + ranks;
+}
+
+// calibration.json without what depends on the machine and the processes (timings, threads).
+nlohmann::json WithoutTimings(nlohmann::json j) {
+  if (j.is_object()) {
+    nlohmann::json out = nlohmann::json::object();
+    for (auto& [key, value] : j.items())
+      if (key.find("wall_time") == std::string::npos && key != "timings" && key != "threads")
+        out[key] = WithoutTimings(value);
+    return out;
+  }
+  if (j.is_array()) {
+    nlohmann::json out = nlohmann::json::array();
+    for (auto& value : j) out.push_back(WithoutTimings(value));
+    return out;
+  }
+  return j;
+}
+
+// mpirun -n 2 talus calibrate: each evaluation's rocks divided between the ranks give the
+// one-process calibration: the same evaluations, optimum, profiles and files (timings aside).
+TEST(CalibrateMpi, TwoRanksGiveTheOneProcessCalibration) {
+  const fs::path dir = MakeEvent("mpi");
+  Write(dir / "cal.toml", kGood);
+  std::string output;
+  const std::string args = " calibrate " + (dir / "cal.toml").string() + " --threads 1 --out ";
+  ASSERT_EQ(RunCommand(TALUS_BINARY + args + (dir / "one").string(), &output), 0) << output;
+  ASSERT_EQ(RunCommand(MpiRun("-n 2 ") + TALUS_BINARY + args + (dir / "two").string(), &output),
+            0)
+      << output;
+  EXPECT_NE(output.find("2 MPI ranks"), std::string::npos) << output;
+  // Rank 0 alone tells the story.
+  std::size_t reports = 0;
+  for (std::size_t at = output.find("Calibration report"); at != std::string::npos;
+       at = output.find("Calibration report", at + 1))
+    ++reports;
+  EXPECT_EQ(reports, 1u) << output;
+  for (const char* name : {"ground_table.toml", "ground_table.csv", "convergence.svg",
+                           "observed_vs_simulated_runout.svg"})
+    EXPECT_EQ(Slurp(dir / "one" / name), Slurp(dir / "two" / name)) << name;
+  const auto one = nlohmann::json::parse(Slurp(dir / "one" / "calibration.json"));
+  const auto two = nlohmann::json::parse(Slurp(dir / "two" / "calibration.json"));
+  EXPECT_EQ(WithoutTimings(one), WithoutTimings(two));
+}
+
+// A rank that cannot load the calibration ends every rank with one message, before any rock runs;
+// ranks started with different calibrations are refused.
+TEST(CalibrateMpi, ARankThatFailsOrDiffersEndsTheRunWithOneMessage) {
+  const fs::path dir = MakeEvent("mpi_bad");
+  Write(dir / "cal.toml", kGood);
+  std::string other = kGood;
+  other.replace(other.find("max_evaluations = 6"), 19, "max_evaluations = 5");
+  Write(dir / "other.toml", other);
+  const std::string out = " --out " + (dir / "out").string();
+  std::string output;
+  EXPECT_EQ(RunCommand(MpiRun("-n 1 ") + TALUS_BINARY + " calibrate " +
+                           (dir / "cal.toml").string() + out + " : -n 1 " + TALUS_BINARY +
+                           " calibrate " + (dir / "missing.toml").string() + out,
+                       &output),
+            2)
+      << output;
+  EXPECT_NE(output.find("talus calibrate: rank 1: "), std::string::npos) << output;
+  EXPECT_NE(output.find("missing.toml"), std::string::npos) << output;
+  EXPECT_FALSE(fs::exists(dir / "out"));
+  EXPECT_EQ(RunCommand(MpiRun("-n 1 ") + TALUS_BINARY + " calibrate " +
+                           (dir / "cal.toml").string() + out + " : -n 1 " + TALUS_BINARY +
+                           " calibrate " + (dir / "other.toml").string() + out,
+                       &output),
+            2)
+      << output;
+  EXPECT_NE(output.find("rank 1: started with another calibration than rank 0"),
+            std::string::npos)
+      << output;
+  EXPECT_FALSE(fs::exists(dir / "out" / "calibration.json"));
+}
+
+#endif
+
 }  // namespace
