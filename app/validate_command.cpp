@@ -72,13 +72,8 @@ int RunValidate(const ValidateArgs& args) {
     options.threads = args.threads;
     options.episodes = event.needs_episodes;
     options.progress = [](long, long) { ThrowIfInterrupted(); };
-    // Trajectory segments: each rock's statistics over its run's observed window.
-    const std::vector<double> windows = fieldobs::SegmentWindows(event.observations, release);
-    if (std::any_of(windows.begin(), windows.end(), [](double w) { return w > 0; }))
-      options.extra_recorders.push_back(
-          fieldobs::SegmentRecorders(event.scene.scene.terrain, windows));
-    if (!event.observations.zones.empty())
-      options.extra_recorders.push_back(fieldobs::ZoneRecorders(event.observations.zones));
+    // Trajectory segments and zones: what each rock gives for them.
+    fieldobs::AddRecordersFor(event.observations, event.scene.scene.terrain, release, options);
     fieldobs::EnsembleSamples simulated(release);
     io::ValidationRun run;
     run.ensemble = ensemble::RunEnsemble(event.scene.scene, release, options, &simulated);

@@ -102,6 +102,7 @@ HeldOutScores ScoreRuns(const Scene& scene, const RunSubset& subset, const Groun
   ensemble::EnsembleOptions options;
   options.threads = threads;
   options.episodes = episodes;
+  fieldobs::AddRecordersFor(subset.observations, scene.terrain, subset.release, options);
   const auto run = [&](const GroundTable& table, fieldobs::EnsembleSamples* samples) {
     Scene edited = scene;  // shares terrain and shapes; only the ground table differs
     edited.ground = table;

@@ -206,6 +206,7 @@ Evaluation Objective::Run(const Eigen::VectorXd& u, const ensemble::ReleaseSpec&
   options.threads = options_.threads;
   options.episodes = episodes_;
   options.progress = options_.progress;
+  fieldobs::AddRecordersFor(observations_, scene_.terrain, release, options);
   fieldobs::EnsembleSamples samples(release);
   const ensemble::EnsembleReport report =
       RunWith(options_.run_ensemble, scene, release, options, &samples);

@@ -153,6 +153,15 @@ ensemble::RecorderFactory ZoneRecorders(std::vector<Zone> zones) {
   };
 }
 
+void AddRecordersFor(const ObservationSet& observations, const Terrain& terrain,
+                     const ensemble::ReleaseSpec& release, ensemble::EnsembleOptions& options) {
+  const std::vector<double> windows = SegmentWindows(observations, release);
+  if (std::any_of(windows.begin(), windows.end(), [](double w) { return w > 0; }))
+    options.extra_recorders.push_back(SegmentRecorders(terrain, windows));
+  if (!observations.zones.empty())
+    options.extra_recorders.push_back(ZoneRecorders(observations.zones));
+}
+
 std::vector<double> SegmentWindows(const ObservationSet& observations,
                                    const ensemble::ReleaseSpec& release) {
   std::vector<double> windows(static_cast<std::size_t>(release.release_count()), 0.0);

@@ -30,6 +30,13 @@ std::vector<double> SegmentWindows(const ObservationSet& observations,
 // step); for a polygon, whether the centre of mass entered it and the largest values inside.
 ensemble::RecorderFactory ZoneRecorders(std::vector<Zone> zones);
 
+// Adds to options.extra_recorders the recorders `observations` need for EnsembleSamples to give
+// their values: SegmentRecorders for trajectory segments, ZoneRecorders for zones; none when they
+// need neither. Validation and calibration runs both call it, so an observation that validates
+// can be calibrated against. `terrain` must outlive the run.
+void AddRecordersFor(const ObservationSet& observations, const Terrain& terrain,
+                     const ensemble::ReleaseSpec& release, ensemble::EnsembleOptions& options);
+
 class EnsembleSamples : public ensemble::RockSink {
  public:
   // `release` names the runs; it must outlive this object. The runner must record episodes

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include "calibration/holdout.hpp"
 #include "common/error.hpp"
 #include "fieldobs/validation.hpp"
 #include "tests/calibration/fixtures.hpp"
@@ -120,6 +121,40 @@ TEST(Objective, InfeasibleVectorsRunNoRockAndGetTheStatedPenalty) {
   EXPECT_EQ(e.rocks, 0);
   EXPECT_DOUBLE_EQ(e.value, 1e3 * (1 + 0.6));
   EXPECT_EQ(e.infeasible, "medium_hard: mu_max = 0.3 violates mu_min <= mu_max < infinity");
+}
+
+// Trajectory-segment and zone observations are scored in calibration as in validation: the
+// evaluation records what they need (fieldobs::AddRecordersFor), in the fit and in the held-out
+// scores alike. Without the recorders no rock gives these values and the vector is infeasible.
+TEST(Objective, SegmentAndZoneObservationsAreScored) {
+  const auto& p = Problem();
+  fieldobs::ObservationSet observations;
+  fieldobs::Zone line;
+  line.id = "profile";
+  line.points = {{6.0, -40.0}, {6.0, 40.0}};  // across the slope, 4 m below the starts (x = 2)
+  observations.zones.push_back(line);
+  for (const ensemble::ReleaseRun& run : p.release.runs) {
+    const double spread = 0.1 * static_cast<double>(observations.scalars.size());
+    fieldobs::ScalarObservation segment{fieldobs::Quantity::kSegmentMaxSpeed, run.id,
+                                        4.0 + spread, run.id};
+    segment.window_s = 1.0;
+    observations.scalars.push_back(segment);
+    fieldobs::ScalarObservation zone{fieldobs::Quantity::kZoneSpeed, run.id, 5.0 + spread,
+                                     run.id};
+    zone.zone = 0;
+    observations.scalars.push_back(zone);
+  }
+  const Objective objective(p.scene, p.release, observations, {MuMin()}, Threads(2));
+  const Evaluation e = objective.Evaluate(Eigen::VectorXd::Constant(1, 0.5));
+  ASSERT_TRUE(e.feasible) << e.infeasible;
+  ASSERT_EQ(objective.kinds().size(), 2u);
+  for (std::size_t k = 0; k < 2; ++k) EXPECT_EQ(e.kind_scored[k], 20) << objective.kinds()[k];
+
+  const RunSubset subset = SelectRuns(p.release, observations, {"run0", "run1"}, false);
+  const HeldOutScores held =
+      ScoreRuns(p.scene, subset, objective.GroundOf(e.u), nullptr, 2, false, nullptr);
+  ASSERT_EQ(held.kinds.size(), 2u);
+  for (const HeldOutKind& kind : held.kinds) EXPECT_EQ(kind.scored, 2) << kind.kind;
 }
 
 TEST(Objective, WeightOfAKindWithoutObservationsIsAnError) {
