@@ -16,8 +16,8 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <functional>
 #include <filesystem>
+#include <functional>
 #include <iostream>
 #include <limits>
 #include <memory>
@@ -54,6 +54,19 @@ struct CalibrateArgs {
 };
 
 const char* kCheckpoint = "checkpoint.json";
+// Seconds between two writes of the checkpoint during an optimisation.
+constexpr double kCheckpointEvery_s = 10;
+
+// Writes the checkpoint on the way out of a failed or interrupted run; a failure to write it is
+// reported but does not replace the reason the run ended.
+template <class Save>
+void SaveBeforeLeaving(const Save& save) {
+  try {
+    save();
+  } catch (const std::exception& e) {
+    std::cerr << "talus calibrate: the checkpoint could not be written: " << e.what() << "\n";
+  }
+}
 
 // The held-out runs of --holdout: K runs drawn by the optimiser's seed, or the listed ids.
 std::vector<std::string> HoldoutRuns(const std::string& text, const ensemble::ReleaseSpec& release,
@@ -96,7 +109,7 @@ struct Processes {
   // rank that failed, on every rank, with its message printed once. Empty: one process, which
   // prints its own message.
   std::function<int(int code, const std::string& message)> agree;
-  calibration::EnsembleRunner runner;  // empty: the rocks run here
+  calibration::EnsembleRunner runner;                        // empty: the rocks run here
   std::function<std::string(const std::string&)> broadcast;  // rank 0's text on every rank
   bool root() const { return rank == 0; }
   bool mpi() const { return static_cast<bool>(agree); }
@@ -166,14 +179,15 @@ int RunCalibrate(const CalibrateArgs& args, const Processes& processes) {
   if (const int failed = processes.Step(code, message)) return failed;
   if (processes.mpi()) {
     // Every rank must run the same calibration as rank 0 (same files, options and splits).
-    const std::string identity = "calibration " + fs::absolute(args.file).lexically_normal().string() +
+    const std::string identity = "calibration " +
+                                 fs::absolute(args.file).lexically_normal().string() +
                                  " (inputs hash " + file.inputs_hash + "), --holdout '" +
                                  args.holdout + "', --folds " + std::to_string(args.folds) +
                                  ", --out " + fs::absolute(args.out).lexically_normal().string();
     if (const std::string of_root = processes.broadcast(identity); of_root != identity) {
       code = kExitBadInput;
-      message = "started with another calibration than rank 0: " + identity + " instead of " +
-                of_root;
+      message =
+          "started with another calibration than rank 0: " + identity + " instead of " + of_root;
     }
   }
   if (const int failed = processes.Step(code, message)) return failed;
@@ -188,16 +202,26 @@ int RunCalibrate(const CalibrateArgs& args, const Processes& processes) {
 
   const io::EventFile& event = file.event;
   const ensemble::ReleaseSpec& release = objective->release();
-  std::printf("Calibration %s: %d parameters, %zu observations of %ld runs x %ld rocks, %s%s\n",
-              args.file.c_str(), objective->dimension(), fit.observations.size(),
-              release.release_count(), release.rocks_per_release, file.optimizer.algorithm.c_str(),
-              processes.mpi() ? (", " + std::to_string(processes.size) + " MPI ranks").c_str()
-                              : "");
+  std::printf(
+      "Calibration %s: %d parameters, %zu observations of %ld runs x %ld rocks, %s%s\n",
+      args.file.c_str(), objective->dimension(), fit.observations.size(), release.release_count(),
+      release.rocks_per_release, file.optimizer.algorithm.c_str(),
+      processes.mpi() ? (", " + std::to_string(processes.size) + " MPI ranks").c_str() : "");
   if (!holdout.empty())
     std::printf("Holding out %zu runs: %s\n", holdout.size(), Join(holdout).c_str());
   if (!checkpoint.stages.empty()) std::printf("Resuming from %s\n", checkpoint_path.c_str());
   std::fflush(stdout);
   const bool terminal = ::isatty(STDOUT_FILENO) != 0;
+  // The checkpoint holds every evaluation so far; rewriting it after each one would cost time and
+  // disk quadratic in the evaluations, so it is written at most every kCheckpointEvery_s, at the
+  // end of each optimisation, and when the run is interrupted or fails. A process killed outright
+  // loses at most that interval's evaluations, which --resume computes again, identically.
+  auto last_save = std::chrono::steady_clock::now();
+  const auto save_checkpoint = [&]() {
+    if (!root || checkpoint.stages.empty()) return;
+    WriteFileAtomically(checkpoint_path, io::CheckpointJson(checkpoint));
+    last_save = std::chrono::steady_clock::now();
+  };
   // One optimisation, its evaluations replayed from and kept in the checkpoint.
   const auto optimise = [&](const calibration::Objective& target, const std::string& stage) {
     calibration::OptimizerOptions options = file.optimizer;
@@ -206,7 +230,9 @@ int RunCalibrate(const CalibrateArgs& args, const Processes& processes) {
       std::vector<calibration::Evaluation>& kept = checkpoint.stages[stage];
       if (index >= static_cast<int>(kept.size())) {
         kept.push_back(e);
-        if (root) WriteFileAtomically(checkpoint_path, io::CheckpointJson(checkpoint));
+        if (std::chrono::steady_clock::now() - last_save >
+            std::chrono::duration<double>(kCheckpointEvery_s))
+          save_checkpoint();
       }
       // Under MPI the ranks stop together, inside an evaluation (the runner agrees on it).
       if (!processes.mpi()) ThrowIfInterrupted();
@@ -216,6 +242,7 @@ int RunCalibrate(const CalibrateArgs& args, const Processes& processes) {
       std::fflush(stdout);
     };
     calibration::Summary summary = calibration::Calibrate(target, options);
+    save_checkpoint();
     if (terminal) std::printf("\n");
     return summary;
   };
@@ -266,9 +293,9 @@ int RunCalibrate(const CalibrateArgs& args, const Processes& processes) {
     // The fitted runs scored before and after, for the observed-vs-simulated plots.
     std::printf("Scoring the observations before and after for the plots...\n");
     std::fflush(stdout);
-    const calibration::HeldOutScores before =
-        calibration::ScoreRuns(event.scene.scene, fit, objective->GroundOf(run.summary.initial.u),
-                               nullptr, args.threads, objective->needs_episodes(), processes.runner);
+    const calibration::HeldOutScores before = calibration::ScoreRuns(
+        event.scene.scene, fit, objective->GroundOf(run.summary.initial.u), nullptr, args.threads,
+        objective->needs_episodes(), processes.runner);
     const calibration::HeldOutScores after =
         calibration::ScoreRuns(event.scene.scene, fit, fitted, nullptr, args.threads,
                                objective->needs_episodes(), processes.runner);
@@ -320,7 +347,8 @@ int RunCalibrate(const CalibrateArgs& args, const Processes& processes) {
       staging.emplace(args.out);
       WriteFileAtomically(staging->path("ground_table.toml"),
                           io::GroundTableToml(file, *objective, fitted));
-      WriteFileAtomically(staging->path("ground_table.csv"), io::GroundTableCsv(*objective, fitted));
+      WriteFileAtomically(staging->path("ground_table.csv"),
+                          io::GroundTableCsv(*objective, fitted));
       WriteFileAtomically(staging->path("history.csv"), io::HistoryCsv(*objective, run.summary));
       std::vector<std::string> outputs = {"ground_table.toml", "ground_table.csv", "history.csv",
                                           "convergence.svg"};
@@ -328,8 +356,8 @@ int RunCalibrate(const CalibrateArgs& args, const Processes& processes) {
       for (const std::string& kind : objective->kinds()) {
         if (kind == "deposit") continue;
         const std::string name = "observed_vs_simulated_" + kind + ".svg";
-        WriteFileAtomically(staging->path(name),
-                            io::ObservedSimulatedSvg(kind, before.observations, after.observations));
+        WriteFileAtomically(staging->path(name), io::ObservedSimulatedSvg(kind, before.observations,
+                                                                          after.observations));
         outputs.push_back(name);
       }
       outputs.push_back("calibration.json");
@@ -351,15 +379,17 @@ int RunCalibrate(const CalibrateArgs& args, const Processes& processes) {
     }
   } catch (const Interrupted& e) {
     staging.reset();
+    SaveBeforeLeaving(save_checkpoint);
     code = ExitCodeForSignal(e.signal());
     message = std::string(e.what()) + "; no output written, " + args.out +
               " is as it was before the run but for " + kCheckpoint + " (resume with --resume)";
     if (root) std::printf("\n");
   } catch (const std::exception& e) {
     code = kExitRunFailed;
-    message = (staging ? staging->Describe(e.what()) : std::string(e.what())) +
-              " (no output written)";
+    message =
+        (staging ? staging->Describe(e.what()) : std::string(e.what())) + " (no output written)";
     staging.reset();
+    SaveBeforeLeaving(save_checkpoint);
   }
   return processes.Step(code, message);
 }
@@ -368,9 +398,9 @@ int RunCalibrate(const CalibrateArgs& args, const Processes& processes) {
 
 // Counts of an ensemble report as bytes, and back.
 std::string CountsBytes(const ensemble::EnsembleReport& r) {
-  const std::array<long, 9> counts = {r.rocks,  r.by_end[0], r.by_end[1],
-                                      r.by_end[2], r.by_end[3], r.raised,
-                                      r.stayed_at_release, r.steps, r.unconverged_steps};
+  const std::array<long, 9> counts = {
+      r.rocks,  r.by_end[0],         r.by_end[1], r.by_end[2],        r.by_end[3],
+      r.raised, r.stayed_at_release, r.steps,     r.unconverged_steps};
   return std::string(reinterpret_cast<const char*>(counts.data()), sizeof counts);
 }
 ensemble::EnsembleReport ReportOfCounts(const std::string& bytes) {

@@ -1,9 +1,9 @@
 #include "fieldobs/samples.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
-#include <cmath>
 #include <limits>
 #include <memory>
 #include <stdexcept>
@@ -334,9 +334,9 @@ std::string EnsembleSamples::Serialize() const {
     Put<std::int32_t>(out, r.release);
     Put(out, r.runout_m);
     for (double v : {r.end_m.x(), r.end_m.y(), r.start_m.x(), r.start_m.y()}) Put(out, v);
-    for (const auto* v : {&r.speed_out_m_s, &r.energy_ratio, &r.angular_speed_out_rad_s,
-                          &r.duration_s, &r.scar_m, &r.segment_max_speed_m_s,
-                          &r.segment_mean_angular_speed_rad_s, &r.segment_max_jump_m})
+    for (const auto* v :
+         {&r.speed_out_m_s, &r.energy_ratio, &r.angular_speed_out_rad_s, &r.duration_s, &r.scar_m,
+          &r.segment_max_speed_m_s, &r.segment_mean_angular_speed_rad_s, &r.segment_max_jump_m})
       PutOptional(out, *v);
     Put<std::uint64_t>(out, r.zones.size());
     for (double v : r.zones) Put(out, v);
@@ -358,9 +358,9 @@ void EnsembleSamples::Append(const std::string& bytes) {
     r.end_m.y() = in.Get<double>();
     r.start_m.x() = in.Get<double>();
     r.start_m.y() = in.Get<double>();
-    for (auto* v : {&r.speed_out_m_s, &r.energy_ratio, &r.angular_speed_out_rad_s, &r.duration_s,
-                    &r.scar_m, &r.segment_max_speed_m_s, &r.segment_mean_angular_speed_rad_s,
-                    &r.segment_max_jump_m})
+    for (auto* v :
+         {&r.speed_out_m_s, &r.energy_ratio, &r.angular_speed_out_rad_s, &r.duration_s, &r.scar_m,
+          &r.segment_max_speed_m_s, &r.segment_mean_angular_speed_rad_s, &r.segment_max_jump_m})
       *v = in.GetOptional();
     const auto zones = in.Get<std::uint64_t>();
     if (zones > (std::uint64_t{1} << 32))

@@ -2,16 +2,19 @@
 // with mistakes, each refused with its file, line, key and reason before any rock runs.
 
 #include <gtest/gtest.h>
+#include <signal.h>
 #include <sys/wait.h>
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
+#include <thread>
 
 #include "run_talus.hpp"
 
@@ -268,6 +271,50 @@ TEST(CalibrateCommand, ResumedCalibrationEqualsAnUninterruptedOne) {
             without_times(Slurp(parts / "out" / "history.csv")));
 }
 
+// SIGINT in the middle of a fit: exit code 130, no output but the checkpoint, which holds every
+// evaluation the run printed (it is written at least on the way out, not only every few seconds),
+// and --resume goes on from all of them to a complete result.
+TEST(CalibrateCommand, SigintKeepsEveryEvaluationForResume) {
+  const fs::path dir = MakeEvent("sigint", true);
+  std::string cal = kGood;
+  cal.replace(cal.find("max_evaluations = 6"), 19, "max_evaluations = 12\nxtol_abs = 0");
+  cal.insert(cal.find("[[parameters]]"), "rocks = 24\n");  // slow enough to be interrupted
+  Write(dir / "cal.toml", cal);
+  const fs::path out = dir / "out";
+  const fs::path log = dir / "log.txt";
+  const pid_t pid = talus::app::testing::StartProgram(
+      TALUS_BINARY, {"calibrate", (dir / "cal.toml").string(), "--out", out.string()}, log);
+  ASSERT_GT(pid, 0);
+  const auto printed = [&] {
+    const std::string text = Slurp(log);
+    int n = 0;
+    for (std::size_t at = text.find("fit evaluation"); at != std::string::npos;
+         at = text.find("fit evaluation", at + 1))
+      ++n;
+    return n;
+  };
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (printed() < 3 && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  ::kill(pid, SIGINT);
+  const int status = talus::app::testing::WaitFor(pid, 60);
+  const std::string text = Slurp(log);
+  ASSERT_EQ(status, 130) << text;
+  const int before = printed();
+  ASSERT_GE(before, 3) << text;
+  ASSERT_LT(before, 12) << "the fit ended before the signal\n" << text;
+  const auto checkpoint = nlohmann::json::parse(Slurp(out / "checkpoint.json"));
+  EXPECT_GE(static_cast<int>(checkpoint["stages"]["fit"].size()), before);
+  EXPECT_FALSE(fs::exists(out / "calibration.json"));
+
+  std::string output;
+  ASSERT_EQ(Calibrate(dir, "--resume", &output), "0") << output;
+  EXPECT_NE(output.find(std::to_string(checkpoint["stages"]["fit"].size()) + " from a checkpoint"),
+            std::string::npos)
+      << output;
+  EXPECT_EQ(nlohmann::json::parse(Slurp(out / "calibration.json"))["evaluations"], 12);
+}
+
 #ifdef TALUS_MPIEXEC
 
 std::string MpiRun(const std::string& ranks) {
@@ -300,8 +347,7 @@ TEST(CalibrateMpi, TwoRanksGiveTheOneProcessCalibration) {
   std::string output;
   const std::string args = " calibrate " + (dir / "cal.toml").string() + " --threads 1 --out ";
   ASSERT_EQ(RunCommand(TALUS_BINARY + args + (dir / "one").string(), &output), 0) << output;
-  ASSERT_EQ(RunCommand(MpiRun("-n 2 ") + TALUS_BINARY + args + (dir / "two").string(), &output),
-            0)
+  ASSERT_EQ(RunCommand(MpiRun("-n 2 ") + TALUS_BINARY + args + (dir / "two").string(), &output), 0)
       << output;
   EXPECT_NE(output.find("2 MPI ranks"), std::string::npos) << output;
   // Rank 0 alone tells the story.
@@ -343,8 +389,7 @@ TEST(CalibrateMpi, ARankThatFailsOrDiffersEndsTheRunWithOneMessage) {
                        &output),
             2)
       << output;
-  EXPECT_NE(output.find("rank 1: started with another calibration than rank 0"),
-            std::string::npos)
+  EXPECT_NE(output.find("rank 1: started with another calibration than rank 0"), std::string::npos)
       << output;
   EXPECT_FALSE(fs::exists(dir / "out" / "calibration.json"));
 }

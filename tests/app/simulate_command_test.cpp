@@ -38,6 +38,12 @@ fs::path FreshDir(const std::string& name) {
 
 using talus::app::testing::RunCommand;
 
+pid_t StartTalus(const std::vector<std::string>& arguments, const fs::path& log) {
+  return talus::app::testing::StartProgram(TALUS_BINARY, arguments, log);
+}
+
+using talus::app::testing::WaitFor;
+
 using talus::app::testing::Slurp;
 
 // Every regular file of `dir` by name, with its contents.
@@ -60,40 +66,6 @@ std::vector<std::string> Temporaries(const fs::path& dir) {
 
 std::string Talus(const std::string& arguments) {
   return std::string(TALUS_BINARY) + " " + arguments;
-}
-
-// Starts `talus arguments...` with stdout and stderr into `log`; returns its process id.
-pid_t StartTalus(const std::vector<std::string>& arguments, const fs::path& log) {
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log.c_str(),
-                                   O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
-  std::vector<std::string> words = {TALUS_BINARY};
-  words.insert(words.end(), arguments.begin(), arguments.end());
-  std::vector<char*> argv;
-  for (std::string& word : words) argv.push_back(word.data());
-  argv.push_back(nullptr);
-  pid_t pid = -1;
-  const int error = posix_spawn(&pid, TALUS_BINARY, &actions, nullptr, argv.data(), environ);
-  posix_spawn_file_actions_destroy(&actions);
-  return error == 0 ? pid : -1;
-}
-
-// Waits up to `seconds` for `pid` to end; its exit code, 256 + the signal if a signal killed it
-// (not an exit code), or -1 if it did not end (it is then killed).
-int WaitFor(pid_t pid, double seconds) {
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
-  int status = 0;
-  while (::waitpid(pid, &status, WNOHANG) == 0) {
-    if (std::chrono::steady_clock::now() > deadline) {
-      ::kill(pid, SIGKILL);
-      ::waitpid(pid, &status, 0);
-      return -1;
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  }
-  return WIFEXITED(status) ? WEXITSTATUS(status) : 256 + WTERMSIG(status);
 }
 
 // The id of a process that has ended (a child that exited and was reaped).

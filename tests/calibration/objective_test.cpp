@@ -135,12 +135,11 @@ TEST(Objective, SegmentAndZoneObservationsAreScored) {
   observations.zones.push_back(line);
   for (const ensemble::ReleaseRun& run : p.release.runs) {
     const double spread = 0.1 * static_cast<double>(observations.scalars.size());
-    fieldobs::ScalarObservation segment{fieldobs::Quantity::kSegmentMaxSpeed, run.id,
-                                        4.0 + spread, run.id};
+    fieldobs::ScalarObservation segment{fieldobs::Quantity::kSegmentMaxSpeed, run.id, 4.0 + spread,
+                                        run.id};
     segment.window_s = 1.0;
     observations.scalars.push_back(segment);
-    fieldobs::ScalarObservation zone{fieldobs::Quantity::kZoneSpeed, run.id, 5.0 + spread,
-                                     run.id};
+    fieldobs::ScalarObservation zone{fieldobs::Quantity::kZoneSpeed, run.id, 5.0 + spread, run.id};
     zone.zone = 0;
     observations.scalars.push_back(zone);
   }
