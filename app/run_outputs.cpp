@@ -139,7 +139,8 @@ bool QuickLookSample(const ensemble::ReleaseSpec& release, long rock) {
 std::vector<std::string> TalusOutputNames() {
   std::vector<std::string> names = {
       "rocks.csv",    "trajectories.h5",       "summary.json", "quicklook.png", "passages.tif",
-      "deposits.tif", "reach_probability.tif", "partial.json", "partial.bin",  "report.html",  "rocks.gpkg"};
+      "deposits.tif", "reach_probability.tif", "partial.json", "partial.bin",   "report.html",
+      "rocks.gpkg"};
   for (const char* quantity : {"speed", "energy", "jump_height"})
     for (const char* statistic : {"max", "mean", "p95"})
       names.push_back(std::string(quantity) + "_" + statistic + ".tif");
@@ -253,6 +254,10 @@ io::SceneFile LoadSceneOfPart(const io::PartialInfo& part) {
   scene.inputs = part.inputs;
   scene.release.rocks_per_release = part.rocks_per_release;
   scene.release.seed = part.seed;
+  SolverPreset preset = SolverPreset::kDefault;
+  if (!ParseSolverPreset(part.solver_preset, &preset))
+    throw InputError(part.dir + ": unknown solver preset '" + part.solver_preset + "'");
+  io::UseSolverPreset(scene, preset);
   if (scene.release.total_rocks() != part.total_rocks)
     throw InputError(part.dir + ": the scene gives " + std::to_string(scene.release.total_rocks()) +
                      " rocks, the part " + std::to_string(part.total_rocks));

@@ -22,6 +22,7 @@ struct SimulateArgs {
   int threads = 0;
   std::optional<std::uint64_t> seed;
   std::string rock_range;  // "A:B": write a partial result of rocks A .. B - 1
+  std::string preset;      // --preset: fast, default, accurate; empty: the scene's
 };
 
 // Loads the scene with the overrides of `args` and the rocks to run ([0, total), or --rock-range).

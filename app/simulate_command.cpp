@@ -61,6 +61,13 @@ int LoadForSimulate(const SimulateArgs& args, io::SceneFile* scene, std::pair<lo
     *scene = io::LoadScene(args.scene);
     if (args.rocks > 0) scene->release.rocks_per_release = args.rocks;
     if (args.seed) scene->release.seed = *args.seed;
+    if (!args.preset.empty()) {
+      SolverPreset preset = SolverPreset::kDefault;
+      if (!ParseSolverPreset(args.preset, &preset))
+        throw InputError("--preset: unknown preset '" + args.preset +
+                         "'; known: fast, default, accurate");
+      io::UseSolverPreset(*scene, preset);
+    }
     // The scene was valid; only --rocks can break it now (too many rocks in all).
     if (std::string why; !scene->release.IsValid(&why))
       throw InputError("--rocks " + std::to_string(args.rocks) + ": " + why);
@@ -175,6 +182,9 @@ Runner AddSimulateCommand(CLI::App& app) {
          "--seed", [args](const std::uint64_t& seed) { args->seed = seed; },
          "Random seed (overrides the scene)")
       ->check(IntegerRange(0, std::numeric_limits<std::int64_t>::max()));
+  cmd->add_option("--preset", args->preset,
+                  "Solver accuracy: fast, default or accurate (overrides the scene's [solver] "
+                  "preset; keys the scene sets itself are kept)");
   cmd->add_option("--rock-range", args->rock_range,
                   "Run only rocks A .. B-1 (A:B) and write a partial result for talus merge");
   return [cmd, args]() { return *cmd ? RunSimulate(*args) : -1; };

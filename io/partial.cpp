@@ -43,6 +43,7 @@ std::string PartialJson(const SceneFile& scene, const std::string& version, long
   j["inputs_hash_fnv1a64"] = scene.inputs_hash;
   j["seed"] = scene.release.seed;
   j["rocks_per_release"] = scene.release.rocks_per_release;
+  j["solver_preset"] = ToString(scene.solver_preset);
   j["total_rocks"] = scene.release.total_rocks();
   j["first_rock"] = first_rock;
   j["end_rock"] = end_rock;
@@ -93,6 +94,7 @@ PartialInfo ReadPartialInfo(const std::string& dir) {
     p.inputs_hash = j.at("inputs_hash_fnv1a64");
     p.seed = j.at("seed");
     p.rocks_per_release = j.at("rocks_per_release");
+    p.solver_preset = j.at("solver_preset");
     p.total_rocks = j.at("total_rocks");
     p.first_rock = j.at("first_rock");
     p.end_rock = j.at("end_rock");
@@ -127,6 +129,8 @@ std::vector<PartialInfo> CheckPartials(std::vector<PartialInfo> parts) {
       differ("scenes (inputs hash)", a.scene + " " + a.inputs_hash, b.scene + " " + b.inputs_hash);
     if (b.scene_file != a.scene_file) differ("scene files", a.scene_file, b.scene_file);
     if (b.seed != a.seed) differ("seeds", std::to_string(a.seed), std::to_string(b.seed));
+    if (b.solver_preset != a.solver_preset)
+      differ("solver presets", a.solver_preset, b.solver_preset);
     if (b.rocks_per_release != a.rocks_per_release || b.total_rocks != a.total_rocks)
       differ("rocks", std::to_string(a.total_rocks), std::to_string(b.total_rocks));
   }

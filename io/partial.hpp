@@ -30,6 +30,7 @@ struct PartialInfo {
   std::string inputs_hash;
   std::uint64_t seed = 0;
   long rocks_per_release = 0;
+  std::string solver_preset;  // "fast", "default", "accurate" (the scene's or --preset)
   long total_rocks = 0;
   long first_rock = 0, end_rock = 0;  // rocks [first_rock, end_rock)
   bool trajectories = false;

@@ -691,7 +691,21 @@ void LoadRelease(const Context& context, const Section& s, SceneFile& out) {
                        Fmt(g.y_max_m()) + ")");
 }
 
-void LoadSolver(const Section& s, SolverOptions& o) {
+void LoadSolver(const Section& s, SolverOptions& o, SolverPreset& preset,
+                std::vector<std::string>& given) {
+  // The preset sets the accuracy knobs' defaults; keys given here override them.
+  if (s.Has("preset")) {
+    const std::string name = s.String("preset", "");
+    if (!ParseSolverPreset(name, &preset)) {
+      const std::string hint = ClosestName(name, {"fast", "default", "accurate"});
+      s.Fail("preset", "unknown preset '" + name + "'" +
+                           (hint.empty() ? "" : " (did you mean '" + hint + "'?)") +
+                           "; known: fast, default, accurate");
+    }
+  }
+  ApplyPreset(preset, &o);
+  for (const char* key : {"dt_s", "tolerance_m_s", "max_iterations"})
+    if (s.Has(key)) given.push_back(key);
   o.dt_s = s.Number("dt_s", o.dt_s);
   o.max_time_s = s.Number("max_time_s", o.max_time_s);
   o.gravity_m_s2 = s.Number("gravity_m_s2", o.gravity_m_s2);
@@ -772,6 +786,19 @@ std::string ClosestName(const std::string& word, const std::vector<std::string>&
   return best_distance <= limit ? best : "";
 }
 
+void UseSolverPreset(SceneFile& scene, SolverPreset preset) {
+  SolverOptions o = scene.scene.options;
+  ApplyPreset(preset, &o);
+  const SolverOptions& given = scene.scene.options;
+  for (const std::string& key : scene.solver_keys_given) {
+    if (key == "dt_s") o.dt_s = given.dt_s;
+    if (key == "tolerance_m_s") o.tolerance_m_s = given.tolerance_m_s;
+    if (key == "max_iterations") o.max_iterations = given.max_iterations;
+  }
+  scene.scene.options = o;
+  scene.solver_preset = preset;
+}
+
 ensemble::RasterRequest OutputSpec::Request(const GridGeometry& grid) const {
   ensemble::RasterRequest r;
   r.grid = grid;
@@ -823,14 +850,15 @@ SceneFile LoadScene(const std::string& path) {
                       {"points", "lines", "polygons", "file", "runs", "block_column", "height_m",
                        "rocks", "orientation", "velocity_m_s", "angular_velocity_rad_s", "seed"}),
               out);
-  LoadSolver(
-      Section(context, SubTable(context, root, "solver"), "solver",
-              {"dt_s", "max_time_s", "gravity_m_s2", "normal_restitution", "tangential_restitution",
-               "viscous", "contact_solve", "tolerance_m_s", "max_iterations", "prox_alpha",
-               "rest_speed_m_s", "rest_angular_speed_rad_s", "rest_hold_s"}),
-      out.scene.options);
+  LoadSolver(Section(context, SubTable(context, root, "solver"), "solver",
+                     {"preset", "dt_s", "max_time_s", "gravity_m_s2", "normal_restitution",
+                      "tangential_restitution", "viscous", "contact_solve", "tolerance_m_s",
+                      "max_iterations", "prox_alpha", "rest_speed_m_s", "rest_angular_speed_rad_s",
+                      "rest_hold_s"}),
+             out.scene.options, out.solver_preset, out.solver_keys_given);
   LoadOutput(Section(context, SubTable(context, root, "output"), "output",
-                     {"trajectories", "trajectory_interval_s", "rasters", "quicklook", "report", "geopackage"}),
+                     {"trajectories", "trajectory_interval_s", "rasters", "quicklook", "report",
+                      "geopackage"}),
              out.output);
   if (!out.release.blocks.empty() && out.release.runs.empty())
     context.Fail(root.get("blocks"), "blocks",

@@ -30,9 +30,8 @@ nlohmann::ordered_json GroundJson(const GroundTable& table) {
   for (int i = 0; i < table.size(); ++i) {
     const GroundCategory& c = table.category(i);
     const GroundParams& p = c.params;
-    nlohmann::ordered_json g = {{"code", c.code},           {"mu_min", p.mu_min},
-                                {"mu_max", p.mu_max},       {"beta", p.beta_1_s},
-                                {"kappa", p.kappa_1_m},     {"nu", p.nu_1_s}};
+    nlohmann::ordered_json g = {{"code", c.code},     {"mu_min", p.mu_min},   {"mu_max", p.mu_max},
+                                {"beta", p.beta_1_s}, {"kappa", p.kappa_1_m}, {"nu", p.nu_1_s}};
     if (p.HasDragLayer()) {
       g["drag_height_m"] = p.drag_height_m;
       g["drag_translational"] = p.drag_translational_1_s;
@@ -85,6 +84,7 @@ std::string SummaryJson(const SceneFile& scene, const ensemble::EnsembleReport& 
   // What the run used, whatever the scene file left to the defaults: a run can be repeated from
   // summary.json alone (with the inputs of the same hash).
   j["solver"] = SolverJson(scene.scene.options);
+  j["solver"]["preset"] = ToString(scene.solver_preset);
   j["ground"] = GroundJson(scene.scene.ground);
   j["threads"] = report.threads;
   j["wall_time_s"] = report.wall_time_s;

@@ -45,6 +45,46 @@ bool ParseContactSolveMethod(std::string_view name, ContactSolveMethod* method) 
   return false;
 }
 
+const char* ToString(SolverPreset preset) {
+  switch (preset) {
+    case SolverPreset::kFast:
+      return "fast";
+    case SolverPreset::kDefault:
+      return "default";
+    case SolverPreset::kAccurate:
+      return "accurate";
+  }
+  return "unknown";
+}
+
+bool ParseSolverPreset(std::string_view name, SolverPreset* preset) {
+  for (SolverPreset p : {SolverPreset::kFast, SolverPreset::kDefault, SolverPreset::kAccurate}) {
+    if (name == ToString(p)) {
+      *preset = p;
+      return true;
+    }
+  }
+  return false;
+}
+
+void ApplyPreset(SolverPreset preset, SolverOptions* options) {
+  const SolverOptions defaults;
+  options->dt_s = defaults.dt_s;
+  options->tolerance_m_s = defaults.tolerance_m_s;
+  options->max_iterations = defaults.max_iterations;
+  switch (preset) {
+    case SolverPreset::kFast:
+      options->tolerance_m_s = 1e-2;
+      break;
+    case SolverPreset::kDefault:
+      break;
+    case SolverPreset::kAccurate:
+      options->dt_s = 0.001;
+      options->max_iterations = 1000;
+      break;
+  }
+}
+
 bool SolverOptions::IsValid(std::string* why) const {
   std::ostringstream msg;
   auto check = [&](bool ok, const char* field, double value, const char* bound) {

@@ -66,4 +66,19 @@ struct SolverOptions {
   bool IsValid(std::string* why) const;
 };
 
+// Named settings of the accuracy knobs (dt_s, tolerance_m_s, max_iterations), chosen from the
+// work-precision study on the ramp (bench/README.md, "Work against precision"), where ensemble
+// statistics (runout mean and 95th percentile, largest speed) were compared with the tightest
+// setting over three seeds:
+// - kFast: tolerance 1e-2 m/s, the knob with the most speed per unit of error (1.6-1.7 times the
+//   trajectories per second, every statistic within the spread between seeds of the reference);
+// - kDefault: dt 2 ms, tolerance 1e-7 m/s, 200 sweeps (SolverOptions' defaults);
+// - kAccurate: dt 1 ms, tolerance 1e-7 m/s, 1000 sweeps (half the step: about 1.6 times the cost,
+//   statistics within the seeds' spread of the default, the setting to check a result against).
+enum class SolverPreset { kFast, kDefault, kAccurate };
+const char* ToString(SolverPreset preset);  // "fast", "default", "accurate"
+bool ParseSolverPreset(std::string_view name, SolverPreset* preset);
+// Sets the preset's knobs in *options, leaving every other option as it is.
+void ApplyPreset(SolverPreset preset, SolverOptions* options);
+
 }  // namespace talus

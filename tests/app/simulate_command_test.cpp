@@ -167,6 +167,25 @@ TEST(SimulateCommand, OverridesRocksAndSeed) {
   const auto summary = nlohmann::json::parse(Slurp(dir / "out" / "summary.json"));
   EXPECT_EQ(summary["rocks"], 2);
   EXPECT_EQ(summary["seed"], 9);
+  EXPECT_EQ(summary["solver"]["preset"], "default");
+  EXPECT_EQ(summary["solver"]["tolerance_m_s"], 1e-7);
+
+  // --preset fast: the solver options the run used, recorded in summary.json; a bad name is a
+  // bad input.
+  ASSERT_EQ(RunCommand(std::string(TALUS_BINARY) + " simulate " + (dir / "scene.toml").string() +
+                           " --out " + (dir / "fast").string() + " --rocks 1 --preset fast",
+                       &log),
+            0)
+      << log;
+  const auto fast = nlohmann::json::parse(Slurp(dir / "fast" / "summary.json"));
+  EXPECT_EQ(fast["solver"]["preset"], "fast");
+  EXPECT_EQ(fast["solver"]["tolerance_m_s"], 1e-2);
+  EXPECT_EQ(RunCommand(std::string(TALUS_BINARY) + " simulate " + (dir / "scene.toml").string() +
+                           " --out " + (dir / "bad").string() + " --preset quick",
+                       &log),
+            2)
+      << log;
+  EXPECT_NE(log.find("--preset: unknown preset 'quick'"), std::string::npos) << log;
 }
 
 // --rocks is checked like the scene's rocks: 2 releases x 2^63 - 1 rocks used to overflow to a

@@ -18,6 +18,7 @@ PartialInfo Part(const std::string& dir, long first, long end, long total = 10) 
   p.scene_file = "/data/scene.toml";
   p.inputs_hash = "abc";
   p.seed = 1;
+  p.solver_preset = "default";
   p.rocks_per_release = total;
   p.total_rocks = total;
   p.first_rock = first;
@@ -65,6 +66,10 @@ TEST(CheckPartials, NamesWhatDiffersBetweenRuns) {
   b.inputs_hash = "abd";
   EXPECT_NE(Message({Part("a", 0, 5), b}).find("different runs: scenes (inputs hash)"),
             std::string::npos);
+  b = Part("b", 5, 10);
+  b.solver_preset = "fast";  // talus simulate --preset fast for one part only
+  EXPECT_EQ(Message({Part("a", 0, 5), b}),
+            "a and b are parts of different runs: solver presets default and fast");
 }
 
 TEST(ReadPartialInfo, ADirectoryWithoutPartialJsonIsNotAPart) {

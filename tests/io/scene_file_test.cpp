@@ -161,9 +161,8 @@ TEST(LoadScene, ViscousReadingIsChosenByNameWithDidYouMean) {
   testing::WriteText(dir / "scene.toml", kPlaneScene);
   EXPECT_EQ(LoadScene((dir / "scene.toml").string()).scene.options.viscous,
             ViscousReading::kContactFriction);  // the default
-  testing::WriteText(
-      dir / "scene.toml",
-      Replace(kPlaneScene, "max_time_s = 20", "max_time_s = 20\nviscous = \"centre_of_mass\""));
+  testing::WriteText(dir / "scene.toml", Replace(kPlaneScene, "max_time_s = 20",
+                                                 "max_time_s = 20\nviscous = \"centre_of_mass\""));
   EXPECT_EQ(LoadScene((dir / "scene.toml").string()).scene.options.viscous,
             ViscousReading::kCentreOfMass);
   EXPECT_HAS(ErrorOf(Replace(kPlaneScene, "max_time_s = 20",
@@ -192,8 +191,9 @@ TEST(LoadScene, DragLayerPerCategoryWithBounds) {
   EXPECT_TRUE(s.scene.ground.AnyDragLayer());
   testing::WriteText(dir / "scene.toml", kPlaneScene);
   EXPECT_FALSE(LoadScene((dir / "scene.toml").string()).scene.ground.AnyDragLayer());  // off
-  EXPECT_HAS(ErrorOf(std::string(kPlaneScene) + "[ground.medium]\ndrag_height_m = 500\n", dir),
-             "ground.medium.drag_height_m: drag_height_m = 500 violates 0 <= drag_height_m <= 100 (m)");
+  EXPECT_HAS(
+      ErrorOf(std::string(kPlaneScene) + "[ground.medium]\ndrag_height_m = 500\n", dir),
+      "ground.medium.drag_height_m: drag_height_m = 500 violates 0 <= drag_height_m <= 100 (m)");
   EXPECT_HAS(ErrorOf(std::string(kPlaneScene) + "[ground.medium]\ndrag_rotational = -1\n", dir),
              "drag_rotational = -1 violates");
   EXPECT_HAS(ErrorOf(std::string(kPlaneScene) + "[ground.medium]\ndrag_hight_m = 5\n", dir),
@@ -213,6 +213,43 @@ TEST(LoadScene, ContactSolveMethodIsChosenByNameWithDidYouMean) {
       ErrorOf(Replace(kPlaneScene, "max_time_s = 20", "max_time_s = 20\ncontact_solve = \"blok\""),
               dir),
       "scene.toml:23: solver.contact_solve: unknown method 'blok' (did you mean 'block'?)");
+}
+
+// [solver] preset sets the accuracy knobs (solver/options.hpp); keys the scene gives win, also
+// when talus simulate --preset (UseSolverPreset) changes the preset afterwards.
+TEST(LoadScene, SolverPresetSetsTheKnobsTheSceneDoesNotGive) {
+  const auto dir = testing::FreshDir("preset");
+  const auto load = [&](const std::string& extra) {
+    testing::WriteText(dir / "scene.toml", Replace(kPlaneScene, "dt_s = 0.004\nmax_time_s = 20",
+                                                   "max_time_s = 20\n" + extra));
+    return LoadScene((dir / "scene.toml").string());
+  };
+  const SolverOptions defaults;
+  SceneFile scene = load("");
+  EXPECT_EQ(scene.solver_preset, SolverPreset::kDefault);
+  EXPECT_EQ(scene.scene.options.tolerance_m_s, defaults.tolerance_m_s);
+  scene = load("preset = \"fast\"");
+  EXPECT_EQ(scene.solver_preset, SolverPreset::kFast);
+  EXPECT_EQ(scene.scene.options.tolerance_m_s, 1e-2);
+  EXPECT_EQ(scene.scene.options.dt_s, defaults.dt_s);
+  scene = load("preset = \"accurate\"\ntolerance_m_s = 1e-6");
+  EXPECT_EQ(scene.scene.options.dt_s, 0.001);
+  EXPECT_EQ(scene.scene.options.max_iterations, 1000);
+  EXPECT_EQ(scene.scene.options.tolerance_m_s, 1e-6);  // given: kept
+  UseSolverPreset(scene, SolverPreset::kFast);
+  EXPECT_EQ(scene.solver_preset, SolverPreset::kFast);
+  EXPECT_EQ(scene.scene.options.dt_s, defaults.dt_s);
+  EXPECT_EQ(scene.scene.options.max_iterations, defaults.max_iterations);
+  EXPECT_EQ(scene.scene.options.tolerance_m_s, 1e-6);  // still the scene's own
+  EXPECT_HAS(
+      ErrorOf(Replace(kPlaneScene, "max_time_s = 20", "max_time_s = 20\npreset = \"fats\""), dir),
+      "scene.toml:23: solver.preset: unknown preset 'fats' (did you mean 'fast'?)");
+  for (SolverPreset p : {SolverPreset::kFast, SolverPreset::kDefault, SolverPreset::kAccurate}) {
+    SolverOptions o;
+    ApplyPreset(p, &o);
+    std::string why;
+    EXPECT_TRUE(o.IsValid(&why)) << ToString(p) << ": " << why;
+  }
 }
 
 TEST(LoadScene, ReleaseOutsideTheDemIsAnError) {
