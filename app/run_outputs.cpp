@@ -130,10 +130,10 @@ bool QuickLookSample(const ensemble::ReleaseSpec& release, long rock) {
   const long releases = release.release_count();
   const long stride = (releases + kReleases - 1) / kReleases;  // draw every stride-th release
   const long drawn = (releases + stride - 1) / stride;
+  const int which = release.ReleaseOf(rock);
   const long per_release =
-      std::clamp<long>((kPaths + drawn - 1) / drawn, 1, release.rocks_per_release);
-  const long which = release.ReleaseOf(rock);
-  return which % stride == 0 && rock - which * release.rocks_per_release < per_release;
+      std::clamp<long>((kPaths + drawn - 1) / drawn, 1, release.RocksOf(which));
+  return which % stride == 0 && rock - release.FirstRockOf(which) < per_release;
 }
 
 std::vector<std::string> TalusOutputNames() {
@@ -251,7 +251,8 @@ io::SceneFile LoadSceneOfPart(const io::PartialInfo& part) {
                      scene.inputs_hash + ", was " + part.inputs_hash + ")");
   scene.path = part.scene;
   scene.inputs = part.inputs;
-  scene.release.rocks_per_release = part.rocks_per_release;
+  // A part run with --rocks has that many rocks per release (0: the scene's counts).
+  if (part.rocks_per_release > 0) scene.release.SetRocksPerRelease(part.rocks_per_release);
   scene.release.seed = part.seed;
   if (scene.release.total_rocks() != part.total_rocks)
     throw InputError(part.dir + ": the scene gives " + std::to_string(scene.release.total_rocks()) +
