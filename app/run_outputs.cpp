@@ -168,8 +168,8 @@ std::vector<std::string> RunIntoStaging(const io::SceneFile& scene, int threads,
   io::RocksCsvWriter csv(staging.path("rocks.csv"), scene.scene, scene.release);
   std::unique_ptr<io::TrajectoryWriter> trajectories;
   if (scene.output.trajectories) {
-    trajectories =
-        std::make_unique<io::TrajectoryWriter>(staging.path("trajectories.h5"), scene.scene.rock);
+    trajectories = std::make_unique<io::TrajectoryWriter>(staging.path("trajectories.h5"),
+                                                          scene.scene.rock, scene.crs_wkt);
     outputs.push_back("trajectories.h5");
   }
   FileSink sink(csv, trajectories.get(), options.sample_trajectories);
@@ -204,7 +204,7 @@ std::vector<std::string> MergeIntoStaging(const io::SceneFile& scene,
     if (!csv) throw std::runtime_error("cannot write " + staging.path("rocks.csv"));
   }
   if (scene.output.trajectories) {
-    io::TrajectoryWriter out(staging.path("trajectories.h5"), scene.scene.rock);
+    io::TrajectoryWriter out(staging.path("trajectories.h5"), scene.scene.rock, scene.crs_wkt);
     for (const io::PartialInfo& part : parts) {
       const io::TrajectoryReader in((fs::path(part.dir) / "trajectories.h5").string());
       for (long rock = part.first_rock; rock < part.end_rock; ++rock) {
