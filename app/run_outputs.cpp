@@ -130,10 +130,10 @@ bool QuickLookSample(const ensemble::ReleaseSpec& release, long rock) {
   const long releases = release.release_count();
   const long stride = (releases + kReleases - 1) / kReleases;  // draw every stride-th release
   const long drawn = (releases + stride - 1) / stride;
+  const int which = release.ReleaseOf(rock);
   const long per_release =
-      std::clamp<long>((kPaths + drawn - 1) / drawn, 1, release.rocks_per_release);
-  const long which = release.ReleaseOf(rock);
-  return which % stride == 0 && rock - which * release.rocks_per_release < per_release;
+      std::clamp<long>((kPaths + drawn - 1) / drawn, 1, release.RocksOf(which));
+  return which % stride == 0 && rock - release.FirstRockOf(which) < per_release;
 }
 
 std::vector<std::string> TalusOutputNames() {
@@ -169,8 +169,8 @@ std::vector<std::string> RunIntoStaging(const io::SceneFile& scene, int threads,
   io::RocksCsvWriter csv(staging.path("rocks.csv"), scene.scene, scene.release);
   std::unique_ptr<io::TrajectoryWriter> trajectories;
   if (scene.output.trajectories) {
-    trajectories =
-        std::make_unique<io::TrajectoryWriter>(staging.path("trajectories.h5"), scene.scene.rock);
+    trajectories = std::make_unique<io::TrajectoryWriter>(staging.path("trajectories.h5"),
+                                                          scene.scene.rock, scene.crs_wkt);
     outputs.push_back("trajectories.h5");
   }
   FileSink sink(csv, trajectories.get(), options.sample_trajectories);
@@ -205,7 +205,7 @@ std::vector<std::string> MergeIntoStaging(const io::SceneFile& scene,
     if (!csv) throw std::runtime_error("cannot write " + staging.path("rocks.csv"));
   }
   if (scene.output.trajectories) {
-    io::TrajectoryWriter out(staging.path("trajectories.h5"), scene.scene.rock);
+    io::TrajectoryWriter out(staging.path("trajectories.h5"), scene.scene.rock, scene.crs_wkt);
     for (const io::PartialInfo& part : parts) {
       const io::TrajectoryReader in((fs::path(part.dir) / "trajectories.h5").string());
       for (long rock = part.first_rock; rock < part.end_rock; ++rock) {
@@ -252,7 +252,8 @@ io::SceneFile LoadSceneOfPart(const io::PartialInfo& part) {
                      scene.inputs_hash + ", was " + part.inputs_hash + ")");
   scene.path = part.scene;
   scene.inputs = part.inputs;
-  scene.release.rocks_per_release = part.rocks_per_release;
+  // A part run with --rocks has that many rocks per release (0: the scene's counts).
+  if (part.rocks_per_release > 0) scene.release.SetRocksPerRelease(part.rocks_per_release);
   scene.release.seed = part.seed;
   SolverPreset preset = SolverPreset::kDefault;
   if (!ParseSolverPreset(part.solver_preset, &preset))

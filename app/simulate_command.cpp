@@ -38,12 +38,18 @@ std::string DescribeRocks(const io::SceneFile& scene) {
                   r.shape_per_rock ? " (a shape of its own per rock)" : "",
                   static_cast<unsigned long long>(r.seed));
   } else {
-    std::snprintf(line, sizeof line,
-                  "rock %s (%.1f kg, %zu hull vertices)%s; %zu releases x %ld rocks, seed %llu",
+    char rocks[96];
+    if (r.release_first_rock.empty())
+      std::snprintf(rocks, sizeof rocks, "%zu releases x %ld rocks", r.releases.size(),
+                    r.rocks_per_release);
+    else  // rocks per area
+      std::snprintf(rocks, sizeof rocks, "%zu releases, %ld rocks by area", r.releases.size(),
+                    r.total_rocks());
+    std::snprintf(line, sizeof line, "rock %s (%.1f kg, %zu hull vertices)%s; %s, seed %llu",
                   scene.rock_description.c_str(), scene.scene.rock.mass_kg,
                   scene.scene.rock.vertices_m.size(),
-                  r.shape_per_rock ? ", a shape of its own per rock" : "", r.releases.size(),
-                  r.rocks_per_release, static_cast<unsigned long long>(r.seed));
+                  r.shape_per_rock ? ", a shape of its own per rock" : "", rocks,
+                  static_cast<unsigned long long>(r.seed));
   }
   return line;
 }
@@ -59,7 +65,7 @@ int LoadForSimulate(const SimulateArgs& args, io::SceneFile* scene, std::pair<lo
   }
   try {
     *scene = io::LoadScene(args.scene);
-    if (args.rocks > 0) scene->release.rocks_per_release = args.rocks;
+    if (args.rocks > 0) scene->release.SetRocksPerRelease(args.rocks);
     if (args.seed) scene->release.seed = *args.seed;
     if (!args.preset.empty()) {
       SolverPreset preset = SolverPreset::kDefault;

@@ -39,7 +39,7 @@ int RunValidate(const ValidateArgs& args) {
   try {
     event = io::LoadEvent(args.event);
     ensemble::ReleaseSpec& release = event.scene.release;
-    if (args.rocks > 0) release.rocks_per_release = args.rocks;
+    if (args.rocks > 0) release.SetRocksPerRelease(args.rocks);
     if (args.seed) release.seed = *args.seed;
     if (std::string why; !release.IsValid(&why))
       throw InputError("--rocks " + std::to_string(args.rocks) + ": " + why);

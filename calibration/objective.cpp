@@ -104,7 +104,7 @@ Objective::Objective(const Scene& scene, const ensemble::ReleaseSpec& release,
         const auto start_of = [&](const std::string& run) -> std::optional<Eigen::Vector2d> {
           for (long r = 0; r < release_.release_count(); ++r)
             if (release_.ReleaseName(static_cast<int>(r)) == run)
-              return ensemble::Release(scene_, release_, r * release_.rocks_per_release)
+              return ensemble::Release(scene_, release_, release_.FirstRockOf(static_cast<int>(r)))
                   .start.position_m.head<2>();
           return std::nullopt;
         };

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 #include "solver/random.hpp"
@@ -42,24 +43,119 @@ Eigen::Vector2d PointOnLine(const std::vector<Eigen::Vector2d>& line, double u) 
   return line.back();
 }
 
+// A start point uniform along `line` where `keep` holds (rejection: ClipToDem releases cover at
+// least kMinPolygonFill of their length, checked when the scene is loaded).
+template <class Keep>
+Eigen::Vector2d PointOnLine(const std::vector<Eigen::Vector2d>& line, RockRandom& random,
+                            Keep keep) {
+  Eigen::Vector2d p = line.front();
+  for (int attempt = 0; attempt < 100000; ++attempt) {
+    p = PointOnLine(line, random.Uniform());
+    if (keep(p)) return p;
+  }
+  return p;
+}
+
+template <class Keep>
 Eigen::Vector2d PointInPolygon(const std::vector<std::vector<Eigen::Vector2d>>& rings,
-                               RockRandom& random) {
+                               RockRandom& random, Keep keep) {
   Eigen::Vector2d lo = rings[0][0], hi = rings[0][0];
   for (const Eigen::Vector2d& v : rings[0]) {
     lo = lo.cwiseMin(v);
     hi = hi.cwiseMax(v);
   }
-  // Rejection sampling in the bounding box. IsValid ensures the polygon covers at least
-  // kMinPolygonFill of its box, so all attempts fail with probability (1 - 1e-3)^1e5 < 1e-43.
+  // Rejection sampling in the bounding box. IsValid ensures the polygon (the part where `keep`
+  // holds, checked when the scene is loaded) covers at least kMinPolygonFill of its box, so all
+  // attempts fail with probability (1 - 1e-3)^1e5 < 1e-43.
   for (int attempt = 0; attempt < 100000; ++attempt) {
     const double u = random.Uniform(), v = random.Uniform();
     const Eigen::Vector2d p(lo.x() + u * (hi.x() - lo.x()), lo.y() + v * (hi.y() - lo.y()));
-    if (InsidePolygon(rings, p)) return p;
+    if (InsidePolygon(rings, p) && keep(p)) return p;
   }
   return rings[0][0];
 }
 
+// The bounding box of a polygon's outer ring.
+void Bounds(const std::vector<Eigen::Vector2d>& ring, Eigen::Vector2d* lo, Eigen::Vector2d* hi) {
+  *lo = *hi = ring[0];
+  for (const Eigen::Vector2d& v : ring) {
+    *lo = lo->cwiseMin(v);
+    *hi = hi->cwiseMax(v);
+  }
+}
+
 }  // namespace
+
+void ReleaseSpec::SetRocksPerRelease(long rocks) {
+  rocks_per_release = rocks;
+  release_first_rock.clear();
+}
+
+void ReleaseSpec::SetRocksPerRelease(const std::vector<long>& rocks) {
+  release_first_rock.assign(1, 0);
+  for (long n : rocks) release_first_rock.push_back(release_first_rock.back() + n);
+  rocks_per_release = rocks.empty() ? 1 : rocks.front();
+}
+
+int ReleaseSpec::ReleaseOf(long rock) const {
+  if (release_first_rock.empty()) return static_cast<int>(rock / rocks_per_release);
+  const auto after = std::upper_bound(release_first_rock.begin(), release_first_rock.end(), rock);
+  return static_cast<int>(after - release_first_rock.begin()) - 1;
+}
+
+long ReleaseSpec::FirstRockOf(int release) const {
+  return release_first_rock.empty() ? release * rocks_per_release
+                                    : release_first_rock[static_cast<std::size_t>(release)];
+}
+
+long ReleaseSpec::RocksOf(int release) const {
+  return release_first_rock.empty() ? rocks_per_release
+                                    : release_first_rock[static_cast<std::size_t>(release) + 1] -
+                                          release_first_rock[static_cast<std::size_t>(release)];
+}
+
+bool OnTerrain(const Terrain& terrain, const Eigen::Vector2d& p) {
+  double height_m;
+  return terrain.Height(p.x(), p.y(), &height_m);
+}
+
+double ReleaseArea(const ReleaseGeometry& release) {
+  if (release.kind != ReleaseGeometry::Kind::kPolygon || release.rings.empty()) return 0;
+  double holes = 0;
+  for (std::size_t k = 1; k < release.rings.size(); ++k)
+    holes += std::abs(RingArea(release.rings[k]));
+  return std::abs(RingArea(release.rings[0])) - holes;
+}
+
+double FractionOnTerrain(const Terrain& terrain, const ReleaseGeometry& release) {
+  const GridGeometry& grid = terrain.heights().grid;
+  const double cell_m = std::min(grid.dx_m, grid.dy_m);
+  const auto& ring = release.rings[0];
+  long on = 0, all = 0;
+  if (release.kind == ReleaseGeometry::Kind::kPoint) return OnTerrain(terrain, ring[0]) ? 1 : 0;
+  if (release.kind == ReleaseGeometry::Kind::kLine) {
+    const long n = std::clamp<long>(static_cast<long>(std::ceil(4 * LineLength(ring) / cell_m)),
+                                    10000, 1000000);
+    for (long k = 0; k < n; ++k, ++all)
+      on += OnTerrain(terrain, PointOnLine(ring, (k + 0.5) / double(n))) ? 1 : 0;
+    return double(on) / double(all);
+  }
+  Eigen::Vector2d lo, hi;
+  Bounds(ring, &lo, &hi);
+  const auto points = [&](double extent_m) {
+    return std::clamp<long>(static_cast<long>(std::ceil(4 * extent_m / cell_m)), 200, 1000);
+  };
+  const long nx = points(hi.x() - lo.x()), ny = points(hi.y() - lo.y());
+  for (long j = 0; j < ny; ++j)
+    for (long i = 0; i < nx; ++i) {
+      const Eigen::Vector2d p(lo.x() + (i + 0.5) / double(nx) * (hi.x() - lo.x()),
+                              lo.y() + (j + 0.5) / double(ny) * (hi.y() - lo.y()));
+      if (!InsidePolygon(release.rings, p)) continue;
+      ++all;
+      on += OnTerrain(terrain, p) ? 1 : 0;
+    }
+  return all == 0 ? 0 : double(on) / double(all);
+}
 
 std::string ReleaseSpec::ReleaseName(int release) const {
   return runs.empty() ? std::to_string(release) : runs[static_cast<std::size_t>(release)].id;
@@ -117,11 +213,24 @@ bool ReleaseSpec::IsValid(std::string* why) const {
         (!run.orientation->coeffs().allFinite() || std::abs(run.orientation->norm() - 1) > 1e-6))
       return bad("orientation must be a unit quaternion [w, x, y, z]");
   }
-  if (rocks_per_release < 1) {
+  if (!release_first_rock.empty()) {
+    if (static_cast<long>(release_first_rock.size()) != release_count() + 1 ||
+        release_first_rock.front() != 0)
+      return Fail(why, "release_first_rock does not match the releases");
+    for (std::size_t r = 0; r + 1 < release_first_rock.size(); ++r)
+      if (release_first_rock[r + 1] - release_first_rock[r] < 1) {
+        s << "release " << r << " has " << release_first_rock[r + 1] - release_first_rock[r]
+          << " rocks, must have >= 1";
+        return Fail(why, s.str());
+      }
+    if (release_first_rock.back() > kMaxTotalRocks) {
+      s << "rocks = " << release_first_rock.back() << " in all is more than " << kMaxTotalRocks;
+      return Fail(why, s.str());
+    }
+  } else if (rocks_per_release < 1) {
     s << "rocks = " << rocks_per_release << " must be >= 1";
     return Fail(why, s.str());
-  }
-  if (rocks_per_release > kMaxTotalRocks / release_count()) {
+  } else if (rocks_per_release > kMaxTotalRocks / release_count()) {
     s << "rocks = " << rocks_per_release << " per release x " << release_count()
       << " releases is more than " << kMaxTotalRocks << " rocks";
     return Fail(why, s.str());
@@ -267,26 +376,45 @@ ReleasedRock Release(const Scene& scene, const ReleaseSpec& spec, long rock) {
     out.shape = std::shared_ptr<const RockShape>(std::shared_ptr<const RockShape>(), &scene.rock);
   }
 
-  // Position: on the release geometry, or the run's.
+  // Position: on the release geometry (where the terrain has a height, with clip_to_dem), or the
+  // run's.
   Eigen::Vector2d xy;
   if (run) {
     xy = run->xy_m;
   } else {
     const ReleaseGeometry& g = spec.releases[static_cast<std::size_t>(release)];
+    const auto keep = [&](const Eigen::Vector2d& p) {
+      return !spec.clip_to_dem || OnTerrain(scene.terrain, p);
+    };
     xy = g.rings[0][0];
-    if (g.kind == ReleaseGeometry::Kind::kLine) xy = PointOnLine(g.rings[0], random.Uniform());
-    if (g.kind == ReleaseGeometry::Kind::kPolygon) xy = PointInPolygon(g.rings, random);
+    if (g.kind == ReleaseGeometry::Kind::kLine) xy = PointOnLine(g.rings[0], random, keep);
+    if (g.kind == ReleaseGeometry::Kind::kPolygon) xy = PointInPolygon(g.rings, random, keep);
   }
-  RockState& state = out.start;
-  TerrainSample ground;
-  const double z = scene.terrain.Sample(xy.x(), xy.y(), &ground) ? ground.height_m : 0.0;
-  const double height = run && run->height_m ? *run->height_m : spec.height_m;
-  state.position_m = Eigen::Vector3d(xy.x(), xy.y(), run && run->z_m ? *run->z_m : z + height);
 
   // The user's orientation rotates the shape as given; the state holds principal -> world.
+  RockState& state = out.start;
   const std::optional<Eigen::Quaterniond>& fixed = run ? run->orientation : spec.orientation;
   const Eigen::Quaterniond user = fixed ? *fixed : random.Orientation();
   state.orientation = out.shape->PrincipalOrientation(user);
+
+  // Height: the centre of mass height_m above the ground below it, or the lowest vertex height_m
+  // above the ground below that vertex.
+  TerrainSample ground;
+  const double z = scene.terrain.Sample(xy.x(), xy.y(), &ground) ? ground.height_m : 0.0;
+  const double height = run && run->height_m ? *run->height_m : spec.height_m;
+  double z_m = z + height;
+  if (spec.height_reference == ReleaseSpec::HeightReference::kLowestPoint) {
+    const Eigen::Matrix3d rotation = state.orientation.toRotationMatrix();
+    double highest_m = -std::numeric_limits<double>::infinity();  // of ground - vertex offset
+    for (const Eigen::Vector3d& v : out.shape->vertices_m) {
+      const Eigen::Vector3d offset = rotation * v;
+      double ground_m;
+      if (!scene.terrain.Height(xy.x() + offset.x(), xy.y() + offset.y(), &ground_m)) ground_m = z;
+      highest_m = std::max(highest_m, ground_m - offset.z());
+    }
+    if (std::isfinite(highest_m)) z_m = highest_m + height;
+  }
+  state.position_m = Eigen::Vector3d(xy.x(), xy.y(), run && run->z_m ? *run->z_m : z_m);
   const Eigen::Vector3d& v = run ? run->velocity_m_s : spec.velocity_m_s;
   const Eigen::Vector3d& w = run ? run->angular_velocity_rad_s : spec.angular_velocity_rad_s;
   state.velocity_m_s = v;

@@ -30,7 +30,7 @@ struct ReleaseRun {
   std::string id;  // e.g. the trajectory_id of a run table; unique within a spec
   Eigen::Vector2d xy_m = Eigen::Vector2d::Zero();
   std::optional<double> z_m;       // centre of mass height; else height_m above the ground
-  std::optional<double> height_m;  // centre of mass above the ground; else ReleaseSpec::height_m
+  std::optional<double> height_m;  // as ReleaseSpec::height_m (and its reference); else that
   Eigen::Vector3d velocity_m_s = Eigen::Vector3d::Zero();
   Eigen::Vector3d angular_velocity_rad_s = Eigen::Vector3d::Zero();
   int block = -1;  // index into ReleaseSpec::blocks; -1: the scene's rock
@@ -55,8 +55,19 @@ struct ReleaseSpec {
   // block of its run (-1: the scene's rock) and a seed that depends on (seed, rock) only. It is
   // called from worker threads and must be thread-safe; a bad shape is an exception.
   std::function<RockShape(int block, std::uint64_t shape_seed)> shape_per_rock;
-  long rocks_per_release = 1;  // per release geometry or per run
-  double height_m = 1.0;       // centre of mass above the ground at release (before any raise)
+  long rocks_per_release = 1;  // per release geometry or per run (when release_first_rock is empty)
+  // When not empty: release r holds rocks [release_first_rock[r], release_first_rock[r + 1])
+  // (release_count() + 1 entries from 0, e.g. rocks per m2 of each polygon); set it with
+  // SetRocksPerRelease.
+  std::vector<long> release_first_rock;
+  double height_m = 1.0;  // height above the ground at release (before any raise), see below
+  // What height_m measures: the centre of mass above the ground below it, or the lowest hull
+  // vertex (in the start orientation) above the ground below that vertex.
+  enum class HeightReference { kCentreOfMass, kLowestPoint };
+  HeightReference height_reference = HeightReference::kCentreOfMass;
+  // Start points of lines and polygons only where the terrain has a height (the parts over
+  // nodata or off the DEM are left out); false: such releases are an error (see PointOffTerrain).
+  bool clip_to_dem = false;
   // Fixed orientation of the shape as given (w, x, y, z), or nullopt for uniform on SO(3).
   std::optional<Eigen::Quaterniond> orientation;
   Eigen::Vector3d velocity_m_s = Eigen::Vector3d::Zero();            // world frame
@@ -67,9 +78,19 @@ struct ReleaseSpec {
   long release_count() const {
     return static_cast<long>(runs.empty() ? releases.size() : runs.size());
   }
-  long total_rocks() const { return rocks_per_release * release_count(); }
+  long total_rocks() const {
+    return release_first_rock.empty() ? rocks_per_release * release_count()
+                                      : release_first_rock.back();
+  }
+  // The same number of rocks for every release.
+  void SetRocksPerRelease(long rocks);
+  // Rocks of each release (one count per release geometry or run).
+  void SetRocksPerRelease(const std::vector<long>& rocks);
   // Index of the release geometry or run of a rock: rocks of one release are consecutive.
-  int ReleaseOf(long rock) const { return static_cast<int>(rock / rocks_per_release); }
+  int ReleaseOf(long rock) const;
+  // The first rock of a release and how many it has.
+  long FirstRockOf(int release) const;
+  long RocksOf(int release) const;
   // The run id of a rock's release: the run's id, or the release's index for geometries.
   std::string ReleaseName(int release) const;
   // False, naming the field and value, when a value is out of range (more than kMaxTotalRocks
@@ -98,6 +119,17 @@ bool InsidePolygon(const std::vector<std::vector<Eigen::Vector2d>>& rings,
 std::optional<Eigen::Vector2d> PointOffTerrain(const Terrain& terrain,
                                                const ReleaseGeometry& release);
 
+// Whether rocks can start at (x, y): the terrain has a height there.
+bool OnTerrain(const Terrain& terrain, const Eigen::Vector2d& p);
+
+// The fraction of `release` (of a line's length, or a polygon's area) over which the terrain has a
+// height, estimated on a lattice of at least 4 points per cell and 200 x 200 points (lines: every
+// 1/4 cell and 10^4 points); 1 for a point on the terrain, 0 off it.
+double FractionOnTerrain(const Terrain& terrain, const ReleaseGeometry& release);
+
+// The area of a polygon net of its holes (m2); 0 for points and lines.
+double ReleaseArea(const ReleaseGeometry& release);
+
 // A rock ready to run: its shape and start state.
 struct ReleasedRock {
   std::shared_ptr<const RockShape> shape;  // the scene's rock, a block's, or the rock's own
@@ -106,7 +138,8 @@ struct ReleasedRock {
 };
 
 // The one way to release rock `rock` (0-based, releases one after another): its shape, position
-// on its release (or its run's position) with the centre of mass height_m above the ground (or at
+// on its release (or its run's position; only where the terrain has a height with clip_to_dem)
+// with the centre of mass or the lowest vertex height_m above the ground (height_reference; or at
 // the run's z_m), orientation (fixed, or uniform on SO(3)), velocities; then raised until no
 // vertex is below the terrain. Depends on (spec.seed, rock) only. `scene` must outlive the result
 // when the rock uses the scene's shape.

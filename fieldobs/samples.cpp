@@ -218,9 +218,9 @@ void EnsembleSamples::ForRun(const std::string& run, F&& f) const {
   const auto it = run_index_.find(run);
   if (it == run_index_.end()) return;
   // Rocks of one release are consecutive (ReleaseSpec::ReleaseOf).
-  const long first = static_cast<long>(it->second) * release_.rocks_per_release;
-  for (long k = first; k < first + release_.rocks_per_release && k < rocks(); ++k)
-    f(rocks_[static_cast<std::size_t>(k)]);
+  const long first = release_.FirstRockOf(static_cast<int>(it->second));
+  const long end = first + release_.RocksOf(static_cast<int>(it->second));
+  for (long k = first; k < end && k < rocks(); ++k) f(rocks_[static_cast<std::size_t>(k)]);
 }
 
 std::vector<double> EnsembleSamples::Values(Quantity quantity, const std::string& run,

@@ -253,7 +253,7 @@ CalibrationFile LoadCalibration(const std::string& path) {
     top.Fail("rocks", std::to_string(rocks) +
                           " must be in 2 .. 100000 (rocks per run; a score "
                           "needs at least 2)");
-  release.rocks_per_release = rocks;
+  release.SetRocksPerRelease(rocks);
   const long seed = top.Integer("seed", static_cast<long>(release.seed));
   if (seed < 0) top.Fail("seed", std::to_string(seed) + " must be >= 0");
   release.seed = static_cast<std::uint64_t>(seed);

@@ -42,7 +42,9 @@ std::string PartialJson(const SceneFile& scene, const std::string& version, long
   j["inputs"] = scene.inputs;
   j["inputs_hash_fnv1a64"] = scene.inputs_hash;
   j["seed"] = scene.release.seed;
-  j["rocks_per_release"] = scene.release.rocks_per_release;
+  // 0 when the releases have rocks of their own (rocks_per_m2): the scene gives them.
+  j["rocks_per_release"] =
+      scene.release.release_first_rock.empty() ? scene.release.rocks_per_release : 0;
   j["solver_preset"] = ToString(scene.solver_preset);
   j["total_rocks"] = scene.release.total_rocks();
   j["first_rock"] = first_rock;

@@ -2,7 +2,7 @@
 // Partial results (docs/cluster.md): `talus simulate SCENE --rock-range A:B` runs rocks A .. B - 1
 // of the scene's ensemble and writes, instead of the rasters and summary.json,
 //   rocks.csv        the rows of its rocks (with the header),
-//   trajectories.h5  their groups, when the scene asks for trajectories,
+//   trajectories.h5  their rows, when the scene asks for trajectories,
 //   partial.bin      the raster accumulator (per-cell summaries) and the quick-look's sample paths,
 //   partial.json     what the part is (scene, its inputs' hash, seed, range, version, counts);
 //                    written last, so that a directory with a partial.json is a complete part.

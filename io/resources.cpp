@@ -18,12 +18,12 @@
 namespace talus::io {
 namespace {
 
-// Sizes of the output files, measured on cases/tirol (200 rocks, 157 499 samples at 0.1 s and
-// 16 027 at 1 s: 17 625 136 and 5 730 968 bytes; bench/README.md, "Output sizes"):
-// trajectories.h5 takes a fixed part per rock (its group, seven datasets and two attributes,
-// 21.9 kB) and a part per sample (deflate-compressed doubles, 84 bytes); a row of rocks.csv
-// (148 bytes). GeoTIFFs are counted uncompressed (4 bytes per cell), an upper bound.
-constexpr double kTrajectoryBytesPerRock = 22000;
+// Sizes of the output files. trajectories.h5 takes a row of its rock index per rock (56 bytes
+// before compression) and a part per sample (deflate-compressed doubles: 84 bytes measured on
+// cases/tirol, 82 on a 40 degree plane, 10^4 rocks of 41 samples in 33.5 MB; bench/README.md,
+// "Output sizes"); a row of rocks.csv (148 bytes). GeoTIFFs are counted uncompressed (4 bytes per
+// cell), an upper bound.
+constexpr double kTrajectoryBytesPerRock = 56;
 constexpr double kTrajectoryBytesPerSample = 84;
 constexpr double kRocksCsvBytesPerRow = 150;
 // rocks.gpkg: an end point with its fields and spatial index; a path's vertex (x, y, z) and per path

@@ -621,8 +621,17 @@ void LoadRelease(const Context& context, const Section& s, SceneFile& out) {
   }
   if (s.Has("file")) {
     const std::string path = context.Resolve(s.String("file", ""));
+    FeatureSelection select;
+    if (s.Has("layer")) {
+      select.layer = s.String("layer", "");
+      select.layer_what = context.Where(s.Node("layer")) + ": " + s.Key("layer");
+    }
+    if (s.Has("where")) {
+      select.where = s.String("where", "");
+      select.where_what = context.Where(s.Node("where")) + ": " + s.Key("where");
+    }
     const auto geometries = ReadReleaseGeometries(
-        path, out.crs_wkt, context.Where(s.Node("file")) + ": " + s.Key("file"));
+        path, out.crs_wkt, context.Where(s.Node("file")) + ": " + s.Key("file"), select);
     out.inputs.push_back(path);
     for (std::size_t k = 0; k < geometries.size(); ++k) {
       r.releases.push_back(geometries[k]);
@@ -630,6 +639,9 @@ void LoadRelease(const Context& context, const Section& s, SceneFile& out) {
                        ", geometry " + std::to_string(k) + ")");
     }
   }
+  for (const char* key : {"layer", "where"})
+    if (s.Has(key) && !s.Has("file"))
+      s.Fail(key, "chooses features of a vector file: give file = \"...\" as well");
   if (s.Has("runs")) {
     if (!r.releases.empty())
       s.Fail("runs", "a run table cannot be combined with points, lines, polygons or a file");
@@ -638,6 +650,15 @@ void LoadRelease(const Context& context, const Section& s, SceneFile& out) {
   if (r.releases.empty() && r.runs.empty())
     s.Fail("points", "missing: give points, lines, polygons, a vector file or a run table (runs)");
 
+  const std::vector<std::string> count_keys = {"rocks", "rocks_per_m2", "rocks_per_cell"};
+  std::string count_key = "rocks";
+  for (const std::string& key : count_keys)
+    if (s.Has(key)) {
+      if (key != count_key && s.Has(count_key))
+        s.Fail(key,
+               "give one of rocks, rocks_per_m2 and rocks_per_cell, not " + count_key + " as well");
+      count_key = key;
+    }
   const long rocks = s.Integer("rocks", 1);
   if (rocks < 1) s.Fail("rocks", std::to_string(rocks) + " must be >= 1");
   r.rocks_per_release = rocks;
@@ -645,6 +666,18 @@ void LoadRelease(const Context& context, const Section& s, SceneFile& out) {
       "height_m", 1.0, [](double v) { return v >= 0; }, "must be >= 0");
   if (r.height_m > kMaxReleaseHeight_m)
     s.Fail("height_m", Fmt(r.height_m) + " is more than " + Fmt(kMaxReleaseHeight_m) + " m");
+  if (s.Has("height_reference")) {
+    const std::string name = s.String("height_reference", "");
+    if (name == "lowest_point") {
+      r.height_reference = ensemble::ReleaseSpec::HeightReference::kLowestPoint;
+    } else if (name != "centre_of_mass") {
+      const std::string hint = ClosestName(name, {"centre_of_mass", "lowest_point"});
+      s.Fail("height_reference", "unknown reference '" + name + "'" +
+                                     (hint.empty() ? "" : " (did you mean '" + hint + "'?)") +
+                                     "; known: centre_of_mass, lowest_point");
+    }
+  }
+  r.clip_to_dem = s.Bool("clip_to_dem", false);
   if (const toml::node* node = s.Node("orientation")) {
     if (node->is_string()) {
       if (s.String("orientation", "") != "random")
@@ -679,16 +712,66 @@ void LoadRelease(const Context& context, const Section& s, SceneFile& out) {
     if (const std::string problem = ensemble::ReleaseGeometryProblem(r.releases[k]);
         !problem.empty())
       throw InputError(origin[k] + ": " + problem);
+  // Every point a rock can start from must lie on valid terrain: vertices, lines, polygon insides;
+  // with clip_to_dem, lines and polygons start rocks only where it has a height (but somewhere).
+  const GridGeometry& g = out.scene.terrain.heights().grid;
+  std::vector<double> on_terrain(r.releases.size(), 1.0);  // fraction of each release
+  for (std::size_t k = 0; k < r.releases.size(); ++k) {
+    const ReleaseGeometry& release = r.releases[k];
+    const auto v = ensemble::PointOffTerrain(out.scene.terrain, release);
+    if (!v) continue;
+    const std::string dem = " (the DEM covers x " + Fmt(g.x0_m) + " .. " + Fmt(g.x_max_m()) +
+                            ", y " + Fmt(g.y0_m) + " .. " + Fmt(g.y_max_m()) + ")";
+    if (!r.clip_to_dem || release.kind == ReleaseGeometry::Kind::kPoint)
+      throw InputError(origin[k] + ": (" + Fmt(v->x()) + ", " + Fmt(v->y()) +
+                       ") is outside the DEM or on nodata" + dem +
+                       (r.clip_to_dem ? "" : "; clip_to_dem = true starts rocks on the rest"));
+    on_terrain[k] = ensemble::FractionOnTerrain(out.scene.terrain, release);
+    if (on_terrain[k] == 0)
+      throw InputError(origin[k] + ": lies entirely outside the DEM or on nodata" + dem +
+                       ": clip_to_dem leaves no start point");
+    // Start points are drawn by rejection: the part on the terrain must not be a sliver.
+    double fill = on_terrain[k];
+    if (release.kind == ReleaseGeometry::Kind::kPolygon) {
+      Eigen::Vector2d lo = release.rings[0][0], hi = lo;
+      for (const Eigen::Vector2d& p : release.rings[0]) {
+        lo = lo.cwiseMin(p);
+        hi = hi.cwiseMax(p);
+      }
+      fill *= ensemble::ReleaseArea(release) / (hi - lo).prod();
+    }
+    if (fill < ensemble::kMinPolygonFill)
+      throw InputError(origin[k] + ": the part on valid DEM cells is " + Fmt(100 * fill) +
+                       " % of its " +
+                       (release.kind == ReleaseGeometry::Kind::kLine ? "length" : "bounding box") +
+                       ", less than " + Fmt(100 * ensemble::kMinPolygonFill) +
+                       " %: too little to draw start points from" + dem);
+  }
+  if (count_key != "rocks") {
+    // Rocks by area: round(density x area on the terrain) per polygon, at least 1.
+    const bool per_cell = count_key == "rocks_per_cell";
+    const double density = s.Checked(
+        count_key, 1.0, [](double v) { return v > 0; }, "must be > 0");
+    const double per_m2 = per_cell ? density / (g.dx_m * g.dy_m) : density;
+    if (!r.runs.empty())
+      s.Fail(count_key, "rocks by area are for polygons, not the runs of a run table");
+    std::vector<long> counts;
+    for (std::size_t k = 0; k < r.releases.size(); ++k) {
+      if (r.releases[k].kind != ReleaseGeometry::Kind::kPolygon)
+        s.Fail(count_key,
+               "rocks by area are for polygons only, but " + origin[k] + " is a " +
+                   (r.releases[k].kind == ReleaseGeometry::Kind::kPoint ? "point" : "line") +
+                   ": give rocks instead");
+      const double n = std::round(per_m2 * ensemble::ReleaseArea(r.releases[k]) * on_terrain[k]);
+      if (!(n <= double(ensemble::ReleaseSpec::kMaxTotalRocks)))
+        s.Fail(count_key, Fmt(n) + " rocks for " + origin[k] + ", more than " +
+                              std::to_string(ensemble::ReleaseSpec::kMaxTotalRocks));
+      counts.push_back(std::max(1L, static_cast<long>(n)));
+    }
+    r.SetRocksPerRelease(counts);
+  }
   std::string why;
   if (!r.IsValid(&why)) s.FailCheck(why);
-  // Every point a rock can start from must lie on valid terrain: vertices, lines, polygon insides.
-  const GridGeometry& g = out.scene.terrain.heights().grid;
-  for (std::size_t k = 0; k < r.releases.size(); ++k)
-    if (const auto v = ensemble::PointOffTerrain(out.scene.terrain, r.releases[k]))
-      throw InputError(origin[k] + ": (" + Fmt(v->x()) + ", " + Fmt(v->y()) +
-                       ") is outside the DEM or on nodata (the DEM covers x " + Fmt(g.x0_m) +
-                       " .. " + Fmt(g.x_max_m()) + ", y " + Fmt(g.y0_m) + " .. " +
-                       Fmt(g.y_max_m()) + ")");
 }
 
 void LoadSolver(const Section& s, SolverOptions& o, SolverPreset& preset,
@@ -845,11 +928,13 @@ SceneFile LoadScene(const std::string& path) {
     out.scene.rock = *out.release.blocks.front().shape;  // the shape of runs' first block
     out.rock_description = "blocks (" + std::to_string(out.release.blocks.size()) + ")";
   }
-  LoadRelease(context,
-              Section(context, SubTable(context, root, "release"), "release",
-                      {"points", "lines", "polygons", "file", "runs", "block_column", "height_m",
-                       "rocks", "orientation", "velocity_m_s", "angular_velocity_rad_s", "seed"}),
-              out);
+  LoadRelease(
+      context,
+      Section(context, SubTable(context, root, "release"), "release",
+              {"points", "lines", "polygons", "file", "layer", "where", "runs", "block_column",
+               "height_m", "height_reference", "rocks", "rocks_per_m2", "rocks_per_cell",
+               "clip_to_dem", "orientation", "velocity_m_s", "angular_velocity_rad_s", "seed"}),
+      out);
   LoadSolver(Section(context, SubTable(context, root, "solver"), "solver",
                      {"preset", "dt_s", "max_time_s", "gravity_m_s2", "normal_restitution",
                       "tangential_restitution", "viscous", "contact_solve", "tolerance_m_s",

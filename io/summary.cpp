@@ -69,7 +69,14 @@ std::string SummaryJson(const SceneFile& scene, const ensemble::EnsembleReport& 
     j["blocks"] = blocks;
   }
   j["shape_per_rock"] = static_cast<bool>(scene.release.shape_per_rock);
-  j["rocks_per_release"] = scene.release.rocks_per_release;
+  if (scene.release.release_first_rock.empty()) {
+    j["rocks_per_release"] = scene.release.rocks_per_release;
+  } else {  // rocks_per_m2: each release its own number
+    nlohmann::ordered_json counts = nlohmann::ordered_json::array();
+    for (long r = 0; r < scene.release.release_count(); ++r)
+      counts.push_back(scene.release.RocksOf(static_cast<int>(r)));
+    j["rocks_per_release"] = counts;
+  }
   j["rocks"] = report.rocks;
   j["ends"] = {{"rest", report.count(EndReason::kRest)},
                {"left_domain", report.count(EndReason::kLeftDomain)},

@@ -1,11 +1,18 @@
 #pragma once
-// trajectories.h5 (docs/scenes.md): group /rocks/<rock> per rock with datasets t (n),
-// position (n x 3), quaternion (n x 4, w x y z, the shape as given), velocity (n x 3),
-// angular_velocity (n x 3, world frame), contact (n, 0/1), scar (n); chunked and
-// deflate-compressed, written rock by rock (nothing is kept in memory), complete or absent.
-// Objects carry no timestamps: the same rocks give the same bytes. Every HDF5 failure (a full
-// disk, a file-size limit) is one std::runtime_error naming the file and the reason; HDF5 prints
-// nothing itself; a writer that failed writes nothing more and its temporary file goes with it.
+// trajectories.h5 (docs/scenes.md "Outputs"): one table per quantity over the samples of all rocks,
+// rock after rock, and an index with one row per rock:
+//   /samples/t (n), position (n x 3), quaternion (n x 4, w x y z, the shape as given),
+//            velocity (n x 3), angular_velocity (n x 3, world frame), contact (n, 0/1), scar (n)
+//   /rocks/rock (r), first_sample (r), sample_count (r), mass_kg (r),
+//          principal_inertia_kg_m2 (r x 3)
+// Every dataset has string attributes `units` and `frame` ("world", "body" or "none"); the root
+// has `format`, `format_version`, `crs` (the DEM's WKT, or "local metres") and the scene rock's
+// mass_kg and principal_inertia_kg_m2. Tables are chunked (8192 rows), shuffled and
+// deflate-compressed, written a chunk at a time (memory does not grow with the rocks), complete or
+// absent. Objects carry no timestamps and the bytes depend on the rocks alone: the same rocks give
+// the same bytes, however they were split. Every HDF5 failure (a full disk, a file-size limit) is
+// one std::runtime_error naming the file and the reason; HDF5 prints nothing itself; a writer that
+// failed writes nothing more and its temporary file goes with it.
 
 #include <memory>
 #include <string>
@@ -17,7 +24,11 @@
 
 namespace talus::io {
 
-// One rock's group of a trajectories.h5, as read back.
+inline constexpr const char* kTrajectoryFormat = "talus trajectories";
+inline constexpr int kTrajectoryFormatVersion = 2;        // 1: a group per rock (/rocks/<rock>/...)
+inline constexpr const char* kLocalCrs = "local metres";  // the crs of a scene without one
+
+// One rock of a trajectories.h5, as read back.
 struct StoredTrajectory {
   double mass_kg = 0;
   Eigen::Vector3d principal_inertia_kg_m2 = Eigen::Vector3d::Zero();
@@ -27,12 +38,14 @@ struct StoredTrajectory {
 class TrajectoryWriter {
  public:
   // Creates the file under a temporary name; root attributes mass_kg and principal_inertia_kg_m2
-  // of the scene's rock. Each rock's group carries those of the shape it ran with.
-  TrajectoryWriter(const std::string& path, const RockShape& rock);
+  // of the scene's rock and `crs` (`crs_wkt`, or kLocalCrs when empty). Each rock's row carries
+  // those of the shape it ran with.
+  TrajectoryWriter(const std::string& path, const RockShape& rock, const std::string& crs_wkt);
   ~TrajectoryWriter();
   TrajectoryWriter(const TrajectoryWriter&) = delete;
   TrajectoryWriter& operator=(const TrajectoryWriter&) = delete;
 
+  // Rocks come in increasing order (else std::logic_error).
   void Write(const ensemble::RockOutcome& rock);
   // Writes a rock read from another file: the same bytes as Write of the rock it came from.
   void Write(long rock, const StoredTrajectory& trajectory);
@@ -53,7 +66,10 @@ class TrajectoryReader {
   TrajectoryReader(const TrajectoryReader&) = delete;
   TrajectoryReader& operator=(const TrajectoryReader&) = delete;
 
+  // One rock: its index row, then its rows of the sample tables (rocks read in order share the
+  // index and sample chunks HDF5 caches).
   StoredTrajectory Read(long rock) const;
+  long rocks() const;  // rows of the index
 
  private:
   struct Impl;

@@ -1,5 +1,6 @@
 #include "io/vector.hpp"
 
+#include <cpl_error.h>
 #include <gdal_priv.h>
 #include <ogrsf_frmts.h>
 
@@ -63,10 +64,57 @@ void Collect(const OGRGeometry& geometry, const std::string& where,
 
 namespace {
 
-// Calls visit(feature, geometry in the target CRS, where) for every feature with a geometry.
+// The layers of `dataset` that `select` chooses (null: all of them).
+std::vector<OGRLayer*> SelectLayers(GDALDataset& dataset, const std::string& path,
+                                    const FeatureSelection* select) {
+  std::vector<OGRLayer*> all;
+  std::string names;
+  for (OGRLayer* layer : dataset.GetLayers()) {
+    all.push_back(layer);
+    names += std::string(names.empty() ? "" : ", ") + "'" + layer->GetName() + "'";
+  }
+  if (!select) return all;
+  OGRLayer* chosen = nullptr;
+  if (select->layer.empty()) {
+    if (all.size() > 1)
+      throw InputError(select->layer_what + ": " + path + " has " + std::to_string(all.size()) +
+                       " layers (" + names + "): choose one with layer = \"...\"");
+    if (!all.empty()) chosen = all.front();
+  } else {
+    for (OGRLayer* layer : all)
+      if (select->layer == layer->GetName()) chosen = layer;
+    if (!chosen)
+      throw InputError(select->layer_what + ": " + path + " has no layer '" + select->layer +
+                       "' (its layers: " + names + ")");
+  }
+  if (!chosen) return {};
+  // GDAL reports a bad clause through its error handler as well: keep it off stderr. Some drivers
+  // (GeoPackage) check the clause only when reading: read one feature to see.
+  CPLPushErrorHandler(CPLQuietErrorHandler);
+  CPLErrorReset();
+  OGRErr error =
+      chosen->SetAttributeFilter(select->where.empty() ? nullptr : select->where.c_str());
+  if (error == OGRERR_NONE && !select->where.empty()) {
+    chosen->ResetReading();
+    OGRFeature::DestroyFeature(chosen->GetNextFeature());
+    if (CPLGetLastErrorType() >= CE_Failure) error = OGRERR_FAILURE;
+    chosen->ResetReading();
+  }
+  const std::string message = CPLGetLastErrorMsg();
+  CPLPopErrorHandler();
+  if (error != OGRERR_NONE)
+    throw InputError(select->where_what + ": '" + select->where + "' is not a valid filter of " +
+                     path + " layer '" + chosen->GetName() + "'" +
+                     (message.empty() ? "" : ": " + message));
+  return {chosen};
+}
+
+// Calls visit(feature, geometry in the target CRS, where) for every feature with a geometry of
+// the layers `select` chooses (null: every layer).
 template <class Visit>
 void ForEachFeature(const std::string& path, const std::string& target_crs_wkt,
-                    const std::string& what, const std::string& placed, Visit&& visit) {
+                    const std::string& what, const std::string& placed,
+                    const FeatureSelection* select, Visit&& visit) {
   RegisterGdal();
   if (!std::filesystem::exists(path)) throw InputError(what + ": file not found: " + path);
   std::unique_ptr<GDALDataset> dataset(GDALDataset::Open(
@@ -77,7 +125,7 @@ void ForEachFeature(const std::string& path, const std::string& target_crs_wkt,
     target.importFromWkt(target_crs_wkt.c_str());
     target.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
   }
-  for (OGRLayer* layer : dataset->GetLayers()) {
+  for (OGRLayer* layer : SelectLayers(*dataset, path, select)) {
     std::unique_ptr<OGRCoordinateTransformation> transform;
     const OGRSpatialReference* source = layer->GetSpatialRef();
     if (source && target_crs_wkt.empty()) {
@@ -114,13 +162,19 @@ void ForEachFeature(const std::string& path, const std::string& target_crs_wkt,
 
 std::vector<ReleaseGeometry> ReadReleaseGeometries(const std::string& path,
                                                    const std::string& target_crs_wkt,
-                                                   const std::string& what) {
+                                                   const std::string& what,
+                                                   const FeatureSelection& select) {
+  FeatureSelection named = select;
+  if (named.layer_what.empty()) named.layer_what = what;
+  if (named.where_what.empty()) named.where_what = what;
   std::vector<ReleaseGeometry> out;
-  ForEachFeature(path, target_crs_wkt, what, "release",
+  ForEachFeature(path, target_crs_wkt, what, "release", &named,
                  [&](OGRFeature&, const OGRGeometry& geometry, const std::string& where) {
                    Collect(geometry, where, out);
                  });
-  if (out.empty()) throw InputError(what + ": " + path + " has no point, line or polygon");
+  if (out.empty())
+    throw InputError(what + ": " + path + " has no point, line or polygon" +
+                     (select.where.empty() ? "" : " where " + select.where));
   return out;
 }
 
@@ -129,7 +183,7 @@ std::vector<fieldobs::DepositObservation> ReadDepositPoints(const std::string& p
                                                             const std::string& run_field,
                                                             const std::string& what) {
   std::vector<fieldobs::DepositObservation> out;
-  ForEachFeature(path, target_crs_wkt, what, "observations",
+  ForEachFeature(path, target_crs_wkt, what, "observations", nullptr,
                  [&](OGRFeature& feature, const OGRGeometry& geometry, const std::string& where) {
                    if (wkbFlatten(geometry.getGeometryType()) != wkbPoint)
                      throw InputError(where + ": a rest position must be a point, not a " +

@@ -9,13 +9,23 @@
 
 namespace talus::io {
 
-// Every point, line and polygon of every layer (multi-geometries are split), in the CRS
+// Which features of a vector file: those of `layer` (empty: the file's only layer; a file of
+// several layers is then an error listing them) that pass the OGR attribute filter `where`
+// (OGRLayer::SetAttributeFilter, an SQL WHERE clause such as "zone = 'A' AND active = 1"; empty:
+// all). `layer_what` and `where_what` name the scene keys in errors.
+struct FeatureSelection {
+  std::string layer, layer_what;
+  std::string where, where_what;
+};
+
+// Every point, line and polygon of the selected features (multi-geometries are split), in the CRS
 // `target_crs_wkt` when both it and the file have a CRS, else as stored. `what` names the scene
 // key in errors. Throws InputError (missing file, no features, unsupported geometry, a CRS the
-// DEM lacks).
+// DEM lacks, an unknown layer, several layers and none chosen, a bad where clause).
 std::vector<ensemble::ReleaseGeometry> ReadReleaseGeometries(const std::string& path,
                                                              const std::string& target_crs_wkt,
-                                                             const std::string& what);
+                                                             const std::string& what,
+                                                             const FeatureSelection& select = {});
 
 // Surveyed rest positions from the point features of a vector file, in the DEM's CRS: reprojected
 // when the file and the DEM both have a CRS; an error when the file has one and the DEM none (a

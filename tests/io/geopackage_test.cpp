@@ -42,7 +42,7 @@ TEST(RocksGeoPackage, EndPointsWithEveryColumnAndPathsInTheDemsCrs) {
   const auto dir = testing::FreshDir("gpkg");
   testing::WriteText(dir / "rocks.csv", RocksCsv(3));
   {
-    TrajectoryWriter writer((dir / "t.h5").string(), MakeRockShape(MakeBox(1, 1, 1), 2000));
+    TrajectoryWriter writer((dir / "t.h5").string(), MakeRockShape(MakeBox(1, 1, 1), 2000), "");
     for (long rock = 0; rock < 3; ++rock) {
       StoredTrajectory t;
       t.mass_kg = 2000;

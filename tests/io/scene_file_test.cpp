@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <limits>
 
 #include "common/error.hpp"
@@ -813,6 +814,124 @@ TEST(LoadScene, AbsurdRunTableAndBlockValuesAreErrorsStatingTheBound) {
   EXPECT_HAS(
       error(ok, Replace(kRunScene, "size_m = [1.0, 0.5, 0.2]", "size_m = [1e-4, 1e-4, 1e-4]")),
       "blocks.slab: block 'slab': the volume 1e-12 is outside 1e-09 .. 1000000 m3");
+}
+
+// clip_to_dem: a polygon half over a nodata hole starts every rock on valid terrain and keeps
+// its rock count; without the option the release is an error, and a point off the DEM or a
+// polygon entirely over nodata stays one.
+TEST(LoadScene, ClipToDemStartsRocksOnlyOverValidCells) {
+  const auto dir = testing::FreshDir("clip");
+  std::filesystem::create_directories(dir / "data");
+  // 7 x 7 nodes of 10 m at the pixel centres (x 1005 .. 1065, y 1985 .. 2045); the nodes from
+  // x = 1035 east are nodata, so the terrain east of x = 1025 has no height.
+  std::vector<std::vector<double>> dem(7, std::vector<double>(7, 500.0));
+  for (auto& row : dem)
+    for (int c = 3; c < 7; ++c) row[c] = -9999;
+  testing::WriteGdalRaster(dir / "data" / "dem.tif", dem, kGeo, 31287, -9999.0);
+  const std::string scene =
+      "[terrain]\ndem = \"data/dem.tif\"\n[rock]\nshape = { sphere = 0.3 }\n[release]\n"
+      "rocks = 400\n";
+  const std::string half =
+      "polygons = [[[1010, 1995], [1040, 1995], [1040, 2035], [1010, 2035]]]\n";
+  EXPECT_HAS(ErrorOf(scene + half, dir), "is outside the DEM or on nodata");
+  EXPECT_HAS(ErrorOf(scene + half, dir), "clip_to_dem = true starts rocks on the rest");
+
+  testing::WriteText(dir / "scene.toml", scene + half + "clip_to_dem = true\n");
+  const SceneFile s = LoadScene((dir / "scene.toml").string());
+  ASSERT_EQ(s.release.total_rocks(), 400);
+  int west_of_hole = 0;
+  for (long k = 0; k < s.release.total_rocks(); ++k) {
+    const Eigen::Vector3d p = ensemble::Release(s.scene, s.release, k).start.position_m;
+    EXPECT_TRUE(ensemble::OnTerrain(s.scene.terrain, p.head<2>())) << k << ": " << p.transpose();
+    EXPECT_LE(p.x(), 1025.0) << k;
+    EXPECT_GE(p.x(), 1010.0) << k;
+    west_of_hole += p.x() < 1025 ? 1 : 0;
+  }
+  EXPECT_EQ(west_of_hole, 400);
+  // The same start points for the same seed (deterministic), and on a line too.
+  EXPECT_EQ(ensemble::Release(s.scene, s.release, 7).start.position_m,
+            ensemble::Release(LoadScene((dir / "scene.toml").string()).scene, s.release, 7)
+                .start.position_m);
+  testing::WriteText(dir / "scene.toml",
+                     scene + "lines = [[[1010, 2010], [1060, 2010]]]\nclip_to_dem = true\n");
+  const SceneFile line = LoadScene((dir / "scene.toml").string());
+  for (long k = 0; k < line.release.total_rocks(); ++k)
+    EXPECT_LE(ensemble::Release(line.scene, line.release, k).start.position_m.x(), 1025.0);
+
+  EXPECT_HAS(ErrorOf(scene + "points = [[1045, 2010]]\nclip_to_dem = true\n", dir),
+             "release.points[0]: (1045, 2010) is outside the DEM or on nodata");
+  EXPECT_HAS(
+      ErrorOf(scene + "polygons = [[[1040, 1995], [1060, 1995], [1060, 2035], [1040, 2035]]]\n"
+                      "clip_to_dem = true\n",
+              dir),
+      "release.polygons[0]: lies entirely outside the DEM or on nodata");
+  EXPECT_HAS(ErrorOf(scene + half + "clip_to_dem = 1\n", dir),
+             "release.clip_to_dem: expected true or false");
+}
+
+// rocks_per_m2: each polygon gets round(density x area) rocks, so that polygons of different
+// areas get the same rocks per m2; rocks_per_cell is the same per DEM cell.
+TEST(LoadScene, RocksPerAreaGiveEachPolygonRocksByItsArea) {
+  const auto dir = testing::FreshDir("per_area");
+  const std::string scene =
+      "[terrain]\nplane = { slope_deg = 30, slope_length_m = 40, runout_m = 20, width_m = 30, "
+      "cell_m = 2 }\n[rock]\nshape = { sphere = 0.3 }\n[release]\n"
+      "polygons = [[[2, -2], [4, -2], [4, 0], [2, 0]], [[10, 0], [18, 0], [18, 4], [10, 4]],"
+      " [[20, 0], [20.3, 0], [20.3, 0.3]]]\n";  // 4 m2, 32 m2 and 0.045 m2
+  testing::WriteText(dir / "scene.toml", scene + "rocks_per_m2 = 2.5\n");
+  const SceneFile s = LoadScene((dir / "scene.toml").string());
+  EXPECT_EQ(s.release.RocksOf(0), 10);  // 2.5 x 4
+  EXPECT_EQ(s.release.RocksOf(1), 80);  // 2.5 x 32: the same 2.5 rocks per m2
+  EXPECT_EQ(s.release.RocksOf(2), 1);   // round(0.1125) = 0, but every polygon gets a rock
+  EXPECT_EQ(s.release.total_rocks(), 91);
+  EXPECT_EQ(s.release.ReleaseOf(9), 0);
+  EXPECT_EQ(s.release.ReleaseOf(10), 1);
+  EXPECT_EQ(s.release.ReleaseOf(89), 1);
+  EXPECT_EQ(s.release.ReleaseOf(90), 2);
+  EXPECT_EQ(s.release.FirstRockOf(2), 90);
+  // Each rock starts inside its own polygon.
+  EXPECT_GE(ensemble::Release(s.scene, s.release, 10).start.position_m.x(), 10.0);
+  EXPECT_LE(ensemble::Release(s.scene, s.release, 9).start.position_m.x(), 4.0);
+
+  // Per cell of 2 x 2 m: 6 rocks per cell are 1.5 per m2.
+  testing::WriteText(dir / "scene.toml", scene + "rocks_per_cell = 6\n");
+  const SceneFile c = LoadScene((dir / "scene.toml").string());
+  EXPECT_EQ(c.release.RocksOf(0), 6);
+  EXPECT_EQ(c.release.RocksOf(1), 48);
+
+  EXPECT_HAS(ErrorOf(scene + "rocks = 3\nrocks_per_m2 = 1\n", dir),
+             "release.rocks_per_m2: give one of rocks, rocks_per_m2 and rocks_per_cell, not rocks "
+             "as well");
+  EXPECT_HAS(ErrorOf(scene + "rocks_per_m2 = -1\n", dir), "release.rocks_per_m2: -1 must be > 0");
+  EXPECT_HAS(ErrorOf(scene + "points = [[5, 0]]\nrocks_per_m2 = 1\n", dir),
+             "rocks by area are for polygons only, but");
+  EXPECT_HAS(ErrorOf(scene + "rocks_per_m2 = 1e12\n", dir), "more than 1000000000");
+}
+
+// height_reference: the centre of mass, or the lowest hull vertex, height_m above the ground
+// below it. A 2 x 1 x 0.5 m box, unrotated, on a 30 deg plane falling to +x: its lowest vertex
+// relative to the ground is the uphill bottom one, (-1, *, -0.25) m from the centre, so
+// z_centre = ground(x) + h + 0.25 + 1 * tan 30 (plane geometry; exact up to round-off).
+TEST(LoadScene, HeightReferenceCentreOfMassOrLowestPoint) {
+  const auto dir = testing::FreshDir("height_reference");
+  const std::string scene =
+      "[terrain]\nplane = { slope_deg = 30, slope_length_m = 40, runout_m = 20, width_m = 30 }\n"
+      "[rock]\nshape = { box = [2, 1, 0.5] }\n[release]\npoints = [[10, 0]]\n"
+      "orientation = [1, 0, 0, 0]\nheight_m = 1\n";
+  const double ground = (40 - 10) * std::tan(30 * M_PI / 180);
+  for (const std::string reference : {"", "height_reference = \"centre_of_mass\"\n"}) {
+    testing::WriteText(dir / "scene.toml", scene + reference);
+    const SceneFile s = LoadScene((dir / "scene.toml").string());
+    EXPECT_NEAR(ensemble::Release(s.scene, s.release, 0).start.position_m.z(), ground + 1, 1e-9);
+  }
+  testing::WriteText(dir / "scene.toml", scene + "height_reference = \"lowest_point\"\n");
+  const SceneFile s = LoadScene((dir / "scene.toml").string());
+  const ensemble::ReleasedRock r = ensemble::Release(s.scene, s.release, 0);
+  EXPECT_NEAR(r.start.position_m.z(), ground + 1 + 0.25 + std::tan(30 * M_PI / 180), 1e-9);
+  EXPECT_EQ(r.lift_m, 0);
+  EXPECT_HAS(
+      ErrorOf(scene + "height_reference = \"lowest_pont\"\n", dir),
+      "release.height_reference: unknown reference 'lowest_pont' (did you mean 'lowest_point'?)");
 }
 
 }  // namespace
