@@ -168,6 +168,7 @@ int RunSimulateOnRanks(const SimulateArgs& args) {
     std::printf("Scene %s: %s; %s; %d ranks\n", args.scene.c_str(),
                 scene.terrain_description.c_str(), DescribeRocks(scene).c_str(), mpi.size());
     std::fflush(stdout);
+    PrintSceneWarnings(scene);
   }
 
   // Running: rank r's rocks are [r N / R, (r + 1) N / R), written as a part into a staging

@@ -258,6 +258,35 @@ void LoadTerrain(const Context& context, const Section& s, SceneFile& out) {
   }
 }
 
+// [rock] clean: `false` (no outlier removal) or { <the fields of CleanOptions> }, the defaults
+// for the fields not given.
+pointclouds::CleanOptions LoadClean(const Context& context, const Section& rock) {
+  pointclouds::CleanOptions o;
+  const toml::node* node = rock.Node("clean");
+  if (!node) return o;
+  if (node->is_boolean()) return *node->value<bool>() ? o : pointclouds::CleanOptions::Off();
+  if (!node->is_table())
+    rock.Fail("clean", "expected false or an inline table { outlier_neighbours = 16, ... }");
+  const Section s(context, node->as_table(), "rock.clean",
+                  {"drop_non_finite", "drop_duplicates", "outlier_neighbours", "outlier_std_ratio",
+                   "outlier_spacing_ratio", "outlier_passes", "voxel_m"});
+  o.drop_non_finite = s.Bool("drop_non_finite", o.drop_non_finite);
+  o.drop_duplicates = s.Bool("drop_duplicates", o.drop_duplicates);
+  const auto integer = [&](const std::string& key, int fallback) {
+    const long v = s.Integer(key, fallback);
+    if (v != static_cast<int>(v)) s.Fail(key, std::to_string(v) + " is out of range");
+    return static_cast<int>(v);
+  };
+  o.outlier_neighbours = integer("outlier_neighbours", o.outlier_neighbours);
+  o.outlier_std_ratio = s.Number("outlier_std_ratio", o.outlier_std_ratio);
+  o.outlier_spacing_ratio = s.Number("outlier_spacing_ratio", o.outlier_spacing_ratio);
+  o.outlier_passes = integer("outlier_passes", o.outlier_passes);
+  o.voxel_m = s.Number("voxel_m", o.voxel_m);
+  std::string why;
+  if (!o.IsValid(&why)) s.FailCheck(why);
+  return o;
+}
+
 void LoadRock(const Context& context, const Section& s, SceneFile& out) {
   pointclouds::RockSpec& rock = out.rock;
   if (!s.Has("shape"))
@@ -278,10 +307,13 @@ void LoadRock(const Context& context, const Section& s, SceneFile& out) {
            std::to_string(max_vertices) + " must be 0 (no simplification) or in 4 .. 100000");
   rock.max_vertices = static_cast<int>(max_vertices);
   const toml::node* shape = s.Node("shape");
+  if (s.Has("clean") && !shape->is_string())
+    s.Fail("clean", "only a point cloud file is cleaned; the shape is a built-in");
   if (shape->is_string()) {
     rock.file = context.Resolve(s.String("shape", ""));
     if (!fs::exists(rock.file)) s.Fail("shape", "file not found: " + rock.file);
     out.inputs.push_back(rock.file);
+    rock.clean = LoadClean(context, s);
   } else if (shape->is_table()) {
     const Section b(context, shape->as_table(), "rock.shape",
                     {"box", "ellipsoid", "sphere", "cylinder", "rock", "eota", "size_m", "points",
@@ -353,6 +385,8 @@ void LoadRock(const Context& context, const Section& s, SceneFile& out) {
     pointclouds::RockReport report;
     out.scene.rock = pointclouds::MakeRock(rock, &report);
     out.rock_description = report.source;
+    for (const std::string& warning : report.warnings)
+      out.warnings.push_back(context.Where(shape) + ": rock.shape: " + warning);
   } catch (const InputError& e) {
     throw InputError(context.Where(shape) + ": rock.shape: " + e.what());
   }
@@ -812,7 +846,7 @@ SceneFile LoadScene(const std::string& path) {
     LoadRock(context,
              Section(context, SubTable(context, root, "rock"), "rock",
                      {"shape", "density_kg_m3", "volume_m3", "mass_kg", "max_vertices",
-                      "shape_per_rock"}),
+                      "shape_per_rock", "clean"}),
              out);
   } else {
     out.scene.rock = *out.release.blocks.front().shape;  // the shape of runs' first block
@@ -830,7 +864,8 @@ SceneFile LoadScene(const std::string& path) {
                "rest_speed_m_s", "rest_angular_speed_rad_s", "rest_hold_s"}),
       out.scene.options);
   LoadOutput(Section(context, SubTable(context, root, "output"), "output",
-                     {"trajectories", "trajectory_interval_s", "rasters", "quicklook", "report", "geopackage"}),
+                     {"trajectories", "trajectory_interval_s", "rasters", "quicklook", "report",
+                      "geopackage"}),
              out.output);
   if (!out.release.blocks.empty() && out.release.runs.empty())
     context.Fail(root.get("blocks"), "blocks",

@@ -30,9 +30,8 @@ nlohmann::ordered_json GroundJson(const GroundTable& table) {
   for (int i = 0; i < table.size(); ++i) {
     const GroundCategory& c = table.category(i);
     const GroundParams& p = c.params;
-    nlohmann::ordered_json g = {{"code", c.code},           {"mu_min", p.mu_min},
-                                {"mu_max", p.mu_max},       {"beta", p.beta_1_s},
-                                {"kappa", p.kappa_1_m},     {"nu", p.nu_1_s}};
+    nlohmann::ordered_json g = {{"code", c.code},     {"mu_min", p.mu_min},   {"mu_max", p.mu_max},
+                                {"beta", p.beta_1_s}, {"kappa", p.kappa_1_m}, {"nu", p.nu_1_s}};
     if (p.HasDragLayer()) {
       g["drag_height_m"] = p.drag_height_m;
       g["drag_translational"] = p.drag_translational_1_s;
@@ -90,6 +89,7 @@ std::string SummaryJson(const SceneFile& scene, const ensemble::EnsembleReport& 
   j["wall_time_s"] = report.wall_time_s;
   j["trajectories_per_s"] = report.trajectories_per_s();
   j["outputs"] = outputs;
+  j["warnings"] = scene.warnings;
   return j.dump(2) + "\n";
 }
 

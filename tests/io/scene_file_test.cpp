@@ -2,9 +2,14 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <fstream>
 #include <limits>
+#include <nlohmann/json.hpp>
+#include <random>
 
 #include "common/error.hpp"
+#include "io/summary.hpp"
 #include "test_files.hpp"
 
 namespace talus::io {
@@ -161,9 +166,8 @@ TEST(LoadScene, ViscousReadingIsChosenByNameWithDidYouMean) {
   testing::WriteText(dir / "scene.toml", kPlaneScene);
   EXPECT_EQ(LoadScene((dir / "scene.toml").string()).scene.options.viscous,
             ViscousReading::kContactFriction);  // the default
-  testing::WriteText(
-      dir / "scene.toml",
-      Replace(kPlaneScene, "max_time_s = 20", "max_time_s = 20\nviscous = \"centre_of_mass\""));
+  testing::WriteText(dir / "scene.toml", Replace(kPlaneScene, "max_time_s = 20",
+                                                 "max_time_s = 20\nviscous = \"centre_of_mass\""));
   EXPECT_EQ(LoadScene((dir / "scene.toml").string()).scene.options.viscous,
             ViscousReading::kCentreOfMass);
   EXPECT_HAS(ErrorOf(Replace(kPlaneScene, "max_time_s = 20",
@@ -192,8 +196,9 @@ TEST(LoadScene, DragLayerPerCategoryWithBounds) {
   EXPECT_TRUE(s.scene.ground.AnyDragLayer());
   testing::WriteText(dir / "scene.toml", kPlaneScene);
   EXPECT_FALSE(LoadScene((dir / "scene.toml").string()).scene.ground.AnyDragLayer());  // off
-  EXPECT_HAS(ErrorOf(std::string(kPlaneScene) + "[ground.medium]\ndrag_height_m = 500\n", dir),
-             "ground.medium.drag_height_m: drag_height_m = 500 violates 0 <= drag_height_m <= 100 (m)");
+  EXPECT_HAS(
+      ErrorOf(std::string(kPlaneScene) + "[ground.medium]\ndrag_height_m = 500\n", dir),
+      "ground.medium.drag_height_m: drag_height_m = 500 violates 0 <= drag_height_m <= 100 (m)");
   EXPECT_HAS(ErrorOf(std::string(kPlaneScene) + "[ground.medium]\ndrag_rotational = -1\n", dir),
              "drag_rotational = -1 violates");
   EXPECT_HAS(ErrorOf(std::string(kPlaneScene) + "[ground.medium]\ndrag_hight_m = 5\n", dir),
@@ -442,6 +447,98 @@ TEST(LoadScene, PointCloudFileIsTheRocksHull) {
   EXPECT_NEAR(s.scene.rock.mass_kg, 1.0 * 0.5 * 0.2 * 2000, 1e-6);
   EXPECT_EQ(s.scene.rock.vertices_m.size(), 8u);
   EXPECT_EQ(s.inputs.size(), 2u);  // the scene and the point cloud
+}
+
+// A scan of an ellipsoid with semi-axes 1.4 x 1.0 x 0.8 m (6000 points on its surface) and
+// `outliers` stray returns 3 .. 10 m from its centre, as an .xyz file.
+void WriteScan(const std::filesystem::path& path, int outliers) {
+  std::mt19937_64 rng(51);
+  std::normal_distribution<double> g;
+  std::uniform_real_distribution<double> r(3, 10);
+  std::ofstream out(path);
+  out.precision(17);
+  for (int i = 0; i < 6000; ++i) {
+    const Eigen::Vector3d d = Eigen::Vector3d(g(rng), g(rng), g(rng)).normalized();
+    out << 1.4 * d.x() << " " << 1.0 * d.y() << " " << 0.8 * d.z() << "\n";
+  }
+  for (int i = 0; i < outliers; ++i) {
+    const Eigen::Vector3d d = Eigen::Vector3d(g(rng), g(rng), g(rng)).normalized() * r(rng);
+    out << d.x() << " " << d.y() << " " << d.z() << "\n";
+  }
+}
+
+// A scan with 1 % stray returns: the default scene gives the clean rock (4/3 pi abc = 4.69 m^3,
+// the hull of 6000 surface points within 1 % of it), with cleaning off the scene warns (and
+// summary.json lists the warning); a clean scan gives no warning and the same hull either way.
+TEST(LoadScene, PointCloudsAreCleanedByDefaultAndDominatedHullsWarn) {
+  const auto dir = testing::FreshDir("clean");
+  WriteScan(dir / "clean.xyz", 0);
+  WriteScan(dir / "dirty.xyz", 60);
+  const std::string scene =
+      "[terrain]\nplane = {}\n[rock]\nshape = \"dirty.xyz\"\n[release]\npoints = [[10, 0]]\n";
+  const double ellipsoid_m3 = 4.0 / 3.0 * std::acos(-1.0) * 1.4 * 1.0 * 0.8;
+  testing::WriteText(dir / "scene.toml", scene);
+  const SceneFile cleaned = LoadScene((dir / "scene.toml").string());
+  EXPECT_NEAR(cleaned.scene.rock.volume_m3, ellipsoid_m3, 0.01 * ellipsoid_m3);
+  EXPECT_TRUE(cleaned.warnings.empty());
+
+  testing::WriteText(dir / "scene.toml", Replace(scene, "[release]", "clean = false\n[release]"));
+  const SceneFile kept = LoadScene((dir / "scene.toml").string());
+  EXPECT_GT(kept.scene.rock.volume_m3, 10 * ellipsoid_m3);
+  ASSERT_EQ(kept.warnings.size(), 1u);
+  EXPECT_HAS(kept.warnings[0], "scene.toml:4: rock.shape: " + (dir / "dirty.xyz").string() +
+                                   ": a few points dominate the rock's hull");
+  ensemble::EnsembleReport report;
+  const auto j = nlohmann::json::parse(SummaryJson(kept, report, "0", {}));
+  EXPECT_EQ(j["warnings"][0], kept.warnings[0]);
+
+  // Outlier removal off by its own key: the same.
+  testing::WriteText(dir / "scene.toml",
+                     Replace(scene, "[release]", "clean = { outlier_neighbours = 0 }\n[release]"));
+  EXPECT_EQ(LoadScene((dir / "scene.toml").string()).warnings.size(), 1u);
+
+  // The clean scan: no warning, and cleaning leaves its hull as it is.
+  const std::string clean_scene = Replace(scene, "dirty.xyz", "clean.xyz");
+  testing::WriteText(dir / "scene.toml", clean_scene);
+  const SceneFile a = LoadScene((dir / "scene.toml").string());
+  testing::WriteText(dir / "scene.toml",
+                     Replace(clean_scene, "[release]", "clean = false\n[release]"));
+  const SceneFile b = LoadScene((dir / "scene.toml").string());
+  EXPECT_TRUE(a.warnings.empty());
+  EXPECT_TRUE(b.warnings.empty());
+  EXPECT_EQ(a.scene.rock.volume_m3, b.scene.rock.volume_m3);
+  EXPECT_EQ(a.scene.rock.vertices_m, b.scene.rock.vertices_m);
+  EXPECT_NEAR(a.scene.rock.volume_m3, ellipsoid_m3, 0.01 * ellipsoid_m3);
+}
+
+TEST(LoadScene, CleanOptionsAreCheckedByName) {
+  const auto dir = testing::FreshDir("clean_errors");
+  WriteScan(dir / "scan.xyz", 0);
+  const std::string scene =
+      "[terrain]\nplane = {}\n[rock]\nshape = \"scan.xyz\"\nclean = CLEAN\n"
+      "[release]\npoints = [[10, 0]]\n";
+  EXPECT_HAS(ErrorOf(Replace(scene, "CLEAN", "{ outlier_neighbors = 8 }"), dir),
+             "scene.toml:5: rock.clean.outlier_neighbors: unknown key (did you mean "
+             "'outlier_neighbours'?)");
+  EXPECT_HAS(ErrorOf(Replace(scene, "CLEAN", "{ outlier_std_ratio = -1 }"), dir),
+             "scene.toml:5: rock.clean.outlier_std_ratio: outlier_std_ratio = -1 violates");
+  EXPECT_HAS(ErrorOf(Replace(scene, "CLEAN", "{ outlier_passes = 0 }"), dir),
+             "rock.clean.outlier_passes: outlier_passes = 0 violates 1 <= outlier_passes <= 100");
+  EXPECT_HAS(ErrorOf(Replace(scene, "CLEAN", "{ voxel_m = \"fine\" }"), dir),
+             "rock.clean.voxel_m: expected a number");
+  EXPECT_HAS(ErrorOf(Replace(scene, "CLEAN", "\"yes\""), dir),
+             "rock.clean: expected false or an inline table");
+  EXPECT_HAS(ErrorOf("[terrain]\nplane = {}\n[rock]\nshape = { box = [1, 1, 1] }\nclean = false\n"
+                     "[release]\npoints = [[10, 0]]\n",
+                     dir),
+             "rock.clean: only a point cloud file is cleaned");
+  // Every field by its name.
+  EXPECT_EQ(ErrorOf(Replace(scene, "CLEAN",
+                            "{ drop_non_finite = true, drop_duplicates = true, "
+                            "outlier_neighbours = 8, outlier_std_ratio = 5, "
+                            "outlier_spacing_ratio = 4, outlier_passes = 3, voxel_m = 0.01 }"),
+                    dir),
+            "");
 }
 
 }  // namespace
