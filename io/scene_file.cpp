@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -150,6 +151,70 @@ std::string HashFiles(const std::vector<std::string>& files) {
   return Hex(h);
 }
 
+// [terrain] ground_polygons = { file, field }: the polygons rasterised onto the DEM's grid (a
+// node takes the category of the last polygon holding it), over the ground raster's category at
+// the node where there is one.
+void LoadGroundPolygons(const Context& context, const Section& terrain, SceneFile& out) {
+  const toml::node* node = terrain.Node("ground_polygons");
+  if (!node->is_table())
+    terrain.Fail("ground_polygons", "expected an inline table { file = \"...\", field = \"...\" }");
+  const Section s(context, node->as_table(), "terrain.ground_polygons", {"file", "field"});
+  for (const char* required : {"file", "field"})
+    if (!s.Has(required))
+      context.Fail(node, s.Key(required), "missing: give the vector file and its category field");
+  const std::string path = context.Resolve(s.String("file", ""));
+  const std::string field = s.String("field", "");
+  const std::string what = context.Where(node) + ": " + terrain.Key("ground_polygons");
+  const std::vector<GroundPolygon> polygons = ReadGroundPolygons(path, out.crs_wkt, field, what);
+  out.inputs.push_back(path);
+  Scene& scene = out.scene;
+  std::vector<std::vector<std::vector<Eigen::Vector2d>>> rings;
+  std::vector<int> burn;
+  for (const GroundPolygon& p : polygons) {
+    int index = p.numeric ? -1 : scene.ground.IndexOfName(p.value);
+    if (index < 0 && (p.numeric || p.value.find_first_not_of("0123456789") == std::string::npos)) {
+      const long code = std::strtol(p.value.c_str(), nullptr, 10);
+      if (code >= 0 && code <= 254) index = scene.ground.IndexOfCode(static_cast<int>(code));
+    }
+    if (index < 0) {
+      std::vector<std::string> names;
+      for (int k = 0; k < scene.ground.size(); ++k) names.push_back(scene.ground.category(k).name);
+      const std::string hint = p.numeric ? "" : ClosestName(p.value, names);
+      throw InputError(p.where + ": field '" + field + "' is '" + p.value +
+                       "', which is neither the name nor the code of a ground category" +
+                       (hint.empty() ? "" : " (did you mean '" + hint + "'?)"));
+    }
+    rings.push_back(p.rings);
+    burn.push_back(index);
+  }
+  const GridGeometry& d = scene.terrain.heights().grid;
+  const std::vector<int> burnt = RasterisePolygons(d, rings, burn);
+  GroundGrid grid;
+  grid.grid = d;
+  grid.index.resize(burnt.size());
+  bool any = false;
+  const bool raster = scene.terrain.has_ground_grid();
+  for (std::size_t k = 0; k < burnt.size(); ++k) {
+    any = any || burnt[k] >= 0;
+    if (burnt[k] >= 0) {
+      grid.index[k] = static_cast<std::uint8_t>(burnt[k]);
+    } else if (raster) {
+      const double x = d.x0_m + d.dx_m * static_cast<double>(k % static_cast<std::size_t>(d.nx));
+      const double y = d.y0_m + d.dy_m * static_cast<double>(k / static_cast<std::size_t>(d.nx));
+      grid.index[k] = static_cast<std::uint8_t>(scene.terrain.GroundAt(x, y));
+    } else {
+      grid.index[k] = GroundGrid::kNoGround;
+    }
+  }
+  if (!any)
+    throw InputError(what + ": " + path + " covers no cell centre of the DEM (x " + Fmt(d.x0_m) +
+                     " .. " + Fmt(d.x_max_m()) + ", y " + Fmt(d.y0_m) + " .. " + Fmt(d.y_max_m()) +
+                     "): every contact would get the default ground");
+  scene.terrain.SetGroundGrid(std::move(grid));
+  std::string why;
+  if (!scene.terrain.IsValid(&why)) terrain.Fail("ground_polygons", why);
+}
+
 void LoadTerrain(const Context& context, const Section& s, SceneFile& out) {
   Scene& scene = out.scene;
   if (s.Has("dem") == s.Has("plane"))
@@ -216,15 +281,11 @@ void LoadTerrain(const Context& context, const Section& s, SceneFile& out) {
   if (s.Has("ground")) {
     const std::string path = context.Resolve(s.String("ground", ""));
     const std::string what = context.Where(s.Node("ground")) + ": " + s.Key("ground");
-    const Raster codes = ReadRaster(path, what);
+    std::string reprojected_from;
+    const Raster codes = ReadRasterIn(path, out.crs_wkt, what, &reprojected_from);
     out.inputs.push_back(path);
-    if (!codes.crs_wkt.empty() && !out.crs_wkt.empty() && !SameCrs(codes.crs_wkt, out.crs_wkt))
-      s.Fail("ground", path + " is in another CRS than the DEM: " + DescribeCrs(codes.crs_wkt) +
-                           (IsGeographicCrs(codes.crs_wkt) ? ", in degrees," : "") +
-                           " where the DEM is in " + DescribeCrs(out.crs_wkt) +
-                           "; reprojecting ground rasters is not supported yet: warp it onto the "
-                           "DEM's CRS and grid first (gdalwarp -t_srs with the DEM's CRS, "
-                           "-r near to keep the codes)");
+    if (!reprojected_from.empty())
+      out.terrain_description += ", ground map reprojected from " + DescribeCrs(reprojected_from);
     // A ground raster off the DEM would give the default ground everywhere.
     const GridGeometry& d = scene.terrain.heights().grid;
     const GridGeometry& c = codes.grid;
@@ -256,6 +317,7 @@ void LoadTerrain(const Context& context, const Section& s, SceneFile& out) {
     scene.terrain.SetGroundGrid(std::move(grid));
     if (!scene.terrain.IsValid(&why)) s.Fail("ground", why);
   }
+  if (s.Has("ground_polygons")) LoadGroundPolygons(context, s, out);
 }
 
 // [rock] clean: `false` (no outlier removal) or { <the fields of CleanOptions> }, the defaults
@@ -838,7 +900,7 @@ SceneFile LoadScene(const std::string& path) {
   LoadGround(context, SubTable(context, root, "ground"), out.scene.ground);
   LoadTerrain(context,
               Section(context, SubTable(context, root, "terrain"), "terrain",
-                      {"dem", "plane", "ground", "default_ground"}),
+                      {"dem", "plane", "ground", "ground_polygons", "default_ground"}),
               out);
   LoadBlocks(context, SubTable(context, root, "blocks"), out);
   out.has_rock = root.get("rock") != nullptr;
