@@ -7,9 +7,9 @@
 #include <fstream>
 #include <limits>
 #include <memory>
-#include <sstream>
 #include <nlohmann/json.hpp>
 #include <random>
+#include <sstream>
 
 #include "common/error.hpp"
 #include "io/summary.hpp"
@@ -522,8 +522,8 @@ void WritePolygons(const std::filesystem::path& path, const std::string& feature
 
 std::string Feature(const std::string& properties, const std::string& geometry) {
   std::ostringstream out;
-  out << R"({"type": "Feature", "properties": {)" << properties << R"(}, "geometry": )"
-      << geometry << "}";
+  out << R"({"type": "Feature", "properties": {)" << properties << R"(}, "geometry": )" << geometry
+      << "}";
   return out.str();
 }
 
