@@ -480,7 +480,15 @@ int RunCalibrateOnProcesses(const CalibrateArgs& args) {
   // Rank 0 tells the story; the others would tell it again.
   if (mpi.rank() != 0 && !std::freopen("/dev/null", "w", stdout))
     std::cerr << "talus calibrate: rank " << mpi.rank() << " cannot silence its output\n";
-  return RunCalibrate(args, processes);
+  try {
+    return RunCalibrate(args, processes);
+  } catch (const Interrupted& e) {
+    // A signal while this rank waited for the others outside a run (mpirun ends every rank when
+    // one dies): unwinding to here removed this rank's temporary files.
+    std::cerr << "talus calibrate: rank " << mpi.rank() << ": " << e.what()
+              << " while waiting for the other ranks\n";
+    return ExitCodeForSignal(e.signal());
+  }
 #endif
 }
 

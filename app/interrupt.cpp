@@ -35,6 +35,8 @@ InterruptScope::~InterruptScope() {
   sigaction(SIGTERM, &g_previous_term, nullptr);
 }
 
+int PendingSignal() { return g_signal; }
+
 void ThrowIfInterrupted() {
   if (const int signal = g_signal; signal != 0) throw Interrupted(signal);
 }

@@ -31,5 +31,7 @@ class InterruptScope {
 
 // Throws Interrupted when SIGINT or SIGTERM arrived inside an InterruptScope.
 void ThrowIfInterrupted();
+// The signal that arrived inside the current InterruptScope, or 0.
+int PendingSignal();
 
 }  // namespace talus::app

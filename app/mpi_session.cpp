@@ -6,14 +6,21 @@
 #include <iostream>
 #include <thread>
 
+#include "app/interrupt.hpp"
+
 namespace talus::app {
 
 // Waits for a non-blocking operation without keeping a core busy: a rank that is done waits on a
 // node where other ranks (or other jobs) still work, and a blocking MPI call would spin.
+// A signal that arrives during the wait ends it (Interrupted): it is how mpirun ends the ranks
+// when one has died, and a dead rank never answers. A signal that arrived before the wait was
+// seen by the run, which waits here to agree with the others on it.
 void Wait(MPI_Request request) {
+  const bool signalled_before = PendingSignal() != 0;
   int done = 0;
   MPI_Test(&request, &done, MPI_STATUS_IGNORE);
   while (!done) {
+    if (!signalled_before) ThrowIfInterrupted();
     std::this_thread::sleep_for(std::chrono::milliseconds(2));
     MPI_Test(&request, &done, MPI_STATUS_IGNORE);
   }

@@ -52,13 +52,23 @@ void AddShapeOptions(CLI::App* verb, RockArgs& args) {
   verb->add_option("--max-vertices", spec.max_vertices,
                    "Simplify the hull to at most K vertices (0: off)")
       ->capture_default_str();
-  verb->add_option("--outliers", spec.clean.outlier_neighbours,
-                   "Statistical outlier removal over K nearest neighbours (0: off)");
-  verb->add_option("--outlier-std", spec.clean.outlier_std_ratio,
+  // The fields of pointclouds::CleanOptions, the keys of a scene's [rock] clean = { ... }.
+  verb->add_option("--outliers,--outlier-neighbours", spec.clean.outlier_neighbours,
+                   "Statistical outlier removal over K nearest neighbours (0: off)")
+      ->capture_default_str();
+  verb->add_option("--outlier-std,--outlier-std-ratio", spec.clean.outlier_std_ratio,
                    "Outlier threshold in standard deviations of the mean neighbour distance")
       ->capture_default_str();
-  verb->add_option("--voxel", spec.clean.voxel_m,
-                   "Downsample to one point per voxel of this size in m (0: off)");
+  verb->add_option("--outlier-spacing-ratio", spec.clean.outlier_spacing_ratio,
+                   "Drop an outlier only when its mean neighbour distance is also this many times "
+                   "the median (0: the statistical rule alone)")
+      ->capture_default_str();
+  verb->add_option("--outlier-passes", spec.clean.outlier_passes,
+                   "Repeat outlier removal until a pass drops nothing, at most this often")
+      ->capture_default_str();
+  verb->add_option("--voxel,--voxel-m", spec.clean.voxel_m,
+                   "Downsample to one point per voxel of this size in m (0: off)")
+      ->capture_default_str();
 }
 
 // Builds the rock; on failure prints one line on stderr and returns the exit code (bad input, or
@@ -73,6 +83,8 @@ int BuildRock(const char* verb, RockArgs& args, pointclouds::RockReport* report)
   if (*args.mass) args.spec.mass_kg = args.mass_kg;
   try {
     pointclouds::MakeRock(args.spec, report);
+    for (const std::string& warning : report->warnings)
+      std::cerr << "talus rock " << verb << ": WARNING: " << warning << "\n";
     return kExitOk;
   } catch (const std::bad_alloc&) {
     std::cerr << "talus rock " << verb << ": out of memory\n";

@@ -34,6 +34,10 @@ int LoadForSimulate(const SimulateArgs& args, io::SceneFile* scene, std::pair<lo
 // and blocks of a run table.
 std::string DescribeRocks(const io::SceneFile& scene);
 
+// Prints the scene's warnings (io::SceneFile::warnings) on stderr, one "talus simulate: WARNING:"
+// line each.
+void PrintSceneWarnings(const io::SceneFile& scene);
+
 // How many processes an MPI launcher (mpirun, srun) started this one among; 1 without a launcher.
 int LaunchedRanks();
 

@@ -54,6 +54,12 @@ std::string DescribeRocks(const io::SceneFile& scene) {
   return line;
 }
 
+void PrintSceneWarnings(const io::SceneFile& scene) {
+  for (const std::string& warning : scene.warnings)
+    std::fprintf(stderr, "talus simulate: WARNING: %s\n", warning.c_str());
+  std::fflush(stderr);
+}
+
 int LoadForSimulate(const SimulateArgs& args, io::SceneFile* scene, std::pair<long, long>* range,
                     std::string* message) {
   namespace fs = std::filesystem;
@@ -125,6 +131,7 @@ int RunSimulate(const SimulateArgs& args) {
 
   std::printf("Scene %s: %s; %s\n", args.scene.c_str(), scene.terrain_description.c_str(),
               DescribeRocks(scene).c_str());
+  PrintSceneWarnings(scene);
   std::printf(
       "Needs about %s of memory (%s available) and %s of disk (%s free)\n",
       io::FormatBytes(needs.memory_bytes()).c_str(), io::FormatBytes(capacity.memory_bytes).c_str(),

@@ -123,15 +123,13 @@ void ReceivePart(int from, const fs::path& dir) {
 std::string EnsembleIdentity(const SimulateArgs& args, const io::SceneFile& scene) {
   return "scene " + fs::absolute(args.scene).lexically_normal().string() + " (inputs hash " +
          scene.inputs_hash + "), seed " + std::to_string(scene.release.seed) + ", " +
-         std::to_string(scene.release.total_rocks()) + " rocks, --out " +
+         std::to_string(scene.release.total_rocks()) + " rocks, solver preset " +
+         ToString(scene.solver_preset) + ", --out " +
          fs::absolute(args.out).lexically_normal().string();
 }
 
-}  // namespace
-
-int RunSimulateOnRanks(const SimulateArgs& args) {
+int SimulateOnRanks(const MpiSession& mpi, const SimulateArgs& args) {
   const auto t0 = std::chrono::steady_clock::now();
-  const MpiSession mpi;
   const bool root = mpi.rank() == 0;
 
   // Loading: every rank reads the scene and must find the same ensemble as rank 0.
@@ -168,6 +166,7 @@ int RunSimulateOnRanks(const SimulateArgs& args) {
     std::printf("Scene %s: %s; %s; %d ranks\n", args.scene.c_str(),
                 scene.terrain_description.c_str(), DescribeRocks(scene).c_str(), mpi.size());
     std::fflush(stdout);
+    PrintSceneWarnings(scene);
   }
 
   // Running: rank r's rocks are [r N / R, (r + 1) N / R), written as a part into a staging
@@ -249,6 +248,21 @@ int RunSimulateOnRanks(const SimulateArgs& args) {
   part.reset();
   staging.reset();
   return Agree(mpi, code, message, "talus simulate");
+}
+
+}  // namespace
+
+int RunSimulateOnRanks(const SimulateArgs& args) {
+  const MpiSession mpi;
+  try {
+    return SimulateOnRanks(mpi, args);
+  } catch (const Interrupted& e) {
+    // A signal while this rank waited for the others (mpirun ends every rank when one dies, and
+    // a dead rank never answers): unwinding to here removed this rank's temporary files.
+    std::cerr << "talus simulate: rank " << mpi.rank() << ": " << e.what()
+              << " while waiting for the other ranks; removed this rank's temporary files\n";
+    return ExitCodeForSignal(e.signal());
+  }
 }
 
 #endif

@@ -1,6 +1,9 @@
 #include "io/raster.hpp"
 
+#include <gdal_alg.h>
 #include <gdal_priv.h>
+#include <gdal_utils.h>
+#include <ogr_geometry.h>
 
 #include <algorithm>
 #include <cmath>
@@ -28,12 +31,10 @@ void RegisterGdal() {
   std::call_once(once, [] { GDALAllRegister(); });
 }
 
-Raster ReadRaster(const std::string& path, const std::string& what) {
-  RegisterGdal();
-  if (!std::filesystem::exists(path)) throw InputError(what + ": file not found: " + path);
-  CPLErrorReset();
-  Dataset dataset(static_cast<GDALDataset*>(GDALOpen(path.c_str(), GA_ReadOnly)));
-  if (!dataset) throw InputError(what + ": GDAL cannot read " + path + ": " + CPLGetLastErrorMsg());
+namespace {
+
+// The raster of an open dataset (see ReadRaster); `path` and `what` name it in errors.
+Raster RasterOf(GDALDataset* dataset, const std::string& path, const std::string& what) {
   if (dataset->GetRasterCount() < 1) throw InputError(what + ": " + path + " has no raster band");
   double gt[6];
   if (dataset->GetGeoTransform(gt) != CE_None)
@@ -84,6 +85,53 @@ Raster ReadRaster(const std::string& path, const std::string& what) {
   return raster;
 }
 
+}  // namespace
+
+Raster ReadRaster(const std::string& path, const std::string& what) {
+  return ReadRasterIn(path, "", what, nullptr);
+}
+
+Raster ReadRasterIn(const std::string& path, const std::string& target_crs_wkt,
+                    const std::string& what, std::string* reprojected_from) {
+  RegisterGdal();
+  if (!std::filesystem::exists(path)) throw InputError(what + ": file not found: " + path);
+  CPLErrorReset();
+  Dataset dataset(static_cast<GDALDataset*>(GDALOpen(path.c_str(), GA_ReadOnly)));
+  if (!dataset) throw InputError(what + ": GDAL cannot read " + path + ": " + CPLGetLastErrorMsg());
+  if (dataset->GetRasterCount() < 1) throw InputError(what + ": " + path + " has no raster band");
+  const OGRSpatialReference* srs = dataset->GetSpatialRef();
+  std::string source_wkt;
+  if (srs) {
+    char* wkt = nullptr;
+    srs->exportToWkt(&wkt);
+    source_wkt = wkt ? wkt : "";
+    CPLFree(wkt);
+  }
+  if (target_crs_wkt.empty() || source_wkt.empty() || SameCrs(source_wkt, target_crs_wkt))
+    return RasterOf(dataset.get(), path, what);
+  // gdalwarp -t_srs <target> -r near -ot Float64 -dstnodata nan -of MEM: every value stays a
+  // value of the file (nearest neighbour), cells off the file are nodata.
+  const std::vector<std::string> args = {"-t_srs",  target_crs_wkt, "-r",  "near", "-ot",
+                                         "Float64", "-dstnodata",   "nan", "-of",  "MEM"};
+  std::vector<char*> argv;
+  for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+  argv.push_back(nullptr);
+  std::unique_ptr<GDALWarpAppOptions, decltype(&GDALWarpAppOptionsFree)> options(
+      GDALWarpAppOptionsNew(argv.data(), nullptr), &GDALWarpAppOptionsFree);
+  GDALDatasetH source = dataset.get();
+  int usage_error = 0;
+  CPLErrorReset();
+  Dataset warped(
+      GDALDataset::FromHandle(GDALWarp("", nullptr, 1, &source, options.get(), &usage_error)));
+  if (!warped)
+    throw InputError(what + ": cannot reproject " + path + " from " + DescribeCrs(source_wkt) +
+                     " to " + DescribeCrs(target_crs_wkt) + ": " + CPLGetLastErrorMsg());
+  if (reprojected_from) *reprojected_from = source_wkt;
+  Raster raster = RasterOf(warped.get(), path + " (reprojected)", what);
+  raster.crs_wkt = target_crs_wkt;
+  return raster;
+}
+
 bool SameCrs(const std::string& a_wkt, const std::string& b_wkt) {
   if (a_wkt == b_wkt) return true;
   OGRSpatialReference a, b;
@@ -121,6 +169,54 @@ std::string UtmEpsgFor(double lon_deg, double lat_deg) {
 std::array<double, 6> GeoTransformOf(const GridGeometry& grid) {
   return {grid.x0_m - 0.5 * grid.dx_m,      grid.dx_m, 0.0,
           grid.y_max_m() + 0.5 * grid.dy_m, 0.0,       -grid.dy_m};
+}
+
+std::vector<int> RasterisePolygons(
+    const GridGeometry& grid,
+    const std::vector<std::vector<std::vector<Eigen::Vector2d>>>& polygons,
+    const std::vector<int>& burn) {
+  RegisterGdal();
+  GDALDriver* mem = GetGDALDriverManager()->GetDriverByName("MEM");
+  if (!mem) throw std::runtime_error("GDAL has no MEM driver");
+  Dataset dataset(mem->Create("", grid.nx, grid.ny, 1, GDT_Int32, nullptr));
+  if (!dataset)
+    throw std::runtime_error("cannot rasterise polygons: " + std::string(CPLGetLastErrorMsg()));
+  std::array<double, 6> gt = GeoTransformOf(grid);
+  dataset->SetGeoTransform(gt.data());
+  GDALRasterBand* band = dataset->GetRasterBand(1);
+  band->Fill(-1);
+  std::vector<std::unique_ptr<OGRPolygon>> geometries;
+  std::vector<OGRGeometryH> handles;
+  std::vector<double> values;
+  for (std::size_t k = 0; k < polygons.size(); ++k) {
+    auto polygon = std::make_unique<OGRPolygon>();
+    for (const auto& ring : polygons[k]) {
+      auto r = std::make_unique<OGRLinearRing>();
+      for (const Eigen::Vector2d& p : ring) r->addPoint(p.x(), p.y());
+      r->closeRings();
+      polygon->addRingDirectly(r.release());
+    }
+    handles.push_back(OGRGeometry::ToHandle(polygon.get()));
+    geometries.push_back(std::move(polygon));
+    values.push_back(burn[k]);
+  }
+  int band_list[] = {1};
+  // No ALL_TOUCHED: a node is burnt when the cell centre is inside; polygons are burnt in order.
+  if (GDALRasterizeGeometries(GDALDataset::ToHandle(dataset.get()), 1, band_list,
+                              static_cast<int>(handles.size()), handles.data(), nullptr, nullptr,
+                              values.data(), nullptr, nullptr, nullptr) != CE_None)
+    throw std::runtime_error("cannot rasterise polygons: " + std::string(CPLGetLastErrorMsg()));
+  std::vector<int> rows(static_cast<std::size_t>(grid.nx) * grid.ny);
+  if (band->RasterIO(GF_Read, 0, 0, grid.nx, grid.ny, rows.data(), grid.nx, grid.ny, GDT_Int32, 0,
+                     0) != CE_None)
+    throw std::runtime_error("cannot rasterise polygons: " + std::string(CPLGetLastErrorMsg()));
+  std::vector<int> out(rows.size());
+  for (int r = 0; r < grid.ny; ++r) {
+    const int j = grid.ny - 1 - r;  // GDAL row r (from the north) is grid row j (from the south)
+    std::copy_n(rows.begin() + static_cast<long>(r) * grid.nx, grid.nx,
+                out.begin() + static_cast<long>(j) * grid.nx);
+  }
+  return out;
 }
 
 void WriteGeoTiff(const std::string& path, const GridGeometry& grid, const std::string& crs_wkt,

@@ -2,6 +2,7 @@
 // GDAL rasters: reading a DEM or a code raster into the solver's grid convention, and writing
 // GeoTIFFs on a grid with its CRS.
 
+#include <Eigen/Core>
 #include <array>
 #include <string>
 #include <vector>
@@ -26,6 +27,13 @@ inline constexpr double kMaxRasterCells = 4e8;
 // (file missing or unreadable, rotated or south-up geotransform, more than kMaxRasterCells cells).
 Raster ReadRaster(const std::string& path, const std::string& what);
 
+// The same, in the CRS `target_crs_wkt`: a raster with a CRS other than the target is warped to it
+// by GDAL (nearest neighbour, so every value is a value of the file; cells off it are NaN) on the
+// grid GDAL suggests (about the file's resolution, north-up), and *reprojected_from (when given)
+// gets the file's CRS. A raster without CRS, or an empty target, is read as it is.
+Raster ReadRasterIn(const std::string& path, const std::string& target_crs_wkt,
+                    const std::string& what, std::string* reprojected_from);
+
 // True when two WKT CRS definitions describe the same CRS.
 bool SameCrs(const std::string& a_wkt, const std::string& b_wkt);
 
@@ -48,6 +56,14 @@ std::array<double, 6> GeoTransformOf(const GridGeometry& grid);
 void WriteGeoTiff(const std::string& path, const GridGeometry& grid, const std::string& crs_wkt,
                   const std::vector<float>& values, bool has_nodata, double nodata,
                   const std::string& description);
+
+// Rasterises polygons onto the nodes of `grid` (GDAL's rasteriser): a node takes burn[k] of the
+// last polygon k whose inside holds it (later polygons over earlier ones), else -1. Each polygon is
+// its rings, the outer ring first, then holes, in the grid's coordinates.
+std::vector<int> RasterisePolygons(
+    const GridGeometry& grid,
+    const std::vector<std::vector<std::vector<Eigen::Vector2d>>>& polygons,
+    const std::vector<int>& burn);
 
 // Makes sure GDAL's drivers are registered (idempotent, thread-safe).
 void RegisterGdal();

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -150,6 +151,70 @@ std::string HashFiles(const std::vector<std::string>& files) {
   return Hex(h);
 }
 
+// [terrain] ground_polygons = { file, field }: the polygons rasterised onto the DEM's grid (a
+// node takes the category of the last polygon holding it), over the ground raster's category at
+// the node where there is one.
+void LoadGroundPolygons(const Context& context, const Section& terrain, SceneFile& out) {
+  const toml::node* node = terrain.Node("ground_polygons");
+  if (!node->is_table())
+    terrain.Fail("ground_polygons", "expected an inline table { file = \"...\", field = \"...\" }");
+  const Section s(context, node->as_table(), "terrain.ground_polygons", {"file", "field"});
+  for (const char* required : {"file", "field"})
+    if (!s.Has(required))
+      context.Fail(node, s.Key(required), "missing: give the vector file and its category field");
+  const std::string path = context.Resolve(s.String("file", ""));
+  const std::string field = s.String("field", "");
+  const std::string what = context.Where(node) + ": " + terrain.Key("ground_polygons");
+  const std::vector<GroundPolygon> polygons = ReadGroundPolygons(path, out.crs_wkt, field, what);
+  out.inputs.push_back(path);
+  Scene& scene = out.scene;
+  std::vector<std::vector<std::vector<Eigen::Vector2d>>> rings;
+  std::vector<int> burn;
+  for (const GroundPolygon& p : polygons) {
+    int index = p.numeric ? -1 : scene.ground.IndexOfName(p.value);
+    if (index < 0 && (p.numeric || p.value.find_first_not_of("0123456789") == std::string::npos)) {
+      const long code = std::strtol(p.value.c_str(), nullptr, 10);
+      if (code >= 0 && code <= 254) index = scene.ground.IndexOfCode(static_cast<int>(code));
+    }
+    if (index < 0) {
+      std::vector<std::string> names;
+      for (int k = 0; k < scene.ground.size(); ++k) names.push_back(scene.ground.category(k).name);
+      const std::string hint = p.numeric ? "" : ClosestName(p.value, names);
+      throw InputError(p.where + ": field '" + field + "' is '" + p.value +
+                       "', which is neither the name nor the code of a ground category" +
+                       (hint.empty() ? "" : " (did you mean '" + hint + "'?)"));
+    }
+    rings.push_back(p.rings);
+    burn.push_back(index);
+  }
+  const GridGeometry& d = scene.terrain.heights().grid;
+  const std::vector<int> burnt = RasterisePolygons(d, rings, burn);
+  GroundGrid grid;
+  grid.grid = d;
+  grid.index.resize(burnt.size());
+  bool any = false;
+  const bool raster = scene.terrain.has_ground_grid();
+  for (std::size_t k = 0; k < burnt.size(); ++k) {
+    any = any || burnt[k] >= 0;
+    if (burnt[k] >= 0) {
+      grid.index[k] = static_cast<std::uint8_t>(burnt[k]);
+    } else if (raster) {
+      const double x = d.x0_m + d.dx_m * static_cast<double>(k % static_cast<std::size_t>(d.nx));
+      const double y = d.y0_m + d.dy_m * static_cast<double>(k / static_cast<std::size_t>(d.nx));
+      grid.index[k] = static_cast<std::uint8_t>(scene.terrain.GroundAt(x, y));
+    } else {
+      grid.index[k] = GroundGrid::kNoGround;
+    }
+  }
+  if (!any)
+    throw InputError(what + ": " + path + " covers no cell centre of the DEM (x " + Fmt(d.x0_m) +
+                     " .. " + Fmt(d.x_max_m()) + ", y " + Fmt(d.y0_m) + " .. " + Fmt(d.y_max_m()) +
+                     "): every contact would get the default ground");
+  scene.terrain.SetGroundGrid(std::move(grid));
+  std::string why;
+  if (!scene.terrain.IsValid(&why)) terrain.Fail("ground_polygons", why);
+}
+
 void LoadTerrain(const Context& context, const Section& s, SceneFile& out) {
   Scene& scene = out.scene;
   if (s.Has("dem") == s.Has("plane"))
@@ -216,15 +281,11 @@ void LoadTerrain(const Context& context, const Section& s, SceneFile& out) {
   if (s.Has("ground")) {
     const std::string path = context.Resolve(s.String("ground", ""));
     const std::string what = context.Where(s.Node("ground")) + ": " + s.Key("ground");
-    const Raster codes = ReadRaster(path, what);
+    std::string reprojected_from;
+    const Raster codes = ReadRasterIn(path, out.crs_wkt, what, &reprojected_from);
     out.inputs.push_back(path);
-    if (!codes.crs_wkt.empty() && !out.crs_wkt.empty() && !SameCrs(codes.crs_wkt, out.crs_wkt))
-      s.Fail("ground", path + " is in another CRS than the DEM: " + DescribeCrs(codes.crs_wkt) +
-                           (IsGeographicCrs(codes.crs_wkt) ? ", in degrees," : "") +
-                           " where the DEM is in " + DescribeCrs(out.crs_wkt) +
-                           "; reprojecting ground rasters is not supported yet: warp it onto the "
-                           "DEM's CRS and grid first (gdalwarp -t_srs with the DEM's CRS, "
-                           "-r near to keep the codes)");
+    if (!reprojected_from.empty())
+      out.terrain_description += ", ground map reprojected from " + DescribeCrs(reprojected_from);
     // A ground raster off the DEM would give the default ground everywhere.
     const GridGeometry& d = scene.terrain.heights().grid;
     const GridGeometry& c = codes.grid;
@@ -256,6 +317,36 @@ void LoadTerrain(const Context& context, const Section& s, SceneFile& out) {
     scene.terrain.SetGroundGrid(std::move(grid));
     if (!scene.terrain.IsValid(&why)) s.Fail("ground", why);
   }
+  if (s.Has("ground_polygons")) LoadGroundPolygons(context, s, out);
+}
+
+// [rock] clean: `false` (no outlier removal) or { <the fields of CleanOptions> }, the defaults
+// for the fields not given.
+pointclouds::CleanOptions LoadClean(const Context& context, const Section& rock) {
+  pointclouds::CleanOptions o;
+  const toml::node* node = rock.Node("clean");
+  if (!node) return o;
+  if (node->is_boolean()) return *node->value<bool>() ? o : pointclouds::CleanOptions::Off();
+  if (!node->is_table())
+    rock.Fail("clean", "expected false or an inline table { outlier_neighbours = 16, ... }");
+  const Section s(context, node->as_table(), "rock.clean",
+                  {"drop_non_finite", "drop_duplicates", "outlier_neighbours", "outlier_std_ratio",
+                   "outlier_spacing_ratio", "outlier_passes", "voxel_m"});
+  o.drop_non_finite = s.Bool("drop_non_finite", o.drop_non_finite);
+  o.drop_duplicates = s.Bool("drop_duplicates", o.drop_duplicates);
+  const auto integer = [&](const std::string& key, int fallback) {
+    const long v = s.Integer(key, fallback);
+    if (v != static_cast<int>(v)) s.Fail(key, std::to_string(v) + " is out of range");
+    return static_cast<int>(v);
+  };
+  o.outlier_neighbours = integer("outlier_neighbours", o.outlier_neighbours);
+  o.outlier_std_ratio = s.Number("outlier_std_ratio", o.outlier_std_ratio);
+  o.outlier_spacing_ratio = s.Number("outlier_spacing_ratio", o.outlier_spacing_ratio);
+  o.outlier_passes = integer("outlier_passes", o.outlier_passes);
+  o.voxel_m = s.Number("voxel_m", o.voxel_m);
+  std::string why;
+  if (!o.IsValid(&why)) s.FailCheck(why);
+  return o;
 }
 
 void LoadRock(const Context& context, const Section& s, SceneFile& out) {
@@ -278,10 +369,13 @@ void LoadRock(const Context& context, const Section& s, SceneFile& out) {
            std::to_string(max_vertices) + " must be 0 (no simplification) or in 4 .. 100000");
   rock.max_vertices = static_cast<int>(max_vertices);
   const toml::node* shape = s.Node("shape");
+  if (s.Has("clean") && !shape->is_string())
+    s.Fail("clean", "only a point cloud file is cleaned; the shape is a built-in");
   if (shape->is_string()) {
     rock.file = context.Resolve(s.String("shape", ""));
     if (!fs::exists(rock.file)) s.Fail("shape", "file not found: " + rock.file);
     out.inputs.push_back(rock.file);
+    rock.clean = LoadClean(context, s);
   } else if (shape->is_table()) {
     const Section b(context, shape->as_table(), "rock.shape",
                     {"box", "ellipsoid", "sphere", "cylinder", "rock", "eota", "size_m", "points",
@@ -353,6 +447,8 @@ void LoadRock(const Context& context, const Section& s, SceneFile& out) {
     pointclouds::RockReport report;
     out.scene.rock = pointclouds::MakeRock(rock, &report);
     out.rock_description = report.source;
+    for (const std::string& warning : report.warnings)
+      out.warnings.push_back(context.Where(shape) + ": rock.shape: " + warning);
   } catch (const InputError& e) {
     throw InputError(context.Where(shape) + ": rock.shape: " + e.what());
   }
@@ -914,7 +1010,7 @@ SceneFile LoadScene(const std::string& path) {
   LoadGround(context, SubTable(context, root, "ground"), out.scene.ground);
   LoadTerrain(context,
               Section(context, SubTable(context, root, "terrain"), "terrain",
-                      {"dem", "plane", "ground", "default_ground"}),
+                      {"dem", "plane", "ground", "ground_polygons", "default_ground"}),
               out);
   LoadBlocks(context, SubTable(context, root, "blocks"), out);
   out.has_rock = root.get("rock") != nullptr;
@@ -922,7 +1018,7 @@ SceneFile LoadScene(const std::string& path) {
     LoadRock(context,
              Section(context, SubTable(context, root, "rock"), "rock",
                      {"shape", "density_kg_m3", "volume_m3", "mass_kg", "max_vertices",
-                      "shape_per_rock"}),
+                      "shape_per_rock", "clean"}),
              out);
   } else {
     out.scene.rock = *out.release.blocks.front().shape;  // the shape of runs' first block

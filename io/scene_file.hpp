@@ -44,6 +44,9 @@ struct SceneFile {
   std::string inputs_hash;          // FNV-1a 64 over the contents of `inputs`, hex
   SolverPreset solver_preset = SolverPreset::kDefault;  // [solver] preset, or --preset
   std::vector<std::string> solver_keys_given;           // the preset's knobs the scene sets itself
+  // Inputs that load but look wrong (e.g. a few points dominating the rock's hull), each naming
+  // the file, line and key: printed by talus simulate and listed in summary.json.
+  std::vector<std::string> warnings;
 };
 
 // Loads and validates a scene. Throws talus::InputError with "<file>:<line>: <key>: <reason>".

@@ -97,6 +97,7 @@ std::string SummaryJson(const SceneFile& scene, const ensemble::EnsembleReport& 
   j["wall_time_s"] = report.wall_time_s;
   j["trajectories_per_s"] = report.trajectories_per_s();
   j["outputs"] = outputs;
+  j["warnings"] = scene.warnings;
   return j.dump(2) + "\n";
 }
 

@@ -27,6 +27,24 @@ std::vector<ensemble::ReleaseGeometry> ReadReleaseGeometries(const std::string& 
                                                              const std::string& what,
                                                              const FeatureSelection& select = {});
 
+// One polygon of a ground map: its rings (the outer ring first, then holes; not repeating the first
+// point) and the value of the category field as text (numbers as integers: "6").
+struct GroundPolygon {
+  std::vector<std::vector<Eigen::Vector2d>> rings;
+  std::string value;
+  bool numeric = false;  // the field is a number (a category code), not text
+  std::string where;     // "<what> (<file>, feature <fid>)", for errors
+};
+
+// Every polygon of every layer of a vector file (multi-polygons split), in feature order, in the
+// CRS `target_crs_wkt` as for releases, with the value of the field `field`. Throws InputError
+// naming `what`, the file and the feature: missing file, no polygon, a point or line feature, no
+// field of that name (listing the fields there are), an empty value or a number that is not an
+// integer.
+std::vector<GroundPolygon> ReadGroundPolygons(const std::string& path,
+                                              const std::string& target_crs_wkt,
+                                              const std::string& field, const std::string& what);
+
 // Surveyed rest positions from the point features of a vector file, in the DEM's CRS: reprojected
 // when the file and the DEM both have a CRS; an error when the file has one and the DEM none (a
 // GeoJSON without a "crs" member is taken as local coordinates then, as for releases). Each

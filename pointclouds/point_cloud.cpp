@@ -6,6 +6,7 @@
 #include <pcl/io/pcd_io.h>
 #include <pcl/io/ply_io.h>
 #include <pcl/point_types.h>
+#include <pcl/search/kdtree.h>
 
 #include <algorithm>
 #include <array>
@@ -363,7 +364,10 @@ std::size_t DropDuplicates(PointCloud& cloud) {
   return dropped;
 }
 
-std::size_t DropOutliers(int neighbours, double std_ratio, PointCloud& cloud) {
+// One pass of PCL's statistical outlier removal, restricted by spacing_ratio (see CleanOptions);
+// the number of points it dropped.
+std::size_t DropOutliersOnce(int neighbours, double std_ratio, double spacing_ratio,
+                             PointCloud& cloud) {
   const std::size_t n = cloud.points_m.size();
   if (n <= static_cast<std::size_t>(neighbours)) return 0;
   // Recentred coordinates fit in float without loss that matters for neighbour statistics.
@@ -374,7 +378,7 @@ std::size_t DropOutliers(int neighbours, double std_ratio, PointCloud& cloud) {
     (*points)[i] = pcl::PointXYZ(static_cast<float>(p.x()), static_cast<float>(p.y()),
                                  static_cast<float>(p.z()));
   }
-  pcl::StatisticalOutlierRemoval<pcl::PointXYZ> filter;
+  pcl::StatisticalOutlierRemoval<pcl::PointXYZ> filter(/*extract_removed_indices=*/true);
   filter.setInputCloud(points);
   filter.setMeanK(neighbours);
   filter.setStddevMulThresh(std_ratio);
@@ -385,8 +389,42 @@ std::size_t DropOutliers(int neighbours, double std_ratio, PointCloud& cloud) {
   }
   std::vector<char> keep(n, 0);
   for (auto i : inliers) keep[static_cast<std::size_t>(i)] = 1;
+  const pcl::IndicesConstPtr flagged = filter.getRemovedIndices();
+  if (spacing_ratio > 0 && !flagged->empty()) {
+    // The mean distance to the neighbours, as the filter measures it, of every point: a flagged
+    // point stays unless it is also spacing_ratio times the median of it away from the others.
+    pcl::search::KdTree<pcl::PointXYZ> tree;
+    tree.setInputCloud(points);
+    pcl::Indices found(static_cast<std::size_t>(neighbours) + 1);
+    std::vector<float> squared(found.size());
+    std::vector<double> mean(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      const int k = tree.nearestKSearch((*points)[i], neighbours + 1, found, squared);
+      double sum = 0;
+      for (int j = 1; j < k; ++j) sum += std::sqrt(static_cast<double>(squared[j]));  // j 0: itself
+      mean[i] = k > 1 ? sum / (k - 1) : 0;
+    }
+    std::vector<double> sorted = mean;
+    std::nth_element(sorted.begin(), sorted.begin() + n / 2, sorted.end());
+    const double limit = spacing_ratio * sorted[n / 2];
+    for (auto i : *flagged)
+      if (mean[static_cast<std::size_t>(i)] <= limit) keep[static_cast<std::size_t>(i)] = 1;
+  }
   Compact(keep, cloud);
   return n - cloud.points_m.size();
+}
+
+// Repeats the pass until one drops nothing (or `passes` are done): the first pass's statistics
+// are inflated by the outliers themselves, so far ones can hide nearer ones.
+std::size_t DropOutliers(const CleanOptions& o, PointCloud& cloud) {
+  std::size_t dropped = 0;
+  for (int pass = 0; pass < o.outlier_passes; ++pass) {
+    const std::size_t now =
+        DropOutliersOnce(o.outlier_neighbours, o.outlier_std_ratio, o.outlier_spacing_ratio, cloud);
+    dropped += now;
+    if (now == 0) break;
+  }
+  return dropped;
 }
 
 std::size_t DownsampleVoxels(double voxel_m, PointCloud& cloud) {
@@ -481,6 +519,11 @@ bool CleanOptions::IsValid(std::string* why) const {
         << " violates 0 <= outlier_neighbours <= 1000";
   else if (!(outlier_std_ratio > 0) || !std::isfinite(outlier_std_ratio))
     msg << "outlier_std_ratio = " << outlier_std_ratio << " violates 0 < outlier_std_ratio < inf";
+  else if (!(outlier_spacing_ratio >= 0) || !std::isfinite(outlier_spacing_ratio))
+    msg << "outlier_spacing_ratio = " << outlier_spacing_ratio
+        << " violates 0 <= outlier_spacing_ratio < inf";
+  else if (outlier_passes < 1 || outlier_passes > 100)
+    msg << "outlier_passes = " << outlier_passes << " violates 1 <= outlier_passes <= 100";
   else if (!(voxel_m == 0 || voxel_m >= kMinVoxel_m) || !std::isfinite(voxel_m))
     msg << "voxel_m = " << voxel_m << " violates voxel_m = 0 (off) or " << kMinVoxel_m
         << " <= voxel_m < inf m";
@@ -494,8 +537,7 @@ CleanReport CleanPointCloud(const CleanOptions& options, PointCloud* cloud) {
   report.points_in = cloud->points_m.size();
   report.non_finite = DropNonFinite(options.drop_non_finite, *cloud);
   if (options.drop_duplicates) report.duplicates = DropDuplicates(*cloud);
-  if (options.outlier_neighbours > 0)
-    report.outliers = DropOutliers(options.outlier_neighbours, options.outlier_std_ratio, *cloud);
+  if (options.outlier_neighbours > 0) report.outliers = DropOutliers(options, *cloud);
   if (options.voxel_m > 0) report.downsampled = DownsampleVoxels(options.voxel_m, *cloud);
   report.points_out = cloud->points_m.size();
   return report;

@@ -169,6 +169,9 @@ RockShape MakeRockFromPoints(PointCloud cloud, const RockSpec& spec, RockReport*
     throw InputError(msg.str());
   }
   Polyhedron hull = ComputeConvexHull(cloud.points_m, source);
+  r.hull_check = CheckHull(cloud.points_m, ComputeMassProperties(hull, 1.0).volume_m3);
+  if (const std::string warning = r.hull_check->Warning(source); !warning.empty())
+    r.warnings.push_back(warning);
   return FinishRock(std::move(hull), cloud.offset_m, checked, r);
 }
 
@@ -183,6 +186,7 @@ std::string RockReport::FullReport() const {
     if (!recentred_by_m.isZero())
       out << "  recentred by " << Vec(recentred_by_m, "%.3f") << " m before any arithmetic\n";
   }
+  for (const std::string& warning : warnings) out << "  WARNING: " << warning << "\n";
   out << "  hull: " << hull_vertices << " vertices, " << hull_faces << " triangles\n";
   if (simplify) out << "  simplified: " << simplify->BriefReport() << "\n";
   if (std::abs(scale - 1) > 1e-9) {
@@ -238,6 +242,18 @@ std::string RockReport::ToJson() const {
                    {"duplicates", clean.duplicates},
                    {"outliers", clean.outliers},
                    {"downsampled", clean.downsampled}};
+  if (hull_check) {
+    j["hull_check"] = {{"centre_m", Array(hull_check->centre_m + recentred_by_m)},
+                       {"core_radius_m", hull_check->core_radius_m},
+                       {"hull_volume_m3", hull_check->hull_volume_m3},
+                       {"core_volume_m3", hull_check->core_volume_m3},
+                       {"far_points", hull_check->far_points},
+                       {"farthest_m", hull_check->farthest_m},
+                       {"dominated", hull_check->Dominated()}};
+  } else {
+    j["hull_check"] = nullptr;
+  }
+  j["warnings"] = warnings;
   if (simplify) {
     j["simplification"] = {{"vertices_before", simplify->vertices_before},
                            {"vertices_after", simplify->vertices_after},

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "pointclouds/hull_check.hpp"
 #include "pointclouds/hull_simplify.hpp"
 #include "pointclouds/point_cloud.hpp"
 #include "pointclouds/shape_descriptors.hpp"
@@ -59,6 +60,9 @@ struct RockReport {
   std::size_t points_read = 0;
   std::size_t points_used = 0;  // after cleaning
   CleanReport clean;
+  // Of a point cloud: whether a few of the used points dominate the hull, and the warning then.
+  std::optional<HullCheck> hull_check;
+  std::vector<std::string> warnings;
   Eigen::Vector3d recentred_by_m = Eigen::Vector3d::Zero();  // subtracted before any arithmetic
   // The hull the rock uses (after simplification).
   int hull_vertices = 0;
@@ -86,7 +90,7 @@ struct RockReport {
   // principal_moments_kg_m2 [3, ascending], principal_axes [3 unit vectors], dimensions_m
   // [a >= b >= c], shape_class, sphericity, hull_vertices, hull_faces, points_read, points_used,
   // and more (source, b_over_a, c_over_b, surface_area_m2, scale, density_from_mass,
-  // recentred_by_m, cleaning, simplification). Keys are only ever added.
+  // recentred_by_m, cleaning, simplification, hull_check, warnings). Keys are only ever added.
   std::string ToJson() const;
 };
 

@@ -1,11 +1,18 @@
 #include "io/scene_file.hpp"
 
 #include <gtest/gtest.h>
+#include <ogr_spatialref.h>
 
 #include <cmath>
+#include <fstream>
 #include <limits>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <random>
+#include <sstream>
 
 #include "common/error.hpp"
+#include "io/summary.hpp"
 #include "test_files.hpp"
 
 namespace talus::io {
@@ -373,12 +380,13 @@ TEST(LoadScene, GdalDemErrors) {
              "ground.my_scree.code: 6 is already the code of 'hard'");
   testing::WriteGdalRaster(dir / "data" / "ground_wgs84.tif", {{6}},
                            {11.0, 0.1, 0.0, 47.0, 0.0, -0.1}, 4326, 255.0);
-  // A ground raster in degrees under a projected DEM: the file and both CRSs, not a warp.
+  // A ground raster in degrees under a projected DEM is reprojected: this one is of another place
+  // (Austria, where the DEM's coordinates are near the origin of the Lambert projection).
   EXPECT_HAS(ErrorOf(Replace(kDemScene, "\"data/ground.tif\"", "\"data/ground_wgs84.tif\""), dir),
              "scene.toml:3: terrain.ground: " + (dir / "data" / "ground_wgs84.tif").string() +
-                 " is in another CRS than the DEM: EPSG:4326 (WGS 84), in degrees, where the DEM "
-                 "is in EPSG:31287 (MGI / Austria Lambert); reprojecting ground rasters is not "
-                 "supported yet");
+                 " covers x");
+  EXPECT_HAS(ErrorOf(Replace(kDemScene, "\"data/ground.tif\"", "\"data/ground_wgs84.tif\""), dir),
+             "which does not overlap the DEM");
   EXPECT_HAS(ErrorOf(Replace(kDemScene, "\"data/ground.tif\"", "\"data/grund.tif\""), dir),
              "scene.toml:3: terrain.ground: file not found");
 }
@@ -480,6 +488,251 @@ TEST(LoadScene, PointCloudFileIsTheRocksHull) {
   EXPECT_NEAR(s.scene.rock.mass_kg, 1.0 * 0.5 * 0.2 * 2000, 1e-6);
   EXPECT_EQ(s.scene.rock.vertices_m.size(), 8u);
   EXPECT_EQ(s.inputs.size(), 2u);  // the scene and the point cloud
+}
+
+// A ground raster in UTM zone 32N (EPSG:32632) under a DEM in the Swiss LV95 (EPSG:2056), the two
+// grids rotated by about 1.3 degrees: reprojected by nearest neighbour, the category at a point is
+// the file's category at that point's UTM coordinates. The map is a checkerboard of 100 m blocks
+// of codes 6 and 7 on 5 m cells; points within 15 m of a block edge (three cells) are not
+// compared.
+TEST(LoadScene, GroundRasterInAnotherCrsIsReprojected) {
+  const auto dir = testing::FreshDir("ground_utm");
+  std::filesystem::create_directories(dir / "data");
+  const double e0 = 2700000, n0 = 1250000;  // LV95, near Zurich
+  std::vector<std::vector<double>> dem(100, std::vector<double>(100));
+  for (int r = 0; r < 100; ++r)
+    for (int c = 0; c < 100; ++c) dem[r][c] = 500 - 0.2 * c;
+  testing::WriteGdalRaster(dir / "data" / "dem.tif", dem, {e0, 10.0, 0.0, n0 + 1000, 0.0, -10.0},
+                           2056, std::nullopt);
+  OGRSpatialReference lv95, utm;
+  lv95.importFromEPSG(2056);
+  utm.importFromEPSG(32632);
+  lv95.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  utm.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  std::unique_ptr<OGRCoordinateTransformation> to_utm(
+      OGRCreateCoordinateTransformation(&lv95, &utm));
+  double x[2] = {e0 - 200, e0 + 1200}, y[2] = {n0 - 200, n0 + 1200};
+  ASSERT_TRUE(to_utm->Transform(2, x, y));  // corners, with a margin
+  const double ux0 = std::floor(std::min(x[0], x[1]) / 100) * 100 - 100;
+  const double uy1 = std::ceil(std::max(y[0], y[1]) / 100) * 100 + 100;
+  const int nx = 360, ny = 360;  // 1800 m of 5 m cells
+  const auto code_at = [](double ux, double uy) {
+    return (static_cast<long>(std::floor(ux / 100)) + static_cast<long>(std::floor(uy / 100))) % 2
+               ? 7
+               : 6;
+  };
+  std::vector<std::vector<double>> codes(ny, std::vector<double>(nx));
+  for (int r = 0; r < ny; ++r)
+    for (int c = 0; c < nx; ++c) codes[r][c] = code_at(ux0 + 5 * c + 2.5, uy1 - 5 * r - 2.5);
+  testing::WriteGdalRaster(dir / "data" / "ground.tif", codes, {ux0, 5.0, 0.0, uy1, 0.0, -5.0},
+                           32632, std::nullopt);
+  testing::WriteText(dir / "scene.toml",
+                     "[terrain]\ndem = \"data/dem.tif\"\nground = \"data/ground.tif\"\n"
+                     "[rock]\nshape = { sphere = 0.3 }\n[release]\npoints = [[" +
+                         std::to_string(e0 + 500) + ", " + std::to_string(n0 + 500) + "]]\n");
+  const SceneFile s = LoadScene((dir / "scene.toml").string());
+  EXPECT_HAS(s.terrain_description, "ground map reprojected from EPSG:32632");
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> u(5, 995);
+  int compared = 0;
+  for (int k = 0; k < 400; ++k) {
+    double px = e0 + u(rng), py = n0 + u(rng);
+    const int index = s.scene.terrain.GroundAt(px, py);
+    ASSERT_TRUE(to_utm->Transform(1, &px, &py));
+    const double edge = std::min({std::fmod(px, 100.0), 100 - std::fmod(px, 100.0),
+                                  std::fmod(py, 100.0), 100 - std::fmod(py, 100.0)});
+    if (edge < 15) continue;
+    ++compared;
+    EXPECT_EQ(s.scene.ground.category(index).code, code_at(px, py)) << px << ", " << py;
+  }
+  EXPECT_GT(compared, 100);
+}
+
+// Ground polygons in GeoJSON (with the DEM's CRS) over the DEM case: rasterised onto the DEM's
+// nodes (cell centres inside a polygon), later polygons over earlier ones, polygons over the
+// ground raster; categories by name or code.
+void WritePolygons(const std::filesystem::path& path, const std::string& features) {
+  testing::WriteText(path, R"({"type": "FeatureCollection", "crs": {"type": "name", "properties": )"
+                           R"({"name": "urn:ogc:def:crs:EPSG::31287"}}, "features": [)" +
+                               features + "]}");
+}
+
+std::string Feature(const std::string& properties, const std::string& geometry) {
+  std::ostringstream out;
+  out << R"({"type": "Feature", "properties": {)" << properties << R"(}, "geometry": )" << geometry
+      << "}";
+  return out.str();
+}
+
+std::string Square(double x0, double y0, double x1, double y1) {
+  std::ostringstream out;
+  out << R"({"type": "Polygon", "coordinates": [[)";
+  const double xs[5] = {x0, x1, x1, x0, x0}, ys[5] = {y0, y0, y1, y1, y0};
+  for (int k = 0; k < 5; ++k) out << (k ? ", [" : "[") << xs[k] << ", " << ys[k] << "]";
+  out << "]]}";
+  return out.str();
+}
+
+TEST(LoadScene, GroundPolygonsAreRasterisedOntoTheDem) {
+  const auto dir = testing::FreshDir("ground_polygons");
+  WriteDemCase(dir);
+  // Scree over x 1020 .. 1050, y 2010 .. 2040 (nodes x 1025, 1035, 1045 and y 2015, 2025, 2035),
+  // then snow by code (8) over x 1040 .. 1060, y 2030 .. 2050, drawn over the scree.
+  WritePolygons(dir / "data" / "ground.geojson",
+                Feature(R"("category": "my_scree", "code": 11)", Square(1020, 2010, 1050, 2040)) +
+                    ", " +
+                    Feature(R"("category": "8", "code": 8)", Square(1040, 2030, 1060, 2050)));
+  const std::string no_raster =
+      Replace(kDemScene, "ground = \"data/ground.tif\"",
+              "ground_polygons = { file = \"data/ground.geojson\", field = \"category\" }");
+  testing::WriteText(dir / "scene.toml", no_raster);
+  const SceneFile s = LoadScene((dir / "scene.toml").string());
+  const Terrain& t = s.scene.terrain;
+  const GroundTable& g = s.scene.ground;
+  const int scree = g.IndexOfName("my_scree"), snow = g.IndexOfName("snow");
+  int inside = 0;
+  for (double x = 1005; x <= 1055; x += 10)
+    for (double y = 2005; y <= 2045; y += 10) {
+      const bool in_snow = x > 1040 && y > 2030,
+                 in_scree = x > 1020 && x < 1050 && y > 2010 && y < 2040;
+      const int expected = in_snow ? snow : in_scree ? scree : g.IndexOfName("medium");
+      EXPECT_EQ(t.GroundAt(x, y), expected) << x << ", " << y;
+      inside += t.GroundAt(x, y) == scree;
+    }
+  EXPECT_EQ(inside, 9 - 1);  // 9 nodes in the scree square, one of them under the snow
+  // A contact inside gets the scree's parameters (contacts look their ground up by GroundAt).
+  EXPECT_DOUBLE_EQ(g.params(t.GroundAt(1026, 2016)).mu_min, 0.5);
+  EXPECT_EQ(s.inputs.size(), 3u);
+
+  // By code, and over the ground raster: the raster where no polygon covers a node.
+  testing::WriteText(dir / "scene.toml",
+                     Replace(kDemScene, "default_ground",
+                             "ground_polygons = { file = \"data/ground.geojson\", field = \"code\" "
+                             "}\ndefault_ground"));
+  const SceneFile both = LoadScene((dir / "scene.toml").string());
+  EXPECT_EQ(both.scene.terrain.GroundAt(1005, 2045), g.IndexOfName("hard"));    // raster code 6
+  EXPECT_EQ(both.scene.terrain.GroundAt(1005, 2005), g.IndexOfName("medium"));  // raster nodata
+  EXPECT_EQ(both.scene.terrain.GroundAt(1025, 2015), scree);  // a polygon over raster code 6
+  EXPECT_EQ(both.scene.terrain.GroundAt(1055, 2045), snow);   // over raster code 11
+
+  // Errors: a missing field, an unknown category, a line, a file off the DEM, keys.
+  const std::string path = (dir / "data" / "ground.geojson").string();
+  EXPECT_HAS(ErrorOf(Replace(no_raster, "\"category\" }", "\"kind\" }"), dir),
+             "scene.toml:3: terrain.ground_polygons (" + path +
+                 ", feature 0): no field 'kind' (the fields are: category, code)");
+  WritePolygons(dir / "data" / "ground.geojson",
+                Feature(R"("category": "scre")", Square(1020, 2010, 1050, 2040)));
+  EXPECT_HAS(ErrorOf(no_raster, dir),
+             "feature 0): field 'category' is 'scre', which is neither the name nor the code of a "
+             "ground category");
+  WritePolygons(
+      dir / "data" / "ground.geojson",
+      Feature(R"("category": "hard")", Square(1020, 2010, 1050, 2040)) + ", " +
+          Feature(R"("category": "hard")",
+                  R"({"type": "LineString", "coordinates": [[1020, 2010], [1050, 2040]]})"));
+  EXPECT_HAS(ErrorOf(no_raster, dir),
+             "feature 1): a ground polygon must be a polygon, not a LINESTRING");
+  WritePolygons(dir / "data" / "ground.geojson",
+                Feature(R"("category": "hard")", Square(5000, 5000, 5100, 5100)));
+  EXPECT_HAS(ErrorOf(no_raster, dir), "covers no cell centre of the DEM");
+  EXPECT_HAS(ErrorOf(Replace(no_raster, ", field = \"category\"", ""), dir),
+             "terrain.ground_polygons.field: missing");
+  EXPECT_HAS(ErrorOf(Replace(no_raster, "field =", "feld ="), dir),
+             "terrain.ground_polygons.feld: unknown key (did you mean 'field'?)");
+  EXPECT_HAS(ErrorOf(Replace(no_raster, "data/ground.geojson", "data/nope.geojson"), dir),
+             "file not found");
+}
+
+// A scan of an ellipsoid with semi-axes 1.4 x 1.0 x 0.8 m (6000 points on its surface) and
+// `outliers` stray returns 3 .. 10 m from its centre, as an .xyz file.
+void WriteScan(const std::filesystem::path& path, int outliers) {
+  std::mt19937_64 rng(51);
+  std::normal_distribution<double> g;
+  std::uniform_real_distribution<double> r(3, 10);
+  std::ofstream out(path);
+  out.precision(17);
+  for (int i = 0; i < 6000; ++i) {
+    const Eigen::Vector3d d = Eigen::Vector3d(g(rng), g(rng), g(rng)).normalized();
+    out << 1.4 * d.x() << " " << 1.0 * d.y() << " " << 0.8 * d.z() << "\n";
+  }
+  for (int i = 0; i < outliers; ++i) {
+    const Eigen::Vector3d d = Eigen::Vector3d(g(rng), g(rng), g(rng)).normalized() * r(rng);
+    out << d.x() << " " << d.y() << " " << d.z() << "\n";
+  }
+}
+
+// A scan with 1 % stray returns: the default scene gives the clean rock (4/3 pi abc = 4.69 m^3,
+// the hull of 6000 surface points within 1 % of it), with cleaning off the scene warns (and
+// summary.json lists the warning); a clean scan gives no warning and the same hull either way.
+TEST(LoadScene, PointCloudsAreCleanedByDefaultAndDominatedHullsWarn) {
+  const auto dir = testing::FreshDir("clean");
+  WriteScan(dir / "clean.xyz", 0);
+  WriteScan(dir / "dirty.xyz", 60);
+  const std::string scene =
+      "[terrain]\nplane = {}\n[rock]\nshape = \"dirty.xyz\"\n[release]\npoints = [[10, 0]]\n";
+  const double ellipsoid_m3 = 4.0 / 3.0 * std::acos(-1.0) * 1.4 * 1.0 * 0.8;
+  testing::WriteText(dir / "scene.toml", scene);
+  const SceneFile cleaned = LoadScene((dir / "scene.toml").string());
+  EXPECT_NEAR(cleaned.scene.rock.volume_m3, ellipsoid_m3, 0.01 * ellipsoid_m3);
+  EXPECT_TRUE(cleaned.warnings.empty());
+
+  testing::WriteText(dir / "scene.toml", Replace(scene, "[release]", "clean = false\n[release]"));
+  const SceneFile kept = LoadScene((dir / "scene.toml").string());
+  EXPECT_GT(kept.scene.rock.volume_m3, 10 * ellipsoid_m3);
+  ASSERT_EQ(kept.warnings.size(), 1u);
+  EXPECT_HAS(kept.warnings[0], "scene.toml:4: rock.shape: " + (dir / "dirty.xyz").string() +
+                                   ": a few points dominate the rock's hull");
+  ensemble::EnsembleReport report;
+  const auto j = nlohmann::json::parse(SummaryJson(kept, report, "0", {}));
+  EXPECT_EQ(j["warnings"][0], kept.warnings[0]);
+
+  // Outlier removal off by its own key: the same.
+  testing::WriteText(dir / "scene.toml",
+                     Replace(scene, "[release]", "clean = { outlier_neighbours = 0 }\n[release]"));
+  EXPECT_EQ(LoadScene((dir / "scene.toml").string()).warnings.size(), 1u);
+
+  // The clean scan: no warning, and cleaning leaves its hull as it is.
+  const std::string clean_scene = Replace(scene, "dirty.xyz", "clean.xyz");
+  testing::WriteText(dir / "scene.toml", clean_scene);
+  const SceneFile a = LoadScene((dir / "scene.toml").string());
+  testing::WriteText(dir / "scene.toml",
+                     Replace(clean_scene, "[release]", "clean = false\n[release]"));
+  const SceneFile b = LoadScene((dir / "scene.toml").string());
+  EXPECT_TRUE(a.warnings.empty());
+  EXPECT_TRUE(b.warnings.empty());
+  EXPECT_EQ(a.scene.rock.volume_m3, b.scene.rock.volume_m3);
+  EXPECT_EQ(a.scene.rock.vertices_m, b.scene.rock.vertices_m);
+  EXPECT_NEAR(a.scene.rock.volume_m3, ellipsoid_m3, 0.01 * ellipsoid_m3);
+}
+
+TEST(LoadScene, CleanOptionsAreCheckedByName) {
+  const auto dir = testing::FreshDir("clean_errors");
+  WriteScan(dir / "scan.xyz", 0);
+  const std::string scene =
+      "[terrain]\nplane = {}\n[rock]\nshape = \"scan.xyz\"\nclean = CLEAN\n"
+      "[release]\npoints = [[10, 0]]\n";
+  EXPECT_HAS(ErrorOf(Replace(scene, "CLEAN", "{ outlier_neighbors = 8 }"), dir),
+             "scene.toml:5: rock.clean.outlier_neighbors: unknown key (did you mean "
+             "'outlier_neighbours'?)");
+  EXPECT_HAS(ErrorOf(Replace(scene, "CLEAN", "{ outlier_std_ratio = -1 }"), dir),
+             "scene.toml:5: rock.clean.outlier_std_ratio: outlier_std_ratio = -1 violates");
+  EXPECT_HAS(ErrorOf(Replace(scene, "CLEAN", "{ outlier_passes = 0 }"), dir),
+             "rock.clean.outlier_passes: outlier_passes = 0 violates 1 <= outlier_passes <= 100");
+  EXPECT_HAS(ErrorOf(Replace(scene, "CLEAN", "{ voxel_m = \"fine\" }"), dir),
+             "rock.clean.voxel_m: expected a number");
+  EXPECT_HAS(ErrorOf(Replace(scene, "CLEAN", "\"yes\""), dir),
+             "rock.clean: expected false or an inline table");
+  EXPECT_HAS(ErrorOf("[terrain]\nplane = {}\n[rock]\nshape = { box = [1, 1, 1] }\nclean = false\n"
+                     "[release]\npoints = [[10, 0]]\n",
+                     dir),
+             "rock.clean: only a point cloud file is cleaned");
+  // Every field by its name.
+  EXPECT_EQ(ErrorOf(Replace(scene, "CLEAN",
+                            "{ drop_non_finite = true, drop_duplicates = true, "
+                            "outlier_neighbours = 8, outlier_std_ratio = 5, "
+                            "outlier_spacing_ratio = 4, outlier_passes = 3, voxel_m = 0.01 }"),
+                    dir),
+            "");
 }
 
 }  // namespace

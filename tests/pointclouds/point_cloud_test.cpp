@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <functional>
 #include <limits>
 
 #include "common/error.hpp"
@@ -53,6 +54,19 @@ TEST(CleanOptions, DefaultsAreValid) {
   bad.voxel_m = 1e-30;
   EXPECT_FALSE(bad.IsValid(&why));
   EXPECT_NE(why.find("voxel_m = 1e-30"), std::string::npos) << why;
+  for (const auto& [field, set] :
+       std::vector<std::pair<std::string, std::function<void(CleanOptions&)>>>{
+           {"outlier_neighbours = -1", [](CleanOptions& o) { o.outlier_neighbours = -1; }},
+           {"outlier_std_ratio = 0", [](CleanOptions& o) { o.outlier_std_ratio = 0; }},
+           {"outlier_spacing_ratio = -1", [](CleanOptions& o) { o.outlier_spacing_ratio = -1; }},
+           {"outlier_passes = 0", [](CleanOptions& o) { o.outlier_passes = 0; }}}) {
+    CleanOptions o;
+    set(o);
+    EXPECT_FALSE(o.IsValid(&why)) << field;
+    EXPECT_NE(why.find(field), std::string::npos) << why;
+  }
+  EXPECT_TRUE(CleanOptions::Off().IsValid(&why));
+  EXPECT_EQ(CleanOptions::Off().outlier_neighbours, 0);
 }
 
 TEST(ReadPointCloud, TextFormatsWithHeadersCommentsAndExtraColumns) {
@@ -243,6 +257,61 @@ TEST(CleanPointCloud, StatisticalOutlierRemoval) {
   for (const auto& p : cloud.points_m) EXPECT_LT(p.norm(), 1.0);
 }
 
+// The default cleaning is safe: the clean scans of rocks, random or on a regular grid, lose no
+// point (so their hull is unchanged), however dense.
+TEST(CleanPointCloud, DefaultsKeepEveryPointOfACleanScan) {
+  std::mt19937_64 rng(21);
+  std::vector<std::pair<std::string, std::vector<Eigen::Vector3d>>> scans = {
+      {"ellipsoid 1:0.7:0.4, 2000", testing::EllipsoidSurface(1.0, 0.7, 0.4, 2000, rng)},
+      {"ellipsoid 1:0.7:0.4, 20000", testing::EllipsoidSurface(1.0, 0.7, 0.4, 20000, rng)},
+      {"ellipsoid 4:1:0.6, 20000", testing::EllipsoidSurface(2.0, 0.5, 0.3, 20000, rng)},
+      {"box surface 2 x 1 x 0.6, 20000", testing::BoxSurface(2, 1, 0.6, 20000, rng)},
+      {"box interior and corners", testing::BoxInterior(2, 1, 0.6, 2000, rng)}};
+  for (const auto& c : testing::BoxCorners(2, 1, 0.6)) scans.back().second.push_back(c);
+  std::vector<Eigen::Vector3d> grid;  // a regular grid: the statistical rule alone drops edges
+  for (int i = 0; i < 20; ++i)
+    for (int j = 0; j < 20; ++j)
+      for (int k = 0; k < 20; ++k) grid.emplace_back(0.01 * i, 0.01 * j, 0.01 * k);
+  scans.emplace_back("regular grid 20^3", grid);
+  for (const auto& [name, points] : scans) {
+    PointCloud cloud;
+    cloud.points_m = points;
+    const CleanReport report = CleanPointCloud(CleanOptions{}, &cloud);
+    EXPECT_EQ(report.outliers, 0u) << name;
+    EXPECT_EQ(cloud.points_m, points) << name;
+  }
+  // Without the spacing condition PCL's rule alone drops the grid's corners and edges.
+  PointCloud cloud;
+  cloud.points_m = grid;
+  CleanOptions statistical;
+  statistical.outlier_spacing_ratio = 0;
+  EXPECT_GT(CleanPointCloud(statistical, &cloud).outliers, 0u);
+}
+
+// ... and removes stray returns metres off the rock: 1 % and 5 % of the points.
+TEST(CleanPointCloud, DefaultsRemoveFarOutliers) {
+  for (const int percent : {1, 5}) {
+    std::mt19937_64 rng(22 + percent);
+    const auto clean = testing::EllipsoidSurface(1.0, 0.7, 0.4, 10000, rng);
+    const auto stray = testing::FarOutliers(100 * percent, 1.5, 10, rng);
+    PointCloud cloud;
+    cloud.points_m = clean;
+    cloud.points_m.insert(cloud.points_m.end(), stray.begin(), stray.end());
+    const CleanReport report = CleanPointCloud(CleanOptions{}, &cloud);
+    EXPECT_EQ(report.outliers, stray.size()) << percent << " %";
+    EXPECT_EQ(cloud.points_m, clean) << percent << " %";
+    // One pass is not enough: the far outliers inflate the standard deviation.
+    CleanOptions once;
+    once.outlier_passes = 1;
+    PointCloud again;
+    again.points_m = clean;
+    again.points_m.insert(again.points_m.end(), stray.begin(), stray.end());
+    if (percent == 5) {
+      EXPECT_LT(CleanPointCloud(once, &again).outliers, stray.size());
+    }
+  }
+}
+
 TEST(CleanPointCloud, VoxelsKeepOneMeasuredPointEach) {
   PointCloud cloud;
   for (int i = 0; i < 20; ++i)
@@ -250,7 +319,7 @@ TEST(CleanPointCloud, VoxelsKeepOneMeasuredPointEach) {
       for (int k = 0; k < 20; ++k)
         cloud.points_m.emplace_back(0.01 * i + 0.005, 0.01 * j + 0.005, 0.01 * k + 0.005);
   const auto original = cloud.points_m;
-  CleanOptions options;
+  CleanOptions options = CleanOptions::Off();
   options.voxel_m = 0.05;
   const CleanReport report = CleanPointCloud(options, &cloud);
   EXPECT_EQ(report.points_out, 64u);  // 4 x 4 x 4 voxels

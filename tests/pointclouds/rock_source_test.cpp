@@ -497,5 +497,44 @@ TEST(RockReport, JsonHasTheStableKeys) {
   EXPECT_EQ(j["points_read"], 0);
 }
 
+// The trial that made a wrong rock silently: a scan with stray returns. By default the rock is the
+// clean scan's (the outliers removed, its hull exactly that of the clean points); with cleaning
+// off the hull is many times larger and the report warns, in text and JSON.
+TEST(MakeRock, StrayReturnsAreRemovedByDefaultAndWarnedAboutWhenKept) {
+  std::mt19937_64 rng(41);
+  // Semi-axes 1.4 x 1.0 x 0.8 m: 4/3 pi abc = 4.69 m^3 (the trial's rock was 4.6 m^3).
+  const auto clean = testing::EllipsoidSurface(1.4, 1.0, 0.8, 6000, rng);
+  auto dirty = clean;
+  for (const auto& p : testing::FarOutliers(60, 3, 10, rng)) dirty.push_back(p);
+  RockReport reference;
+  MakeRockFromPoints(Cloud(clean), FileSpec(""), &reference);
+  EXPECT_NEAR(reference.volume_m3, 4.0 / 3.0 * kPi * 1.4 * 1.0 * 0.8, 0.01 * 4.69);  // sampled
+  EXPECT_TRUE(reference.warnings.empty());
+
+  RockReport cleaned;
+  MakeRockFromPoints(Cloud(dirty), FileSpec(""), &cleaned);
+  EXPECT_EQ(cleaned.clean.outliers, 60u);
+  // Exactly the clean points are left, so the hull is theirs up to round-off.
+  EXPECT_NEAR(cleaned.volume_m3, reference.volume_m3, 1e-12 * reference.volume_m3);
+  EXPECT_TRUE(cleaned.warnings.empty());
+  ASSERT_TRUE(cleaned.hull_check.has_value());
+  EXPECT_FALSE(cleaned.hull_check->Dominated());
+
+  RockSpec off = FileSpec("");
+  off.clean = CleanOptions::Off();
+  RockReport kept;
+  MakeRockFromPoints(Cloud(dirty, "scan.xyz"), off, &kept);
+  EXPECT_GT(kept.volume_m3, 10 * reference.volume_m3);
+  ASSERT_EQ(kept.warnings.size(), 1u);
+  EXPECT_NE(kept.warnings[0].find("scan.xyz: a few points dominate the rock's hull"),
+            std::string::npos)
+      << kept.warnings[0];
+  EXPECT_NE(kept.FullReport().find("WARNING: scan.xyz: a few points dominate"), std::string::npos);
+  const nlohmann::json j = nlohmann::json::parse(kept.ToJson());
+  EXPECT_EQ(j["warnings"].size(), 1u);
+  EXPECT_GT(j["hull_check"]["far_points"].get<int>(), 30);  // those beyond 3 core radii (~4 m)
+  EXPECT_TRUE(j["hull_check"]["dominated"].get<bool>());
+}
+
 }  // namespace
 }  // namespace talus::pointclouds

@@ -83,6 +83,33 @@ inline std::vector<Eigen::Vector3d> EllipsoidSurface(double ra, double rb, doubl
   return p;
 }
 
+// n points uniformly distributed on the surface of the box a x b x c centred at the origin
+// (faces chosen with equal probability).
+inline std::vector<Eigen::Vector3d> BoxSurface(double a, double b, double c, int n,
+                                               std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> u(-0.5, 0.5);
+  std::uniform_int_distribution<int> face(0, 5);
+  std::vector<Eigen::Vector3d> p;
+  for (int i = 0; i < n; ++i) {
+    Eigen::Vector3d q(u(rng), u(rng), u(rng));
+    const int f = face(rng);
+    q[f % 3] = f < 3 ? -0.5 : 0.5;
+    p.push_back(q.cwiseProduct(Eigen::Vector3d(a, b, c)));
+  }
+  return p;
+}
+
+// `count` stray returns in random directions, min_m .. max_m from the origin.
+inline std::vector<Eigen::Vector3d> FarOutliers(int count, double min_m, double max_m,
+                                                std::mt19937_64& rng) {
+  std::normal_distribution<double> g;
+  std::uniform_real_distribution<double> r(min_m, max_m);
+  std::vector<Eigen::Vector3d> p;
+  for (int i = 0; i < count; ++i)
+    p.push_back(Eigen::Vector3d(g(rng), g(rng), g(rng)).normalized() * r(rng));
+  return p;
+}
+
 inline Eigen::Matrix3d RandomRotation(std::mt19937_64& rng) {
   std::normal_distribution<double> g;
   return Eigen::Quaterniond(g(rng), g(rng), g(rng), g(rng)).normalized().toRotationMatrix();
