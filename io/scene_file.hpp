@@ -7,6 +7,7 @@
 
 #include "ensemble/rasters.hpp"
 #include "ensemble/release.hpp"
+#include "io/raster.hpp"
 #include "pointclouds/rock_source.hpp"
 #include "solver/scene.hpp"
 
@@ -21,7 +22,10 @@ struct OutputSpec {
   bool quicklook =
       true;  // quicklook.png: hillshade, reach probability or energy, sample trajectories
   bool geopackage = false;  // rocks.gpkg: end points and (with trajectories) paths as GIS layers
-  bool report = true;  // report.html: one page with what ran, endings, maps and histograms
+  bool report = true;       // report.html: one page with what ran, endings, maps and histograms
+  // The percentiles (percent, ascending, each 1 .. 99) of the <quantity>_p<NN> rasters.
+  std::vector<int> percentiles = {95};
+  io::RasterFormat raster_format = io::RasterFormat::kGeoTiff;  // "gtiff" or "cog"
 
   // The raster request on `grid` (nothing when no raster is listed).
   ensemble::RasterRequest Request(const GridGeometry& grid) const;
@@ -33,10 +37,10 @@ struct SceneFile {
   Scene scene;                    // IsValid() holds
   ensemble::ReleaseSpec release;  // IsValid() holds, every release vertex on valid DEM cells
   OutputSpec output;
-  pointclouds::RockSpec rock;       // the [rock] table
-  bool has_rock = false;            // the scene has a [rock] table (else only [blocks])
+  pointclouds::RockSpec rock;  // the [rock] table
+  bool has_rock = false;       // the scene has a [rock] table (else only [blocks])
   std::vector<pointclouds::RockSpec> block_specs;  // [blocks], parallel to release.blocks
-  bool shape_per_rock = false;      // every rock has a seeded shape of its own
+  bool shape_per_rock = false;                     // every rock has a seeded shape of its own
   std::string rock_description;     // e.g. "eota221 0.93 x 0.93 x 0.47 m, bevel 0.12 m"
   std::string crs_wkt;              // the DEM's CRS; empty for the plane or a DEM without CRS
   std::string terrain_description;  // e.g. "dem.tif (270 x 370 cells of 5 m)"

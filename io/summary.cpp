@@ -30,9 +30,8 @@ nlohmann::ordered_json GroundJson(const GroundTable& table) {
   for (int i = 0; i < table.size(); ++i) {
     const GroundCategory& c = table.category(i);
     const GroundParams& p = c.params;
-    nlohmann::ordered_json g = {{"code", c.code},           {"mu_min", p.mu_min},
-                                {"mu_max", p.mu_max},       {"beta", p.beta_1_s},
-                                {"kappa", p.kappa_1_m},     {"nu", p.nu_1_s}};
+    nlohmann::ordered_json g = {{"code", c.code},     {"mu_min", p.mu_min},   {"mu_max", p.mu_max},
+                                {"beta", p.beta_1_s}, {"kappa", p.kappa_1_m}, {"nu", p.nu_1_s}};
     if (p.HasDragLayer()) {
       g["drag_height_m"] = p.drag_height_m;
       g["drag_translational"] = p.drag_translational_1_s;
@@ -44,6 +43,8 @@ nlohmann::ordered_json GroundJson(const GroundTable& table) {
 }
 
 }  // namespace
+
+std::string GroundTableJson(const GroundTable& table) { return GroundJson(table).dump(); }
 
 std::string SummaryJson(const SceneFile& scene, const ensemble::EnsembleReport& report,
                         const std::string& version, const std::vector<std::string>& outputs) {

@@ -165,7 +165,7 @@ TEST(Rasters, AccumulatorsOfAnySplitMergeToTheSameRasters) {
   merged.Merge(c);
   merged.Merge(a);
   EXPECT_EQ(merged.rocks(), 12);
-  const std::vector<RasterLayer> layers = merged.Finish();
+  const std::vector<RasterLayer> layers = merged.Finish(scene.terrain.heights());
   ASSERT_EQ(layers.size(), whole.rasters.size());
   for (std::size_t l = 0; l < layers.size(); ++l)
     EXPECT_TRUE(layers[l].values == whole.rasters[l].values) << layers[l].name;
@@ -191,7 +191,7 @@ TEST(Rasters, P95IsTheNearestRankPercentile) {
     f.speed_m_s = {static_cast<float>(k)};
     acc.Add(f);
   }
-  const auto layers = acc.Finish();
+  const auto layers = acc.Finish(Heightfield{request.grid, {0.0}});
   ASSERT_EQ(layers.size(), 3u);
   EXPECT_EQ(layers[0].values[0], 40.0f);  // max
   EXPECT_EQ(layers[1].values[0], 20.5f);  // mean

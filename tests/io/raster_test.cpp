@@ -98,7 +98,7 @@ TEST(WriteGeoTiff, RoundTripsGridCrsAndValues) {
   for (int k = 0; k < 12; ++k) values[k] = static_cast<float>(k);
   values[5] = -9999.0f;
   WriteGeoTiff((dir / "out.tif").string(), grid, testing::Wkt(31287), values, true, -9999.0,
-               "test");
+               {"test"});
   const Raster r = ReadRaster((dir / "out.tif").string(), "out");
   EXPECT_DOUBLE_EQ(r.grid.x0_m, grid.x0_m);
   EXPECT_DOUBLE_EQ(r.grid.y0_m, grid.y0_m);
@@ -137,7 +137,7 @@ TEST(WriteGeoTiff, OutputCellLinesUpWithTheDemCell) {
   ASSERT_EQ(report.rasters.size(), 1u);
   const auto out = (dir / "deposits.tif").string();
   WriteGeoTiff(out, scene.scene.terrain.heights().grid, scene.crs_wkt, report.rasters[0].values,
-               false, 0, "deposits");
+               false, 0, {"deposits"});
 
   RegisterGdal();
   GDALDataset* d = static_cast<GDALDataset*>(GDALOpen(out.c_str(), GA_ReadOnly));
