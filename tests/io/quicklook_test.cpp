@@ -81,6 +81,13 @@ TEST(QuickLook, EnergyClassesAreAbsoluteWithTheHazardLimitsAt30And300Kilojoules)
   const ensemble::RasterLayer speed{"speed_p95", "m/s", {1, 50}};
   EXPECT_EQ(LegendOf(speed).ClassOf(12), 2);  // 10 - 20 m/s
   EXPECT_NE(LegendOf(speed).title.find("95th percentile"), std::string::npos);
+  for (auto [name, ordinal] : {std::pair{"energy_p1", "1st"},
+                               {"energy_p22", "22nd"},
+                               {"energy_p13", "13th"},
+                               {"energy_p3", "3rd"}})
+    EXPECT_NE(LegendOf({name, "J", {}}).title.find(std::string(", ") + ordinal + " percentile"),
+              std::string::npos)
+        << LegendOf({name, "J", {}}).title;
 }
 
 TEST(QuickLook, ScaleBarLengthsAreOneTwoOrFiveTimesAPowerOfTen) {
