@@ -71,11 +71,21 @@ std::vector<std::string> WriteSummaryOutputs(const io::SceneFile& scene,
   const GridGeometry& dem = scene.scene.terrain.heights().grid;
   // GDAL would print every failed write of a full disk; the writers throw with its last message.
   const QuietGdal quiet_gdal;
+  const std::string ground = io::GroundTableJson(scene.scene.ground);
   for (const ensemble::RasterLayer& layer : layers) {
     ThrowIfInterrupted();
-    io::WriteGeoTiff(staging.path(layer.name + ".tif"), dem, scene.crs_wkt, layer.values,
-                     layer.has_nodata, ensemble::RasterLayer::kNoData,
-                     layer.name + " (" + layer.unit + ")");
+    // What the raster is and which run made it; nothing that depends on the time or the split.
+    const io::RasterMetadata metadata{layer.description,
+                                      layer.unit,
+                                      {{"TALUS_VERSION", kVersion},
+                                       {"TALUS_INPUTS_HASH", scene.inputs_hash},
+                                       {"TALUS_QUANTITY", layer.quantity},
+                                       {"TALUS_STATISTIC", layer.statistic},
+                                       {"TALUS_ROCKS", std::to_string(report.rocks)},
+                                       {"TALUS_SEED", std::to_string(scene.release.seed)},
+                                       {"TALUS_GROUND", ground}}};
+    io::WriteGeoTiff(staging.path(layer.name + ".tif"), dem, scene.crs_wkt, layer.values, true,
+                     ensemble::RasterLayer::kNoData, metadata, scene.output.raster_format);
     outputs.push_back(layer.name + ".tif");
   }
   ThrowIfInterrupted();
@@ -141,9 +151,12 @@ std::vector<std::string> TalusOutputNames() {
       "rocks.csv",    "trajectories.h5",       "summary.json", "quicklook.png", "passages.tif",
       "deposits.tif", "reach_probability.tif", "partial.json", "partial.bin",   "report.html",
       "rocks.gpkg"};
-  for (const char* quantity : {"speed", "energy", "jump_height"})
-    for (const char* statistic : {"max", "mean", "p95"})
+  for (const char* quantity : {"speed", "energy", "jump_height"}) {
+    for (const char* statistic : {"max", "mean"})
       names.push_back(std::string(quantity) + "_" + statistic + ".tif");
+    for (int percent = 1; percent <= 99; ++percent)  // every percentile [output] may ask for
+      names.push_back(std::string(quantity) + "_p" + std::to_string(percent) + ".tif");
+  }
   return names;
 }
 
@@ -227,7 +240,8 @@ std::vector<std::string> MergeIntoStaging(const io::SceneFile& scene,
   report->threads = threads;
   report->wall_time_s = wall_time_s;
   const std::vector<ensemble::RasterLayer> layers =
-      rasters ? rasters->Finish() : std::vector<ensemble::RasterLayer>{};
+      rasters ? rasters->Finish(scene.scene.terrain.heights())
+              : std::vector<ensemble::RasterLayer>{};
   return WriteSummaryOutputs(scene, *report, layers, paths, staging, outputs);
 }
 

@@ -87,7 +87,15 @@ double ValueSummary::mean() const {
 }
 
 float ValueSummary::Quantile(double q) const {
-  const auto rank = static_cast<std::int64_t>(std::ceil(q * static_cast<double>(count_)));
+  return AtRank(static_cast<std::int64_t>(std::ceil(q * static_cast<double>(count_))));
+}
+
+float ValueSummary::Percentile(int percent) const {
+  const Int128 product = static_cast<Int128>(percent) * count_;
+  return AtRank(static_cast<std::int64_t>((product + 99) / 100));
+}
+
+float ValueSummary::AtRank(std::int64_t rank) const {
   // The extreme ranks are known exactly.
   if (rank <= 1) return min_;
   if (rank >= count_) return max_;

@@ -1,10 +1,10 @@
 #pragma once
 // The summary of one quantity (speed, energy, jump height) in one raster cell over the rocks that
 // passed it: count, minimum, maximum, an exact sum, and a histogram on fixed log-spaced bins for
-// the 95th percentile. Its size does not grow with the number of rocks (at most one bin per 1/64
-// of an octave between the cell's smallest and largest value), and two summaries merge exactly
-// (integer counts, integer sum), so the result does not depend on the order or the split of the
-// rocks: threads, ranks and partial runs give the same bits.
+// percentiles (any integer percent 1 .. 99). Its size does not grow with the number of rocks (at
+// most one bin per 1/64 of an octave between the cell's smallest and largest value), and two
+// summaries merge exactly (integer counts, integer sum), so the result does not depend on the order
+// or the split of the rocks: threads, ranks and partial runs give the same bits.
 //
 // Bins: a float's sign, exponent and first 6 mantissa bits, i.e. 64 bins per octave, each
 // [lo, lo (1 + 2^-6)) at most. A quantile is the bin's midpoint, clamped to [min, max], so
@@ -40,6 +40,10 @@ class ValueSummary {
   // The nearest-rank q-quantile (the smallest value with at least q of the values at or below
   // it), to within kRelativeError; requires count() > 0 and 0 < q <= 1.
   float Quantile(double q) const;
+  // The nearest-rank `percent`-th percentile (rank ceil(percent * count / 100), computed in
+  // integers, so that no rounding of percent / 100 moves it), to within kRelativeError; requires
+  // count() > 0 and 1 <= percent <= 100.
+  float Percentile(int percent) const;
   // Histogram bins held (memory: 8 bytes each).
   std::size_t bins() const { return bins_.size(); }
 
@@ -51,6 +55,9 @@ class ValueSummary {
   static double Midpoint(int bin);
 
  private:
+  // The value of rank `rank` (1-based) in ascending order, to within kRelativeError.
+  float AtRank(std::int64_t rank) const;
+
   struct Bin {
     std::int16_t key;
     std::uint32_t count;

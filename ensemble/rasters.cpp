@@ -1,6 +1,7 @@
 #include "ensemble/rasters.hpp"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <tuple>
 
@@ -128,42 +129,94 @@ void RasterAccumulator::Merge(const RasterAccumulator& other) {
   }
 }
 
-std::vector<RasterLayer> RasterAccumulator::Finish() const {
-  std::vector<RasterLayer> out;
+namespace {
+
+// "1st", "2nd", "3rd", "4th", ..., "11th", "12th", "13th", ..., "21st", ...
+std::string Ordinal(int n) {
+  const int tens = n % 100, ones = n % 10;
+  const char* suffix = (tens >= 11 && tens <= 13) ? "th"
+                       : ones == 1                ? "st"
+                       : ones == 2                ? "nd"
+                       : ones == 3                ? "rd"
+                                                  : "th";
+  return std::to_string(n).append(suffix);
+}
+
+}  // namespace
+
+bool RasterRequest::IsValid(std::string* why) const {
+  for (std::size_t k = 0; k < percentiles.size(); ++k) {
+    const int p = percentiles[k];
+    const char* reason = p < 1 || p > 99                    ? "must each be in 1 .. 99"
+                         : k > 0 && p <= percentiles[k - 1] ? "must be ascending without repeats"
+                                                            : nullptr;
+    if (reason) {
+      if (why) *why = "percentiles = " + std::to_string(p) + " " + reason;
+      return false;
+    }
+  }
+  return true;
+}
+
+std::vector<RasterLayer> RasterAccumulator::Finish(const Heightfield& dem) const {
   const std::size_t cells = static_cast<std::size_t>(request_.grid.nx) * request_.grid.ny;
+  assert(dem.grid.nx == request_.grid.nx && dem.grid.ny == request_.grid.ny &&
+         dem.z_m.size() == cells);
+  std::vector<RasterLayer> out;
+  const auto layer = [&](const std::string& quantity, const std::string& statistic,
+                         const std::string& unit, const std::string& description, float fill) {
+    const std::string name =
+        statistic == "count" || statistic == "fraction" ? quantity : quantity + "_" + statistic;
+    return RasterLayer{name,     unit,      std::vector<float>(cells, fill),
+                       quantity, statistic, description};
+  };
   int quantity = 0;
   for (auto [wanted, name, unit] :
        {std::tuple{request_.speed, "speed", "m/s"}, std::tuple{request_.energy, "energy", "J"},
         std::tuple{request_.jump_height, "jump_height", "m"}}) {
     if (!wanted) continue;
-    const std::string prefix = name;
-    RasterLayer max{prefix + "_max", unit, std::vector<float>(cells, RasterLayer::kNoData), true};
-    RasterLayer mean{prefix + "_mean", unit, std::vector<float>(cells, RasterLayer::kNoData), true};
-    RasterLayer p95{prefix + "_p95", unit, std::vector<float>(cells, RasterLayer::kNoData), true};
+    const std::string what = name;
+    const std::string shown = what == "jump_height" ? "jump height" : what;
+    const std::size_t first = out.size();
+    out.push_back(
+        layer(what, "max", unit, shown + ", largest over passing rocks", RasterLayer::kNoData));
+    out.push_back(
+        layer(what, "mean", unit, shown + ", mean over passing rocks", RasterLayer::kNoData));
+    for (int p : request_.percentiles) {
+      const std::string statistic = std::string("p").append(std::to_string(p));
+      const std::string description = shown + ", " + Ordinal(p) + " percentile over passing rocks";
+      out.push_back(layer(what, statistic, unit, description, RasterLayer::kNoData));
+    }
     for (std::size_t c = 0; c < cells; ++c) {
       if (slot_[c] < 0) continue;
       const ValueSummary& s = summaries_[static_cast<std::size_t>(slot_[c] + quantity)];
       if (s.count() == 0) continue;
-      max.values[c] = s.max();
-      mean.values[c] = static_cast<float>(s.mean());
-      p95.values[c] = s.Quantile(kPercentile);
+      out[first].values[c] = s.max();
+      out[first + 1].values[c] = static_cast<float>(s.mean());
+      for (std::size_t k = 0; k < request_.percentiles.size(); ++k)
+        out[first + 2 + k].values[c] = s.Percentile(request_.percentiles[k]);
     }
-    out.push_back(std::move(max));
-    out.push_back(std::move(mean));
-    out.push_back(std::move(p95));
     ++quantity;
   }
-  const auto to_float = [](const std::vector<int>& counts) {
-    return std::vector<float>(counts.begin(), counts.end());
-  };
-  if (request_.passages) out.push_back({"passages", "rocks", to_float(passages_), false});
-  if (request_.deposits) out.push_back({"deposits", "rocks", to_float(deposits_), false});
-  if (request_.reach_probability) {
-    RasterLayer reach{"reach_probability", "1", std::vector<float>(passages_.size(), 0.0f), false};
-    for (std::size_t c = 0; c < passages_.size(); ++c)
-      reach.values[c] = rocks_ ? static_cast<float>(double(passages_[c]) / double(rocks_)) : 0.0f;
-    out.push_back(std::move(reach));
+  if (request_.passages) {
+    out.push_back(layer("passages", "count", "count", "passages, rocks that passed the cell", 0));
+    std::copy(passages_.begin(), passages_.end(), out.back().values.begin());
   }
+  if (request_.deposits) {
+    out.push_back(layer("deposits", "count", "count", "deposits, rocks at rest in the cell", 0));
+    std::copy(deposits_.begin(), deposits_.end(), out.back().values.begin());
+  }
+  if (request_.reach_probability) {
+    out.push_back(layer("reach_probability", "fraction", "1",
+                        "reach probability, fraction of all rocks that passed the cell", 0));
+    for (std::size_t c = 0; c < cells; ++c)
+      out.back().values[c] =
+          rocks_ ? static_cast<float>(double(passages_[c]) / double(rocks_)) : 0.0f;
+  }
+  // No value where the DEM has none.
+  for (std::size_t c = 0; c < cells; ++c)
+    if (std::isnan(dem.z_m[c]))
+      for (RasterLayer& l : out) l.values[c] = RasterLayer::kNoData;
   return out;
 }
 
@@ -178,7 +231,14 @@ std::size_t RasterAccumulator::MemoryBytes() const {
 namespace {
 
 // Format of RasterAccumulator::Serialize; a change of layout changes the number.
-constexpr std::uint32_t kStateFormat = 1;
+constexpr std::uint32_t kStateFormat = 2;
+
+std::string PercentileList(const std::vector<std::int32_t>& percentiles) {
+  std::string text;
+  for (std::int32_t p : percentiles)
+    text.append(text.empty() ? "p" : ", p").append(std::to_string(p));
+  return text.empty() ? "none" : text;
+}
 
 std::uint32_t RequestBits(const RasterRequest& r) {
   return std::uint32_t(r.speed) | std::uint32_t(r.energy) << 1 | std::uint32_t(r.jump_height) << 2 |
@@ -213,6 +273,8 @@ void GetCounts(ByteReader& in, std::vector<int>& counts) {
 void RasterAccumulator::Serialize(ByteWriter& out) const {
   out.Put(kStateFormat);
   out.Put(RequestBits(request_));
+  out.PutVector(
+      std::vector<std::int32_t>(request_.percentiles.begin(), request_.percentiles.end()));
   out.Put(request_.grid);
   out.Put<std::int64_t>(rocks_);
   PutCounts(out, passages_);
@@ -230,6 +292,11 @@ RasterAccumulator RasterAccumulator::Deserialize(const RasterRequest& request, B
   if (in.Get<std::uint32_t>() != kStateFormat) in.Fail("was written by another version of talus");
   if (in.Get<std::uint32_t>() != RequestBits(request))
     in.Fail("holds other rasters than the scene asks for");
+  const auto percentiles = in.GetVector<std::int32_t>();
+  const std::vector<std::int32_t> wanted(request.percentiles.begin(), request.percentiles.end());
+  if (percentiles != wanted)
+    in.Fail("holds other percentiles (" + PercentileList(percentiles) +
+            ") than the scene asks for (" + PercentileList(wanted) + ")");
   const auto grid = in.Get<GridGeometry>();
   if (grid.nx != request.grid.nx || grid.ny != request.grid.ny || grid.x0_m != request.grid.x0_m ||
       grid.y0_m != request.grid.y0_m || grid.dx_m != request.grid.dx_m ||

@@ -20,13 +20,16 @@ namespace talus::ensemble {
 // `grid`: node (i, j) is the centre of cell (i, j), as for the DEM.
 struct RasterRequest {
   GridGeometry grid;
-  bool speed = false;   // speed_max, speed_mean, speed_p95 (m/s)
-  bool energy = false;  // energy_max, energy_mean, energy_p95 (J, translational + rotational)
+  bool speed = false;   // speed_max, speed_mean, speed_p<NN> (m/s)
+  bool energy = false;  // energy_max, energy_mean, energy_p<NN> (J, translational + rotational)
   bool jump_height =
-      false;  // jump_height_max, _mean, _p95 (m, centre of mass above ground along the normal)
+      false;  // jump_height_max, _mean, _p<NN> (m, centre of mass above ground along the normal)
   bool passages = false;           // rocks that passed the cell
   bool deposits = false;           // rocks that came to rest in the cell
   bool reach_probability = false;  // fraction of all rocks that passed the cell
+  // The percentiles (percent, ascending, each 1 .. 99) of the *_p<NN> rasters of speed, energy
+  // and jump height.
+  std::vector<int> percentiles = {95};
 
   bool any() const {
     return speed || energy || jump_height || passages || deposits || reach_probability;
@@ -34,6 +37,9 @@ struct RasterRequest {
   bool needs_passes() const {
     return speed || energy || jump_height || passages || reach_probability;
   }
+  // False, with "percentiles = ... <reason>" in *why, when the percentiles are not ascending
+  // integers in 1 .. 99.
+  bool IsValid(std::string* why) const;
 };
 
 // Records one rock's footprint (outcome.footprint) from the solver's steps. One per thread,
@@ -57,16 +63,19 @@ class FootprintRecorder : public RockRecorder {
   Eigen::Vector3d previous_ = Eigen::Vector3d::Zero();
 };
 
-// One output raster: values in grid order (row j after row j - 1, j increasing with y).
+// One output raster: values in grid order (row j after row j - 1, j increasing with y). Every
+// raster is kNoData where the DEM has nodata; the statistics also where no rock passed.
 struct RasterLayer {
   std::string name;  // e.g. "speed_p95"; the file is <name>.tif
-  std::string unit;  // e.g. "m/s"
+  std::string unit;  // "m/s", "J", "m", "count", "1"
   std::vector<float> values;
-  bool has_nodata = false;  // statistics are nodata (kNoData) where no rock passed
+  std::string quantity = {};   // speed, energy, jump_height, passages, deposits, reach_probability
+  std::string statistic = {};  // max, mean, p<NN>, count (passages, deposits), fraction (reach)
+  std::string description = {};  // e.g. "energy, 95th percentile over passing rocks"
   static constexpr float kNoData = -9999.0f;
 };
 
-// Merges footprints into per-cell summaries (cell_summary.hpp): counts, maxima, means and 95th
+// Merges footprints into per-cell summaries (cell_summary.hpp): counts, maxima, means and
 // percentiles whose result does not depend on the order of the rocks or on how they were split
 // between accumulators (Merge), to the bit. Memory: 4 bytes per cell for each of the slot,
 // passage and deposit grids in use, plus, per passed cell and requested quantity, one
@@ -78,19 +87,20 @@ class RasterAccumulator {
   void Add(const Footprint& footprint);
   // Adds the rocks of `other`, which must have the same request.
   void Merge(const RasterAccumulator& other);
-  std::vector<RasterLayer> Finish() const;
+  // The rasters, in the order speed, energy, jump height (each max, mean, then the percentiles
+  // ascending), passages, deposits, reach probability; `dem` is the DEM on the request's grid,
+  // whose nodata cells (NaN) are nodata in every raster.
+  std::vector<RasterLayer> Finish(const Heightfield& dem) const;
   long rocks() const { return rocks_; }
   const RasterRequest& request() const { return request_; }
   // Bytes held now (grids, summaries and their bins), for memory reports.
   std::size_t MemoryBytes() const;
 
   // The state, for merging in another process; Deserialize checks that it was made for the same
-  // request and grid, and throws std::runtime_error otherwise or when the bytes are damaged.
+  // request (rasters and percentiles) and grid, and throws std::runtime_error otherwise or when the
+  // bytes are damaged.
   void Serialize(ByteWriter& out) const;
   static RasterAccumulator Deserialize(const RasterRequest& request, ByteReader& in);
-
-  // The fraction whose quantile the *_p95 rasters show.
-  static constexpr double kPercentile = 0.95;
 
  private:
   // The summaries of a passed cell, created on its first passage.

@@ -135,7 +135,7 @@ EnsembleReport RunEnsemble(const Scene& scene, const ReleaseSpec& release,
   if (rasters && options.keep_raster_state)
     report.raster_state = std::move(rasters);
   else if (rasters)
-    report.rasters = rasters->Finish();
+    report.rasters = rasters->Finish(scene.terrain.heights());
   report.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return report;
 }

@@ -18,9 +18,9 @@ namespace {
 
 using Rgb = std::array<double, 3>;
 
-constexpr int kPanelWidth = 250;   // legend panel, pixels
-constexpr int kMinHeight = 380;    // the legend needs this much height
-constexpr int kMapPixels = 900;    // the map's longer side, at most
+constexpr int kPanelWidth = 250;  // legend panel, pixels
+constexpr int kMinHeight = 380;   // the legend needs this much height
+constexpr int kMapPixels = 900;   // the map's longer side, at most
 
 // Yellow (low) through orange to dark red (high), t in [0, 1].
 std::array<unsigned char, 3> Ramp(double t) {
@@ -31,7 +31,8 @@ std::array<unsigned char, 3> Ramp(double t) {
   const double f = s - k;
   std::array<unsigned char, 3> rgb{};
   for (int c = 0; c < 3; ++c)
-    rgb[c] = static_cast<unsigned char>(std::lround(stops[k][c] + f * (stops[k + 1][c] - stops[k][c])));
+    rgb[c] =
+        static_cast<unsigned char>(std::lround(stops[k][c] + f * (stops[k + 1][c] - stops[k][c])));
   return rgb;
 }
 
@@ -59,7 +60,17 @@ std::string StatisticOf(const std::string& name) {
   const std::string statistic = underscore == std::string::npos ? "" : name.substr(underscore + 1);
   if (statistic == "max") return "largest";
   if (statistic == "mean") return "mean";
-  if (statistic.size() > 1 && statistic[0] == 'p') return statistic.substr(1) + "th percentile of";
+  if (statistic.size() > 1 && statistic[0] == 'p') {
+    const std::string n = statistic.substr(1);  // 1st, 2nd, 3rd, 4th, ..., 11th .. 13th, 21st
+    const char last = n.back();
+    const bool teen = n.size() > 1 && n[n.size() - 2] == '1';
+    const char* suffix = teen          ? "th"
+                         : last == '1' ? "st"
+                         : last == '2' ? "nd"
+                         : last == '3' ? "rd"
+                                       : "th";
+    return n + suffix + " percentile of";
+  }
   return statistic;
 }
 
@@ -117,7 +128,8 @@ void PaintMap(cairo_surface_t* surface, const Heightfield& dem, const ensemble::
                           ? legend.ClassOf(layer->values[c])
                           : -1;
         if (k >= 0)
-          for (int b = 0; b < 3; ++b) colour[b] = 0.25 * colour[b] + 0.75 * legend.classes[k].rgb[b];
+          for (int b = 0; b < 3; ++b)
+            colour[b] = 0.25 * colour[b] + 0.75 * legend.classes[k].rgb[b];
       }
       // CAIRO_FORMAT_RGB24: one 32-bit word per pixel, 0x00RRGGBB in native byte order.
       const std::uint32_t word = (static_cast<std::uint32_t>(std::lround(colour[0])) << 16) |
@@ -137,7 +149,8 @@ void DrawScaleBar(cairo_t* cr, const GridGeometry& g, const QuickLookLayout& lay
   const double metres_per_pixel = g.dx_m / layout.scale;
   const double length_m = ScaleBarLength(0.25 * layout.map_width * metres_per_pixel);
   const double length_px = length_m / metres_per_pixel;
-  const std::string label = length_m >= 1000 ? Number(length_m / 1000) + " km" : Number(length_m) + " m";
+  const std::string label =
+      length_m >= 1000 ? Number(length_m / 1000) + " km" : Number(length_m) + " m";
   const double x = 10, y = layout.map_height - 14;
   cairo_set_source_rgba(cr, 1, 1, 1, 0.8);
   cairo_rectangle(cr, x - 6, y - 22, length_px + 12 + TextWidth(cr, 12, label) + 8, 32);
@@ -213,7 +226,8 @@ void DrawLegend(cairo_t* cr, const ensemble::RasterLayer* layer, const QuickLook
   }
   std::vector<std::string> listed;
   for (const MapMarker& m : markers) {
-    if (m.label.empty() || std::find(listed.begin(), listed.end(), m.label) != listed.end()) continue;
+    if (m.label.empty() || std::find(listed.begin(), listed.end(), m.label) != listed.end())
+      continue;
     listed.push_back(m.label);
     SetColour(cr, m.rgb);
     cairo_arc(cr, x + 12, y + 8, std::max(3, m.radius_px), 0, 2 * std::numbers::pi);
@@ -244,20 +258,22 @@ QuickLookLegend LegendOf(const ensemble::RasterLayer& layer) {
     return {"Reach probability",
             Classes({0, 0.01, 0.1, 0.3}, {"below 1 %", "1 - 10 %", "10 - 30 %", "30 - 100 %"})};
   if (StartsWith(name, "energy"))
-    return {"Energy, " + StatisticOf(name) + " (kJ)",
-            Classes({0, 30e3, 300e3, 1000e3, 3000e3},
-                    {"below 30 kJ", "30 - 300 kJ", "300 - 1000 kJ", "1000 - 3000 kJ", "3000 kJ and more"})};
+    return {
+        "Energy, " + StatisticOf(name) + " (kJ)",
+        Classes({0, 30e3, 300e3, 1000e3, 3000e3}, {"below 30 kJ", "30 - 300 kJ", "300 - 1000 kJ",
+                                                   "1000 - 3000 kJ", "3000 kJ and more"})};
   if (StartsWith(name, "speed"))
     return {"Speed, " + StatisticOf(name) + " (m/s)",
-            Classes({0, 5, 10, 20, 30},
-                    {"below 5 m/s", "5 - 10 m/s", "10 - 20 m/s", "20 - 30 m/s", "30 m/s and more"})};
+            Classes({0, 5, 10, 20, 30}, {"below 5 m/s", "5 - 10 m/s", "10 - 20 m/s", "20 - 30 m/s",
+                                         "30 m/s and more"})};
   if (StartsWith(name, "jump_height"))
     return {"Jump height, " + StatisticOf(name) + " (m)",
-            Classes({0, 1, 2, 5, 10}, {"below 1 m", "1 - 2 m", "2 - 5 m", "5 - 10 m", "10 m and more"})};
+            Classes({0, 1, 2, 5, 10},
+                    {"below 1 m", "1 - 2 m", "2 - 5 m", "5 - 10 m", "10 m and more"})};
   if (name == "passages" || name == "deposits")
     return {name == "passages" ? "Rocks that passed" : "Rocks at rest",
-            Classes({0, 1.5, 10.5, 100.5, 1000.5},
-                    {"1 rock", "2 - 10 rocks", "11 - 100 rocks", "101 - 1000 rocks", "more than 1000"})};
+            Classes({0, 1.5, 10.5, 100.5, 1000.5}, {"1 rock", "2 - 10 rocks", "11 - 100 rocks",
+                                                    "101 - 1000 rocks", "more than 1000"})};
   // Anything else: five equal classes up to the largest value.
   double top = 0;
   for (float v : layer.values)

@@ -221,15 +221,20 @@ std::vector<int> RasterisePolygons(
 
 void WriteGeoTiff(const std::string& path, const GridGeometry& grid, const std::string& crs_wkt,
                   const std::vector<float>& values, bool has_nodata, double nodata,
-                  const std::string& description) {
+                  const RasterMetadata& metadata, RasterFormat format) {
   RegisterGdal();
-  GDALDriver* driver = GetGDALDriverManager()->GetDriverByName("GTiff");
-  if (!driver) throw std::runtime_error("GDAL has no GTiff driver");
+  const bool cog = format == RasterFormat::kCog;
+  GDALDriver* driver = GetGDALDriverManager()->GetDriverByName(cog ? "COG" : "GTiff");
+  GDALDriver* memory = GetGDALDriverManager()->GetDriverByName("MEM");
+  if (!driver || !memory)
+    throw std::runtime_error(std::string("GDAL has no ") + (cog ? "COG" : "GTiff") + " driver");
   AtomicFile file(path);
   {
-    const char* options[] = {"COMPRESS=DEFLATE", "TILED=YES", nullptr};
-    Dataset dataset(driver->Create(file.temp_path().c_str(), grid.nx, grid.ny, 1, GDT_Float32,
-                                   const_cast<char**>(options)));
+    // The COG driver only copies a finished dataset: it is built in memory first.
+    const char* gtiff_options[] = {"COMPRESS=DEFLATE", "TILED=YES", nullptr};
+    Dataset dataset(cog ? memory->Create("", grid.nx, grid.ny, 1, GDT_Float32, nullptr)
+                        : driver->Create(file.temp_path().c_str(), grid.nx, grid.ny, 1, GDT_Float32,
+                                         const_cast<char**>(gtiff_options)));
     if (!dataset) throw std::runtime_error("cannot create " + path + ": " + CPLGetLastErrorMsg());
     std::array<double, 6> gt = GeoTransformOf(grid);
     dataset->SetGeoTransform(gt.data());
@@ -238,9 +243,12 @@ void WriteGeoTiff(const std::string& path, const GridGeometry& grid, const std::
       srs.importFromWkt(crs_wkt.c_str());
       dataset->SetSpatialRef(&srs);
     }
+    for (const auto& [name, value] : metadata.items)
+      dataset->SetMetadataItem(name.c_str(), value.c_str());
     GDALRasterBand* band = dataset->GetRasterBand(1);
     if (has_nodata) band->SetNoDataValue(nodata);
-    band->SetDescription(description.c_str());
+    band->SetDescription(metadata.description.c_str());
+    if (!metadata.unit.empty()) band->SetUnitType(metadata.unit.c_str());
     std::vector<float> rows(values.size());
     for (int j = 0; j < grid.ny; ++j) {
       const int r = grid.ny - 1 - j;
@@ -250,6 +258,18 @@ void WriteGeoTiff(const std::string& path, const GridGeometry& grid, const std::
     if (band->RasterIO(GF_Write, 0, 0, grid.nx, grid.ny, rows.data(), grid.nx, grid.ny, GDT_Float32,
                        0, 0) != CE_None)
       throw std::runtime_error("cannot write " + path + ": " + CPLGetLastErrorMsg());
+    if (cog) {
+      // Nearest-neighbour overviews show cell values that exist; one thread keeps the bytes fixed.
+      const char* cog_options[] = {"COMPRESS=DEFLATE", "OVERVIEWS=AUTO", "RESAMPLING=NEAREST",
+                                   "NUM_THREADS=1",    "BLOCKSIZE=512",  nullptr};
+      CPLErrorReset();
+      Dataset copy(driver->CreateCopy(file.temp_path().c_str(), dataset.get(), FALSE,
+                                      const_cast<char**>(cog_options), nullptr, nullptr));
+      if (!copy) throw std::runtime_error("cannot write " + path + ": " + CPLGetLastErrorMsg());
+      copy.reset();  // flushes it
+      if (CPLGetLastErrorType() >= CE_Failure)
+        throw std::runtime_error("cannot write " + path + ": " + CPLGetLastErrorMsg());
+    }
     CPLErrorReset();
   }  // closing the dataset flushes it; a failure there is reported through CPLGetLastErrorType
   if (CPLGetLastErrorType() >= CE_Failure)

@@ -5,6 +5,7 @@
 #include <Eigen/Core>
 #include <array>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "solver/terrain.hpp"
@@ -51,11 +52,25 @@ std::string UtmEpsgFor(double lon_deg, double lat_deg);
 // The GDAL geotransform of a grid whose nodes are cell centres (north-up).
 std::array<double, 6> GeoTransformOf(const GridGeometry& grid);
 
+// The layout of written rasters: a tiled GeoTIFF, or a Cloud-Optimised GeoTIFF (GDAL's COG driver:
+// tiles of 512 x 512, nearest-neighbour overviews down to one tile, header first, so that a
+// viewer reads only what it shows).
+enum class RasterFormat { kGeoTiff, kCog };
+
+// What a written raster says about itself: the band's description and unit
+// (GDALRasterBand::SetDescription / SetUnitType) and dataset metadata items (name, value).
+struct RasterMetadata {
+  std::string description;
+  std::string unit = {};
+  std::vector<std::pair<std::string, std::string>> items = {};
+};
+
 // Writes a one-band Float32 GeoTIFF (deflate-compressed, tiled) on `grid` with `crs_wkt` (may be
-// empty), atomically. `nodata` is set when has_nodata.
+// empty), atomically, in `format`. `nodata` is set when has_nodata. The same arguments give the
+// same bytes (nothing depends on the time or the machine).
 void WriteGeoTiff(const std::string& path, const GridGeometry& grid, const std::string& crs_wkt,
                   const std::vector<float>& values, bool has_nodata, double nodata,
-                  const std::string& description);
+                  const RasterMetadata& metadata, RasterFormat format = RasterFormat::kGeoTiff);
 
 // Rasterises polygons onto the nodes of `grid` (GDAL's rasteriser): a node takes burn[k] of the
 // last polygon k whose inside holds it (later polygons over earlier ones), else -1. Each polygon is

@@ -26,8 +26,9 @@ namespace {
 constexpr double kTrajectoryBytesPerRock = 56;
 constexpr double kTrajectoryBytesPerSample = 84;
 constexpr double kRocksCsvBytesPerRow = 150;
-// rocks.gpkg: an end point with its fields and spatial index; a path's vertex (x, y, z) and per path
-// its row and index (1000 rocks on a plane: 2.26 MB, 1.46 MB of it path geometry, 61 vertices each).
+// rocks.gpkg: an end point with its fields and spatial index; a path's vertex (x, y, z) and per
+// path its row and index (1000 rocks on a plane: 2.26 MB, 1.46 MB of it path geometry, 61 vertices
+// each).
 constexpr double kGeoPackageBytesPerRock = 700;
 constexpr double kGeoPackageBytesPerVertex = 24;
 constexpr double kGeoTiffBytesPerCell = 4;
@@ -112,8 +113,8 @@ ResourceEstimate EstimateResources(const SceneFile& scene, int threads) {
            PercentileStorageBytes(stats, cells, rocks * footprint),
            "fewer rocks (--rocks), a coarser DEM, or leave speed, energy and jump_height "
            "out of [output] rasters"});
-    const double layers =
-        3 * stats + int(rasters.passages) + int(rasters.deposits) + int(rasters.reach_probability);
+    const double layers = (2 + double(rasters.percentiles.size())) * stats + int(rasters.passages) +
+                          int(rasters.deposits) + int(rasters.reach_probability);
     e.memory.push_back({"output rasters", cells * layers * sizeof(float), fewer_rasters});
     e.disk.push_back({"GeoTIFFs (" + std::to_string(int(layers)) + ")",
                       cells * layers * kGeoTiffBytesPerCell, fewer_rasters});
@@ -134,11 +135,10 @@ ResourceEstimate EstimateResources(const SceneFile& scene, int threads) {
 
   e.disk.push_back({"rocks.csv", rocks * kRocksCsvBytesPerRow, "fewer rocks (--rocks)"});
   if (output.geopackage)
-    e.disk.push_back(
-        {"rocks.gpkg",
-         rocks * (kGeoPackageBytesPerRock +
-                  (output.trajectories ? samples * kGeoPackageBytesPerVertex : 0.0)),
-         "geopackage = false in [output], or fewer rocks (--rocks)"});
+    e.disk.push_back({"rocks.gpkg",
+                      rocks * (kGeoPackageBytesPerRock +
+                               (output.trajectories ? samples * kGeoPackageBytesPerVertex : 0.0)),
+                      "geopackage = false in [output], or fewer rocks (--rocks)"});
   if (output.trajectories) {
     char what[160];
     std::snprintf(what, sizeof what, "trajectories.h5 (%.0f samples per rock: %.0f s every %g s)",

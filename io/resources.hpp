@@ -30,7 +30,7 @@ struct ResourceEstimate {
 
 // Estimates the run of `scene` on `threads` worker threads (resolved: >= 1), with the outputs
 // its [output] table asks for. Counts the DEM and ground grid, each thread's raster footprint
-// grid, the raster accumulators, the per-cell storage of the p95 rasters, the finished rocks
+// grid, the raster accumulators, the per-cell storage of the percentile rasters, the finished rocks
 // waiting to be written, the quick-look image, and trajectories.h5, rocks.csv and the GeoTIFFs.
 // Where the size depends on how far and long rocks travel, it assumes that each rock crosses the
 // DEM along its diagonal and travels kAssumedTravelTime_s (or max_time_s when shorter).
@@ -40,7 +40,7 @@ ResourceEstimate EstimateResources(const SceneFile& scene, int threads);
 // average with max_time_s = 120; io/resources.cpp has the measured sizes behind the estimate).
 inline constexpr double kAssumedTravelTime_s = 100;
 
-// Bytes of the per-cell storage behind the p95 rasters for `stats` statistics (speed, energy,
+// Bytes of the per-cell storage behind the percentile rasters for `stats` statistics (speed, energy,
 // jump height: 0 to 3) on `cells` raster cells, holding `passes` (rock, cell) values in all. The
 // one place that knows how RasterAccumulator keeps them.
 double PercentileStorageBytes(int stats, double cells, double passes);

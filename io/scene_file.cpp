@@ -947,6 +947,34 @@ void LoadOutput(const Section& s, OutputSpec& o) {
         o.rasters.push_back(*name);
     }
   }
+  if (const toml::node* node = s.Node("percentiles")) {
+    const toml::array* array = node->as_array();
+    if (!array) s.Fail("percentiles", "expected a list of integer percents in 1 .. 99");
+    o.percentiles.clear();
+    for (const toml::node& item : *array) {
+      if (!item.is_integer())
+        s.Fail("percentiles", "expected a list of integer percents in 1 .. 99 (e.g. [50, 95])");
+      const std::int64_t p = *item.value<std::int64_t>();
+      if (p < 1 || p > 99) s.Fail("percentiles", std::to_string(p) + " is out of range (1 .. 99)");
+      o.percentiles.push_back(static_cast<int>(p));
+    }
+    std::sort(o.percentiles.begin(), o.percentiles.end());
+    o.percentiles.erase(std::unique(o.percentiles.begin(), o.percentiles.end()),
+                        o.percentiles.end());
+  }
+  if (s.Has("raster_format")) {
+    const std::string name = s.String("raster_format", "");
+    if (name == "gtiff") {
+      o.raster_format = RasterFormat::kGeoTiff;
+    } else if (name == "cog") {
+      o.raster_format = RasterFormat::kCog;
+    } else {
+      const std::string hint = ClosestName(name, {"gtiff", "cog"});
+      s.Fail("raster_format", "unknown format '" + name + "'" +
+                                  (hint.empty() ? "" : " (did you mean '" + hint + "'?)") +
+                                  "; known: gtiff, cog");
+    }
+  }
 }
 
 }  // namespace
@@ -990,6 +1018,7 @@ ensemble::RasterRequest OutputSpec::Request(const GridGeometry& grid) const {
   r.passages = has("passages");
   r.deposits = has("deposits");
   r.reach_probability = has("reach_probability");
+  r.percentiles = percentiles;
   return r;
 }
 
@@ -1038,8 +1067,8 @@ SceneFile LoadScene(const std::string& path) {
                       "rest_hold_s"}),
              out.scene.options, out.solver_preset, out.solver_keys_given);
   LoadOutput(Section(context, SubTable(context, root, "output"), "output",
-                     {"trajectories", "trajectory_interval_s", "rasters", "quicklook", "report",
-                      "geopackage"}),
+                     {"trajectories", "trajectory_interval_s", "rasters", "percentiles",
+                      "raster_format", "quicklook", "report", "geopackage"}),
              out.output);
   if (!out.release.blocks.empty() && out.release.runs.empty())
     context.Fail(root.get("blocks"), "blocks",

@@ -7,6 +7,7 @@
 
 #include "ensemble/rasters.hpp"
 #include "ensemble/release.hpp"
+#include "io/raster.hpp"
 #include "pointclouds/rock_source.hpp"
 #include "solver/scene.hpp"
 
@@ -22,6 +23,9 @@ struct OutputSpec {
       true;  // quicklook.png: hillshade, reach probability or energy, sample trajectories
   bool geopackage = false;  // rocks.gpkg: end points and (with trajectories) paths as GIS layers
   bool report = true;       // report.html: one page with what ran, endings, maps and histograms
+  // The percentiles (percent, ascending, each 1 .. 99) of the <quantity>_p<NN> rasters.
+  std::vector<int> percentiles = {95};
+  io::RasterFormat raster_format = io::RasterFormat::kGeoTiff;  // "gtiff" or "cog"
 
   // The raster request on `grid` (nothing when no raster is listed).
   ensemble::RasterRequest Request(const GridGeometry& grid) const;

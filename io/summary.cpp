@@ -44,6 +44,8 @@ nlohmann::ordered_json GroundJson(const GroundTable& table) {
 
 }  // namespace
 
+std::string GroundTableJson(const GroundTable& table) { return GroundJson(table).dump(); }
+
 std::string SummaryJson(const SceneFile& scene, const ensemble::EnsembleReport& report,
                         const std::string& version, const std::vector<std::string>& outputs) {
   nlohmann::ordered_json j;

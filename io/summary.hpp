@@ -14,4 +14,7 @@ namespace talus::io {
 std::string SummaryJson(const SceneFile& scene, const ensemble::EnsembleReport& report,
                         const std::string& version, const std::vector<std::string>& outputs);
 
+// The ground table as used, as summary.json's "ground" holds it, on one line (compact JSON).
+std::string GroundTableJson(const GroundTable& table);
+
 }  // namespace talus::io

@@ -34,6 +34,7 @@ max_time_s = 4
 trajectories = true
 trajectory_interval_s = 0.05
 rasters = ["speed", "energy", "jump_height", "passages", "deposits", "reach_probability"]
+percentiles = [50, 95, 99]
 geopackage = true
 )";
 
@@ -99,7 +100,8 @@ TEST_F(MergeCommand, AnySplitInAnyOrderGivesTheSingleRunsBytes) {
             0)
       << log;
   const auto single = Outputs(dir_ / "single");
-  ASSERT_EQ(single.size(), 18u);  // 12 statistics rasters + 6 files: every output is compared
+  // 3 x (max, mean, p50, p95, p99) + 3 count rasters + 6 files: every output is compared
+  ASSERT_EQ(single.size(), 24u);
 
   const std::vector<std::vector<std::string>> splits = {
       {"0:10"}, {"5:10", "0:5"}, {"9:10", "0:1", "4:9", "1:4"}};

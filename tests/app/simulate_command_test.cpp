@@ -2,6 +2,7 @@
 // interrupts and the command line's messages and exit codes.
 
 #include <fcntl.h>
+#include <gdal_priv.h>
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <spawn.h>
@@ -155,6 +156,119 @@ TEST(SimulateCommand, WritesEveryOutputIdenticallyForOneAndTwoThreads) {
   EXPECT_EQ(lines, 7);
 }
 
+// A 35° slope as an ESRI ASCII grid (30 x 12 cells of 1 m, no CRS) with a nodata hole of 3 x 3
+// cells in the rocks' way.
+std::string SlopeDemWithAHole() {
+  std::string text =
+      "ncols 30\nnrows 12\nxllcorner 0\nyllcorner -6\ncellsize 1\n"
+      "NODATA_value -9999\n";
+  for (int row = 0; row < 12; ++row) {
+    for (int column = 0; column < 30; ++column) {
+      const bool hole = column >= 14 && column < 17 && row >= 4 && row < 7;
+      text += hole ? "-9999" : std::to_string(21.0 - 0.7 * (column + 0.5));
+      text += column + 1 < 30 ? " " : "\n";
+    }
+  }
+  return text;
+}
+
+// Every raster of a run on a DEM with a nodata hole, as COGs with two percentiles: nodata in the
+// hole whatever passed there, 0 counts or nodata statistics elsewhere where no rock passed; each
+// band says what it is and which run made it (summary.json's inputs hash, the ground table), and
+// the bytes are the same for 1 and 2 threads.
+TEST(SimulateCommand, RastersAreNodataOverDemHolesAndDescribeThemselves) {
+  const fs::path dir = FreshDir("hazard_rasters");
+  talus::app::testing::Write(dir / "dem.asc", SlopeDemWithAHole());
+  talus::app::testing::Write(dir / "scene.toml", R"([terrain]
+dem = "dem.asc"
+default_ground = "extra_hard"
+[rock]
+shape = { sphere = 0.2 }
+[release]
+lines = [[[2.5, -1.5], [2.5, 1.5]]]
+rocks = 8
+seed = 5
+[solver]
+max_time_s = 4
+[output]
+rasters = ["speed", "energy", "jump_height", "passages", "deposits", "reach_probability"]
+percentiles = [95, 50]
+raster_format = "cog"
+quicklook = false
+report = false
+)");
+  std::string log;
+  for (const char* threads : {"1", "2"})
+    ASSERT_EQ(RunCommand(std::string(TALUS_BINARY) + " simulate " + (dir / "scene.toml").string() +
+                             " --out " + (dir / (std::string("out") + threads)).string() +
+                             " --threads " + threads,
+                         &log),
+              0)
+        << log;
+  const auto summary = nlohmann::json::parse(Slurp(dir / "out1" / "summary.json"));
+  GDALAllRegister();
+  std::vector<std::string> names;
+  for (const auto& entry : fs::directory_iterator(dir / "out1"))
+    if (entry.path().extension() == ".tif") names.push_back(entry.path().filename().string());
+  std::sort(names.begin(), names.end());
+  EXPECT_EQ(names.size(), 15u);  // 3 quantities x (max, mean, p50, p95) + 3 counts
+  for (const char* name : {"speed_p50.tif", "energy_p95.tif", "jump_height_p50.tif"})
+    EXPECT_TRUE(std::find(names.begin(), names.end(), name) != names.end()) << name;
+  long passed_hole_or_beyond = 0;
+  for (const std::string& name : names) {
+    const fs::path path = dir / "out1" / name;
+    EXPECT_TRUE(Slurp(path) == Slurp(dir / "out2" / name)) << name;
+    GDALDataset* d = static_cast<GDALDataset*>(GDALOpen(path.c_str(), GA_ReadOnly));
+    ASSERT_NE(d, nullptr) << name;
+    EXPECT_STREQ(d->GetMetadataItem("LAYOUT", "IMAGE_STRUCTURE"), "COG") << name;
+    const std::string quantity = d->GetMetadataItem("TALUS_QUANTITY");
+    const std::string statistic = d->GetMetadataItem("TALUS_STATISTIC");
+    const bool count = statistic == "count" || statistic == "fraction";
+    EXPECT_EQ(count ? quantity : quantity + "_" + statistic, name.substr(0, name.size() - 4));
+    EXPECT_EQ(d->GetMetadataItem("TALUS_INPUTS_HASH"),
+              summary["inputs_hash_fnv1a64"].get<std::string>());
+    EXPECT_EQ(d->GetMetadataItem("TALUS_VERSION"), summary["talus_version"].get<std::string>());
+    EXPECT_STREQ(d->GetMetadataItem("TALUS_ROCKS"), "8");
+    EXPECT_STREQ(d->GetMetadataItem("TALUS_SEED"), "5");
+    EXPECT_EQ(nlohmann::json::parse(d->GetMetadataItem("TALUS_GROUND")), summary["ground"]);
+    GDALRasterBand* band = d->GetRasterBand(1);
+    const std::map<std::string, std::string> units = {
+        {"speed", "m/s"},      {"energy", "J"},       {"jump_height", "m"},
+        {"passages", "count"}, {"deposits", "count"}, {"reach_probability", "1"}};
+    EXPECT_EQ(band->GetUnitType(), units.at(quantity)) << name;
+    if (statistic == "p95") {
+      EXPECT_EQ(band->GetDescription(), quantity == "jump_height"
+                                            ? "jump height, 95th percentile over passing rocks"
+                                            : quantity + ", 95th percentile over passing rocks");
+    }
+    int has_nodata = 0;
+    EXPECT_EQ(band->GetNoDataValue(&has_nodata), -9999.0) << name;
+    EXPECT_TRUE(has_nodata) << name;
+    std::vector<float> v(30 * 12);
+    ASSERT_EQ(band->RasterIO(GF_Read, 0, 0, 30, 12, v.data(), 30, 12, GDT_Float32, 0, 0), CE_None);
+    GDALClose(d);
+    long passed = 0, untouched = 0;
+    for (int row = 0; row < 12; ++row)
+      for (int column = 0; column < 30; ++column) {
+        const float value = v[static_cast<std::size_t>(row * 30 + column)];
+        if (column >= 14 && column < 17 && row >= 4 && row < 7) {
+          EXPECT_EQ(value, -9999.0f) << name << " in the hole at " << column << ", " << row;
+        } else if (value == (count ? 0.0f : -9999.0f)) {
+          ++untouched;
+        } else {
+          EXPECT_TRUE(count ? value > 0 : value != -9999.0f) << name;
+          ++passed;
+          if (name == "passages.tif" && column >= 13) passed_hole_or_beyond += long(value);
+        }
+      }
+    if (name != "deposits.tif") {
+      EXPECT_GT(passed, 10) << name;  // rocks passed: values
+    }
+    EXPECT_GT(untouched, 50) << name;  // no rock passed: 0 or nodata
+  }
+  EXPECT_GT(passed_hole_or_beyond, 0);  // rocks rolled up to the hole (and ended there)
+}
+
 TEST(SimulateCommand, OverridesRocksAndSeed) {
   const fs::path dir = FreshDir("overrides");
   std::ofstream(dir / "scene.toml") << kScene;
@@ -221,7 +335,9 @@ TEST(SimulateCommand, BadSceneFailsBeforeAnyWorkNamingFileLineAndKey) {
 
 TEST(SimulateCommand, ARunRemovesOutputsOfAnEarlierRunThatItDoesNotWrite) {
   const fs::path dir = FreshDir("stale");
-  std::ofstream(dir / "all.toml") << kScene;
+  std::string all = kScene;  // with a percentile the next run does not ask for
+  all.replace(all.find("rasters = ["), 0, "percentiles = [50, 95]\n");
+  std::ofstream(dir / "all.toml") << all;
   std::ofstream(dir / "lean.toml") << LeanScene();
   const std::string out = (dir / "out").string();
   std::string log;
@@ -232,6 +348,7 @@ TEST(SimulateCommand, ARunRemovesOutputsOfAnEarlierRunThatItDoesNotWrite) {
       << log;
   ASSERT_TRUE(fs::exists(dir / "out" / "trajectories.h5"));
   ASSERT_TRUE(fs::exists(dir / "out" / "speed_p95.tif"));
+  ASSERT_TRUE(fs::exists(dir / "out" / "speed_p50.tif"));
   std::ofstream(dir / "out" / "notes.txt") << "the user's own file";
   ASSERT_EQ(RunCommand(std::string(TALUS_BINARY) + " simulate " + (dir / "lean.toml").string() +
                            " --out " + out,
@@ -240,6 +357,7 @@ TEST(SimulateCommand, ARunRemovesOutputsOfAnEarlierRunThatItDoesNotWrite) {
       << log;
   EXPECT_FALSE(fs::exists(dir / "out" / "trajectories.h5"));
   EXPECT_FALSE(fs::exists(dir / "out" / "speed_p95.tif"));
+  EXPECT_FALSE(fs::exists(dir / "out" / "speed_p50.tif"));
   EXPECT_FALSE(fs::exists(dir / "out" / "quicklook.png"));
   EXPECT_TRUE(fs::exists(dir / "out" / "rocks.csv"));
   EXPECT_TRUE(fs::exists(dir / "out" / "summary.json"));

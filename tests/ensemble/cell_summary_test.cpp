@@ -162,5 +162,18 @@ TEST(ValueSummary, SerializedStateRoundTripsAndDamageIsAnError) {
   EXPECT_THROW(ValueSummary::Deserialize(truncated), std::runtime_error);
 }
 
+// Percentile(p) takes rank ceil(p n / 100) counted in integers: for the values 1 .. 100 the 7th
+// percentile is the 7th value, where ceil(0.07 * 100) in doubles is 8 (0.07 * 100 rounds to
+// 7.000000000000001); every integer percentile of 1 .. 100 is its own value, within the bound.
+TEST(ValueSummary, PercentileIsTheIntegerNearestRank) {
+  ValueSummary s;
+  for (int k = 100; k >= 1; --k) s.Add(static_cast<float>(k));
+  EXPECT_NEAR(s.Quantile(0.07), 8.0, 8.0 * ValueSummary::kRelativeError);  // the double's rank
+  for (int p = 1; p <= 99; ++p)
+    EXPECT_NEAR(s.Percentile(p), p, p * ValueSummary::kRelativeError) << p;
+  EXPECT_EQ(s.Percentile(1), 1.0f);      // the smallest: exact
+  EXPECT_EQ(s.Percentile(100), 100.0f);  // the largest: exact
+}
+
 }  // namespace
 }  // namespace talus::ensemble

@@ -14,10 +14,14 @@
 namespace talus::ensemble {
 namespace {
 
-const RasterLayer& Layer(const EnsembleReport& report, const std::string& name) {
-  for (const RasterLayer& l : report.rasters)
+const RasterLayer& Layer(const std::vector<RasterLayer>& layers, const std::string& name) {
+  for (const RasterLayer& l : layers)
     if (l.name == name) return l;
   throw std::runtime_error("no raster " + name);
+}
+
+const RasterLayer& Layer(const EnsembleReport& report, const std::string& name) {
+  return Layer(report.rasters, name);
 }
 
 int CellOf(const GridGeometry& g, double x, double y) {
@@ -95,9 +99,11 @@ TEST(Rasters, SlopeRunsAreConsistent) {
   }
 }
 
-// The p95 rasters of a real run agree with the exact nearest-rank percentile of the values each
-// rock left in each cell (its footprint), to within the stated bound (cell_summary.hpp).
-TEST(Rasters, P95OfARunIsWithinTheStatedBoundOfTheExactPercentile) {
+// The percentile rasters of a real run agree with the exact nearest-rank percentile (rank
+// ceil(p n / 100) of the n values, counted in integers) of the values each rock left in each cell
+// (its footprint), to within the stated bound (cell_summary.hpp). 7 is a percentile whose rank a
+// floating-point 0.07 n would put one too high for some n.
+TEST(Rasters, PercentilesOfARunAreWithinTheStatedBoundOfTheExactPercentiles) {
   Scene scene = testing::SmallPlane(35, 15, 15);
   scene.rock = MakeRockShape(MakeIcosphere(0.2, 1), 2700);
   scene.options.max_time_s = 6;
@@ -105,6 +111,7 @@ TEST(Rasters, P95OfARunIsWithinTheStatedBoundOfTheExactPercentile) {
   EnsembleOptions options;
   options.threads = 2;
   options.rasters = {scene.terrain.heights().grid, true, true, true, false, false, false};
+  options.rasters.percentiles = {7, 50, 90, 95, 99};
   // Every value of every rock in every cell, from the footprints.
   struct Collect : RockSink {
     std::map<int, std::array<std::vector<float>, 3>> values;
@@ -119,23 +126,27 @@ TEST(Rasters, P95OfARunIsWithinTheStatedBoundOfTheExactPercentile) {
     }
   } sink;
   const EnsembleReport report = RunEnsemble(scene, release, options, &sink);
-  const char* names[] = {"speed_p95", "energy_p95", "jump_height_p95"};
+  ASSERT_EQ(report.rasters.size(), 3u * (2 + 5));
+  const char* quantities[] = {"speed", "energy", "jump_height"};
   int compared = 0, inside = 0;
   for (const auto& [cell, values] : sink.values) {
     for (int q = 0; q < 3; ++q) {
-      std::vector<float> v = values[static_cast<std::size_t>(q)];
-      const auto rank = static_cast<std::size_t>(std::ceil(0.95 * static_cast<double>(v.size())));
-      std::nth_element(v.begin(), v.begin() + static_cast<long>(rank - 1), v.end());
-      const double exact = v[rank - 1];
-      const double raster = Layer(report, names[q]).values[static_cast<std::size_t>(cell)];
-      EXPECT_LE(std::abs(raster - exact), ValueSummary::kRelativeError * std::abs(exact) + 1e-40)
-          << names[q] << " cell " << cell << " of " << v.size() << " rocks";
-      ++compared;
-      inside += rank < v.size() ? 1 : 0;  // a rank inside the histogram, not the maximum
+      for (int p : options.rasters.percentiles) {
+        std::vector<float> v = values[static_cast<std::size_t>(q)];
+        const std::size_t rank = (static_cast<std::size_t>(p) * v.size() + 99) / 100;
+        std::nth_element(v.begin(), v.begin() + static_cast<long>(rank - 1), v.end());
+        const double exact = v[rank - 1];
+        const std::string name = std::string(quantities[q]) + "_p" + std::to_string(p);
+        const double raster = Layer(report, name).values[static_cast<std::size_t>(cell)];
+        EXPECT_LE(std::abs(raster - exact), ValueSummary::kRelativeError * std::abs(exact) + 1e-40)
+            << name << " cell " << cell << " of " << v.size() << " rocks";
+        ++compared;
+        inside += rank > 1 && rank < v.size() ? 1 : 0;  // inside the histogram, not an extreme
+      }
     }
   }
-  EXPECT_GE(inside, 20);  // the comparison reaches the histogram, not only the exact extremes
-  EXPECT_EQ(compared, 3 * static_cast<int>(sink.values.size()));
+  EXPECT_GE(inside, 100);  // the comparison reaches the histogram, not only the exact extremes
+  EXPECT_EQ(compared, 3 * 5 * static_cast<int>(sink.values.size()));
 }
 
 // The rocks of one run split between accumulators (as threads, ranks or parts would), merged in
@@ -165,7 +176,7 @@ TEST(Rasters, AccumulatorsOfAnySplitMergeToTheSameRasters) {
   merged.Merge(c);
   merged.Merge(a);
   EXPECT_EQ(merged.rocks(), 12);
-  const std::vector<RasterLayer> layers = merged.Finish();
+  const std::vector<RasterLayer> layers = merged.Finish(scene.terrain.heights());
   ASSERT_EQ(layers.size(), whole.rasters.size());
   for (std::size_t l = 0; l < layers.size(); ++l)
     EXPECT_TRUE(layers[l].values == whole.rasters[l].values) << layers[l].name;
@@ -178,6 +189,19 @@ TEST(Rasters, AccumulatorsOfAnySplitMergeToTheSameRasters) {
   other.deposits = false;
   ByteReader third(bytes, "state of b");
   EXPECT_THROW(RasterAccumulator::Deserialize(other, third), std::runtime_error);
+  // The state records its percentiles: a part run for other ones is refused, naming both.
+  other = options.rasters;
+  other.percentiles = {50, 95};
+  ByteReader fourth(bytes, "state of b");
+  try {
+    RasterAccumulator::Deserialize(other, fourth);
+    FAIL() << "other percentiles accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(
+                  "state of b holds other percentiles (p95) than the scene asks for (p50, p95)"),
+              std::string::npos)
+        << e.what();
+  }
 }
 
 TEST(Rasters, P95IsTheNearestRankPercentile) {
@@ -191,12 +215,101 @@ TEST(Rasters, P95IsTheNearestRankPercentile) {
     f.speed_m_s = {static_cast<float>(k)};
     acc.Add(f);
   }
-  const auto layers = acc.Finish();
+  const auto layers = acc.Finish(Heightfield{request.grid, {0.0}});
   ASSERT_EQ(layers.size(), 3u);
   EXPECT_EQ(layers[0].values[0], 40.0f);  // max
   EXPECT_EQ(layers[1].values[0], 20.5f);  // mean
   // ceil(0.95 * 40) = 38th value, to within the summary's stated bound (cell_summary.hpp)
   EXPECT_NEAR(layers[2].values[0], 38.0f, 38.0 * ValueSummary::kRelativeError);
+}
+
+// Where the DEM has nodata every raster is nodata, whatever the rocks left there; elsewhere the
+// counts are 0 and the statistics nodata where no rock passed.
+TEST(Rasters, NodataInTheDemIsNodataInEveryRaster) {
+  RasterRequest request{{3, 2, 0, 0, 1, 1}, true, true, true, true, true, true};
+  request.percentiles = {50, 95};
+  Heightfield dem{request.grid, {1, 1, 1, 1, std::nan(""), 1}};  // cell 4 (i = 1, j = 1) is a hole
+  RasterAccumulator acc(request);
+  for (int rock = 0; rock < 2; ++rock) {
+    Footprint f;
+    f.cells = {0, 4};  // a rock passes the hole (its centre of mass may be in a nodata cell)
+    f.speed_m_s = {2, 3};
+    f.energy_j = {20, 30};
+    f.jump_height_m = {0.5, 0.25};
+    f.deposit_cell = 4;
+    acc.Add(f);
+  }
+  const std::vector<RasterLayer> layers = acc.Finish(dem);
+  ASSERT_EQ(layers.size(), 3u * 4 + 3);
+  for (const RasterLayer& l : layers) {
+    EXPECT_EQ(l.values[4], RasterLayer::kNoData) << l.name;
+    const bool count = l.statistic == "count" || l.statistic == "fraction";
+    for (std::size_t c : {1u, 2u, 3u, 5u})  // valid, no rock passed
+      EXPECT_EQ(l.values[c], count ? 0.0f : RasterLayer::kNoData) << l.name << " " << c;
+  }
+  EXPECT_EQ(Layer(layers, "passages").values[0], 2.0f);
+  EXPECT_EQ(Layer(layers, "reach_probability").values[0], 1.0f);
+  EXPECT_EQ(Layer(layers, "deposits").values[0], 0.0f);
+  EXPECT_EQ(Layer(layers, "speed_p50").values[0], 2.0f);  // every value the same
+  EXPECT_EQ(Layer(layers, "jump_height_max").values[0], 0.5f);
+}
+
+// Each raster says what it is: name, quantity, statistic, unit and a description with the
+// percentile's ordinal.
+TEST(Rasters, LayersAreNamedAndDescribedInOrder) {
+  RasterRequest request{{1, 1, 0, 0, 1, 1}, false, true, false, true, true, true};
+  request.percentiles = {1, 2, 3, 11, 12, 13, 21, 22, 23, 99};
+  RasterAccumulator acc(request);
+  const std::vector<RasterLayer> layers = acc.Finish(Heightfield{request.grid, {0.0}});
+  std::vector<std::string> names, descriptions;
+  for (const RasterLayer& l : layers) {
+    names.push_back(l.name);
+    descriptions.push_back(l.description);
+  }
+  EXPECT_EQ(names, (std::vector<std::string>{"energy_max", "energy_mean", "energy_p1", "energy_p2",
+                                             "energy_p3", "energy_p11", "energy_p12", "energy_p13",
+                                             "energy_p21", "energy_p22", "energy_p23", "energy_p99",
+                                             "passages", "deposits", "reach_probability"}));
+  EXPECT_EQ(descriptions[0], "energy, largest over passing rocks");
+  EXPECT_EQ(descriptions[1], "energy, mean over passing rocks");
+  for (auto [k, ordinal] : {std::pair{2, "1st"},
+                            {3, "2nd"},
+                            {4, "3rd"},
+                            {5, "11th"},
+                            {6, "12th"},
+                            {7, "13th"},
+                            {8, "21st"},
+                            {9, "22nd"},
+                            {10, "23rd"},
+                            {11, "99th"}})
+    EXPECT_EQ(descriptions[static_cast<std::size_t>(k)],
+              std::string("energy, ") + ordinal + " percentile over passing rocks");
+  EXPECT_EQ(layers[4].quantity, "energy");
+  EXPECT_EQ(layers[4].statistic, "p3");
+  EXPECT_EQ(layers[4].unit, "J");
+  EXPECT_EQ(layers[12].unit, "count");
+  EXPECT_EQ(layers[12].statistic, "count");
+  EXPECT_EQ(layers[13].unit, "count");
+  EXPECT_EQ(layers[14].unit, "1");
+  EXPECT_EQ(layers[14].statistic, "fraction");
+  EXPECT_EQ(descriptions[14], "reach probability, fraction of all rocks that passed the cell");
+}
+
+TEST(RasterRequest, PercentilesAreAscendingIntegersInOneToNinetyNine) {
+  RasterRequest request;
+  std::string why;
+  EXPECT_TRUE(request.IsValid(&why)) << why;  // the defaults
+  EXPECT_EQ(request.percentiles, std::vector<int>{95});
+  request.percentiles = {1, 50, 99};
+  EXPECT_TRUE(request.IsValid(&why)) << why;
+  request.percentiles = {95, 50};
+  EXPECT_FALSE(request.IsValid(&why));
+  EXPECT_EQ(why, "percentiles = 50 must be ascending without repeats");
+  request.percentiles = {0};
+  EXPECT_FALSE(request.IsValid(&why));
+  EXPECT_EQ(why, "percentiles = 0 must each be in 1 .. 99");
+  request.percentiles = {100};
+  EXPECT_FALSE(request.IsValid(&why));
 }
 
 }  // namespace

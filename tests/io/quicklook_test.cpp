@@ -30,8 +30,7 @@ unsigned char Pixel(GDALDataset* png, int band, int x, int y) {
 TEST(QuickLook, WritesAnRgbPngNorthUpWithALegendBesideTheMap) {
   const auto dir = testing::FreshDir("png");
   const Heightfield dem = MakePlaneHeightfield({30, 20, 10, 20, 1});
-  ensemble::RasterLayer reach{"reach_probability", "1", std::vector<float>(dem.z_m.size(), 0.0f),
-                              false};
+  ensemble::RasterLayer reach{"reach_probability", "1", std::vector<float>(dem.z_m.size(), 0.0f)};
   reach.values[0] = 1.0f;  // south-west corner cell
   const auto path = (dir / "quicklook.png").string();
   WriteQuickLookPng(path, dem, &reach, {{{2, 0}, {25, 5}}});
@@ -65,7 +64,7 @@ TEST(QuickLook, WritesAnRgbPngNorthUpWithALegendBesideTheMap) {
 }
 
 TEST(QuickLook, EnergyClassesAreAbsoluteWithTheHazardLimitsAt30And300Kilojoules) {
-  const ensemble::RasterLayer energy{"energy_max", "J", {}, true};
+  const ensemble::RasterLayer energy{"energy_max", "J", {}};
   const QuickLookLegend legend = LegendOf(energy);
   EXPECT_EQ(legend.ClassOf(0), -1);      // no rock: not coloured
   EXPECT_EQ(legend.ClassOf(29.9e3), 0);  // below 30 kJ
@@ -76,12 +75,19 @@ TEST(QuickLook, EnergyClassesAreAbsoluteWithTheHazardLimitsAt30And300Kilojoules)
   EXPECT_NE(legend.title.find("kJ"), std::string::npos);
   EXPECT_NE(legend.title.find("largest"), std::string::npos);
   // One rock in a hundred is 1 %, although the float raster holds 0.01f < 0.01.
-  const ensemble::RasterLayer reach{"reach_probability", "1", {}, false};
+  const ensemble::RasterLayer reach{"reach_probability", "1", {}};
   EXPECT_EQ(LegendOf(reach).ClassOf(1.0f / 100.0f), 1);
   // The same value has the same class whatever else the raster holds.
-  const ensemble::RasterLayer speed{"speed_p95", "m/s", {1, 50}, true};
+  const ensemble::RasterLayer speed{"speed_p95", "m/s", {1, 50}};
   EXPECT_EQ(LegendOf(speed).ClassOf(12), 2);  // 10 - 20 m/s
   EXPECT_NE(LegendOf(speed).title.find("95th percentile"), std::string::npos);
+  for (auto [name, ordinal] : {std::pair{"energy_p1", "1st"},
+                               {"energy_p22", "22nd"},
+                               {"energy_p13", "13th"},
+                               {"energy_p3", "3rd"}})
+    EXPECT_NE(LegendOf({name, "J", {}}).title.find(std::string(", ") + ordinal + " percentile"),
+              std::string::npos)
+        << LegendOf({name, "J", {}}).title;
 }
 
 TEST(QuickLook, ScaleBarLengthsAreOneTwoOrFiveTimesAPowerOfTen) {

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
+#include <iterator>
 
 #include "common/error.hpp"
 #include "ensemble/runner.hpp"
@@ -98,7 +100,7 @@ TEST(WriteGeoTiff, RoundTripsGridCrsAndValues) {
   for (int k = 0; k < 12; ++k) values[k] = static_cast<float>(k);
   values[5] = -9999.0f;
   WriteGeoTiff((dir / "out.tif").string(), grid, testing::Wkt(31287), values, true, -9999.0,
-               "test");
+               {"test"});
   const Raster r = ReadRaster((dir / "out.tif").string(), "out");
   EXPECT_DOUBLE_EQ(r.grid.x0_m, grid.x0_m);
   EXPECT_DOUBLE_EQ(r.grid.y0_m, grid.y0_m);
@@ -111,6 +113,93 @@ TEST(WriteGeoTiff, RoundTripsGridCrsAndValues) {
   for (const auto& entry : std::filesystem::directory_iterator(dir))
     files += entry.is_regular_file();
   EXPECT_EQ(files, 1);
+}
+
+std::string Bytes(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+// The band's description and unit and the dataset's metadata items are written, and the same
+// arguments give the same bytes.
+TEST(WriteGeoTiff, BandDescriptionUnitAndMetadataItems) {
+  const auto dir = testing::FreshDir("metadata");
+  const GridGeometry grid{4, 3, 10.5, 20.5, 1.0, 1.0};
+  const std::vector<float> values(12, 2.5f);
+  const RasterMetadata metadata{"energy, 95th percentile over passing rocks",
+                                "J",
+                                {{"TALUS_QUANTITY", "energy"}, {"TALUS_GROUND", R"({"a":1})"}}};
+  for (const char* name : {"a.tif", "b.tif"})
+    WriteGeoTiff((dir / name).string(), grid, testing::Wkt(31287), values, true, -9999.0, metadata);
+  EXPECT_TRUE(Bytes(dir / "a.tif") == Bytes(dir / "b.tif"));
+  GDALDataset* d =
+      static_cast<GDALDataset*>(GDALOpen((dir / "a.tif").string().c_str(), GA_ReadOnly));
+  ASSERT_NE(d, nullptr);
+  GDALRasterBand* band = d->GetRasterBand(1);
+  EXPECT_STREQ(band->GetDescription(), "energy, 95th percentile over passing rocks");
+  EXPECT_STREQ(band->GetUnitType(), "J");
+  int has_nodata = 0;
+  EXPECT_EQ(band->GetNoDataValue(&has_nodata), -9999.0);
+  EXPECT_TRUE(has_nodata);
+  EXPECT_STREQ(d->GetMetadataItem("TALUS_QUANTITY"), "energy");
+  EXPECT_STREQ(d->GetMetadataItem("TALUS_GROUND"), R"({"a":1})");
+  EXPECT_EQ(d->GetMetadataItem("LAYOUT", "IMAGE_STRUCTURE"), nullptr);  // a plain GeoTIFF
+  GDALClose(d);
+}
+
+// A Cloud-Optimised GeoTIFF: GDAL reports LAYOUT=COG and DEFLATE, a raster larger than a tile
+// (512 cells) has overviews down to one tile, values, nodata, CRS and metadata are those given,
+// and the same arguments give the same bytes.
+TEST(WriteGeoTiff, CogHasTheCogLayoutOverviewsAndTheValues) {
+  const auto dir = testing::FreshDir("cog");
+  const GridGeometry grid{1300, 700, 600002.5, 249002.5, 5.0, 5.0};
+  std::vector<float> values(static_cast<std::size_t>(grid.nx) * grid.ny);
+  for (std::size_t c = 0; c < values.size(); ++c)
+    values[c] = c % 7 == 0 ? -9999.0f : static_cast<float>(c % 1000) * 0.5f;
+  const RasterMetadata metadata{"speed, largest over passing rocks", "m/s", {{"TALUS_SEED", "7"}}};
+  for (const char* name : {"a.tif", "b.tif"})
+    WriteGeoTiff((dir / name).string(), grid, testing::Wkt(31287), values, true, -9999.0, metadata,
+                 RasterFormat::kCog);
+  EXPECT_TRUE(Bytes(dir / "a.tif") == Bytes(dir / "b.tif"));
+  int files = 0;  // no temporary file (nor overview file) is left behind
+  for (const auto& entry : std::filesystem::directory_iterator(dir))
+    files += entry.is_regular_file();
+  EXPECT_EQ(files, 2);
+
+  GDALDataset* d =
+      static_cast<GDALDataset*>(GDALOpen((dir / "a.tif").string().c_str(), GA_ReadOnly));
+  ASSERT_NE(d, nullptr);
+  ASSERT_NE(d->GetMetadataItem("LAYOUT", "IMAGE_STRUCTURE"), nullptr);
+  EXPECT_STREQ(d->GetMetadataItem("LAYOUT", "IMAGE_STRUCTURE"), "COG");
+  EXPECT_STREQ(d->GetMetadataItem("COMPRESSION", "IMAGE_STRUCTURE"), "DEFLATE");
+  GDALRasterBand* band = d->GetRasterBand(1);
+  EXPECT_EQ(band->GetOverviewCount(), 2);  // 650 x 350, 325 x 175: the last within one tile
+  int block_x = 0, block_y = 0;
+  band->GetBlockSize(&block_x, &block_y);
+  EXPECT_EQ(block_x, 512);
+  EXPECT_EQ(block_y, 512);
+  EXPECT_STREQ(band->GetDescription(), "speed, largest over passing rocks");
+  EXPECT_STREQ(band->GetUnitType(), "m/s");
+  EXPECT_STREQ(d->GetMetadataItem("TALUS_SEED"), "7");
+  EXPECT_STREQ(d->GetSpatialRef()->GetAuthorityCode(nullptr), "31287");
+  GDALClose(d);
+  const Raster r = ReadRaster((dir / "a.tif").string(), "cog");
+  EXPECT_DOUBLE_EQ(r.grid.x0_m, grid.x0_m);
+  EXPECT_DOUBLE_EQ(r.grid.y0_m, grid.y0_m);
+  ASSERT_EQ(r.values.size(), values.size());
+  std::size_t same = 0;
+  for (std::size_t c = 0; c < values.size(); ++c)
+    same += values[c] == -9999.0f ? std::isnan(r.values[c]) : r.values[c] == values[c];
+  EXPECT_EQ(same, values.size());
+
+  // A raster within one tile needs no overview, and is still a COG.
+  WriteGeoTiff((dir / "small.tif").string(), {10, 8, 0.5, 0.5, 1, 1}, "",
+               std::vector<float>(80, 1.0f), true, -9999.0, metadata, RasterFormat::kCog);
+  d = static_cast<GDALDataset*>(GDALOpen((dir / "small.tif").string().c_str(), GA_ReadOnly));
+  ASSERT_NE(d, nullptr);
+  EXPECT_STREQ(d->GetMetadataItem("LAYOUT", "IMAGE_STRUCTURE"), "COG");
+  EXPECT_EQ(d->GetRasterBand(1)->GetOverviewCount(), 0);
+  GDALClose(d);
 }
 
 // End to end on a georeferenced DEM: a rock set down at rest in one DEM cell shows up as a
@@ -137,7 +226,7 @@ TEST(WriteGeoTiff, OutputCellLinesUpWithTheDemCell) {
   ASSERT_EQ(report.rasters.size(), 1u);
   const auto out = (dir / "deposits.tif").string();
   WriteGeoTiff(out, scene.scene.terrain.heights().grid, scene.crs_wkt, report.rasters[0].values,
-               false, 0, "deposits");
+               false, 0, {"deposits"});
 
   RegisterGdal();
   GDALDataset* d = static_cast<GDALDataset*>(GDALOpen(out.c_str(), GA_ReadOnly));

@@ -260,6 +260,52 @@ TEST(LoadScene, SolverPresetSetsTheKnobsTheSceneDoesNotGive) {
   }
 }
 
+// [output] percentiles: integers 1 .. 99, sorted and without repeats; the default is the p95
+// rasters of earlier versions. raster_format: "gtiff" (default) or "cog".
+TEST(LoadScene, PercentilesAndRasterFormatOfTheOutput) {
+  const auto dir = testing::FreshDir("percentiles");
+  testing::WriteText(dir / "scene.toml", kPlaneScene);
+  const SceneFile plain = LoadScene((dir / "scene.toml").string());
+  EXPECT_EQ(plain.output.percentiles, std::vector<int>{95});
+  EXPECT_EQ(plain.output.raster_format, RasterFormat::kGeoTiff);
+  const GridGeometry& grid = plain.scene.terrain.heights().grid;
+  EXPECT_EQ(plain.output.Request(grid).percentiles, std::vector<int>{95});
+  std::string why;
+  EXPECT_TRUE(plain.output.Request(grid).IsValid(&why)) << why;
+
+  const std::string rasters = "rasters = [\"speed\", \"reach_probability\"]";
+  testing::WriteText(dir / "scene.toml",
+                     Replace(kPlaneScene, rasters,
+                             rasters + "\npercentiles = [99, 1, 50, 99]\nraster_format = \"cog\""));
+  const SceneFile chosen = LoadScene((dir / "scene.toml").string());
+  EXPECT_EQ(chosen.output.percentiles, (std::vector<int>{1, 50, 99}));
+  EXPECT_EQ(chosen.output.Request(grid).percentiles, (std::vector<int>{1, 50, 99}));
+  EXPECT_EQ(chosen.output.raster_format, RasterFormat::kCog);
+  testing::WriteText(dir / "scene.toml",
+                     Replace(kPlaneScene, rasters, rasters + "\npercentiles = []"));
+  EXPECT_TRUE(LoadScene((dir / "scene.toml").string()).output.percentiles.empty());
+
+  const auto error = [&](const std::string& line) {
+    return ErrorOf(Replace(kPlaneScene, rasters, rasters + "\n" + line), dir);
+  };
+  EXPECT_HAS(error("percentiles = [95, 100]"),
+             "scene.toml:28: output.percentiles: 100 is out of range (1 .. 99)");
+  EXPECT_HAS(error("percentiles = [0]"), "output.percentiles: 0 is out of range (1 .. 99)");
+  EXPECT_HAS(error("percentiles = [-5]"), "output.percentiles: -5 is out of range (1 .. 99)");
+  EXPECT_HAS(error("percentiles = [95.5]"),
+             "output.percentiles: expected a list of integer percents in 1 .. 99");
+  EXPECT_HAS(error("percentiles = [\"p95\"]"),
+             "output.percentiles: expected a list of integer percents in 1 .. 99");
+  EXPECT_HAS(error("percentiles = 95"),
+             "output.percentiles: expected a list of integer percents in 1 .. 99");
+  EXPECT_HAS(error("raster_format = \"cogg\""),
+             "scene.toml:28: output.raster_format: unknown format 'cogg' (did you mean 'cog'?); "
+             "known: gtiff, cog");
+  EXPECT_HAS(error("raster_format = true"), "output.raster_format: expected a string");
+  EXPECT_HAS(error("percentile = [95]"),
+             "output.percentile: unknown key (did you mean 'percentiles'?)");
+}
+
 TEST(LoadScene, ReleaseOutsideTheDemIsAnError) {
   const auto dir = testing::FreshDir("outside");
   const std::string e = ErrorOf(Replace(kPlaneScene, "[6, 2]", "[6, 200]"), dir);
