@@ -6,12 +6,15 @@
 #include <vector>
 
 #include "ensemble/runner.hpp"
+#include "io/evaluation_lines.hpp"
 #include "io/scene_file.hpp"
 
 namespace talus::io {
 
-// The summary as JSON text; `outputs` lists the files written next to it.
+// The summary as JSON text; `outputs` lists the files written next to it. `evaluation_lines`, the
+// per-line summary of a scene with evaluation lines, goes under "evaluation_lines".
 std::string SummaryJson(const SceneFile& scene, const ensemble::EnsembleReport& report,
-                        const std::string& version, const std::vector<std::string>& outputs);
+                        const std::string& version, const std::vector<std::string>& outputs,
+                        const std::vector<EvaluationLineSummary>& evaluation_lines = {});
 
 }  // namespace talus::io
