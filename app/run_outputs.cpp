@@ -10,7 +10,7 @@
 
 #include "app/interrupt.hpp"
 #include "common/error.hpp"
-#include "io/evaluation_lines.hpp"
+#include "io/evaluation_lines_csv.hpp"
 #include "io/geopackage.hpp"
 #include "io/quicklook.hpp"
 #include "io/raster.hpp"

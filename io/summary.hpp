@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "ensemble/runner.hpp"
-#include "io/evaluation_lines.hpp"
+#include "io/evaluation_lines_csv.hpp"
 #include "io/scene_file.hpp"
 
 namespace talus::io {

@@ -1,4 +1,4 @@
-#include "io/evaluation_lines.hpp"
+#include "io/evaluation_lines_csv.hpp"
 
 #include <cmath>
 #include <limits>
