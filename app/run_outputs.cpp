@@ -105,7 +105,8 @@ std::vector<std::string> WriteSummaryOutputs(const io::SceneFile& scene,
     ThrowIfInterrupted();
     io::WriteRocksGeoPackage(
         staging.path("rocks.gpkg"), staging.path("rocks.csv"),
-        scene.output.trajectories ? staging.path("trajectories.h5") : std::string(), scene.crs_wkt);
+        scene.output.trajectories ? staging.path("trajectories.h5") : std::string(), scene.crs_wkt,
+        scene.evaluation_lines.empty() ? std::string() : staging.path("evaluation_lines.csv"));
     outputs.push_back("rocks.gpkg");
   }
   if (scene.output.report) outputs.push_back("report.html");

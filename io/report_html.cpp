@@ -187,10 +187,10 @@ std::string RunReportHtml(const RunReportInput& input) {
       "the GeoTIFFs next to this file.</p>\n");
 
   html += "<h2>What ran</h2>\n";
-  html += KeyValueTable(summary, {"ends", "raised_at_release", "stayed_at_release", "steps",
-                                  "unconverged_steps", "threads", "wall_time_s",
-                                  "trajectories_per_s", "outputs", "blocks", "talus_version",
-                                  "inputs_hash_fnv1a64"});
+  html += KeyValueTable(
+      summary, {"ends", "raised_at_release", "stayed_at_release", "steps", "unconverged_steps",
+                "threads", "wall_time_s", "trajectories_per_s", "outputs", "blocks",
+                "talus_version", "inputs_hash_fnv1a64", "evaluation_lines"});
   if (summary.contains("rock") && summary["rock"].is_object()) {
     html += "<h3>Rock</h3>\n";
     html += KeyValueTable(summary["rock"]);
