@@ -10,6 +10,7 @@
 
 #include "app/interrupt.hpp"
 #include "common/error.hpp"
+#include "io/evaluation_lines_csv.hpp"
 #include "io/geopackage.hpp"
 #include "io/quicklook.hpp"
 #include "io/raster.hpp"
@@ -24,17 +25,18 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// Streams each finished rock to rocks.csv and trajectories.h5.
+// Streams each finished rock to rocks.csv, trajectories.h5 and evaluation_lines.csv.
 // Keeps the horizontal paths of the quick-look's sample rocks.
 class FileSink : public ensemble::RockSink {
  public:
   FileSink(io::RocksCsvWriter& csv, io::TrajectoryWriter* trajectories,
-           std::function<bool(long)> sample)
-      : csv_(csv), trajectories_(trajectories), sample_(std::move(sample)) {}
+           io::EvaluationLinesCsvWriter* lines, std::function<bool(long)> sample)
+      : csv_(csv), trajectories_(trajectories), lines_(lines), sample_(std::move(sample)) {}
   void OnRock(const ensemble::RockOutcome& rock) override {
     ThrowIfInterrupted();
     csv_.Write(rock);
     if (trajectories_) trajectories_->Write(rock);
+    if (lines_) lines_->Write(rock);
     if (sample_ && sample_(rock.rock)) {
       io::SamplePath& path = paths.emplace_back();
       path.rock = rock.rock;
@@ -47,6 +49,7 @@ class FileSink : public ensemble::RockSink {
  private:
   io::RocksCsvWriter& csv_;
   io::TrajectoryWriter* trajectories_;
+  io::EvaluationLinesCsvWriter* lines_;
   std::function<bool(long)> sample_;
 };
 
@@ -89,22 +92,35 @@ std::vector<std::string> WriteSummaryOutputs(const io::SceneFile& scene,
     outputs.push_back(layer.name + ".tif");
   }
   ThrowIfInterrupted();
+  // Evaluation lines: summarised from the complete evaluation_lines.csv.
+  std::vector<io::EvaluationLineSummary> lines;
+  if (!scene.evaluation_lines.empty()) {
+    lines = io::SummarizeEvaluationLines(staging.path("evaluation_lines.csv"),
+                                         scene.evaluation_lines, report.rocks);
+    WriteFileAtomically(staging.path("evaluation_lines_summary.csv"),
+                        io::EvaluationLinesSummaryCsv(lines));
+    outputs.push_back("evaluation_lines_summary.csv");
+  }
+  std::vector<io::MapLine> map_lines;
+  for (const ensemble::EvaluationLine& line : scene.evaluation_lines)
+    map_lines.push_back({line.name, line.vertices_m});
   std::vector<std::vector<Eigen::Vector2d>> xy;
   for (const io::SamplePath& p : paths) xy.push_back(p.xy_m);
   if (scene.output.quicklook) {
     io::WriteQuickLookPng(staging.path("quicklook.png"), scene.scene.terrain.heights(),
-                          io::QuickLookLayer(layers), xy);
+                          io::QuickLookLayer(layers), xy, {}, map_lines);
     outputs.push_back("quicklook.png");
   }
   if (scene.output.geopackage) {
     ThrowIfInterrupted();
     io::WriteRocksGeoPackage(
         staging.path("rocks.gpkg"), staging.path("rocks.csv"),
-        scene.output.trajectories ? staging.path("trajectories.h5") : std::string(), scene.crs_wkt);
+        scene.output.trajectories ? staging.path("trajectories.h5") : std::string(), scene.crs_wkt,
+        scene.evaluation_lines.empty() ? std::string() : staging.path("evaluation_lines.csv"));
     outputs.push_back("rocks.gpkg");
   }
   if (scene.output.report) outputs.push_back("report.html");
-  const std::string summary = io::SummaryJson(scene, report, kVersion, outputs);
+  const std::string summary = io::SummaryJson(scene, report, kVersion, outputs, lines);
   if (scene.output.report) {
     ThrowIfInterrupted();
     io::RunReportInput page;
@@ -112,6 +128,7 @@ std::vector<std::string> WriteSummaryOutputs(const io::SceneFile& scene,
     page.dem = &scene.scene.terrain.heights();
     page.layers = &layers;
     page.paths = std::move(xy);
+    page.lines = std::move(map_lines);
     page.rocks = io::ReadRockColumns(staging.path("rocks.csv"));
     WriteFileAtomically(staging.path("report.html"), io::RunReportHtml(page));
   }
@@ -127,7 +144,9 @@ void AppendCsv(const std::string& from, bool skip_header, const std::string& hea
   std::ifstream in(from, std::ios::binary);
   std::string first;
   if (!in || !std::getline(in, first)) throw std::runtime_error("cannot read " + from);
-  if (first != header) throw std::runtime_error(from + " does not start with the rocks.csv header");
+  if (first != header)
+    throw std::runtime_error(from + " does not start with the header of " +
+                             fs::path(from).filename().string());
   if (!skip_header) out << first << '\n';
   if (in.peek() != std::ifstream::traits_type::eof()) out << in.rdbuf();
   if (in.bad()) throw std::runtime_error("cannot read " + from);
@@ -150,7 +169,7 @@ std::vector<std::string> TalusOutputNames() {
   std::vector<std::string> names = {
       "rocks.csv",    "trajectories.h5",       "summary.json", "quicklook.png", "passages.tif",
       "deposits.tif", "reach_probability.tif", "partial.json", "partial.bin",   "report.html",
-      "rocks.gpkg"};
+      "rocks.gpkg",     "evaluation_lines.csv", "evaluation_lines_summary.csv"};
   for (const char* quantity : {"speed", "energy", "jump_height"}) {
     for (const char* statistic : {"max", "mean"})
       names.push_back(std::string(quantity) + "_" + statistic + ".tif");
@@ -177,6 +196,9 @@ std::vector<std::string> RunIntoStaging(const io::SceneFile& scene, int threads,
   options.rasters = scene.output.Request(scene.scene.terrain.heights().grid);
   options.keep_raster_state = part;
   options.progress = std::move(progress);
+  if (!scene.evaluation_lines.empty())
+    options.evaluation_lines =
+        std::make_shared<const std::vector<ensemble::EvaluationLine>>(scene.evaluation_lines);
 
   std::vector<std::string> outputs = {"rocks.csv"};
   io::RocksCsvWriter csv(staging.path("rocks.csv"), scene.scene, scene.release);
@@ -186,11 +208,18 @@ std::vector<std::string> RunIntoStaging(const io::SceneFile& scene, int threads,
                                                           scene.scene.rock, scene.crs_wkt);
     outputs.push_back("trajectories.h5");
   }
-  FileSink sink(csv, trajectories.get(), options.sample_trajectories);
+  std::unique_ptr<io::EvaluationLinesCsvWriter> lines;
+  if (!scene.evaluation_lines.empty()) {
+    lines = std::make_unique<io::EvaluationLinesCsvWriter>(staging.path("evaluation_lines.csv"),
+                                                           scene.evaluation_lines, scene.release);
+    outputs.push_back("evaluation_lines.csv");
+  }
+  FileSink sink(csv, trajectories.get(), lines.get(), options.sample_trajectories);
   *report = ensemble::RunEnsemble(scene.scene, scene.release, options, &sink);
   ThrowIfInterrupted();
   csv.Commit();
   if (trajectories) trajectories->Commit();
+  if (lines) lines->Commit();
   if (!part)
     return WriteSummaryOutputs(scene, *report, report->rasters, sink.paths, staging, outputs);
   WriteFileAtomically(staging.path("partial.bin"), io::PartialState(*report, sink.paths));
@@ -228,6 +257,17 @@ std::vector<std::string> MergeIntoStaging(const io::SceneFile& scene,
     }
     out.Commit();
     outputs.push_back("trajectories.h5");
+  }
+  if (!scene.evaluation_lines.empty()) {
+    std::ofstream csv(staging.path("evaluation_lines.csv"), std::ios::binary);
+    for (std::size_t k = 0; k < parts.size(); ++k) {
+      ThrowIfInterrupted();
+      AppendCsv((fs::path(parts[k].dir) / "evaluation_lines.csv").string(), k > 0,
+                io::EvaluationLinesCsvWriter::Header(), csv);
+    }
+    csv.close();
+    if (!csv) throw std::runtime_error("cannot write " + staging.path("evaluation_lines.csv"));
+    outputs.push_back("evaluation_lines.csv");
   }
   const ensemble::RasterRequest request = scene.output.Request(scene.scene.terrain.heights().grid);
   std::optional<ensemble::RasterAccumulator> rasters;

@@ -32,6 +32,22 @@ struct Footprint {
   int deposit_cell = -1;  // cell of the rest position, -1 when the rock did not come to rest there
 };
 
+// What one rock did at one evaluation line (ensemble/evaluation_lines.hpp): the first crossing of
+// its centre of mass, interpolated linearly within the step (time, position, velocity; rotational
+// energy between the step's ends; orientation by slerp), and its number of crossings in all.
+struct LineCrossing {
+  int line = 0;  // index into the scene's evaluation lines
+  double t_s = 0;
+  Eigen::Vector3d position_m = Eigen::Vector3d::Zero();  // centre of mass, world
+  double speed_m_s = 0;                                  // of the centre of mass
+  double translational_energy_J = 0;                     // 1/2 m |v|^2
+  double rotational_energy_J = 0;                        // 1/2 w . Theta w
+  double com_height_m = 0;     // centre of mass above the terrain, vertical
+  double bounce_height_m = 0;  // lowest hull vertex above the terrain, vertical; 0 when touching
+  long crossings = 0;          // times the centre of mass crossed the line in all
+  double energy_J() const { return translational_energy_J + rotational_energy_J; }
+};
+
 struct RockOutcome {
   long rock = 0;
   int release = 0;                         // index of its release geometry or run
@@ -43,6 +59,9 @@ struct RockOutcome {
   std::vector<TrajectorySample> trajectory;
   std::vector<ContactEpisode> episodes;
   Footprint footprint;
+  // The first crossing of each evaluation line the rock crossed, in line order
+  // (ensemble/evaluation_lines.hpp).
+  std::vector<LineCrossing> line_crossings;
   // Values callers' own recorders store (EnsembleOptions::extra_recorders), each under its own
   // name and in its own layout.
   std::map<std::string, std::vector<double>> extra;

@@ -45,6 +45,8 @@ RecorderSet MakeRecorders(const Scene& scene, const EnsembleOptions& options) {
                                    [all, sample](long rock) { return all || sample(rock); }));
   }
   if (options.episodes) set.Add(MakeEpisodeRecorder(scene.terrain, options.episode_options));
+  if (options.evaluation_lines && !options.evaluation_lines->empty())
+    set.Add(EvaluationLineRecorders(scene.terrain, options.evaluation_lines)());
   for (const RecorderFactory& make : options.extra_recorders) set.Add(make());
   return set;
 }

@@ -9,10 +9,12 @@
 #include <Eigen/Geometry>
 #include <array>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "ensemble/evaluation_lines.hpp"
 #include "ensemble/outcome.hpp"
 #include "ensemble/rasters.hpp"
 #include "ensemble/recorders.hpp"
@@ -36,6 +38,9 @@ struct EnsembleOptions {
   bool keep_raster_state = false;
   bool episodes = false;  // record every rock's contact episodes
   EpisodeOptions episode_options;
+  // Record every rock's crossings of these lines (RockOutcome::line_crossings); null or empty: no
+  // line work at all.
+  std::shared_ptr<const std::vector<EvaluationLine>> evaluation_lines;
   std::vector<RecorderFactory> extra_recorders;  // further per-thread recorders
   // Called on the calling thread with (rocks done, rocks in total), at most every 0.2 s and at the
   // end.

@@ -8,6 +8,8 @@
 #include <memory>
 #include <stdexcept>
 
+#include "ensemble/evaluation_lines.hpp"
+
 namespace talus::fieldobs {
 
 EnsembleSamples::EnsembleSamples(const ensemble::ReleaseSpec& release) : release_(release) {
@@ -62,18 +64,6 @@ class SegmentRecorder : public ensemble::RockRecorder {
   long samples_ = 0;
 };
 
-// Where the step a -> b crosses the segment p -> q: the fraction along a -> b, or -1.
-double Crossing(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& p,
-                const Eigen::Vector2d& q) {
-  const Eigen::Vector2d r = b - a, s = q - p;
-  const double denominator = r.x() * s.y() - r.y() * s.x();
-  if (denominator == 0) return -1;  // parallel: a grazing path does not cross
-  const Eigen::Vector2d d = p - a;
-  const double t = (d.x() * s.y() - d.y() * s.x()) / denominator;
-  const double u = (d.x() * r.y() - d.y() * r.x()) / denominator;
-  return t >= 0 && t <= 1 && u >= 0 && u <= 1 ? t : -1;
-}
-
 class ZoneRecorder : public ensemble::RockRecorder {
  public:
   explicit ZoneRecorder(std::shared_ptr<const std::vector<Zone>> zones)
@@ -104,15 +94,12 @@ class ZoneRecorder : public ensemble::RockRecorder {
         continue;
       }
       if (v[0] == 1) continue;  // the first crossing counts
-      for (std::size_t k = 1; k < zone.points.size(); ++k) {
-        const double t = Crossing(a, b, zone.points[k - 1], zone.points[k]);
-        if (t < 0) continue;
-        v[0] = 1;
-        v[1] = v0 + t * (v1 - v0);
-        v[2] = w0 + t * (w1 - w0);
-        v[3] = j0 + t * (jump - j0);
-        break;
-      }
+      const double t = ensemble::CrossPolyline(a, b, zone.points).fraction;
+      if (t < 0) continue;
+      v[0] = 1;
+      v[1] = v0 + t * (v1 - v0);
+      v[2] = w0 + t * (w1 - w0);
+      v[3] = j0 + t * (jump - j0);
     }
     previous_ = state;
     previous_jump_ = jump;

@@ -21,11 +21,11 @@ namespace {
 
 constexpr int kFeaturesPerTransaction = 20000;
 
-// The field type of a rocks.csv column: counts and indices as integers, names as text, the rest
-// (coordinates, distances, speeds, energies, masses) as reals.
+// The field type of a rocks.csv or evaluation_lines.csv column: counts and indices as integers,
+// names as text, the rest (coordinates, distances, speeds, energies, masses) as reals.
 OGRFieldType FieldType(const std::string& column) {
-  static const char* const integers[] = {"rock", "release", "seed"};
-  static const char* const texts[] = {"run", "end", "block", "end_ground"};
+  static const char* const integers[] = {"rock", "release", "seed", "crossings"};
+  static const char* const texts[] = {"run", "end", "block", "end_ground", "line"};
   for (const char* name : integers)
     if (column == name) return OFTInteger64;
   for (const char* name : texts)
@@ -104,21 +104,15 @@ class Writer {
   int pending_ = 0;
 };
 
-}  // namespace
-
-void WriteRocksGeoPackage(const std::string& path, const std::string& rocks_csv,
-                          const std::string& trajectories_h5, const std::string& crs_wkt) {
-  const FixedGpkgDate fixed_date;
-  AtomicFile file(path);
-  Writer out(path, file.temp_path(), crs_wkt);
-
-  CsvReader rocks(rocks_csv);
-  const std::vector<std::string>& columns = rocks.header();
-  const std::size_t x = rocks.Column("x_end"), y = rocks.Column("y_end"), z = rocks.Column("z_end");
-  const std::size_t rock_column = rocks.Column("rock"), run_column = rocks.Column("run"),
-                    end_column = rocks.Column("end");
-  OGRLayer* ends = out.Layer("end_points", wkbPoint25D);
-  for (const std::string& c : columns) out.Field(ends, c, FieldType(c));
+// A layer of 3-D points at the columns x, y, z of `csv`, one per row, with every column as a
+// field (an empty cell is null); read record by record.
+void PointLayer(Writer& out, const char* name, const std::string& csv, const char* x_column,
+                const char* y_column, const char* z_column) {
+  CsvReader rows(csv);
+  const std::vector<std::string>& columns = rows.header();
+  const std::size_t x = rows.Column(x_column), y = rows.Column(y_column), z = rows.Column(z_column);
+  OGRLayer* layer = out.Layer(name, wkbPoint25D);
+  for (const std::string& c : columns) out.Field(layer, c, FieldType(c));
   std::vector<std::string> fields;
   const auto number = [&](std::size_t c) {
     try {
@@ -127,11 +121,11 @@ void WriteRocksGeoPackage(const std::string& path, const std::string& rocks_csv,
       if (used == fields[c].size()) return v;
     } catch (const std::exception&) {
     }
-    throw InputError(rocks_csv + ":" + std::to_string(rocks.line()) + ": column '" + columns[c] +
-                     "': '" + fields[c] + "' is not a number");
+    throw InputError(csv + ":" + std::to_string(rows.line()) + ": column '" + columns[c] + "': '" +
+                     fields[c] + "' is not a number");
   };
-  while (rocks.Next(&fields)) {
-    OGRFeature feature(ends->GetLayerDefn());
+  while (rows.Next(&fields)) {
+    OGRFeature feature(layer->GetLayerDefn());
     for (std::size_t c = 0; c < columns.size(); ++c) {
       if (fields[c].empty()) continue;  // null
       const OGRFieldType type = FieldType(columns[c]);
@@ -144,10 +138,25 @@ void WriteRocksGeoPackage(const std::string& path, const std::string& rocks_csv,
     }
     OGRPoint point(number(x), number(y), number(z));
     feature.SetGeometry(&point);
-    out.Add(ends, feature);
+    out.Add(layer, feature);
   }
   out.Flush();
+}
 
+}  // namespace
+
+void WriteRocksGeoPackage(const std::string& path, const std::string& rocks_csv,
+                          const std::string& trajectories_h5, const std::string& crs_wkt,
+                          const std::string& evaluation_lines_csv) {
+  const FixedGpkgDate fixed_date;
+  AtomicFile file(path);
+  Writer out(path, file.temp_path(), crs_wkt);
+
+  PointLayer(out, "end_points", rocks_csv, "x_end", "y_end", "z_end");
+  if (!evaluation_lines_csv.empty())
+    PointLayer(out, "evaluation_crossings", evaluation_lines_csv, "x_m", "y_m", "z_m");
+
+  std::vector<std::string> fields;
   if (!trajectories_h5.empty()) {
     const TrajectoryReader trajectories(trajectories_h5);
     OGRLayer* lines = out.Layer("paths", wkbLineString25D);
@@ -155,6 +164,8 @@ void WriteRocksGeoPackage(const std::string& path, const std::string& rocks_csv,
     out.Field(lines, "run", OFTString);
     out.Field(lines, "end", OFTString);
     CsvReader again(rocks_csv);  // a second pass: nothing per rock is kept in memory
+    const std::size_t rock_column = again.Column("rock"), run_column = again.Column("run"),
+                      end_column = again.Column("end");
     while (again.Next(&fields)) {
       const long rock = std::stol(fields[rock_column]);
       const StoredTrajectory t = trajectories.Read(rock);

@@ -2,7 +2,9 @@
 // rocks.gpkg (docs/scenes.md): the rocks of a run as GIS layers QGIS opens directly, in the DEM's
 // CRS: `end_points` (one 3-D point per rock at its end, with every column of rocks.csv as a field)
 // and, when trajectories.h5 was written, `paths` (one 3-D line per rock through its trajectory
-// samples, with the rock, its run and how it ended). Built from rocks.csv and trajectories.h5 after
+// samples, with the rock, its run and how it ended), and with evaluation lines
+// `evaluation_crossings` (one 3-D point per row of evaluation_lines.csv, at the first crossing of
+// the centre of mass, with every column as a field). Built from rocks.csv and trajectories.h5 after
 // they are complete, so a run split into parts gives the same file; the GeoPackage's timestamps are
 // fixed (2000-01-01T00:00:00Z), so the same rocks give the same bytes.
 
@@ -10,10 +12,12 @@
 
 namespace talus::io {
 
-// Writes the GeoPackage atomically. `trajectories_h5` empty: no `paths` layer. `crs_wkt` empty: local
-// coordinates in metres (the analytic plane), an engineering CRS. Throws std::runtime_error naming the file and the reason, and
-// InputError for a rocks.csv it cannot read.
+// Writes the GeoPackage atomically. `trajectories_h5` empty: no `paths` layer;
+// `evaluation_lines_csv` empty: no `evaluation_crossings` layer. `crs_wkt` empty: local
+// coordinates in metres (the analytic plane), an engineering CRS. Throws std::runtime_error naming
+// the file and the reason, and InputError for a CSV file it cannot read.
 void WriteRocksGeoPackage(const std::string& path, const std::string& rocks_csv,
-                          const std::string& trajectories_h5, const std::string& crs_wkt);
+                          const std::string& trajectories_h5, const std::string& crs_wkt,
+                          const std::string& evaluation_lines_csv = "");
 
 }  // namespace talus::io

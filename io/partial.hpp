@@ -3,6 +3,8 @@
 // of the scene's ensemble and writes, instead of the rasters and summary.json,
 //   rocks.csv        the rows of its rocks (with the header),
 //   trajectories.h5  their rows, when the scene asks for trajectories,
+//   evaluation_lines.csv  their crossings, when the scene has evaluation lines (the summary is
+//                    computed from the merged file),
 //   partial.bin      the raster accumulator (per-cell summaries) and the quick-look's sample paths,
 //   partial.json     what the part is (scene, its inputs' hash, seed, range, version, counts);
 //                    written last, so that a directory with a partial.json is a complete part.

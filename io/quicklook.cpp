@@ -188,7 +188,7 @@ void DrawNorthArrow(cairo_t* cr, const QuickLookLayout& layout) {
 }
 
 void DrawLegend(cairo_t* cr, const ensemble::RasterLayer* layer, const QuickLookLegend& legend,
-                std::size_t paths, const std::vector<MapMarker>& markers,
+                std::size_t paths, const std::vector<MapMarker>& markers, std::size_t lines,
                 const QuickLookLayout& layout) {
   const double x = layout.map_width + 16;
   double y = 28;
@@ -222,6 +222,15 @@ void DrawLegend(cairo_t* cr, const ensemble::RasterLayer* layer, const QuickLook
     cairo_set_source_rgb(cr, 0, 0, 0);
     Text(cr, x + 32, y + 12, 12,
          "paths of " + std::to_string(paths) + (paths == 1 ? " rock" : " rocks"));
+    y += 22;
+  }
+  if (lines > 0) {
+    cairo_set_source_rgb(cr, 0, 0, 0);
+    cairo_set_line_width(cr, 2.5);
+    cairo_move_to(cr, x, y + 8);
+    cairo_line_to(cr, x + 24, y + 8);
+    cairo_stroke(cr);
+    Text(cr, x + 32, y + 12, 12, lines == 1 ? "evaluation line" : "evaluation lines");
     y += 22;
   }
   std::vector<std::string> listed;
@@ -315,7 +324,7 @@ double ScaleBarLength(double at_most_m) {
 
 std::string QuickLookPng(const Heightfield& dem, const ensemble::RasterLayer* layer,
                          const std::vector<std::vector<Eigen::Vector2d>>& paths,
-                         const std::vector<MapMarker>& markers) {
+                         const std::vector<MapMarker>& markers, const std::vector<MapLine>& lines) {
   const GridGeometry& g = dem.grid;
   const QuickLookLayout layout = QuickLookLayoutOf(g);
   const QuickLookLegend legend = layer ? LegendOf(*layer) : QuickLookLegend{};
@@ -353,6 +362,32 @@ std::string QuickLookPng(const Heightfield& dem, const ensemble::RasterLayer* la
     }
     cairo_stroke(cr);
   }
+  // Evaluation lines: black over a white halo, named at their first vertex.
+  for (const MapLine& line : lines) {
+    if (line.xy_m.size() < 2) continue;
+    for (const auto& [width, grey] : {std::pair{5.0, 1.0}, std::pair{2.5, 0.0}}) {
+      cairo_set_source_rgb(cr, grey, grey, grey);
+      cairo_set_line_width(cr, width);
+      for (std::size_t k = 0; k < line.xy_m.size(); ++k) {
+        const Eigen::Vector2d p = pixel(line.xy_m[k]);
+        if (k == 0)
+          cairo_move_to(cr, p.x(), p.y());
+        else
+          cairo_line_to(cr, p.x(), p.y());
+      }
+      cairo_stroke(cr);
+    }
+    const Eigen::Vector2d at = pixel(line.xy_m.front());
+    cairo_select_font_face(cr, "DejaVu Sans", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_BOLD);
+    cairo_set_font_size(cr, 13);
+    cairo_move_to(cr, at.x() + 4, at.y() - 6);
+    cairo_text_path(cr, line.name.c_str());
+    cairo_set_source_rgb(cr, 1, 1, 1);
+    cairo_set_line_width(cr, 3);
+    cairo_stroke_preserve(cr);
+    cairo_set_source_rgb(cr, 0, 0, 0);
+    cairo_fill(cr);
+  }
   for (const MapMarker& m : markers) {
     const Eigen::Vector2d centre = pixel(m.xy_m);
     SetColour(cr, m.rgb);
@@ -362,7 +397,7 @@ std::string QuickLookPng(const Heightfield& dem, const ensemble::RasterLayer* la
   DrawScaleBar(cr, g, layout);
   DrawNorthArrow(cr, layout);
   cairo_reset_clip(cr);
-  DrawLegend(cr, layer, legend, paths.size(), markers, layout);
+  DrawLegend(cr, layer, legend, paths.size(), markers, lines.size(), layout);
 
   cairo_surface_flush(surface.get());
   std::string png;
@@ -382,8 +417,8 @@ std::string QuickLookPng(const Heightfield& dem, const ensemble::RasterLayer* la
 void WriteQuickLookPng(const std::string& path, const Heightfield& dem,
                        const ensemble::RasterLayer* layer,
                        const std::vector<std::vector<Eigen::Vector2d>>& paths,
-                       const std::vector<MapMarker>& markers) {
-  WriteFileAtomically(path, QuickLookPng(dem, layer, paths, markers));
+                       const std::vector<MapMarker>& markers, const std::vector<MapLine>& lines) {
+  WriteFileAtomically(path, QuickLookPng(dem, layer, paths, markers, lines));
 }
 
 }  // namespace talus::io

@@ -50,6 +50,13 @@ struct MapMarker {
   std::string label;
 };
 
+// A named polyline drawn on the map (evaluation lines): black over a white halo, its name at its
+// first vertex; listed in the legend.
+struct MapLine {
+  std::string name;
+  std::vector<Eigen::Vector2d> xy_m;  // map coordinates
+};
+
 // The picture's layout in pixels: the map is `scale` pixels per DEM cell, north up, at the top
 // left; the legend panel is to its right.
 struct QuickLookLayout {
@@ -59,15 +66,18 @@ struct QuickLookLayout {
 };
 QuickLookLayout QuickLookLayoutOf(const GridGeometry& grid);
 
-// The picture as PNG bytes (cairo), and written atomically to `path`. paths: horizontal positions, map coordinates; markers are
-// drawn last, in order. The same inputs give the same bytes.
+// The picture as PNG bytes (cairo), and written atomically to `path`. paths: horizontal
+// positions, map coordinates; lines are drawn over the paths, markers last, in order. The same
+// inputs give the same bytes.
 std::string QuickLookPng(const Heightfield& dem, const ensemble::RasterLayer* layer,
                          const std::vector<std::vector<Eigen::Vector2d>>& paths,
-                         const std::vector<MapMarker>& markers = {});
+                         const std::vector<MapMarker>& markers = {},
+                         const std::vector<MapLine>& lines = {});
 void WriteQuickLookPng(const std::string& path, const Heightfield& dem,
                        const ensemble::RasterLayer* layer,
                        const std::vector<std::vector<Eigen::Vector2d>>& paths,
-                       const std::vector<MapMarker>& markers = {});
+                       const std::vector<MapMarker>& markers = {},
+                       const std::vector<MapLine>& lines = {});
 
 // A "nice" length for a scale bar at most `at_most_m` long: 1, 2 or 5 × 10^k m.
 double ScaleBarLength(double at_most_m);

@@ -187,10 +187,10 @@ std::string RunReportHtml(const RunReportInput& input) {
       "the GeoTIFFs next to this file.</p>\n");
 
   html += "<h2>What ran</h2>\n";
-  html += KeyValueTable(summary, {"ends", "raised_at_release", "stayed_at_release", "steps",
-                                  "unconverged_steps", "threads", "wall_time_s",
-                                  "trajectories_per_s", "outputs", "blocks", "talus_version",
-                                  "inputs_hash_fnv1a64"});
+  html += KeyValueTable(
+      summary, {"ends", "raised_at_release", "stayed_at_release", "steps", "unconverged_steps",
+                "threads", "wall_time_s", "trajectories_per_s", "outputs", "blocks",
+                "talus_version", "inputs_hash_fnv1a64", "evaluation_lines"});
   if (summary.contains("rock") && summary["rock"].is_object()) {
     html += "<h3>Rock</h3>\n";
     html += KeyValueTable(summary["rock"]);
@@ -223,7 +223,7 @@ std::string RunReportHtml(const RunReportInput& input) {
   if (!maps.empty()) {
     html += "<h2>Maps</h2>\n";
     for (const ensemble::RasterLayer* layer : maps) {
-      const std::string png = QuickLookPng(*input.dem, layer, input.paths);
+      const std::string png = QuickLookPng(*input.dem, layer, input.paths, {}, input.lines);
       Add(html, "<figure><img alt=\"", Escape(layer->name), "\" src=\"data:image/png;base64,",
           Base64(png), "\"><figcaption>", Escape(LegendOf(*layer).title), " (",
           Escape(layer->name), ".tif)</figcaption></figure>\n");
@@ -254,6 +254,50 @@ std::string RunReportHtml(const RunReportInput& input) {
   stats_row("travel angle (&deg;)", r.travel_angle_deg);
   html += "</table>\n<p class=\"note\">Percentiles are nearest-rank, over the rocks (one value per "
           "rock).</p>\n";
+
+  // Evaluation lines: who crossed, and the design numbers at the crossing.
+  if (summary.contains("evaluation_lines") && summary["evaluation_lines"].is_array()) {
+    const Json& lines = summary["evaluation_lines"];
+    html +=
+        "<h2>Evaluation lines</h2>\n<table>\n<tr><th>line</th><th>length (m)</th>"
+        "<th>rocks</th><th>crossed</th><th>passing probability</th></tr>\n";
+    for (const Json& line : lines) {
+      const double p = line["passing_probability"].is_number()
+                           ? line["passing_probability"].get<double>()
+                           : std::numeric_limits<double>::quiet_NaN();
+      Add(html, "<tr><th>", Cell(line["name"]), "</th><td>", Cell(line["length_m"]), "</td><td>",
+          Cell(line["rocks"]), "</td><td>", Cell(line["crossed"]), "</td><td>",
+          Number(100 * p, "%.1f"), " %</td></tr>\n");
+    }
+    html += "</table>\n";
+    const std::pair<const char*, const char*> quantities[] = {
+        {"speed_m_s", "speed (m/s)"},
+        {"energy_J", "kinetic energy (kJ)"},
+        {"com_height_m", "height of the centre of mass (m)"},
+        {"bounce_height_m", "bounce height (m)"}};
+    for (const Json& line : lines) {
+      Add(html, "<h3>", Cell(line["name"]),
+          "</h3>\n<table>\n<tr><th></th><th>mean</th>"
+          "<th>median</th><th>90 %</th><th>95 %</th><th>99 %</th><th>largest</th></tr>\n");
+      for (const auto& [key, label] : quantities) {
+        Add(html, "<tr><th>", label, "</th>");
+        for (const char* statistic : {"mean", "p50", "p90", "p95", "p99", "max"}) {
+          const Json& v = line[key][statistic];
+          const double scale = std::string(key) == "energy_J" ? 1e-3 : 1.0;
+          Add(html, "<td>",
+              Number(v.is_number() ? scale * v.get<double>()
+                                   : std::numeric_limits<double>::quiet_NaN()),
+              "</td>");
+        }
+        html += "</tr>\n";
+      }
+      html += "</table>\n";
+    }
+    html +=
+        "<p class=\"note\">Over the rocks that crossed each line, at the first crossing of the "
+        "centre of mass (evaluation_lines.csv); heights are vertical, above the terrain; the "
+        "bounce height is that of the rock's lowest point. Percentiles are nearest-rank.</p>\n";
+  }
 
   if (summary.contains("ground")) {
     html += "<h2>Ground table</h2>\n";

@@ -2,7 +2,8 @@
 // report.html: a one-page report of a `talus simulate` run for a browser, in one self-contained
 // file (maps as embedded PNG, histograms as inline SVG, no scripts, nothing fetched): what ran
 // (scene, inputs, rock, releases, ground table, solver options), how the rocks ended, the maps
-// with their legends, and the distributions of runout, energy and jump height over the rocks.
+// with their legends, the distributions of runout, energy and jump height over the rocks, and the
+// summary of the evaluation lines (summary.json's "evaluation_lines").
 // It holds no timings or thread counts, so a run split into parts, or over MPI ranks, gives the
 // same bytes as one run.
 
@@ -11,6 +12,7 @@
 #include <vector>
 
 #include "ensemble/rasters.hpp"
+#include "io/quicklook.hpp"
 #include "solver/terrain.hpp"
 
 namespace talus::io {
@@ -38,6 +40,7 @@ struct RunReportInput {
   const Heightfield* dem = nullptr;
   const std::vector<ensemble::RasterLayer>* layers = nullptr;
   std::vector<std::vector<Eigen::Vector2d>> paths;  // the quick-look's sampled paths
+  std::vector<MapLine> lines;                       // evaluation lines, drawn on the maps
   RockColumns rocks;
 };
 

@@ -26,9 +26,10 @@ namespace {
 constexpr double kTrajectoryBytesPerRock = 56;
 constexpr double kTrajectoryBytesPerSample = 84;
 constexpr double kRocksCsvBytesPerRow = 150;
-// rocks.gpkg: an end point with its fields and spatial index; a path's vertex (x, y, z) and per
-// path its row and index (1000 rocks on a plane: 2.26 MB, 1.46 MB of it path geometry, 61 vertices
-// each).
+// A row of evaluation_lines.csv (cases/tirol, two lines: 260 rows, 35 934 bytes, 138 per row).
+constexpr double kEvaluationLinesCsvBytesPerRow = 150;
+// rocks.gpkg: an end point with its fields and spatial index; a path's vertex (x, y, z) and per path
+// its row and index (1000 rocks on a plane: 2.26 MB, 1.46 MB of it path geometry, 61 vertices each).
 constexpr double kGeoPackageBytesPerRock = 700;
 constexpr double kGeoPackageBytesPerVertex = 24;
 constexpr double kGeoTiffBytesPerCell = 4;
@@ -134,6 +135,17 @@ ResourceEstimate EstimateResources(const SceneFile& scene, int threads) {
   }
 
   e.disk.push_back({"rocks.csv", rocks * kRocksCsvBytesPerRow, "fewer rocks (--rocks)"});
+  if (!scene.evaluation_lines.empty()) {
+    // At most a row per rock and line (every rock crossing every line); the summary holds four
+    // numbers per row while it reads them back (io/evaluation_lines_csv.hpp).
+    const double rows = rocks * double(scene.evaluation_lines.size());
+    const char* fewer = "fewer rocks (--rocks) or fewer evaluation lines";
+    e.disk.push_back({"evaluation_lines.csv", rows * kEvaluationLinesCsvBytesPerRow, fewer});
+    e.memory.push_back({"evaluation line values behind the summary",
+                        rows * 4 * sizeof(double) * kVectorGrowth, fewer});
+    if (output.geopackage)
+      e.disk.push_back({"rocks.gpkg evaluation_crossings", rows * kGeoPackageBytesPerRock, fewer});
+  }
   if (output.geopackage)
     e.disk.push_back({"rocks.gpkg",
                       rocks * (kGeoPackageBytesPerRock +

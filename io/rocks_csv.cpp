@@ -5,17 +5,12 @@
 #include <stdexcept>
 
 namespace talus::io {
-namespace {
-
-// A text field quoted when it holds a comma, quote or line break (RFC 4180).
 std::string CsvField(const std::string& text) {
   if (text.find_first_of(",\"\n\r") == std::string::npos) return text;
   std::string out = "\"";
   for (char c : text) out += c == '"' ? std::string("\"\"") : std::string(1, c);
   return out + "\"";
 }
-
-}  // namespace
 
 const char* RocksCsvWriter::Header() {
   return "rock,release,run,seed,end,x_end,y_end,z_end,runout_m,path_length_m,travel_time_s,"

@@ -11,6 +11,10 @@
 
 namespace talus::io {
 
+// A text field as written to the CSV outputs: quoted when it holds a comma, quote or line break
+// (RFC 4180).
+std::string CsvField(const std::string& text);
+
 class RocksCsvWriter {
  public:
   // Opens a temporary file next to `path` and writes the header. Throws std::runtime_error.

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "ensemble/evaluation_lines.hpp"
 #include "ensemble/rasters.hpp"
 #include "ensemble/release.hpp"
 #include "io/raster.hpp"
@@ -37,6 +38,9 @@ struct SceneFile {
   Scene scene;                    // IsValid() holds
   ensemble::ReleaseSpec release;  // IsValid() holds, every release vertex on valid DEM cells
   OutputSpec output;
+  // [evaluation_lines]: >= 2 finite vertices each, non-zero length, at least partly on the DEM,
+  // unique non-empty names; empty when the scene has none.
+  std::vector<ensemble::EvaluationLine> evaluation_lines;
   pointclouds::RockSpec rock;  // the [rock] table
   bool has_rock = false;       // the scene has a [rock] table (else only [blocks])
   std::vector<pointclouds::RockSpec> block_specs;  // [blocks], parallel to release.blocks

@@ -42,12 +42,32 @@ nlohmann::ordered_json GroundJson(const GroundTable& table) {
   return out;
 }
 
+// One line's summary (evaluation_lines_summary.csv's numbers; NaN, no rock crossed, is null).
+nlohmann::ordered_json EvaluationLineJson(const EvaluationLineSummary& s) {
+  nlohmann::ordered_json j = {{"name", s.name},
+                              {"length_m", s.length_m},
+                              {"rocks", s.rocks},
+                              {"crossed", s.crossed},
+                              {"passing_probability", s.passing_probability}};
+  for (const auto& [key, statistics] :
+       {std::pair{"speed_m_s", &s.speed_m_s}, std::pair{"energy_J", &s.energy_J},
+        std::pair{"com_height_m", &s.com_height_m},
+        std::pair{"bounce_height_m", &s.bounce_height_m}}) {
+    nlohmann::ordered_json q = nlohmann::ordered_json::object();
+    for (std::size_t k = 0; k < CrossingStatistics::kNames.size(); ++k)
+      q[CrossingStatistics::kNames[k]] = statistics->values[k];
+    j[key] = q;
+  }
+  return j;
+}
+
 }  // namespace
 
 std::string GroundTableJson(const GroundTable& table) { return GroundJson(table).dump(); }
 
 std::string SummaryJson(const SceneFile& scene, const ensemble::EnsembleReport& report,
-                        const std::string& version, const std::vector<std::string>& outputs) {
+                        const std::string& version, const std::vector<std::string>& outputs,
+                        const std::vector<EvaluationLineSummary>& evaluation_lines) {
   nlohmann::ordered_json j;
   j["talus_version"] = version;
   j["scene"] = scene.path;
@@ -95,6 +115,11 @@ std::string SummaryJson(const SceneFile& scene, const ensemble::EnsembleReport& 
   j["solver"] = SolverJson(scene.scene.options);
   j["solver"]["preset"] = ToString(scene.solver_preset);
   j["ground"] = GroundJson(scene.scene.ground);
+  if (!scene.evaluation_lines.empty()) {
+    nlohmann::ordered_json lines = nlohmann::ordered_json::array();
+    for (const EvaluationLineSummary& s : evaluation_lines) lines.push_back(EvaluationLineJson(s));
+    j["evaluation_lines"] = lines;
+  }
   j["threads"] = report.threads;
   j["wall_time_s"] = report.wall_time_s;
   j["trajectories_per_s"] = report.trajectories_per_s();

@@ -6,13 +6,16 @@
 #include <vector>
 
 #include "ensemble/runner.hpp"
+#include "io/evaluation_lines_csv.hpp"
 #include "io/scene_file.hpp"
 
 namespace talus::io {
 
-// The summary as JSON text; `outputs` lists the files written next to it.
+// The summary as JSON text; `outputs` lists the files written next to it. `evaluation_lines`, the
+// per-line summary of a scene with evaluation lines, goes under "evaluation_lines".
 std::string SummaryJson(const SceneFile& scene, const ensemble::EnsembleReport& report,
-                        const std::string& version, const std::vector<std::string>& outputs);
+                        const std::string& version, const std::vector<std::string>& outputs,
+                        const std::vector<EvaluationLineSummary>& evaluation_lines = {});
 
 // The ground table as used, as summary.json's "ground" holds it, on one line (compact JSON).
 std::string GroundTableJson(const GroundTable& table);

@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <functional>
 #include <memory>
 
 #include "common/error.hpp"
@@ -221,6 +222,44 @@ std::vector<GroundPolygon> ReadGroundPolygons(const std::string& path,
         }
       });
   if (out.empty()) throw InputError(what + ": " + path + " has no polygon");
+  return out;
+}
+
+std::vector<ensemble::EvaluationLine> ReadLineFeatures(const std::string& path,
+                                                       const std::string& target_crs_wkt,
+                                                       const std::string& name_field,
+                                                       bool require_field, const std::string& what,
+                                                       std::vector<std::string>* where_out) {
+  std::vector<ensemble::EvaluationLine> out;
+  std::function<void(const OGRGeometry&, const std::string&, const std::string&)> collect =
+      [&](const OGRGeometry& geometry, const std::string& name, const std::string& where) {
+        const OGRwkbGeometryType type = wkbFlatten(geometry.getGeometryType());
+        if (type == wkbLineString) {
+          const auto& line = *geometry.toLineString();
+          ensemble::EvaluationLine& l = out.emplace_back();
+          l.name = name;
+          where_out->push_back(where);
+          for (int k = 0; k < line.getNumPoints(); ++k)
+            l.vertices_m.emplace_back(line.getX(k), line.getY(k));
+        } else if (type == wkbMultiLineString) {
+          for (const OGRGeometry* part : *geometry.toGeometryCollection())
+            collect(*part, name, where);
+        } else {
+          throw InputError(where + ": an evaluation line must be a line or multi-line, not a " +
+                           std::string(geometry.getGeometryName()));
+        }
+      };
+  ForEachFeature(path, target_crs_wkt, what, "lines",
+                 [&](OGRFeature& feature, const OGRGeometry& geometry, const std::string& where) {
+                   const int field = feature.GetFieldIndex(name_field.c_str());
+                   if (field < 0 && require_field)
+                     throw InputError(where + ": no attribute '" + name_field + "'");
+                   std::string name;
+                   if (field >= 0 && feature.IsFieldSetAndNotNull(field))
+                     name = feature.GetFieldAsString(field);
+                   collect(geometry, name, where);
+                 });
+  if (out.empty()) throw InputError(what + ": " + path + " has no line");
   return out;
 }
 

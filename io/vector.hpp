@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "ensemble/evaluation_lines.hpp"
 #include "ensemble/release.hpp"
 #include "fieldobs/observations.hpp"
 
@@ -44,6 +45,17 @@ struct GroundPolygon {
 std::vector<GroundPolygon> ReadGroundPolygons(const std::string& path,
                                               const std::string& target_crs_wkt,
                                               const std::string& field, const std::string& what);
+
+// The lines of a vector file (evaluation lines): every line feature, multi-lines split into their
+// parts, in the DEM's CRS as for ReadReleaseGeometries. Each line is named by its feature's
+// `name_field` attribute; a file without that field gives unnamed lines (empty names), unless
+// `require_field`. Other geometries are errors. Throws InputError naming `what`, the file and the
+// feature. *where gets, per line, "<what> (<path>, feature <fid>)" for the caller's checks.
+std::vector<ensemble::EvaluationLine> ReadLineFeatures(const std::string& path,
+                                                       const std::string& target_crs_wkt,
+                                                       const std::string& name_field,
+                                                       bool require_field, const std::string& what,
+                                                       std::vector<std::string>* where);
 
 // Surveyed rest positions from the point features of a vector file, in the DEM's CRS: reprojected
 // when the file and the DEM both have a CRS; an error when the file has one and the DEM none (a

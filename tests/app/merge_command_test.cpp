@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -18,7 +19,7 @@ namespace fs = std::filesystem;
 using talus::app::testing::RunCommand;
 using talus::app::testing::Slurp;
 
-// A small slope with every output: 2 releases x 5 rocks.
+// A small slope with every output: 2 releases x 5 rocks, two evaluation lines that some cross.
 const char* kScene = R"([terrain]
 plane = { slope_deg = 35, slope_length_m = 20, runout_m = 10, width_m = 12, cell_m = 1 }
 default_ground = "medium_hard"
@@ -28,6 +29,9 @@ shape = { box = [0.4, 0.4, 0.3] }
 points = [[3, 0]]
 lines = [[[4, -2], [4, 2]]]
 rocks = 5
+[evaluation_lines]
+lines = [[[5, -6], [5, 6]], [[6, -6], [6, 0], [6, 6]]]
+names = ["barrier A", "net, lower"]
 [solver]
 max_time_s = 4
 [output]
@@ -100,8 +104,13 @@ TEST_F(MergeCommand, AnySplitInAnyOrderGivesTheSingleRunsBytes) {
             0)
       << log;
   const auto single = Outputs(dir_ / "single");
-  // 3 x (max, mean, p50, p95, p99) + 3 count rasters + 6 files: every output is compared
-  ASSERT_EQ(single.size(), 24u);
+  // 3 x (max, mean, p50, p95, p99) + 3 count rasters + 8 files: every output is compared
+  ASSERT_EQ(single.size(), 26u);
+  // Some rocks cross, and not every one: the rows to merge are not trivial.
+  const std::string& crossings = single.at("evaluation_lines.csv");
+  EXPECT_GT(std::count(crossings.begin(), crossings.end(), '\n'), 3);
+  EXPECT_NE(single.at("evaluation_lines_summary.csv").find("\nbarrier A,12,10,"), std::string::npos)
+      << single.at("evaluation_lines_summary.csv");
 
   const std::vector<std::vector<std::string>> splits = {
       {"0:10"}, {"5:10", "0:5"}, {"9:10", "0:1", "4:9", "1:4"}};

@@ -48,7 +48,8 @@ fs::path FreshDir(const std::string& name) {
   return talus::app::testing::FreshDir("talus_mpi_tests", name);
 }
 
-// The real Tirol DEM crop with its CRS, 12 rocks with trajectories and every raster.
+// The real Tirol DEM crop with its CRS, 12 rocks with trajectories, every raster and two
+// evaluation lines.
 TEST(SimulateMpi, RanksTimesThreadsGiveTheOneProcessBytes) {
   const fs::path dir = FreshDir("identity");
   std::string log;
@@ -56,7 +57,8 @@ TEST(SimulateMpi, RanksTimesThreadsGiveTheOneProcessBytes) {
   ASSERT_EQ(RunCommand(Talus() + args + (dir / "single").string() + " --threads 1", &log), 0)
       << log;
   const auto single = Outputs(dir / "single");
-  ASSERT_EQ(single.size(), 17u);
+  ASSERT_EQ(single.size(), 19u);
+  ASSERT_GT(single.at("evaluation_lines.csv").size(), 200u);  // rocks crossed
   for (const auto& [ranks, threads] : {std::pair{2, 1}, std::pair{2, 2}, std::pair{3, 1}}) {
     const std::string name = "mpi-" + std::to_string(ranks) + "x" + std::to_string(threads);
     ASSERT_EQ(RunCommand(MpiRun("-n " + std::to_string(ranks) + " " + Talus()) + args +

@@ -9,6 +9,7 @@
 #include <iterator>
 
 #include "common/error.hpp"
+#include "io/evaluation_lines_csv.hpp"
 #include "io/rocks_csv.hpp"
 #include "io/trajectory_file.hpp"
 #include "solver/shapes.hpp"
@@ -131,6 +132,39 @@ TEST(RocksGeoPackage, ABadRocksCsvIsAnErrorAndLeavesNoFile) {
   const std::string path = (dir / "rocks.gpkg").string();
   EXPECT_THROW(WriteRocksGeoPackage(path, (dir / "rocks.csv").string(), "", ""), InputError);
   EXPECT_FALSE(std::filesystem::exists(path));
+}
+
+// Evaluation lines: one 3-D point per row of evaluation_lines.csv, every column a field.
+TEST(RocksGeoPackage, EvaluationCrossingsArePointsWithEveryColumn) {
+  const auto dir = testing::FreshDir("crossings");
+  testing::WriteText(dir / "rocks.csv", RocksCsv(3));
+  testing::WriteText(dir / "lines.csv",
+                     std::string(EvaluationLinesCsvWriter::Header()) +
+                         "\n\"net, lower\",0,0,\"run, 0\",1.5,11,22,33,4,1000,250,1250,0.75,0,3\n"
+                         "net,2,0,\"run, 2\",2.5,12,23,34,5,2000,250,2250,0.5,0.25,1\n");
+  const std::string path = (dir / "rocks.gpkg").string();
+  WriteRocksGeoPackage(path, (dir / "rocks.csv").string(), "", "", (dir / "lines.csv").string());
+  RegisterGdal();
+  Dataset gpkg(path);
+  ASSERT_NE(gpkg.d, nullptr);
+  OGRLayer* crossings = gpkg.d->GetLayerByName("evaluation_crossings");
+  ASSERT_NE(crossings, nullptr);
+  EXPECT_EQ(crossings->GetFeatureCount(), 2);
+  EXPECT_EQ(crossings->GetLayerDefn()->GetFieldCount(), 15);
+  crossings->ResetReading();
+  const std::unique_ptr<OGRFeature> first(crossings->GetNextFeature());
+  ASSERT_NE(first, nullptr);
+  EXPECT_STREQ(first->GetFieldAsString("line"), "net, lower");
+  EXPECT_EQ(first->GetFieldAsInteger64("crossings"), 3);
+  EXPECT_DOUBLE_EQ(first->GetFieldAsDouble("energy_J"), 1250);
+  const auto* point = first->GetGeometryRef()->toPoint();
+  EXPECT_DOUBLE_EQ(point->getX(), 11);
+  EXPECT_DOUBLE_EQ(point->getY(), 22);
+  EXPECT_DOUBLE_EQ(point->getZ(), 33);
+  // Without the file: no such layer.
+  WriteRocksGeoPackage(path, (dir / "rocks.csv").string(), "", "");
+  Dataset plain(path);
+  EXPECT_EQ(plain.d->GetLayerByName("evaluation_crossings"), nullptr);
 }
 
 }  // namespace

@@ -98,5 +98,26 @@ TEST(QuickLook, ScaleBarLengthsAreOneTwoOrFiveTimesAPowerOfTen) {
   EXPECT_DOUBLE_EQ(ScaleBarLength(0), 0);
 }
 
+// An evaluation line is drawn black across the map (over the grey hillshade, where no rock passed).
+TEST(QuickLook, DrawsEvaluationLinesInBlack) {
+  const auto dir = testing::FreshDir("lines");
+  const Heightfield dem = MakePlaneHeightfield({30, 20, 10, 20, 1});
+  const QuickLookLayout layout = QuickLookLayoutOf(dem.grid);
+  // Across the map at x = 15 m: pixel column (15 + 0.5) cells from the map's western edge.
+  const int column = static_cast<int>(15.5 * layout.scale);
+  const auto path = (dir / "quicklook.png").string();
+  RegisterGdal();
+  for (const bool with_line : {false, true}) {
+    std::vector<MapLine> lines;
+    if (with_line) lines.push_back({"barrier", {{15, -9}, {15, 9}}});
+    WriteQuickLookPng(path, dem, nullptr, {}, {}, lines);
+    GDALDataset* png = static_cast<GDALDataset*>(GDALOpen(path.c_str(), GA_ReadOnly));
+    ASSERT_NE(png, nullptr);
+    const int y = layout.map_height / 2;
+    EXPECT_EQ(Pixel(png, 1, column, y) < 30, with_line) << int(Pixel(png, 1, column, y));
+    GDALClose(png);
+  }
+}
+
 }  // namespace
 }  // namespace talus::io

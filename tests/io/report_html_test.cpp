@@ -92,5 +92,29 @@ TEST(ReportHtml, ShowsTheSummaryWithoutTimingsAndEscapesText) {
   EXPECT_EQ(html.find("<script"), std::string::npos);
 }
 
+// The evaluation lines' summary of summary.json as a table per line; energies in kJ.
+TEST(ReportHtml, ShowsTheEvaluationLinesSummary) {
+  RunReportInput input;
+  input.summary_json = R"({"rocks": 4, "evaluation_lines": [{"name": "net <A>", "length_m": 12.5,
+      "rocks": 4, "crossed": 3, "passing_probability": 0.75,
+      "speed_m_s": {"mean": 10, "p50": 9, "p90": 12, "p95": 12, "p99": 12, "max": 12},
+      "energy_J": {"mean": 15000, "p50": 14000, "p90": 21000, "p95": 21000, "p99": 21000,
+                   "max": 21000},
+      "com_height_m": {"mean": 1, "p50": 1, "p90": 1, "p95": 1, "p99": 1, "max": 1},
+      "bounce_height_m": {"mean": null, "p50": null, "p90": null, "p95": null, "p99": null,
+                          "max": null}}]})";
+  const std::string html = RunReportHtml(input);
+  EXPECT_NE(html.find("<h2>Evaluation lines</h2>"), std::string::npos);
+  EXPECT_NE(html.find("<tr><th>net &lt;A&gt;</th><td>12.5</td><td>4</td><td>3</td><td>75.0 %</td>"),
+            std::string::npos)
+      << html;
+  EXPECT_NE(html.find("<th>kinetic energy (kJ)</th><td>15</td><td>14</td><td>21</td>"),
+            std::string::npos);
+  EXPECT_NE(html.find("<th>bounce height (m)</th><td>&ndash;</td>"), std::string::npos);
+  EXPECT_EQ(html.find("<th>evaluation_lines</th>"), std::string::npos);  // not as raw JSON
+  input.summary_json = R"({"rocks": 4})";
+  EXPECT_EQ(RunReportHtml(input).find("Evaluation lines"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace talus::io

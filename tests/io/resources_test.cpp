@@ -106,6 +106,21 @@ TEST(EstimateResources, CountsEachPartFromTheScene) {
   ASSERT_NE(gpkg, nullptr);
   EXPECT_DOUBLE_EQ(gpkg->bytes, rocks * (700 + 202 * 24));
   EXPECT_HAS(gpkg->knob, "geopackage = false");
+  EXPECT_EQ(Find(with_gpkg.disk, "evaluation_lines.csv"), nullptr);  // no lines, no line work
+
+  // Evaluation lines: at most a row per rock and line, 150 bytes each, and four doubles per row
+  // (with the vectors' growth) for the summary.
+  const ResourceEstimate with_lines = EstimateResources(
+      Load(gis + "[evaluation_lines]\nlines = [[[20, -10], [20, 10]], [[30, -10], [30, 10]]]\n"),
+      1);
+  const ResourceTerm* csv = Find(with_lines.disk, "evaluation_lines.csv");
+  ASSERT_NE(csv, nullptr);
+  EXPECT_DOUBLE_EQ(csv->bytes, rocks * 2 * 150);
+  EXPECT_HAS(csv->knob, "fewer evaluation lines");
+  const ResourceTerm* values = Find(with_lines.memory, "evaluation line values");
+  ASSERT_NE(values, nullptr);
+  EXPECT_DOUBLE_EQ(values->bytes, rocks * 2 * 32 * 1.5);
+  EXPECT_NE(Find(with_lines.disk, "rocks.gpkg evaluation_crossings"), nullptr);
 }
 
 // A run whose estimate exceeds what the machine has is refused with the estimate, what is

@@ -1235,3 +1235,90 @@ TEST(LoadScene, HeightReferenceCentreOfMassOrLowestPoint) {
 
 }  // namespace
 }  // namespace talus::io
+
+namespace talus::io {
+namespace {
+
+const char* kLines = R"(
+[evaluation_lines]
+lines = [[[20, -10], [20, 10]], [[30, -10], [30, 0], [31, 10]]]
+names = ["barrier A", "net, lower"]
+)";
+
+TEST(LoadScene, EvaluationLinesFromTheSceneAndAVectorFile) {
+  const auto dir = testing::FreshDir("lines");
+  // A GeoJSON without "crs" is taken as local coordinates on the plane; the multi-line gives two
+  // lines, named by their place since the feature has no name.
+  testing::WriteText(dir / "barriers.geojson", R"({"type": "FeatureCollection", "features": [
+    {"type": "Feature", "properties": {"name": "road"},
+     "geometry": {"type": "LineString", "coordinates": [[40, -5], [40, 5]]}},
+    {"type": "Feature", "properties": {"name": null},
+     "geometry": {"type": "MultiLineString", "coordinates": [[[45, -5], [45, 0]], [[46, 0], [46, 5]]]}}
+  ]})");
+  testing::WriteText(dir / "scene.toml",
+                     std::string(kPlaneScene) + kLines + "file = \"barriers.geojson\"\n");
+  const SceneFile s = LoadScene((dir / "scene.toml").string());
+  ASSERT_EQ(s.evaluation_lines.size(), 5u);
+  const std::vector<std::string> names = {"barrier A", "net, lower", "road", "line4", "line5"};
+  for (std::size_t k = 0; k < names.size(); ++k) EXPECT_EQ(s.evaluation_lines[k].name, names[k]);
+  EXPECT_EQ(s.evaluation_lines[1].vertices_m.size(), 3u);
+  EXPECT_NEAR(s.evaluation_lines[1].length_m(), 10 + std::sqrt(101.0), 1e-12);
+  EXPECT_EQ(s.evaluation_lines[3].vertices_m.back(), Eigen::Vector2d(45, 0));
+  EXPECT_EQ(s.inputs.back(), (dir / "barriers.geojson").lexically_normal().string());
+  // Default names without a name attribute at all; none without the table.
+  testing::WriteText(dir / "scene.toml", std::string(kPlaneScene) +
+                                             "[evaluation_lines]\nlines = [[[20, -10], [20, "
+                                             "10]]]\n");
+  EXPECT_EQ(LoadScene((dir / "scene.toml").string()).evaluation_lines[0].name, "line1");
+  testing::WriteText(dir / "scene.toml", kPlaneScene);
+  EXPECT_TRUE(LoadScene((dir / "scene.toml").string()).evaluation_lines.empty());
+}
+
+TEST(LoadScene, EvaluationLineErrorsNameTheKeyAndTheLine) {
+  const auto dir = testing::FreshDir("line_errors");
+  const std::string scene = std::string(kPlaneScene) + kLines;
+  const auto error = [&](const std::string& from, const std::string& to) {
+    return ErrorOf(Replace(scene, from, to), dir);
+  };
+  const std::string lines = "lines = [[[20, -10], [20, 10]], [[30, -10], [30, 0], [31, 10]]]";
+  std::string e = error(lines, "lines = [[[20, -10], [20, 10]], [[30, -10]]]");
+  EXPECT_HAS(e, "scene.toml:30: evaluation_lines.lines[1]: a line needs at least 2 vertices");
+  e = error(lines, "lines = [[[20, -10], [20, 10]], [[30, 1], [30, 1]]]");
+  EXPECT_HAS(e, "evaluation_lines.lines[1]: the line has zero length");
+  e = error(lines, "lines = [[[20, -10], [20, 10]], [[30, 1], [nan, 1]]]");
+  EXPECT_HAS(e, "evaluation_lines.lines[1][1]: expected a list of 2 finite numbers");
+  e = error(lines, "lines = [[[20, -10], [20, 10]], [[100, 100], [120, 100]]]");
+  EXPECT_HAS(e, "evaluation_lines.lines[1]: the line 'net, lower' lies entirely outside the DEM");
+  EXPECT_HAS(e, "the DEM covers x 0 .. 60, y -15 .. 15");
+  e = error("\"net, lower\"]", "\"barrier A\"]");
+  EXPECT_HAS(e, "evaluation_lines.lines[1]: the name 'barrier A' is also that of ");
+  EXPECT_HAS(e, "evaluation_lines.lines[0]; names must be unique");
+  e = error("names = [\"barrier A\", \"net, lower\"]", "names = [\"barrier A\"]");
+  EXPECT_HAS(e, "evaluation_lines.names: expected a list of 2 names, one per line of 'lines'");
+  e = error("names = [\"barrier A\", \"net, lower\"]", "names = [\"barrier A\", \"\"]");
+  EXPECT_HAS(e, "evaluation_lines.names: names[1] is empty");
+  e = error("names =", "nmes =");
+  EXPECT_HAS(e, "evaluation_lines.nmes: unknown key (did you mean 'names'?)");
+  e = error("names =", "name_field = \"id\"\nnames =");
+  EXPECT_HAS(e, "evaluation_lines.name_field: only the lines of a vector file");
+  e = ErrorOf(std::string(kPlaneScene) + "[evaluation_lines]\n", dir);
+  EXPECT_HAS(e, "evaluation_lines.lines: missing: give lines and/or a vector file of lines");
+  e = error("names =", "file = \"nowhere.gpkg\"\nnames =");
+  EXPECT_HAS(e, "evaluation_lines.file: file not found: ");
+  testing::WriteText(dir / "points.geojson", R"({"type": "FeatureCollection", "features": [
+    {"type": "Feature", "properties": {"id": "a"},
+     "geometry": {"type": "Point", "coordinates": [40, 0]}}]})");
+  e = error("names =", "file = \"points.geojson\"\nname_field = \"id\"\nnames =");
+  EXPECT_HAS(e, "evaluation_lines.file (");
+  EXPECT_HAS(e,
+             "points.geojson, feature 0): an evaluation line must be a line or multi-line, "
+             "not a POINT");
+  testing::WriteText(dir / "lines.geojson", R"({"type": "FeatureCollection", "features": [
+    {"type": "Feature", "properties": {"id": "a"},
+     "geometry": {"type": "LineString", "coordinates": [[40, 0], [41, 0]]}}]})");
+  e = error("names =", "file = \"lines.geojson\"\nname_field = \"label\"\nnames =");
+  EXPECT_HAS(e, "lines.geojson, feature 0): no attribute 'label'");
+}
+
+}  // namespace
+}  // namespace talus::io

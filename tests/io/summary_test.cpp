@@ -53,5 +53,44 @@ TEST(SummaryJson, HashFollowsTheInputs) {
   EXPECT_NE(LoadScene((dir / "scene.toml").string()).inputs_hash, a);
 }
 
+// The evaluation lines' summary under "evaluation_lines", a line without crossings as nulls; no
+// such key for a scene without lines.
+TEST(SummaryJson, CarriesTheEvaluationLinesSummary) {
+  const auto dir = testing::FreshDir("lines");
+  const std::string text =
+      "[terrain]\nplane = {}\n[rock]\nshape = { box = [1, 1, 1] }\n[release]\npoints = [[10, "
+      "0]]\n";
+  testing::WriteText(dir / "scene.toml", text);
+  ensemble::EnsembleReport report;
+  EXPECT_FALSE(nlohmann::json::parse(
+                   SummaryJson(LoadScene((dir / "scene.toml").string()), report, "9.9.9", {}))
+                   .contains("evaluation_lines"));
+  testing::WriteText(dir / "scene.toml",
+                     text +
+                         "[evaluation_lines]\nlines = [[[50, -5], [50, 5]], [[60, -5], [60, "
+                         "5]]]\nnames = [\"a\", \"b\"]\n");
+  const SceneFile scene = LoadScene((dir / "scene.toml").string());
+  std::vector<EvaluationLineSummary> lines(2);
+  lines[0].name = "a";
+  lines[0].length_m = 10;
+  lines[0].rocks = 4;
+  lines[0].crossed = 2;
+  lines[0].passing_probability = 0.5;
+  lines[0].energy_J = StatisticsOf({1000, 3000});
+  lines[1].name = "b";
+  lines[1].rocks = 4;
+  lines[1].speed_m_s = StatisticsOf({});
+  const auto j = nlohmann::json::parse(SummaryJson(scene, report, "9.9.9", {}, lines));
+  ASSERT_EQ(j["evaluation_lines"].size(), 2u);
+  const auto& a = j["evaluation_lines"][0];
+  EXPECT_EQ(a["name"], "a");
+  EXPECT_EQ(a["crossed"], 2);
+  EXPECT_DOUBLE_EQ(a["passing_probability"].get<double>(), 0.5);
+  EXPECT_DOUBLE_EQ(a["energy_J"]["mean"].get<double>(), 2000);
+  EXPECT_DOUBLE_EQ(a["energy_J"]["p50"].get<double>(), 1000);  // nearest rank: the first of two
+  EXPECT_DOUBLE_EQ(a["energy_J"]["max"].get<double>(), 3000);
+  EXPECT_TRUE(j["evaluation_lines"][1]["speed_m_s"]["p95"].is_null());
+}
+
 }  // namespace
 }  // namespace talus::io

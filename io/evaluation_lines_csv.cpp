@@ -1,0 +1,148 @@
+#include "io/evaluation_lines_csv.hpp"
+
+#include <cmath>
+#include <limits>
+#include <map>
+#include <stdexcept>
+
+#include "common/csv_table.hpp"
+#include "common/error.hpp"
+#include "io/report_html.hpp"
+#include "io/rocks_csv.hpp"
+
+namespace talus::io {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// "%.10g", or an empty field for NaN (no rock crossed).
+std::string Field(double v) {
+  if (std::isnan(v)) return "";
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, "%.10g", v);
+  return buffer;
+}
+
+}  // namespace
+
+const char* EvaluationLinesCsvWriter::Header() {
+  return "line,rock,release,run,t_s,x_m,y_m,z_m,speed_m_s,translational_energy_J,"
+         "rotational_energy_J,energy_J,com_height_m,bounce_height_m,crossings";
+}
+
+EvaluationLinesCsvWriter::EvaluationLinesCsvWriter(
+    const std::string& path, const std::vector<ensemble::EvaluationLine>& lines,
+    const ensemble::ReleaseSpec& release)
+    : file_(path), lines_(lines), release_(release) {
+  out_ = std::fopen(file_.temp_path().c_str(), "w");
+  if (!out_) throw std::runtime_error("cannot create " + file_.temp_path());
+  std::fprintf(out_, "%s\n", Header());
+}
+
+EvaluationLinesCsvWriter::~EvaluationLinesCsvWriter() {
+  if (out_) std::fclose(out_);
+}
+
+void EvaluationLinesCsvWriter::Write(const ensemble::RockOutcome& rock) {
+  if (rock.line_crossings.empty()) return;
+  const std::string run = CsvField(release_.ReleaseName(rock.release));
+  for (const ensemble::LineCrossing& c : rock.line_crossings) {
+    const std::string line = CsvField(lines_[static_cast<std::size_t>(c.line)].name);
+    std::fprintf(
+        out_, "%s,%ld,%d,%s,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%ld\n",
+        line.c_str(), rock.rock, rock.release, run.c_str(), c.t_s, c.position_m.x(),
+        c.position_m.y(), c.position_m.z(), c.speed_m_s, c.translational_energy_J,
+        c.rotational_energy_J, c.energy_J(), c.com_height_m, c.bounce_height_m, c.crossings);
+  }
+}
+
+void EvaluationLinesCsvWriter::Commit() {
+  const bool ok = std::fflush(out_) == 0 && !std::ferror(out_);
+  std::fclose(out_);
+  out_ = nullptr;
+  if (!ok) throw std::runtime_error("cannot write " + file_.temp_path());
+  file_.Commit();
+}
+
+CrossingStatistics StatisticsOf(const std::vector<double>& values) {
+  CrossingStatistics s;
+  double sum = 0;
+  for (double v : values) sum += v;
+  s.values[0] = values.empty() ? kNaN : sum / static_cast<double>(values.size());
+  const double percent[] = {50, 90, 95, 99, 100};
+  for (std::size_t k = 0; k < 5; ++k) s.values[k + 1] = NearestRankPercentile(values, percent[k]);
+  return s;
+}
+
+std::vector<EvaluationLineSummary> SummarizeEvaluationLines(
+    const std::string& csv_path, const std::vector<ensemble::EvaluationLine>& lines, long rocks) {
+  std::map<std::string, std::size_t> index;
+  for (std::size_t l = 0; l < lines.size(); ++l) index[lines[l].name] = l;
+  // Per line: speed, energy, centre-of-mass height and bounce height of each crossing rock.
+  std::vector<std::array<std::vector<double>, 4>> values(lines.size());
+
+  CsvReader in(csv_path);
+  const std::size_t line_column = in.Column("line");
+  const std::array<std::size_t, 4> columns = {in.Column("speed_m_s"), in.Column("energy_J"),
+                                              in.Column("com_height_m"),
+                                              in.Column("bounce_height_m")};
+  std::vector<std::string> fields;
+  while (in.Next(&fields)) {
+    const auto at = index.find(fields[line_column]);
+    if (at == index.end())
+      throw InputError(csv_path + ":" + std::to_string(in.line()) + ": column 'line': '" +
+                       fields[line_column] + "' is not an evaluation line of the scene");
+    for (std::size_t q = 0; q < 4; ++q) {
+      const std::string& text = fields[columns[q]];
+      std::size_t used = 0;
+      double v = kNaN;
+      try {
+        v = std::stod(text, &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (text.empty() || used != text.size())
+        throw InputError(csv_path + ":" + std::to_string(in.line()) + ": column '" +
+                         in.header()[columns[q]] + "': '" + text + "' is not a number");
+      values[at->second][q].push_back(v);
+    }
+  }
+
+  std::vector<EvaluationLineSummary> out;
+  for (std::size_t l = 0; l < lines.size(); ++l) {
+    EvaluationLineSummary& s = out.emplace_back();
+    s.name = lines[l].name;
+    s.length_m = lines[l].length_m();
+    s.rocks = rocks;
+    s.crossed = static_cast<long>(values[l][0].size());
+    s.passing_probability = rocks > 0 ? double(s.crossed) / double(rocks) : kNaN;
+    s.speed_m_s = StatisticsOf(values[l][0]);
+    s.energy_J = StatisticsOf(values[l][1]);
+    s.com_height_m = StatisticsOf(values[l][2]);
+    s.bounce_height_m = StatisticsOf(values[l][3]);
+    values[l] = {};  // release the line's values before the next line's statistics
+  }
+  return out;
+}
+
+std::string EvaluationLinesSummaryCsv(const std::vector<EvaluationLineSummary>& summary) {
+  std::string out = "name,length_m,rocks,crossed,passing_probability";
+  for (const auto& [quantity, unit] :
+       {std::pair{"speed", "m_s"}, std::pair{"energy", "J"}, std::pair{"com_height", "m"},
+        std::pair{"bounce_height", "m"}})
+    for (const char* statistic : CrossingStatistics::kNames)
+      out.append(",").append(quantity).append("_").append(statistic).append("_").append(unit);
+  out.append("\n");
+  for (const EvaluationLineSummary& s : summary) {
+    out.append(CsvField(s.name)).append(",").append(Field(s.length_m));
+    out.append(",").append(std::to_string(s.rocks)).append(",").append(std::to_string(s.crossed));
+    out.append(",").append(Field(s.passing_probability));
+    for (const CrossingStatistics* q :
+         {&s.speed_m_s, &s.energy_J, &s.com_height_m, &s.bounce_height_m})
+      for (double v : q->values) out.append(",").append(Field(v));
+    out.append("\n");
+  }
+  return out;
+}
+
+}  // namespace talus::io
