@@ -249,7 +249,7 @@ std::vector<ensemble::EvaluationLine> ReadLineFeatures(const std::string& path,
                            std::string(geometry.getGeometryName()));
         }
       };
-  ForEachFeature(path, target_crs_wkt, what, "lines",
+  ForEachFeature(path, target_crs_wkt, what, "lines", nullptr,
                  [&](OGRFeature& feature, const OGRGeometry& geometry, const std::string& where) {
                    const int field = feature.GetFieldIndex(name_field.c_str());
                    if (field < 0 && require_field)
