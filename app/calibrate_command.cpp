@@ -141,6 +141,7 @@ int RunCalibrate(const CalibrateArgs& args, const Processes& processes) {
     objective_options.progress = [](long, long) { ThrowIfInterrupted(); };
     objective_options.run_ensemble = processes.runner;
     const io::EventFile& event = file.event;
+    if (root) PrintSceneWarnings(event.scene, "calibrate");
     holdout = HoldoutRuns(args.holdout, event.scene.release, file.optimizer.seed);
     fit = calibration::SelectRuns(event.scene.release, event.observations,
                                   calibration::OtherRuns(event.scene.release, holdout), true);

@@ -34,9 +34,9 @@ int LoadForSimulate(const SimulateArgs& args, io::SceneFile* scene, std::pair<lo
 // and blocks of a run table.
 std::string DescribeRocks(const io::SceneFile& scene);
 
-// Prints the scene's warnings (io::SceneFile::warnings) on stderr, one "talus simulate: WARNING:"
+// Prints the scene's warnings (io::SceneFile::warnings) on stderr, one "talus <command>: WARNING:"
 // line each.
-void PrintSceneWarnings(const io::SceneFile& scene);
+void PrintSceneWarnings(const io::SceneFile& scene, const char* command = "simulate");
 
 // How many processes an MPI launcher (mpirun, srun) started this one among; 1 without a launcher.
 int LaunchedRanks();

@@ -54,9 +54,9 @@ std::string DescribeRocks(const io::SceneFile& scene) {
   return line;
 }
 
-void PrintSceneWarnings(const io::SceneFile& scene) {
+void PrintSceneWarnings(const io::SceneFile& scene, const char* command) {
   for (const std::string& warning : scene.warnings)
-    std::fprintf(stderr, "talus simulate: WARNING: %s\n", warning.c_str());
+    std::fprintf(stderr, "talus %s: WARNING: %s\n", command, warning.c_str());
   std::fflush(stderr);
 }
 

@@ -14,6 +14,7 @@
 
 #include "app/commands.hpp"
 #include "app/interrupt.hpp"
+#include "app/simulate.hpp"
 #include "common/atomic_file.hpp"
 #include "common/error.hpp"
 #include "fieldobs/samples.hpp"
@@ -54,6 +55,7 @@ int RunValidate(const ValidateArgs& args) {
     std::cerr << "talus validate: " << why << "\n";
     return kExitBadInput;
   }
+  PrintSceneWarnings(event.scene, "validate");
   // From here on SIGINT / SIGTERM unwind the run: no temporary file is left behind.
   const InterruptScope interrupts;
   RemoveStaleTemporaries(args.out);

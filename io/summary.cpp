@@ -115,6 +115,11 @@ std::string SummaryJson(const SceneFile& scene, const ensemble::EnsembleReport& 
   j["solver"] = SolverJson(scene.scene.options);
   j["solver"]["preset"] = ToString(scene.solver_preset);
   j["ground"] = GroundJson(scene.scene.ground);
+  // How the rasters were asked for (the statistics rasters' percentiles and the file layout).
+  j["raster_output"] = {
+      {"rasters", scene.output.rasters},
+      {"percentiles", scene.output.percentiles},
+      {"format", scene.output.raster_format == RasterFormat::kCog ? "cog" : "gtiff"}};
   if (!scene.evaluation_lines.empty()) {
     nlohmann::ordered_json lines = nlohmann::ordered_json::array();
     for (const EvaluationLineSummary& s : evaluation_lines) lines.push_back(EvaluationLineJson(s));

@@ -33,6 +33,10 @@ TEST(SummaryJson, CarriesHashVersionCountsAndRate) {
   EXPECT_EQ(j["solver"]["viscous"], "contact_friction");
   EXPECT_DOUBLE_EQ(j["solver"]["dt_s"].get<double>(), 0.002);
   EXPECT_DOUBLE_EQ(j["solver"]["tolerance_m_s"].get<double>(), 1e-7);
+  EXPECT_EQ(j["solver"]["preset"], "default");
+  EXPECT_EQ(j["raster_output"]["percentiles"], nlohmann::json::array({95}));
+  EXPECT_EQ(j["raster_output"]["format"], "gtiff");
+  EXPECT_EQ(j["raster_output"]["rasters"], nlohmann::json::array());
   EXPECT_EQ(j["ground"].size(), 8u);  // Table 1
   EXPECT_EQ(j["ground"]["medium"]["code"], 4);
   EXPECT_DOUBLE_EQ(j["ground"]["medium"]["mu_min"].get<double>(), 0.35);
