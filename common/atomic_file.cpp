@@ -53,6 +53,25 @@ AtomicFile::~AtomicFile() {
   }
 }
 
+AtomicTextFile::AtomicTextFile(std::string final_path, const char* first_line)
+    : file_(std::move(final_path)) {
+  out_ = std::fopen(file_.temp_path().c_str(), "w");
+  if (!out_) throw std::runtime_error("cannot create " + file_.temp_path());
+  std::fprintf(out_, "%s\n", first_line);
+}
+
+AtomicTextFile::~AtomicTextFile() {
+  if (out_) std::fclose(out_);
+}
+
+void AtomicTextFile::Commit() {
+  const bool ok = std::fflush(out_) == 0 && !std::ferror(out_);
+  std::fclose(out_);
+  out_ = nullptr;
+  if (!ok) throw std::runtime_error("cannot write " + file_.temp_path());
+  file_.Commit();
+}
+
 void AtomicFile::Commit() {
   std::error_code error;
   fs::rename(temp_path_, final_path_, error);

@@ -3,6 +3,7 @@
 // renamed into place only when complete. Temporary names are ".<name>.tmp-<pid>", so that a later
 // run can tell the leftovers of a process that died (RemoveStaleTemporaries).
 
+#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -24,6 +25,25 @@ class AtomicFile {
   std::string final_path_;
   std::string temp_path_;
   bool committed_ = false;
+};
+
+// A text file written line by line under a temporary name (AtomicFile) and renamed into place by
+// Commit(), which fails when any write failed (a full disk): the CSV writers' common part.
+class AtomicTextFile {
+ public:
+  // Creates the temporary file and writes `first_line` and a newline. Throws std::runtime_error.
+  AtomicTextFile(std::string final_path, const char* first_line);
+  ~AtomicTextFile();  // closes and removes the temporary file unless committed
+  AtomicTextFile(const AtomicTextFile&) = delete;
+  AtomicTextFile& operator=(const AtomicTextFile&) = delete;
+
+  std::FILE* get() const { return out_; }
+  // Flushes, closes and renames into place. Throws std::runtime_error naming the file.
+  void Commit();
+
+ private:
+  AtomicFile file_;
+  std::FILE* out_ = nullptr;
 };
 
 // Writes `contents` to `path` atomically. Throws std::runtime_error naming the file and the reason.

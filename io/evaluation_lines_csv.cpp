@@ -33,36 +33,23 @@ const char* EvaluationLinesCsvWriter::Header() {
 EvaluationLinesCsvWriter::EvaluationLinesCsvWriter(
     const std::string& path, const std::vector<ensemble::EvaluationLine>& lines,
     const ensemble::ReleaseSpec& release)
-    : file_(path), lines_(lines), release_(release) {
-  out_ = std::fopen(file_.temp_path().c_str(), "w");
-  if (!out_) throw std::runtime_error("cannot create " + file_.temp_path());
-  std::fprintf(out_, "%s\n", Header());
-}
-
-EvaluationLinesCsvWriter::~EvaluationLinesCsvWriter() {
-  if (out_) std::fclose(out_);
-}
+    : file_(path, Header()), lines_(lines), release_(release) {}
 
 void EvaluationLinesCsvWriter::Write(const ensemble::RockOutcome& rock) {
   if (rock.line_crossings.empty()) return;
   const std::string run = CsvField(release_.ReleaseName(rock.release));
   for (const ensemble::LineCrossing& c : rock.line_crossings) {
     const std::string line = CsvField(lines_[static_cast<std::size_t>(c.line)].name);
-    std::fprintf(
-        out_, "%s,%ld,%d,%s,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%ld\n",
-        line.c_str(), rock.rock, rock.release, run.c_str(), c.t_s, c.position_m.x(),
-        c.position_m.y(), c.position_m.z(), c.speed_m_s, c.translational_energy_J,
-        c.rotational_energy_J, c.energy_J(), c.com_height_m, c.bounce_height_m, c.crossings);
+    std::fprintf(file_.get(),
+                 "%s,%ld,%d,%s,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%ld\n",
+                 line.c_str(), rock.rock, rock.release, run.c_str(), c.t_s, c.position_m.x(),
+                 c.position_m.y(), c.position_m.z(), c.speed_m_s, c.translational_energy_J,
+                 c.rotational_energy_J, c.energy_J(), c.com_height_m, c.bounce_height_m,
+                 c.crossings);
   }
 }
 
-void EvaluationLinesCsvWriter::Commit() {
-  const bool ok = std::fflush(out_) == 0 && !std::ferror(out_);
-  std::fclose(out_);
-  out_ = nullptr;
-  if (!ok) throw std::runtime_error("cannot write " + file_.temp_path());
-  file_.Commit();
-}
+void EvaluationLinesCsvWriter::Commit() { file_.Commit(); }
 
 CrossingStatistics StatisticsOf(const std::vector<double>& values) {
   CrossingStatistics s;

@@ -23,7 +23,6 @@ class EvaluationLinesCsvWriter {
   EvaluationLinesCsvWriter(const std::string& path,
                            const std::vector<ensemble::EvaluationLine>& lines,
                            const ensemble::ReleaseSpec& release);
-  ~EvaluationLinesCsvWriter();
   EvaluationLinesCsvWriter(const EvaluationLinesCsvWriter&) = delete;
   EvaluationLinesCsvWriter& operator=(const EvaluationLinesCsvWriter&) = delete;
 
@@ -34,8 +33,7 @@ class EvaluationLinesCsvWriter {
   static const char* Header();
 
  private:
-  AtomicFile file_;
-  std::FILE* out_ = nullptr;
+  AtomicTextFile file_;
   const std::vector<ensemble::EvaluationLine>& lines_;
   const ensemble::ReleaseSpec& release_;
 };

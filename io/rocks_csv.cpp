@@ -20,15 +20,7 @@ const char* RocksCsvWriter::Header() {
 
 RocksCsvWriter::RocksCsvWriter(const std::string& path, const Scene& scene,
                                const ensemble::ReleaseSpec& release)
-    : file_(path), scene_(scene), release_(release) {
-  out_ = std::fopen(file_.temp_path().c_str(), "w");
-  if (!out_) throw std::runtime_error("cannot create " + file_.temp_path());
-  std::fprintf(out_, "%s\n", Header());
-}
-
-RocksCsvWriter::~RocksCsvWriter() {
-  if (out_) std::fclose(out_);
-}
+    : file_(path, Header()), scene_(scene), release_(release) {}
 
 void RocksCsvWriter::Write(const ensemble::RockOutcome& rock) {
   const RockResult& r = rock.result;
@@ -44,7 +36,7 @@ void RocksCsvWriter::Write(const ensemble::RockOutcome& rock) {
   const std::string& end_ground =
       scene_.ground.category(scene_.terrain.GroundAt(end.x(), end.y())).name;
   std::fprintf(
-      out_,
+      file_.get(),
       "%ld,%d,%s,%llu,%s,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,"
       "%s,%.10g,%.10g,%.10g,%.10g,%.10g,%s\n",
       rock.rock, rock.release, CsvField(release_.ReleaseName(rock.release)).c_str(),
@@ -55,12 +47,6 @@ void RocksCsvWriter::Write(const ensemble::RockOutcome& rock) {
       CsvField(end_ground).c_str());
 }
 
-void RocksCsvWriter::Commit() {
-  const bool ok = std::fflush(out_) == 0 && !std::ferror(out_);
-  std::fclose(out_);
-  out_ = nullptr;
-  if (!ok) throw std::runtime_error("cannot write " + file_.temp_path());
-  file_.Commit();
-}
+void RocksCsvWriter::Commit() { file_.Commit(); }
 
 }  // namespace talus::io

@@ -21,7 +21,6 @@ class RocksCsvWriter {
   // `release` names each rock's run and block, `scene` the ground category where it ended; both
   // must outlive the writer.
   RocksCsvWriter(const std::string& path, const Scene& scene, const ensemble::ReleaseSpec& release);
-  ~RocksCsvWriter();
   RocksCsvWriter(const RocksCsvWriter&) = delete;
   RocksCsvWriter& operator=(const RocksCsvWriter&) = delete;
 
@@ -31,8 +30,7 @@ class RocksCsvWriter {
   static const char* Header();
 
  private:
-  AtomicFile file_;
-  std::FILE* out_ = nullptr;
+  AtomicTextFile file_;
   const Scene& scene_;
   const ensemble::ReleaseSpec& release_;
 };

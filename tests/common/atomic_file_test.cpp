@@ -4,6 +4,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -60,6 +61,25 @@ TEST(AtomicFile, CompleteOrAbsent) {
   EXPECT_EQ(FilesIn(dir), 1);
   EXPECT_THROW(WriteFileAtomically((dir / "no_such_dir" / "x.txt").string(), "x"),
                std::runtime_error);
+}
+
+// A text file starts with its first line, is absent until committed, and is not left behind
+// when abandoned.
+TEST(AtomicTextFile, FirstLineThenRowsCompleteOrAbsent) {
+  const auto dir = FreshDir("atomic_text");
+  const auto path = (dir / "table.csv").string();
+  {
+    AtomicTextFile file(path, "a,b");
+    std::fprintf(file.get(), "1,2\n");
+  }  // not committed
+  EXPECT_EQ(FilesIn(dir), 0);
+  AtomicTextFile file(path, "a,b");
+  std::fprintf(file.get(), "1,2\n");
+  EXPECT_FALSE(fs::exists(path));
+  file.Commit();
+  EXPECT_EQ(Slurp(path), "a,b\n1,2\n");
+  EXPECT_EQ(FilesIn(dir), 1);
+  EXPECT_THROW(AtomicTextFile((dir / "no_such_dir" / "x.csv").string(), "x"), std::runtime_error);
 }
 
 TEST(AtomicFile, ErrorsSayWhy) {
