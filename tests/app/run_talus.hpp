@@ -17,12 +17,13 @@
 #include <string>
 #include <thread>
 #include <vector>
+#include "tests/test_tmp.hpp"
 
 namespace talus::app::testing {
 
 // An empty directory <tmp>/<group>/<name>.
 inline std::filesystem::path FreshDir(const std::string& group, const std::string& name) {
-  const std::filesystem::path dir = std::filesystem::temp_directory_path() / group / name;
+  const std::filesystem::path dir = talus::testing::TestTmpRoot() / group / name;
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir;

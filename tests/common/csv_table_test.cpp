@@ -6,12 +6,15 @@
 #include <fstream>
 
 #include "common/error.hpp"
+#include "tests/test_tmp.hpp"
 
 namespace talus {
 namespace {
 
 std::string WriteFile(const std::string& name, const std::string& text) {
-  const auto path = std::filesystem::temp_directory_path() / ("talus_csv_reader_" + name);
+  const auto dir = talus::testing::TestTmpRoot();
+  std::filesystem::create_directories(dir);
+  const auto path = dir / ("talus_csv_reader_" + name);
   std::ofstream(path, std::ios::binary) << text;
   return path.string();
 }

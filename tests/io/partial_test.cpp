@@ -6,6 +6,7 @@
 #include <fstream>
 
 #include "common/error.hpp"
+#include "tests/test_tmp.hpp"
 
 namespace talus::io {
 namespace {
@@ -73,7 +74,7 @@ TEST(CheckPartials, NamesWhatDiffersBetweenRuns) {
 }
 
 TEST(ReadPartialInfo, ADirectoryWithoutPartialJsonIsNotAPart) {
-  const auto dir = std::filesystem::temp_directory_path() / "talus_partial_test_empty";
+  const auto dir = talus::testing::TestTmpRoot() / "talus_partial_test_empty";
   std::filesystem::create_directories(dir);
   EXPECT_THROW(ReadPartialInfo(dir.string()), InputError);
   std::ofstream(dir / "partial.json") << "{\"format\": \"something else\"}";

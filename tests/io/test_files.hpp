@@ -12,13 +12,14 @@
 #include <vector>
 
 #include "io/raster.hpp"
+#include "tests/test_tmp.hpp"
 
 namespace talus::io::testing {
 
 inline std::filesystem::path FreshDir(const std::string& name) {
   const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
   const std::filesystem::path dir =
-      std::filesystem::temp_directory_path() / "talus_io_tests" /
+      talus::testing::TestTmpRoot() / "talus_io_tests" /
       (std::string(info->test_suite_name()) + "." + info->name() + "." + name);
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
