@@ -20,49 +20,22 @@ using talus::app::testing::RunCommand;
 using talus::app::testing::Slurp;
 
 // A small slope with every output: 2 releases x 5 rocks, two evaluation lines that some cross.
-const char* kScene = R"([terrain]
-plane = { slope_deg = 35, slope_length_m = 20, runout_m = 10, width_m = 12, cell_m = 1 }
-default_ground = "medium_hard"
-[rock]
-shape = { box = [0.4, 0.4, 0.3] }
-[release]
-points = [[3, 0]]
-lines = [[[4, -2], [4, 2]]]
-rocks = 5
-[evaluation_lines]
-lines = [[[5, -6], [5, 6]], [[6, -6], [6, 0], [6, 6]]]
-names = ["barrier A", "net, lower"]
-[solver]
-max_time_s = 4
-[output]
-trajectories = true
+const std::string kScene = talus::app::testing::SmallSlopeScene(5, R"(trajectories = true
 trajectory_interval_s = 0.05
 rasters = ["speed", "energy", "jump_height", "passages", "deposits", "reach_probability"]
 percentiles = [50, 95, 99]
 geopackage = true
-)";
+)",
+                                                                    R"([evaluation_lines]
+lines = [[[5, -6], [5, 6]], [[6, -6], [6, 0], [6, 6]]]
+names = ["barrier A", "net, lower"]
+)");
 
 std::string Talus(const std::string& arguments) {
   return std::string(TALUS_BINARY) + " " + arguments;
 }
 
-// summary.json without what depends on the machine and the split (threads and timings).
-std::string WithoutTimings(const std::string& summary) {
-  nlohmann::ordered_json j = nlohmann::ordered_json::parse(summary);
-  for (const char* key : {"threads", "wall_time_s", "trajectories_per_s"}) j.erase(key);
-  return j.dump(2);
-}
-
-// Every file of `dir` by name; summary.json without timings.
-std::map<std::string, std::string> Outputs(const fs::path& dir) {
-  std::map<std::string, std::string> files;
-  for (const auto& entry : fs::directory_iterator(dir)) {
-    const std::string name = entry.path().filename().string();
-    files[name] =
-        name == "summary.json" ? WithoutTimings(Slurp(entry.path())) : Slurp(entry.path());
-  }
-  return files;
-}
+using talus::app::testing::OutputsWithoutTimings;
 
 class MergeCommand : public ::testing::Test {
  protected:
@@ -103,7 +76,7 @@ TEST_F(MergeCommand, AnySplitInAnyOrderGivesTheSingleRunsBytes) {
                        &log),
             0)
       << log;
-  const auto single = Outputs(dir_ / "single");
+  const auto single = OutputsWithoutTimings(dir_ / "single");
   // 3 x (max, mean, p50, p95, p99) + 3 count rasters + 8 files: every output is compared
   ASSERT_EQ(single.size(), 26u);
   // Some rocks cross, and not every one: the rows to merge are not trivial.
@@ -120,7 +93,7 @@ TEST_F(MergeCommand, AnySplitInAnyOrderGivesTheSingleRunsBytes) {
     for (const std::string& range : split) parts.push_back(Part(range, 1 + (k++ % 2)));
     const std::string out = "merged-" + std::to_string(split.size());
     ASSERT_EQ(Merge(parts, &log, out), 0) << log;
-    const auto merged = Outputs(dir_ / out);
+    const auto merged = OutputsWithoutTimings(dir_ / out);
     ASSERT_EQ(merged.size(), single.size());
     for (const auto& [name, bytes] : single)
       EXPECT_TRUE(merged.at(name) == bytes) << name << " differs for a split into " << split.size();

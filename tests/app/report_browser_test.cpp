@@ -17,20 +17,9 @@ using talus::app::testing::RunCommand;
 using talus::app::testing::Slurp;
 using talus::app::testing::Write;
 
-const char* kScene = R"([terrain]
-plane = { slope_deg = 35, slope_length_m = 20, runout_m = 10, width_m = 12, cell_m = 1 }
-default_ground = "medium_hard"
-[rock]
-shape = { box = [0.4, 0.4, 0.3] }
-[release]
-points = [[3, 0]]
-lines = [[[4, -2], [4, 2]]]
-rocks = 3
-[solver]
-max_time_s = 4
-[output]
-rasters = ["speed", "energy", "jump_height", "passages", "reach_probability"]
-)";
+const std::string kScene = talus::app::testing::SmallSlopeScene(
+    3, R"(rasters = ["speed", "energy", "jump_height", "passages", "reach_probability"]
+)");
 
 // What the check script put on <body>: data-<name>="<number>", or -1 when absent.
 int BodyNumber(const std::string& dom, const std::string& name) {

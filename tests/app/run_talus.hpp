@@ -13,10 +13,13 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
+#include <nlohmann/json.hpp>
+
 #include "tests/test_tmp.hpp"
 
 namespace talus::app::testing {
@@ -85,6 +88,42 @@ inline std::string Slurp(const std::filesystem::path& path) {
 
 inline void Write(const std::filesystem::path& path, const std::string& text) {
   std::ofstream(path) << text;
+}
+
+// The small slope of the end-to-end tests: a 35 degree plane 20 m long with 10 m of runout, a
+// 0.4 x 0.4 x 0.3 m box released at a point and along a line, `rocks` per release, 4 s at most;
+// `output` is the [output] section's body, `more` further sections.
+inline std::string SmallSlopeScene(int rocks, const std::string& output,
+                                   const std::string& more = "") {
+  return R"([terrain]
+plane = { slope_deg = 35, slope_length_m = 20, runout_m = 10, width_m = 12, cell_m = 1 }
+default_ground = "medium_hard"
+[rock]
+shape = { box = [0.4, 0.4, 0.3] }
+[release]
+points = [[3, 0]]
+lines = [[[4, -2], [4, 2]]]
+rocks = )" + std::to_string(rocks) +
+         "\n" + more + "[solver]\nmax_time_s = 4\n[output]\n" + output;
+}
+
+// summary.json without what depends on the machine and the split (threads and timings).
+inline std::string WithoutTimings(const std::string& summary) {
+  nlohmann::ordered_json j = nlohmann::ordered_json::parse(summary);
+  for (const char* key : {"threads", "wall_time_s", "trajectories_per_s"}) j.erase(key);
+  return j.dump(2);
+}
+
+// Every file of `dir` by name, summary.json without timings: what must be byte-identical between
+// runs that differ only in how the rocks were split (threads, ranks, parts).
+inline std::map<std::string, std::string> OutputsWithoutTimings(const std::filesystem::path& dir) {
+  std::map<std::string, std::string> files;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    const std::string name = entry.path().filename().string();
+    files[name] =
+        name == "summary.json" ? WithoutTimings(Slurp(entry.path())) : Slurp(entry.path());
+  }
+  return files;
 }
 
 }  // namespace talus::app::testing

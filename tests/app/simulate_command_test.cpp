@@ -77,22 +77,10 @@ pid_t DeadPid() {
   return child;
 }
 
-const char* kScene = R"([terrain]
-plane = { slope_deg = 35, slope_length_m = 20, runout_m = 10, width_m = 12, cell_m = 1 }
-default_ground = "medium_hard"
-[rock]
-shape = { box = [0.4, 0.4, 0.3] }
-[release]
-points = [[3, 0]]
-lines = [[[4, -2], [4, 2]]]
-rocks = 3
-[solver]
-max_time_s = 4
-[output]
-trajectories = true
+const std::string kScene = talus::app::testing::SmallSlopeScene(3, R"(trajectories = true
 trajectory_interval_s = 0.05
 rasters = ["speed", "energy", "jump_height", "passages", "deposits", "reach_probability"]
-)";
+)");
 
 // kScene writing only rocks.csv and summary.json.
 std::string LeanScene() {

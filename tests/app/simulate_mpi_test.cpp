@@ -28,21 +28,7 @@ std::string MpiRun(const std::string& ranks) {
 
 std::string Talus() { return TALUS_BINARY; }
 
-std::string WithoutTimings(const std::string& summary) {
-  nlohmann::ordered_json j = nlohmann::ordered_json::parse(summary);
-  for (const char* key : {"threads", "wall_time_s", "trajectories_per_s"}) j.erase(key);
-  return j.dump(2);
-}
-
-std::map<std::string, std::string> Outputs(const fs::path& dir) {
-  std::map<std::string, std::string> files;
-  for (const auto& entry : fs::directory_iterator(dir)) {
-    const std::string name = entry.path().filename().string();
-    files[name] =
-        name == "summary.json" ? WithoutTimings(Slurp(entry.path())) : Slurp(entry.path());
-  }
-  return files;
-}
+using talus::app::testing::OutputsWithoutTimings;
 
 fs::path FreshDir(const std::string& name) {
   return talus::app::testing::FreshDir("talus_mpi_tests", name);
@@ -56,7 +42,7 @@ TEST(SimulateMpi, RanksTimesThreadsGiveTheOneProcessBytes) {
   const std::string args = " simulate " + kScene + " --rocks 12 --out ";
   ASSERT_EQ(RunCommand(Talus() + args + (dir / "single").string() + " --threads 1", &log), 0)
       << log;
-  const auto single = Outputs(dir / "single");
+  const auto single = OutputsWithoutTimings(dir / "single");
   ASSERT_EQ(single.size(), 19u);
   ASSERT_GT(single.at("evaluation_lines.csv").size(), 200u);  // rocks crossed
   for (const auto& [ranks, threads] : {std::pair{2, 1}, std::pair{2, 2}, std::pair{3, 1}}) {
@@ -67,7 +53,7 @@ TEST(SimulateMpi, RanksTimesThreadsGiveTheOneProcessBytes) {
               0)
         << log;
     EXPECT_NE(log.find(std::to_string(ranks) + " ranks"), std::string::npos) << log;
-    const auto merged = Outputs(dir / name);
+    const auto merged = OutputsWithoutTimings(dir / name);
     ASSERT_EQ(merged.size(), single.size()) << name;
     for (const auto& [file, bytes] : single)
       EXPECT_TRUE(merged.at(file) == bytes) << file << " differs for " << name;
