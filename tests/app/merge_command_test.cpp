@@ -100,6 +100,39 @@ TEST_F(MergeCommand, AnySplitInAnyOrderGivesTheSingleRunsBytes) {
   }
 }
 
+// Rocks per area (a polygon of 18 m^2 at 0.5 rocks/m^2: 9 rocks) and Cloud-Optimised GeoTIFFs:
+// the rock count comes from the polygon's area in every part, and the COG rasters merge to the
+// single run's bytes as plain GeoTIFFs do.
+TEST_F(MergeCommand, RocksPerAreaAndCloudOptimisedRastersMergeToTheSingleRunsBytes) {
+  talus::app::testing::Write(scene_, R"([terrain]
+plane = { slope_deg = 35, slope_length_m = 20, runout_m = 10, width_m = 12, cell_m = 1 }
+default_ground = "medium_hard"
+[rock]
+shape = { box = [0.4, 0.4, 0.3] }
+[release]
+polygons = [[[2, -3], [5, -3], [5, 3], [2, 3]]]
+rocks_per_m2 = 0.5
+[solver]
+max_time_s = 4
+[output]
+rasters = ["speed", "passages", "reach_probability"]
+raster_format = "cog"
+)");
+  std::string log;
+  ASSERT_EQ(RunCommand(Talus("simulate " + scene_.string() + " --out " +
+                             (dir_ / "single").string() + " --threads 2"),
+                       &log),
+            0)
+      << log;
+  const auto single = OutputsWithoutTimings(dir_ / "single");
+  EXPECT_NE(single.at("summary.json").find("\"rocks\": 9"), std::string::npos)
+      << single.at("summary.json");
+  ASSERT_EQ(Merge({Part("4:9"), Part("0:4", 2)}, &log), 0) << log;
+  const auto merged = OutputsWithoutTimings(dir_ / "merged");
+  ASSERT_EQ(merged.size(), single.size());
+  for (const auto& [name, bytes] : single) EXPECT_TRUE(merged.at(name) == bytes) << name;
+}
+
 TEST_F(MergeCommand, OverlappingPartsAreRefused) {
   std::string log;
   EXPECT_EQ(Merge({Part("0:6"), Part("4:10")}, &log), 2);
