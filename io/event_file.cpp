@@ -19,8 +19,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-const std::vector<std::string> kKinds = {"runout", "deposits",     "impacts",       "scars",
-                                         "trajectories", "zones", "single_impacts"};
+const std::vector<std::string> kKinds = {"runout",       "deposits", "impacts",       "scars",
+                                         "trajectories", "zones",    "single_impacts"};
 
 // The column keys of a single_impacts observation table (defaults: SingleImpactColumns).
 fieldobs::SingleImpactColumns SingleImpactColumnsOf(const Section& o) {
@@ -114,8 +114,8 @@ EventFile LoadEvent(const std::string& path) {
     const toml::table* t = tables->get(k)->as_table();
     if (!t) context.Fail(tables->get(k), name, "expected a table (kind, file)");
     const Section o(context, t, name,
-                    {"kind", "file", "run_column", "omega_from", "id_column",
-                     "energy_ratio_column", "speed_out_column", "scar_depth_column"});
+                    {"kind", "file", "run_column", "omega_from", "id_column", "energy_ratio_column",
+                     "speed_out_column", "scar_depth_column"});
     for (const char* required : {"kind", "file"})
       if (!o.Has(required)) context.Fail(t, o.Key(required), "missing");
     const std::string kind = o.String("kind", "");

@@ -702,10 +702,10 @@ void LoadSingleImpacts(const Context& context, const Section& release, SceneFile
   const toml::node* node = release.Node("single_impacts");
   if (!node->is_table())
     release.Fail("single_impacts", "expected an inline table { file = \"impacts.csv\", ... }");
-  const Section s(context, node->as_table(), release.Key("single_impacts"),
-                  {"file", "at", "clearance_m", "id_column", "normal_speed_column",
-                   "tangent_speed_column", "total_speed_column", "angle_column",
-                   "angular_speed_column"});
+  const Section s(
+      context, node->as_table(), release.Key("single_impacts"),
+      {"file", "at", "clearance_m", "id_column", "normal_speed_column", "tangent_speed_column",
+       "total_speed_column", "angle_column", "angular_speed_column"});
   if (!s.Has("file")) context.Fail(node, s.Key("file"), "missing");
   for (const char* key : {"height_m", "height_reference", "velocity_m_s", "angular_velocity_rad_s"})
     if (release.Has(key))
@@ -742,7 +742,8 @@ void LoadSingleImpacts(const Context& context, const Section& release, SceneFile
       release.Fail("block_column", e.what());
     }
   }
-  const std::vector<fieldobs::IncomingImpact> impacts = fieldobs::ReadIncomingImpacts(rows, columns);
+  const std::vector<fieldobs::IncomingImpact> impacts =
+      fieldobs::ReadIncomingImpacts(rows, columns);
   for (int k = 0; k < rows.rows(); ++k) {
     const fieldobs::IncomingImpact& impact = impacts[static_cast<std::size_t>(k)];
     const double speed = std::hypot(impact.normal_speed_m_s, impact.tangent_speed_m_s);
@@ -752,8 +753,8 @@ void LoadSingleImpacts(const Context& context, const Section& release, SceneFile
     if (std::abs(impact.angular_speed_rad_s) > kMaxAngularSpeed_rad_s)
       throw InputError(rows.Where(k, columns.angular_speed) + ": more than " +
                        Fmt(kMaxAngularSpeed_rad_s) + " rad/s");
-    out.release.runs.push_back(fieldobs::SingleImpactRun(
-        impact, out.scene.terrain, at, clearance_m, BlockOfRow(rows, k, block_column, out)));
+    out.release.runs.push_back(fieldobs::SingleImpactRun(impact, out.scene.terrain, at, clearance_m,
+                                                         BlockOfRow(rows, k, block_column, out)));
   }
   out.release.height_reference = ensemble::ReleaseSpec::HeightReference::kLowestPoint;
 }
@@ -812,8 +813,9 @@ void LoadRelease(const Context& context, const Section& s, SceneFile& out) {
   }
   if (s.Has("single_impacts")) {
     if (!r.releases.empty() || s.Has("runs"))
-      s.Fail("single_impacts",
-             "a single-impact table cannot be combined with points, lines, polygons, a file or runs");
+      s.Fail(
+          "single_impacts",
+          "a single-impact table cannot be combined with points, lines, polygons, a file or runs");
     LoadSingleImpacts(context, s, out);
   }
   if (r.releases.empty() && r.runs.empty())
@@ -1211,14 +1213,13 @@ SceneFile LoadScene(const std::string& path) {
     out.scene.rock = *out.release.blocks.front().shape;  // the shape of runs' first block
     out.rock_description = "blocks (" + std::to_string(out.release.blocks.size()) + ")";
   }
-  LoadRelease(
-      context,
-      Section(context, SubTable(context, root, "release"), "release",
-              {"points", "lines", "polygons", "file", "layer", "where", "runs", "single_impacts",
-               "block_column",
-               "height_m", "height_reference", "rocks", "rocks_per_m2", "rocks_per_cell",
-               "clip_to_dem", "orientation", "velocity_m_s", "angular_velocity_rad_s", "seed"}),
-      out);
+  LoadRelease(context,
+              Section(context, SubTable(context, root, "release"), "release",
+                      {"points", "lines", "polygons", "file", "layer", "where", "runs",
+                       "single_impacts", "block_column", "height_m", "height_reference", "rocks",
+                       "rocks_per_m2", "rocks_per_cell", "clip_to_dem", "orientation",
+                       "velocity_m_s", "angular_velocity_rad_s", "seed"}),
+              out);
   LoadEvaluationLines(context,
                       Section(context, SubTable(context, root, "evaluation_lines"),
                               "evaluation_lines", {"lines", "names", "file", "name_field"}),

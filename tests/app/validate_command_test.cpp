@@ -159,11 +159,11 @@ TEST(ValidateCommand, ChantSuraSingleImpactsAreScoredAndTheirDepthsReportedNotSc
   ASSERT_NE(angle, std::string::npos);
   table.replace(angle, 19, ",95,");
   Write(bad / "impacts_esurf2019.csv", table);
-  EXPECT_EQ(RunCommand(std::string(TALUS_BINARY) + " validate " +
-                           (bad / "event_impacts.toml").string() + " --out " +
-                           (bad / "out").string(),
-                       &output),
-            2)
+  EXPECT_EQ(
+      RunCommand(std::string(TALUS_BINARY) + " validate " + (bad / "event_impacts.toml").string() +
+                     " --out " + (bad / "out").string(),
+                 &output),
+      2)
       << output;
   EXPECT_NE(output.find("impacts_esurf2019.csv:2: column 'impact_angle_deg': impact angle 95 deg "
                         "is outside (0, 90]"),

@@ -40,10 +40,10 @@ TEST(SingleImpacts, ComponentsComeFromTheTotalSpeedAndAngleOrTheComponentColumns
   EXPECT_NEAR(from_angle[1].tangent_speed_m_s, 0, 1e-12);
   EXPECT_EQ(from_angle[1].where, "impacts.csv:3");
   // All four columns: the components, checked against the total and the angle.
-  const auto both = ReadIncomingImpacts(
-      Table("impact_id,incoming_normal_speed_mps,incoming_tangent_speed_mps,"
-            "incoming_total_speed_mps,impact_angle_deg\na,3,4,5,36.87\n"),
-      {});
+  const auto both =
+      ReadIncomingImpacts(Table("impact_id,incoming_normal_speed_mps,incoming_tangent_speed_mps,"
+                                "incoming_total_speed_mps,impact_angle_deg\na,3,4,5,36.87\n"),
+                          {});
   EXPECT_EQ(both[0].normal_speed_m_s, 3);
   EXPECT_EQ(both[0].tangent_speed_m_s, 4);
   EXPECT_EQ(both[0].angular_speed_rad_s, 0);  // no spin column: no spin
@@ -63,13 +63,14 @@ TEST(SingleImpacts, BadTablesAreErrorsNamingFileLineAndColumn) {
             std::string::npos);
   for (const char* angle : {"0", "-10", "95"})
     EXPECT_NE(ErrorOf(header + "a,3," + angle + "\n")
-                  .find("impacts.csv:2: column 'impact_angle_deg': impact angle " + std::string(angle) +
-                        " deg is outside (0, 90]"),
+                  .find("impacts.csv:2: column 'impact_angle_deg': impact angle " +
+                        std::string(angle) + " deg is outside (0, 90]"),
               std::string::npos)
         << angle;
   EXPECT_NE(ErrorOf(header + "a,-3,20\n").find("must be >= 0"), std::string::npos);
-  EXPECT_NE(ErrorOf(header + "a,3,20\na,4,20\n").find("impacts.csv:3: column 'impact_id': impact "
-                                                      "'a' appears twice"),
+  EXPECT_NE(ErrorOf(header + "a,3,20\na,4,20\n")
+                .find("impacts.csv:3: column 'impact_id': impact "
+                      "'a' appears twice"),
             std::string::npos);
   EXPECT_NE(ErrorOf(header + ",3,20\n").find("empty impact id"), std::string::npos);
   EXPECT_NE(ErrorOf(header).find("no impact"), std::string::npos);
@@ -87,8 +88,8 @@ TEST(SingleImpacts, BadTablesAreErrorsNamingFileLineAndColumn) {
 }
 
 TEST(SingleImpacts, OutcomesAreObservationsOfTheRunAndScarDepthsAreReportedNotScored) {
-  const CsvTable t = Table(
-      "impact_id,energy_ratio,outgoing_speed_mps,scar_depth_m\na,0.4,3,0.1\nb,,2,0.2\n");
+  const CsvTable t =
+      Table("impact_id,energy_ratio,outgoing_speed_mps,scar_depth_m\na,0.4,3,0.1\nb,,2,0.2\n");
   ObservationSet set;
   std::vector<std::string> not_scored;
   ReadSingleImpactOutcomes(t, {}, set, &not_scored);
@@ -104,9 +105,9 @@ TEST(SingleImpacts, OutcomesAreObservationsOfTheRunAndScarDepthsAreReportedNotSc
   ObservationSet none;
   EXPECT_THROW(ReadSingleImpactOutcomes(Table("impact_id,mass_kg\na,780\n"), {}, none, nullptr),
                InputError);
-  EXPECT_THROW(ReadSingleImpactOutcomes(Table("impact_id,energy_ratio\na,-0.1\n"), {}, none,
-                                        nullptr),
-               InputError);
+  EXPECT_THROW(
+      ReadSingleImpactOutcomes(Table("impact_id,energy_ratio\na,-0.1\n"), {}, none, nullptr),
+      InputError);
 }
 
 // A plane of `slope_deg` falling along +x (x in 0 .. 40 m, slope then 10 m of runout), a 0.4 m
@@ -121,8 +122,8 @@ Scene PlaneScene(double slope_deg, const GroundParams& ground) {
 }
 
 // The first contact episode of every rock of `runs` (rocks per run), run with the scene's rock.
-std::vector<ContactEpisode> FirstEpisodes(const Scene& scene, std::vector<ensemble::ReleaseRun> runs,
-                                          long rocks) {
+std::vector<ContactEpisode> FirstEpisodes(const Scene& scene,
+                                          std::vector<ensemble::ReleaseRun> runs, long rocks) {
   ensemble::ReleaseSpec release;
   release.runs = std::move(runs);
   release.rocks_per_release = rocks;

@@ -273,8 +273,7 @@ namespace {
 // A 30 deg plane scene whose runs are the impacts of impacts.csv (with `release` as the
 // single_impacts table) and an event scoring them (`observation`: extra keys).
 std::filesystem::path MakeSingleImpacts(const std::string& name, const std::string& release,
-                                        const std::string& observation,
-                                        const std::string& table) {
+                                        const std::string& observation, const std::string& table) {
   const auto dir = testing::FreshDir(name);
   testing::WriteText(dir / "scene.toml",
                      "[terrain]\nplane = { slope_deg = 30, slope_length_m = 40, runout_m = 10, "
