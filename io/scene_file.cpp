@@ -725,8 +725,9 @@ void LoadSingleImpacts(const Context& context, const Section& release, SceneFile
   if (s.Has("at")) {
     const std::vector<double> xy = s.Numbers("at", 2);
     at = Eigen::Vector2d(xy[0], xy[1]);
-  } else if (out.plane) {
-    at = Eigen::Vector2d(0.5 * out.plane->slope_length_m, 0);
+  } else if (out.plane) {  // the middle of the slope, or of the runout of a level plane
+    const PlaneSpec& p = *out.plane;
+    at = Eigen::Vector2d(0.5 * (p.slope_length_m > 0 ? p.slope_length_m : p.runout_m), 0);
   } else {
     s.Fail("at", "missing: give the point [x, y] of the DEM where the impacts happen");
   }

@@ -330,6 +330,23 @@ TEST(LoadEvent, SingleImpactErrorsNameFileLineAndKey) {
   EXPECT_HAS(error("si_off", "{ file = \"impacts.csv\", at = [100, 0] }", ratio),
              "release.single_impacts.at: (100, 0) is outside the DEM");
   EXPECT_HAS(error("si_missing", "{ file = \"missing.csv\" }", ratio), "file not found");
+  EXPECT_HAS(error("si_height", file + "\nheight_m = 2", ratio),
+             "release.height_m: a single-impact table sets each run's start");
+  EXPECT_HAS(error("si_points", file + "\npoints = [[5, 0]]", ratio),
+             "release.single_impacts: a single-impact table cannot be combined with points");
+  // Over a DEM the point of the impacts must be given.
+  const auto dem = MakeEvent("si_dem", 32632);
+  testing::WriteText(dem / "impacts.csv", kImpacts);
+  testing::WriteText(dem / "scene.toml",
+                     "[terrain]\ndem = \"dem.tif\"\n[rock]\nshape = { box = [0.5, 0.5, 0.5] }\n"
+                     "[release]\nsingle_impacts = { file = \"impacts.csv\" }\n");
+  std::string dem_error;
+  try {
+    LoadScene((dem / "scene.toml").string());
+  } catch (const InputError& e) {
+    dem_error = e.what();
+  }
+  EXPECT_HAS(dem_error, "release.single_impacts.at: missing: give the point [x, y] of the DEM");
   // An impact the scene does not release is not a run of it.
   EXPECT_HAS(ErrorOf([&] {
                const auto dir = MakeSingleImpacts("si_unknown", file, ratio, kImpacts);
