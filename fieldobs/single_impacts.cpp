@@ -20,12 +20,6 @@ std::string Fmt(double v) {
   return s.str();
 }
 
-double NonNegative(const CsvTable& t, int row, const std::string& column) {
-  const double v = t.Number(row, column);
-  if (v < 0) throw InputError(t.Where(row, column) + ": " + t.Text(row, column) + " must be >= 0");
-  return v;
-}
-
 double Angle_deg(const CsvTable& t, int row, const std::string& column) {
   const double a = t.Number(row, column);
   if (!(a > 0 && a <= 90))
@@ -39,11 +33,11 @@ double Angle_deg(const CsvTable& t, int row, const std::string& column) {
 void ReadVelocity(const CsvTable& t, const SingleImpactColumns& c, int row, bool components,
                   bool total, IncomingImpact& impact) {
   if (components) {
-    impact.normal_speed_m_s = NonNegative(t, row, c.normal_speed);
-    impact.tangent_speed_m_s = NonNegative(t, row, c.tangent_speed);
+    impact.normal_speed_m_s = t.NonNegativeNumber(row, c.normal_speed);
+    impact.tangent_speed_m_s = t.NonNegativeNumber(row, c.tangent_speed);
   }
   if (!total) return;
-  const double speed = NonNegative(t, row, c.total_speed);
+  const double speed = t.NonNegativeNumber(row, c.total_speed);
   const double angle = Angle_deg(t, row, c.angle);
   if (!components) {
     impact.normal_speed_m_s = speed * std::sin(angle * kPi / 180);
@@ -131,10 +125,10 @@ void ReadSingleImpactOutcomes(const CsvTable& t, const SingleImpactColumns& c, O
     const std::string where = t.path() + ":" + std::to_string(t.line(row));
     if (!t.Empty(row, c.energy_ratio))
       out.scalars.push_back(
-          {Quantity::kImpactEnergyRatio, run, NonNegative(t, row, c.energy_ratio), where});
+          {Quantity::kImpactEnergyRatio, run, t.NonNegativeNumber(row, c.energy_ratio), where});
     if (!t.Empty(row, c.speed_out))
       out.scalars.push_back(
-          {Quantity::kImpactSpeedOut, run, NonNegative(t, row, c.speed_out), where});
+          {Quantity::kImpactSpeedOut, run, t.NonNegativeNumber(row, c.speed_out), where});
   }
   if (!not_scored || !t.Has(c.scar_depth)) return;
   int depths = 0;
