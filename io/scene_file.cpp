@@ -865,6 +865,9 @@ void LoadRelease(const Context& context, const Section& s, SceneFile& out) {
       r.orientation = quat.normalized();
     }
   }
+  // Runs take their own orientation (Release): single impacts take the one given here.
+  if (s.Has("single_impacts"))
+    for (ensemble::ReleaseRun& run : r.runs) run.orientation = r.orientation;
   if (s.Has("velocity_m_s")) {
     const auto v = s.Numbers("velocity_m_s", 3);
     r.velocity_m_s = Eigen::Vector3d(v[0], v[1], v[2]);

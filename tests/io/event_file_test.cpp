@@ -304,6 +304,13 @@ TEST(LoadEvent, SingleImpactsAreRunsOnThePlaneAndObservationsOfTheirFirstEpisode
   EXPECT_EQ(release.runs[0].xy_m, Eigen::Vector2d(20, 0));  // the middle of the slope
   EXPECT_NEAR(release.runs[0].velocity_m_s.norm(), 20, 1e-12);
   EXPECT_EQ(release.height_reference, ensemble::ReleaseSpec::HeightReference::kLowestPoint);
+  EXPECT_FALSE(release.runs[0].orientation);  // random per rock
+  const auto fixed = MakeSingleImpacts("single_impacts_fixed",
+                                       "{ file = \"impacts.csv\" }\norientation = [0, 1, 0, 0]",
+                                       "energy_ratio_column = \"ratio\"\n", kImpacts);
+  const EventFile flipped = LoadEvent((fixed / "event.toml").string());
+  ASSERT_TRUE(flipped.scene.release.runs[1].orientation);
+  EXPECT_EQ(flipped.scene.release.runs[1].orientation->x(), 1);
   EXPECT_TRUE(event.needs_episodes);
   ASSERT_EQ(event.observations.scalars.size(), 2u);
   EXPECT_EQ(event.observations.scalars[1].run, "i2");
