@@ -142,6 +142,7 @@ int RunCalibrate(const CalibrateArgs& args, const Processes& processes) {
     objective_options.run_ensemble = processes.runner;
     const io::EventFile& event = file.event;
     if (root) PrintSceneWarnings(event.scene, "calibrate");
+    if (root) PrintNotScored(event.not_scored);
     holdout = HoldoutRuns(args.holdout, event.scene.release, file.optimizer.seed);
     fit = calibration::SelectRuns(event.scene.release, event.observations,
                                   calibration::OtherRuns(event.scene.release, holdout), true);

@@ -37,6 +37,8 @@ std::string DescribeRocks(const io::SceneFile& scene);
 // Prints the scene's warnings (io::SceneFile::warnings) on stderr, one "talus <command>: WARNING:"
 // line each.
 void PrintSceneWarnings(const io::SceneFile& scene, const char* command = "simulate");
+// Prints each observed value an event holds but does not score (io::EventFile::not_scored).
+void PrintNotScored(const std::vector<std::string>& not_scored);
 
 // How many processes an MPI launcher (mpirun, srun) started this one among; 1 without a launcher.
 int LaunchedRanks();

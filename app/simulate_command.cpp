@@ -60,6 +60,11 @@ void PrintSceneWarnings(const io::SceneFile& scene, const char* command) {
   std::fflush(stderr);
 }
 
+void PrintNotScored(const std::vector<std::string>& not_scored) {
+  for (const std::string& line : not_scored) std::printf("Not scored: %s\n", line.c_str());
+  std::fflush(stdout);
+}
+
 int LoadForSimulate(const SimulateArgs& args, io::SceneFile* scene, std::pair<long, long>* range,
                     std::string* message) {
   namespace fs = std::filesystem;

@@ -64,7 +64,7 @@ int RunValidate(const ValidateArgs& args) {
               args.event.c_str(), event.observations.size(), event.observations.scalars.size(),
               event.observations.deposits.size(), release.release_count(),
               release.rocks_per_release);
-  std::fflush(stdout);
+  PrintNotScored(event.not_scored);
   // Every output is staged and moved into --out only when all are complete.
   std::optional<StagingDirectory> staging;
   try {

@@ -146,6 +146,12 @@ double CsvTable::Number(int row, const std::string& column) const {
   return v;
 }
 
+double CsvTable::NonNegativeNumber(int row, const std::string& column) const {
+  const double v = Number(row, column);
+  if (v < 0) throw InputError(Where(row, column) + ": " + Text(row, column) + " must be >= 0");
+  return v;
+}
+
 std::optional<double> CsvTable::OptionalNumber(int row, const std::string& column) const {
   if (Empty(row, column)) return std::nullopt;
   return Number(row, column);

@@ -34,6 +34,8 @@ class CsvTable {
   bool Empty(int row, const std::string& column) const;
   // A finite number; throws "<path>:<line>: column '<c>': '<text>' is not a finite number".
   double Number(int row, const std::string& column) const;
+  // As Number, and >= 0; throws "<path>:<line>: column '<c>': <text> must be >= 0".
+  double NonNegativeNumber(int row, const std::string& column) const;
   // nullopt when Empty, else as Number.
   std::optional<double> OptionalNumber(int row, const std::string& column) const;
 

@@ -81,12 +81,6 @@ std::string Where(const CsvTable& t, int row) {
   return t.path() + ":" + std::to_string(t.line(row));
 }
 
-double NonNegative(const CsvTable& t, int row, const std::string& column) {
-  const double v = t.Number(row, column);
-  if (v < 0) throw InputError(t.Where(row, column) + ": " + t.Text(row, column) + " must be >= 0");
-  return v;
-}
-
 }  // namespace
 
 void ReadRunouts(const CsvTable& t, const TableColumns& c, ObservationSet& out) {
@@ -94,7 +88,7 @@ void ReadRunouts(const CsvTable& t, const TableColumns& c, ObservationSet& out) 
   for (int row = 0; row < t.rows(); ++row) {
     if (t.Empty(row, "observed_runout_m")) continue;
     out.scalars.push_back({Quantity::kRunout, RunOf(t, c, row),
-                           NonNegative(t, row, "observed_runout_m"), Where(t, row)});
+                           t.NonNegativeNumber(row, "observed_runout_m"), Where(t, row)});
   }
 }
 
@@ -105,7 +99,7 @@ void ReadDeposits(const CsvTable& t, const TableColumns& c, ObservationSet& out)
     DepositObservation d;
     d.run = RunOf(t, c, row);
     d.xy_m = Eigen::Vector2d(t.Number(row, "x_m"), t.Number(row, "y_m"));
-    if (!t.Empty(row, "radius_m")) d.radius_m = NonNegative(t, row, "radius_m");
+    if (!t.Empty(row, "radius_m")) d.radius_m = t.NonNegativeNumber(row, "radius_m");
     d.where = Where(t, row);
     out.deposits.push_back(d);
   }
@@ -162,8 +156,8 @@ void ReadImpacts(const CsvTable& t, const TableColumns& c, ObservationSet& out,
       in = v("incoming_vx_mps", "incoming_vy_mps", "incoming_vz_mps").norm();
       out_speed = v("outgoing_vx_mps", "outgoing_vy_mps", "outgoing_vz_mps").norm();
     } else {
-      in = NonNegative(t, row, "incoming_speed_mps");
-      out_speed = NonNegative(t, row, "outgoing_speed_mps");
+      in = t.NonNegativeNumber(row, "incoming_speed_mps");
+      out_speed = t.NonNegativeNumber(row, "outgoing_speed_mps");
     }
     if (in <= 0)
       throw InputError(Where(t, row) + ": incoming speed 0: an impact needs an incoming velocity");
@@ -173,7 +167,7 @@ void ReadImpacts(const CsvTable& t, const TableColumns& c, ObservationSet& out,
         {Quantity::kImpactEnergyRatio, run, (out_speed * out_speed) / (in * in), Where(t, row)});
     if (!t.Empty(row, "omega_out_radps")) {
       out.scalars.push_back({Quantity::kImpactAngularSpeedOut, run,
-                             NonNegative(t, row, "omega_out_radps"), Where(t, row)});
+                             t.NonNegativeNumber(row, "omega_out_radps"), Where(t, row)});
     } else if (next_samples && !t.Empty(row, c.next_run)) {
       const std::string next = t.Text(row, c.next_run);
       const auto it = next_omega.find(next);
@@ -185,7 +179,7 @@ void ReadImpacts(const CsvTable& t, const TableColumns& c, ObservationSet& out,
     }
     if (!t.Empty(row, "duration_s"))
       out.scalars.push_back(
-          {Quantity::kImpactDuration, run, NonNegative(t, row, "duration_s"), Where(t, row)});
+          {Quantity::kImpactDuration, run, t.NonNegativeNumber(row, "duration_s"), Where(t, row)});
   }
 }
 
@@ -198,7 +192,7 @@ void ReadScars(const CsvTable& t, const TableColumns& c, ObservationSet& out) {
   for (int row = 0; row < t.rows(); ++row) {
     if (t.Empty(row, "scar_length_m")) continue;
     out.scalars.push_back({Quantity::kScarLength, RunOf(t, c, row),
-                           NonNegative(t, row, "scar_length_m"), Where(t, row)});
+                           t.NonNegativeNumber(row, "scar_length_m"), Where(t, row)});
   }
 }
 
@@ -231,7 +225,7 @@ void ReadZoneObservations(const CsvTable& t, const TableColumns& c, ObservationS
                        "' (known: speed_mps, angular_speed_radps, jump_height_m, passed)");
     }
     const double value = quantity == Quantity::kZoneJumpHeight ? t.Number(row, "value")
-                                                               : NonNegative(t, row, "value");
+                                                               : t.NonNegativeNumber(row, "value");
     if (quantity == Quantity::kZonePassed && value != 0 && value != 1)
       throw InputError(t.Where(row, "value") + ": passed is 0 or 1, not " + t.Text(row, "value"));
     ScalarObservation o{quantity, RunOf(t, c, row), value, Where(t, row)};
@@ -274,7 +268,7 @@ void ReadTrajectories(const CsvTable& t, const TableColumns& c, const Terrain& t
         throw InputError(t.Where(row, "time_s") + ": times of run '" + runs[k] + "' must increase");
       previous_t = time;
       const double speed = speeds
-                               ? NonNegative(t, row, "speed_mps")
+                               ? t.NonNegativeNumber(row, "speed_mps")
                                : Eigen::Vector3d(t.Number(row, "vx_mps"), t.Number(row, "vy_mps"),
                                                  t.Number(row, "vz_mps"))
                                      .norm();

@@ -10,6 +10,7 @@
 
 #include "common/csv_table.hpp"
 #include "common/error.hpp"
+#include "fieldobs/single_impacts.hpp"
 #include "io/toml_section.hpp"
 #include "io/vector.hpp"
 
@@ -18,8 +19,18 @@ namespace {
 
 namespace fs = std::filesystem;
 
-const std::vector<std::string> kKinds = {"runout", "deposits",     "impacts",
-                                         "scars",  "trajectories", "zones"};
+const std::vector<std::string> kKinds = {"runout",       "deposits", "impacts",       "scars",
+                                         "trajectories", "zones",    "single_impacts"};
+
+// The column keys of a single_impacts observation table (defaults: SingleImpactColumns).
+fieldobs::SingleImpactColumns SingleImpactColumnsOf(const Section& o) {
+  fieldobs::SingleImpactColumns c;
+  c.id = o.String("id_column", c.id);
+  c.energy_ratio = o.String("energy_ratio_column", c.energy_ratio);
+  c.speed_out = o.String("speed_out_column", c.speed_out);
+  c.scar_depth = o.String("scar_depth_column", c.scar_depth);
+  return c;
+}
 
 }  // namespace
 
@@ -102,7 +113,9 @@ EventFile LoadEvent(const std::string& path) {
     const std::string name = "observations[" + std::to_string(k) + "]";
     const toml::table* t = tables->get(k)->as_table();
     if (!t) context.Fail(tables->get(k), name, "expected a table (kind, file)");
-    const Section o(context, t, name, {"kind", "file", "run_column", "omega_from"});
+    const Section o(context, t, name,
+                    {"kind", "file", "run_column", "omega_from", "id_column", "energy_ratio_column",
+                     "speed_out_column", "scar_depth_column"});
     for (const char* required : {"kind", "file"})
       if (!o.Has(required)) context.Fail(t, o.Key(required), "missing");
     const std::string kind = o.String("kind", "");
@@ -110,8 +123,15 @@ EventFile LoadEvent(const std::string& path) {
       const std::string hint = ClosestName(kind, kKinds);
       o.Fail("kind", "unknown kind '" + kind + "'" +
                          (hint.empty() ? "" : " (did you mean '" + hint + "'?)") +
-                         "; known: runout, deposits, impacts, scars, trajectories, zones");
+                         "; known: runout, deposits, impacts, scars, trajectories, zones, "
+                         "single_impacts");
     }
+    for (const char* key :
+         {"id_column", "energy_ratio_column", "speed_out_column", "scar_depth_column"})
+      if (o.Has(key) && kind != "single_impacts")
+        o.Fail(key, "only single_impacts tables take " + std::string(key));
+    if (o.Has("run_column") && kind == "single_impacts")
+      o.Fail("run_column", "single_impacts name their runs by id_column (default impact_id)");
     const std::string file = context.Resolve(o.String("file", ""));
     if (!fs::exists(file)) o.Fail("file", "file not found: " + file);
     fieldobs::TableColumns columns;
@@ -149,9 +169,13 @@ EventFile LoadEvent(const std::string& path) {
       if (kind == "trajectories")
         fieldobs::ReadTrajectories(table, columns, event.scene.scene.terrain, event.observations);
       if (kind == "zones") fieldobs::ReadZoneObservations(table, columns, event.observations);
+      if (kind == "single_impacts")
+        fieldobs::ReadSingleImpactOutcomes(table, SingleImpactColumnsOf(o), event.observations,
+                                           &event.not_scored);
     }
     if (event.observations.size() == before) o.Fail("file", file + " holds no observation");
-    event.needs_episodes = event.needs_episodes || kind == "impacts" || kind == "scars";
+    event.needs_episodes =
+        event.needs_episodes || kind == "impacts" || kind == "scars" || kind == "single_impacts";
     for (const std::string& input : {file, omega_file})
       if (!input.empty() &&
           std::find(event.inputs.begin(), event.inputs.end(), input) == event.inputs.end())

@@ -21,15 +21,21 @@ struct EventFile {
   // The reference parameter set skill scores compare with: "table1" (the seed paper's Table 1
   // values of the built-in categories the scene uses, user categories unchanged) or "none".
   std::string reference = "table1";
+  // Observed values the tables hold that have no simulated counterpart (e.g. scar depths), one
+  // line each naming the file and column and saying why: printed and listed in scores.json.
+  std::vector<std::string> not_scored;
   std::vector<std::string> inputs;  // the event file, the scene's inputs, the observation tables
   std::string inputs_hash;
 };
 
 // Throws InputError "<file>:<line>: <key>: <reason>" (or the table's file:line: column).
 // Keys: `scene`, `reference`, and [[observations]] tables with `kind` (runout, deposits, impacts,
-// scars), `file`, optional `run_column` (default trajectory_id) and, for impacts only,
-// `omega_from`: a table of observed trajectory samples from which each impact's angular speed
-// after the impact is taken (fieldobs::ReadImpacts' `next_samples`).
+// scars, trajectories, zones, single_impacts), `file`, optional `run_column` (default
+// trajectory_id) and, for impacts only, `omega_from`: a table of observed trajectory samples from
+// which each impact's angular speed after the impact is taken (fieldobs::ReadImpacts'
+// `next_samples`). single_impacts (fieldobs::ReadSingleImpactOutcomes) take `id_column`,
+// `energy_ratio_column`, `speed_out_column` and `scar_depth_column` instead of `run_column`; their
+// runs are the scene's [release] single_impacts.
 EventFile LoadEvent(const std::string& path);
 
 // The scene's ground table with the Table 1 values for the built-in categories (user categories

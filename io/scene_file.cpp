@@ -12,6 +12,7 @@
 
 #include "common/csv_table.hpp"
 #include "common/error.hpp"
+#include "fieldobs/single_impacts.hpp"
 #include "io/raster.hpp"
 #include "io/toml_section.hpp"
 #include "io/vector.hpp"
@@ -234,6 +235,7 @@ void LoadTerrain(const Context& context, const Section& s, SceneFile& out) {
     std::string why;
     if (!spec.IsValid(&why)) p.FailCheck(why);
     heights = MakePlaneHeightfield(spec);
+    out.plane = spec;
     out.terrain_description =
         "plane " + Fmt(spec.slope_deg) + " deg, " + std::to_string(heights.grid.nx) + " x " +
         std::to_string(heights.grid.ny) + " cells of " + Fmt(spec.cell_m) + " m";
@@ -591,6 +593,26 @@ void LoadBlocks(const Context& context, const toml::table* table, SceneFile& out
     s.Fail("shape_per_rock", "only rock blocks have a shape of their own per rock");
 }
 
+// The block a row of a run table names in its column `block_column` (the index into [blocks]), or
+// -1 for the scene's [rock] when the cell is empty.
+int BlockOfRow(const CsvTable& rows, int k, const std::string& block_column, const SceneFile& out) {
+  const ensemble::ReleaseSpec& r = out.release;
+  if (rows.Empty(k, block_column)) {
+    if (!out.has_rock)
+      throw InputError(rows.Where(k, block_column) +
+                       ": a run without a block needs the scene's [rock]");
+    return -1;
+  }
+  const std::string id = rows.Text(k, block_column);
+  std::string known;
+  for (std::size_t b = 0; b < r.blocks.size(); ++b) {
+    if (r.blocks[b].id == id) return static_cast<int>(b);
+    known += (known.empty() ? "" : ", ") + r.blocks[b].id;
+  }
+  throw InputError(rows.Where(k, block_column) + ": unknown block '" + id + "'" +
+                   (r.blocks.empty() ? " (the scene has no [blocks])" : " (known: " + known + ")"));
+}
+
 // [release] runs = "file.csv": one row per run, columns by name (docs/scenes.md). A run names its
 // block by the text of the column `block_column` (default block_id; e.g. mass_kg when the blocks
 // are told apart by their mass).
@@ -657,26 +679,7 @@ void LoadRuns(const Context& context, const Section& s, SceneFile& out) {
                          Fmt(q.norm()) + ", expected 1");
       run.orientation = q.normalized();
     }
-    if (!rows.Empty(k, block_column)) {
-      const std::string id = rows.Text(k, block_column);
-      int index = -1;
-      std::vector<std::string> ids;
-      for (std::size_t b = 0; b < r.blocks.size(); ++b) {
-        ids.push_back(r.blocks[b].id);
-        if (r.blocks[b].id == id) index = static_cast<int>(b);
-      }
-      if (index < 0)
-        throw InputError(rows.Where(k, block_column) + ": unknown block '" + id + "'" +
-                         (r.blocks.empty() ? " (the scene has no [blocks])" : " (known: " + [&] {
-                           std::string all;
-                           for (const auto& i : ids) all += (all.empty() ? "" : ", ") + i;
-                           return all;
-                         }() + ")"));
-      run.block = index;
-    } else if (!out.has_rock) {
-      throw InputError(rows.Where(k, block_column) +
-                       ": a run without a block needs the scene's [rock]");
-    }
+    run.block = BlockOfRow(rows, k, block_column, out);
     double ground_m;
     if (!out.scene.terrain.Height(run.xy_m.x(), run.xy_m.y(), &ground_m))
       throw InputError(rows.Where(k, "x_m") + ": (" + Fmt(run.xy_m.x()) + ", " + Fmt(run.xy_m.y()) +
@@ -689,6 +692,72 @@ void LoadRuns(const Context& context, const Section& s, SceneFile& out) {
                        Fmt(kMaxReleaseHeight_m) + " m");
     r.runs.push_back(run);
   }
+}
+
+// [release] single_impacts = { file = "impacts.csv", ... }: one run per impact of the table
+// (fieldobs/single_impacts.hpp, docs/scenes.md), each starting at `at` (default: the middle of a
+// plane's slope) with the lowest vertex clearance_m above the ground, with the incoming velocity
+// relative to the terrain's tangent plane there. Blocks by `block_column` as for run tables.
+void LoadSingleImpacts(const Context& context, const Section& release, SceneFile& out) {
+  const toml::node* node = release.Node("single_impacts");
+  if (!node->is_table())
+    release.Fail("single_impacts", "expected an inline table { file = \"impacts.csv\", ... }");
+  const Section s(
+      context, node->as_table(), release.Key("single_impacts"),
+      {"file", "at", "clearance_m", "id_column", "normal_speed_column", "tangent_speed_column",
+       "total_speed_column", "angle_column", "angular_speed_column"});
+  if (!s.Has("file")) context.Fail(node, s.Key("file"), "missing");
+  for (const char* key : {"height_m", "height_reference", "velocity_m_s", "angular_velocity_rad_s"})
+    if (release.Has(key))
+      release.Fail(key, "a single-impact table sets each run's start (single_impacts)");
+  const std::string path = context.Resolve(s.String("file", ""));
+  if (!fs::exists(path)) s.Fail("file", "file not found: " + path);
+  fieldobs::SingleImpactColumns columns;
+  columns.id = s.String("id_column", columns.id);
+  columns.normal_speed = s.String("normal_speed_column", columns.normal_speed);
+  columns.tangent_speed = s.String("tangent_speed_column", columns.tangent_speed);
+  columns.total_speed = s.String("total_speed_column", columns.total_speed);
+  columns.angle = s.String("angle_column", columns.angle);
+  columns.angular_speed = s.String("angular_speed_column", "");
+  const double clearance_m = s.Checked(
+      "clearance_m", 0.001, [](double v) { return v >= 0 && v <= 1; }, "must be in 0 .. 1 m");
+  Eigen::Vector2d at;
+  if (s.Has("at")) {
+    const std::vector<double> xy = s.Numbers("at", 2);
+    at = Eigen::Vector2d(xy[0], xy[1]);
+  } else if (out.plane) {  // the middle of the slope, or of the runout of a level plane
+    const PlaneSpec& p = *out.plane;
+    at = Eigen::Vector2d(0.5 * (p.slope_length_m > 0 ? p.slope_length_m : p.runout_m), 0);
+  } else {
+    s.Fail("at", "missing: give the point [x, y] of the DEM where the impacts happen");
+  }
+  if (!ensemble::OnTerrain(out.scene.terrain, at))
+    s.Fail("at", "(" + Fmt(at.x()) + ", " + Fmt(at.y()) + ") is outside the DEM or on nodata");
+  const std::string block_column = release.String("block_column", "block_id");
+  out.inputs.push_back(path);
+  const CsvTable rows = CsvTable::Read(path);
+  if (release.Has("block_column")) {
+    try {
+      rows.Require({block_column});
+    } catch (const InputError& e) {
+      release.Fail("block_column", e.what());
+    }
+  }
+  const std::vector<fieldobs::IncomingImpact> impacts =
+      fieldobs::ReadIncomingImpacts(rows, columns);
+  for (int k = 0; k < rows.rows(); ++k) {
+    const fieldobs::IncomingImpact& impact = impacts[static_cast<std::size_t>(k)];
+    const double speed = std::hypot(impact.normal_speed_m_s, impact.tangent_speed_m_s);
+    if (speed > kMaxSpeed_m_s)
+      throw InputError(impact.where + ": incoming speed " + Fmt(speed) + " m/s is more than " +
+                       Fmt(kMaxSpeed_m_s) + " m/s");
+    if (std::abs(impact.angular_speed_rad_s) > kMaxAngularSpeed_rad_s)
+      throw InputError(rows.Where(k, columns.angular_speed) + ": more than " +
+                       Fmt(kMaxAngularSpeed_rad_s) + " rad/s");
+    out.release.runs.push_back(fieldobs::SingleImpactRun(impact, out.scene.terrain, at, clearance_m,
+                                                         BlockOfRow(rows, k, block_column, out)));
+  }
+  out.release.height_reference = ensemble::ReleaseSpec::HeightReference::kLowestPoint;
 }
 
 void LoadRelease(const Context& context, const Section& s, SceneFile& out) {
@@ -743,8 +812,17 @@ void LoadRelease(const Context& context, const Section& s, SceneFile& out) {
       s.Fail("runs", "a run table cannot be combined with points, lines, polygons or a file");
     LoadRuns(context, s, out);
   }
+  if (s.Has("single_impacts")) {
+    if (!r.releases.empty() || s.Has("runs"))
+      s.Fail(
+          "single_impacts",
+          "a single-impact table cannot be combined with points, lines, polygons, a file or runs");
+    LoadSingleImpacts(context, s, out);
+  }
   if (r.releases.empty() && r.runs.empty())
-    s.Fail("points", "missing: give points, lines, polygons, a vector file or a run table (runs)");
+    s.Fail("points",
+           "missing: give points, lines, polygons, a vector file, a run table (runs) or a "
+           "single-impact table (single_impacts)");
 
   const std::vector<std::string> count_keys = {"rocks", "rocks_per_m2", "rocks_per_cell"};
   std::string count_key = "rocks";
@@ -787,6 +865,9 @@ void LoadRelease(const Context& context, const Section& s, SceneFile& out) {
       r.orientation = quat.normalized();
     }
   }
+  // Runs take their own orientation (Release): single impacts take the one given here.
+  if (s.Has("single_impacts"))
+    for (ensemble::ReleaseRun& run : r.runs) run.orientation = r.orientation;
   if (s.Has("velocity_m_s")) {
     const auto v = s.Numbers("velocity_m_s", 3);
     r.velocity_m_s = Eigen::Vector3d(v[0], v[1], v[2]);
@@ -1136,13 +1217,13 @@ SceneFile LoadScene(const std::string& path) {
     out.scene.rock = *out.release.blocks.front().shape;  // the shape of runs' first block
     out.rock_description = "blocks (" + std::to_string(out.release.blocks.size()) + ")";
   }
-  LoadRelease(
-      context,
-      Section(context, SubTable(context, root, "release"), "release",
-              {"points", "lines", "polygons", "file", "layer", "where", "runs", "block_column",
-               "height_m", "height_reference", "rocks", "rocks_per_m2", "rocks_per_cell",
-               "clip_to_dem", "orientation", "velocity_m_s", "angular_velocity_rad_s", "seed"}),
-      out);
+  LoadRelease(context,
+              Section(context, SubTable(context, root, "release"), "release",
+                      {"points", "lines", "polygons", "file", "layer", "where", "runs",
+                       "single_impacts", "block_column", "height_m", "height_reference", "rocks",
+                       "rocks_per_m2", "rocks_per_cell", "clip_to_dem", "orientation",
+                       "velocity_m_s", "angular_velocity_rad_s", "seed"}),
+              out);
   LoadEvaluationLines(context,
                       Section(context, SubTable(context, root, "evaluation_lines"),
                               "evaluation_lines", {"lines", "names", "file", "name_field"}),

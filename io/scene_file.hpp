@@ -2,6 +2,7 @@
 // Scene files (TOML, docs/scenes.md): loading and validation. Every error names the file, the
 // line and key, and the reason, and is raised before any simulation starts.
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -47,6 +48,7 @@ struct SceneFile {
   bool shape_per_rock = false;                     // every rock has a seeded shape of its own
   std::string rock_description;     // e.g. "eota221 0.93 x 0.93 x 0.47 m, bevel 0.12 m"
   std::string crs_wkt;              // the DEM's CRS; empty for the plane or a DEM without CRS
+  std::optional<PlaneSpec> plane;   // [terrain] plane, when the terrain is the analytic plane
   std::string terrain_description;  // e.g. "dem.tif (270 x 370 cells of 5 m)"
   std::vector<std::string> inputs;  // the scene file and every data file it read
   std::string inputs_hash;          // FNV-1a 64 over the contents of `inputs`, hex

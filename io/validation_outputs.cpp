@@ -77,6 +77,7 @@ std::string ScoresJson(const EventFile& event, const fieldobs::ValidationReport&
                {"failed", run.ensemble.count(EndReason::kFailed)}};
   j["observations"] = report.observations.size();
   j["observations_scored"] = report.observations_scored;
+  j["not_scored"] = event.not_scored;  // observed values without a simulated counterpart
   j["overall"] = {{"skill_vs_reference", Num(report.skill_vs_reference)},
                   {"skill_vs_climatology", Num(report.skill_vs_climatology)}};
   nlohmann::ordered_json kinds = nlohmann::ordered_json::object();

@@ -3,10 +3,12 @@
 # category that could describe the slope and each reading of the viscous term, with 30 rocks per run.
 # Usage: cases/chant_sura/validate_table.sh [TALUS] [OUT] [ROCKS] [SEED] [EVENT]
 #   (defaults: build/app/talus, out/chant_sura, 30, 1, event.toml). Needs jq and awk.
-#   EVENT: event.toml (the impacts) or event_segments.toml (the flight segments).
-# Each variant is the case's scene with only `default_ground` and `[solver] viscous` changed,
+#   EVENT: event.toml (the impacts), event_segments.toml (the flight segments) or
+#   event_impacts.toml (the six single impacts of impacts_esurf2019.csv).
+# Each variant is the event's scene with only `default_ground` and `[solver] viscous` changed,
 # written with absolute data paths into OUT/<category>-<reading>/ (segments:
-# OUT/segments-<category>-<reading>/), and the event naming it.
+# OUT/segments-<category>-<reading>/, single impacts: OUT/single-<category>-<reading>/), and the
+# event naming it.
 set -eu
 case_dir=$(cd "$(dirname "$0")" && pwd)
 talus=${1:-build/app/talus}
@@ -14,6 +16,7 @@ out=${2:-out/chant_sura}
 rocks=${3:-30}
 seed=${4:-1}
 event=${5:-event.toml}
+scene=scene.toml
 case $event in
   event.toml)
     prefix=
@@ -25,7 +28,13 @@ case $event in
     kinds="segment_max_speed segment_mean_angular_speed segment_max_jump_height"
     printf '| ground | viscous | CRPS max speed (m/s) | skill_c | in 90%% | CRPS mean angular speed (rad/s) | skill_c | in 90%% | CRPS max jump height (m) | skill_c | in 90%% | mean bias: speed / angular speed / jump height | scored |\n'
     printf '|---|---|---|---|---|---|---|---|---|---|---|---|---|\n' ;;
-  *) echo "validate_table.sh: EVENT must be event.toml or event_segments.toml, not '$event'" >&2
+  event_impacts.toml)
+    prefix=single-
+    scene=scene_impacts.toml
+    kinds="impact_energy_ratio"
+    printf '| ground | viscous | CRPS energy ratio | skill_c | in 90%% | median energy ratio sim / obs | scored |\n'
+    printf '|---|---|---|---|---|---|---|\n' ;;
+  *) echo "validate_table.sh: EVENT must be event.toml, event_segments.toml or event_impacts.toml, not '$event'" >&2
      exit 2 ;;
 esac
 mkdir -p "$out"
@@ -38,9 +47,11 @@ for ground in hard medium_hard medium; do
         -e "s|^\[solver\]|[solver]\nviscous = \"$viscous\"|" \
         -e "s|\"terrain_rf16_patch.asc\"|\"$case_dir/terrain_rf16_patch.asc\"|" \
         -e "s|\"release_points.csv\"|\"$case_dir/release_points.csv\"|" \
-        "$case_dir/scene.toml" > "$dir/scene.toml"
+        -e "s|\"impacts_esurf2019.csv\"|\"$case_dir/impacts_esurf2019.csv\"|" \
+        "$case_dir/$scene" > "$dir/$scene"
     sed -e "s|\"contact_events.csv\"|\"$case_dir/contact_events.csv\"|" \
         -e "s|\"observed_trajectories.csv\"|\"$case_dir/observed_trajectories.csv\"|" \
+        -e "s|\"impacts_esurf2019.csv\"|\"$case_dir/impacts_esurf2019.csv\"|" \
         "$case_dir/$event" > "$dir/event.toml"
     "$talus" validate "$dir/event.toml" --out "$dir/out" --rocks "$rocks" --seed "$seed" \
       > "$dir/validate.log"
@@ -51,7 +62,7 @@ for ground in hard medium_hard medium; do
     }
     columns=
     for k in $kinds; do columns="$columns$(kind "$k") | "; done
-    if [ "$event" = event.toml ]; then
+    if [ "$event" != event_segments.toml ]; then
       # Medians over the scored energy-ratio observations: of the ensembles' medians, of the observed.
       extra=$(awk -F, '$1 == "impact_energy_ratio" && $7 == 1 { print $12, $4 }' "$dir/out/observations.csv" |
         awk '{ s[NR] = $1; o[NR] = $2 } END {

@@ -124,3 +124,52 @@ TEST(ValidateCommand, BadEventsFailBeforeAnyRockNamingFileLineAndKey) {
 }
 
 }  // namespace
+
+namespace {
+
+// The Chant Sura single impacts end to end (cases/chant_sura/event_impacts.toml): six runs made
+// from the table, their energy ratios scored, the scar depths reported as not scored; a table
+// with an impact angle out of range fails before any rock with its file, line and column.
+TEST(ValidateCommand, ChantSuraSingleImpactsAreScoredAndTheirDepthsReportedNotScored) {
+  const fs::path dir = FreshDir("single_impacts");
+  const fs::path event = fs::path(TALUS_SOURCE_DIR) / "cases/chant_sura/event_impacts.toml";
+  std::string output;
+  ASSERT_EQ(RunCommand(std::string(TALUS_BINARY) + " validate " + event.string() + " --out " +
+                           (dir / "out").string() + " --rocks 8 --threads 2",
+                       &output),
+            0)
+      << output;
+  EXPECT_NE(output.find("Not scored: "), std::string::npos) << output;
+  const auto scores = nlohmann::json::parse(Slurp(dir / "out" / "scores.json"));
+  EXPECT_EQ(scores["runs"], 6);
+  EXPECT_EQ(scores["observations"], 6);
+  EXPECT_EQ(scores["kinds"]["impact_energy_ratio"]["scored"], 6);
+  ASSERT_EQ(scores["not_scored"].size(), 1u);
+  EXPECT_NE(scores["not_scored"][0].get<std::string>().find(
+                "column 'observed_scarring_depth_m': 6 scar depths not scored"),
+            std::string::npos);
+
+  // The same event over a copy of the table with an impact angle of 95 degrees.
+  const fs::path bad = FreshDir("single_impacts_bad");
+  const fs::path cases = fs::path(TALUS_SOURCE_DIR) / "cases/chant_sura";
+  for (const char* file : {"scene_impacts.toml", "event_impacts.toml"})
+    fs::copy_file(cases / file, bad / file);
+  std::string table = Slurp(cases / "impacts_esurf2019.csv");
+  const std::size_t angle = table.find(",24.90702392018205,");
+  ASSERT_NE(angle, std::string::npos);
+  table.replace(angle, 19, ",95,");
+  Write(bad / "impacts_esurf2019.csv", table);
+  EXPECT_EQ(
+      RunCommand(std::string(TALUS_BINARY) + " validate " + (bad / "event_impacts.toml").string() +
+                     " --out " + (bad / "out").string(),
+                 &output),
+      2)
+      << output;
+  EXPECT_NE(output.find("impacts_esurf2019.csv:2: column 'impact_angle_deg': impact angle 95 deg "
+                        "is outside (0, 90]"),
+            std::string::npos)
+      << output;
+  EXPECT_FALSE(fs::exists(bad / "out" / "scores.json"));
+}
+
+}  // namespace

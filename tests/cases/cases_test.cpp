@@ -85,5 +85,31 @@ TEST(Cases, EveryCalibrationFileLoads) {
   EXPECT_GE(files, 1);  // tschamut2014
 }
 
+// The Chant Sura single impacts (cases/chant_sura/scene_impacts.toml): every rock's first contact
+// episode, the simulated impact, starts at release and is ended by a flight before max_time_s, so
+// the run is long enough for what is scored.
+TEST(Cases, ChantSuraSingleImpactsEndTheirFirstEpisodeInFlight) {
+  io::SceneFile scene =
+      io::LoadScene((fs::path(TALUS_SOURCE_DIR) / "cases/chant_sura/scene_impacts.toml").string());
+  ensemble::EnsembleOptions options;
+  options.threads = 2;
+  options.episodes = true;
+  struct Episodes : ensemble::RockSink {
+    double max_time_s = 0;
+    long rocks = 0;
+    void OnRock(const ensemble::RockOutcome& rock) override {
+      ++rocks;
+      ASSERT_FALSE(rock.episodes.empty()) << rock.rock;
+      const ContactEpisode& first = rock.episodes.front();
+      EXPECT_LE(first.start_time_s, 0.002 + 1e-12) << rock.rock;  // at once
+      // Ended by a flight of EpisodeOptions::min_flight_s, not by the end of the run.
+      EXPECT_LT(first.end_time_s, max_time_s - 0.05) << rock.rock;
+    }
+  } sink;
+  sink.max_time_s = scene.scene.options.max_time_s;
+  ensemble::RunEnsemble(scene.scene, scene.release, options, &sink);
+  EXPECT_EQ(sink.rocks, 6 * scene.release.rocks_per_release);
+}
+
 }  // namespace
 }  // namespace talus

@@ -55,5 +55,18 @@ TEST(CsvReader, ErrorsNameTheFileLineAndColumn) {
   EXPECT_THROW(CsvReader(WriteFile("empty.csv", "")), InputError);
 }
 
+TEST(CsvTable, NonNegativeNumbersNameTheCellOfANegativeOne) {
+  const CsvTable t = CsvTable::Parse("a,b\n0,2.5\n-1,x\n", "t.csv");
+  EXPECT_EQ(t.NonNegativeNumber(0, "a"), 0);
+  EXPECT_EQ(t.NonNegativeNumber(0, "b"), 2.5);
+  try {
+    t.NonNegativeNumber(1, "a");
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(), "t.csv:3: column 'a': -1 must be >= 0");
+  }
+  EXPECT_THROW(t.NonNegativeNumber(1, "b"), InputError);  // not a number
+}
+
 }  // namespace
 }  // namespace talus

@@ -266,3 +266,106 @@ TEST(LoadEvent, OmegaFromErrorsNameFileLineAndKey) {
 
 }  // namespace
 }  // namespace talus::io
+
+namespace talus::io {
+namespace {
+
+// A 30 deg plane scene whose runs are the impacts of impacts.csv (with `release` as the
+// single_impacts table) and an event scoring them (`observation`: extra keys).
+std::filesystem::path MakeSingleImpacts(const std::string& name, const std::string& release,
+                                        const std::string& observation, const std::string& table) {
+  const auto dir = testing::FreshDir(name);
+  testing::WriteText(dir / "scene.toml",
+                     "[terrain]\nplane = { slope_deg = 30, slope_length_m = 40, runout_m = 10, "
+                     "width_m = 20, cell_m = 1 }\n[rock]\nshape = { box = [0.5, 0.5, 0.5] }\n"
+                     "[release]\nsingle_impacts = " +
+                         release + "\nrocks = 4\n");
+  testing::WriteText(dir / "impacts.csv", table);
+  testing::WriteText(dir / "event.toml",
+                     "scene = \"scene.toml\"\n[[observations]]\nkind = \"single_impacts\"\n"
+                     "file = \"impacts.csv\"\n" +
+                         observation);
+  return dir;
+}
+
+const char* kImpacts =
+    "impact_id,incoming_total_speed_mps,impact_angle_deg,ratio,depth_m\n"
+    "i1,20,30,0.4,0.1\ni2,15,10,0.6,0.05\n";
+
+TEST(LoadEvent, SingleImpactsAreRunsOnThePlaneAndObservationsOfTheirFirstEpisode) {
+  const auto dir = MakeSingleImpacts("single_impacts", "{ file = \"impacts.csv\" }",
+                                     "energy_ratio_column = \"ratio\"\n"
+                                     "scar_depth_column = \"depth_m\"\n",
+                                     kImpacts);
+  const EventFile event = LoadEvent((dir / "event.toml").string());
+  const ensemble::ReleaseSpec& release = event.scene.release;
+  ASSERT_EQ(release.runs.size(), 2u);
+  EXPECT_EQ(release.runs[1].id, "i2");
+  EXPECT_EQ(release.runs[0].xy_m, Eigen::Vector2d(20, 0));  // the middle of the slope
+  EXPECT_NEAR(release.runs[0].velocity_m_s.norm(), 20, 1e-12);
+  EXPECT_EQ(release.height_reference, ensemble::ReleaseSpec::HeightReference::kLowestPoint);
+  EXPECT_FALSE(release.runs[0].orientation);  // random per rock
+  const auto fixed = MakeSingleImpacts("single_impacts_fixed",
+                                       "{ file = \"impacts.csv\" }\norientation = [0, 1, 0, 0]",
+                                       "energy_ratio_column = \"ratio\"\n", kImpacts);
+  const EventFile flipped = LoadEvent((fixed / "event.toml").string());
+  ASSERT_TRUE(flipped.scene.release.runs[1].orientation);
+  EXPECT_EQ(flipped.scene.release.runs[1].orientation->x(), 1);
+  EXPECT_TRUE(event.needs_episodes);
+  ASSERT_EQ(event.observations.scalars.size(), 2u);
+  EXPECT_EQ(event.observations.scalars[1].run, "i2");
+  EXPECT_EQ(event.observations.scalars[1].value, 0.6);
+  ASSERT_EQ(event.not_scored.size(), 1u);
+  EXPECT_HAS(event.not_scored[0], "column 'depth_m': 2 scar depths not scored");
+}
+
+TEST(LoadEvent, SingleImpactErrorsNameFileLineAndKey) {
+  const auto error = [](const std::string& name, const std::string& release,
+                        const std::string& observation, const std::string& table = kImpacts) {
+    return ErrorOf(MakeSingleImpacts(name, release, observation, table) / "event.toml");
+  };
+  const std::string file = "{ file = \"impacts.csv\" }";
+  const std::string ratio = "energy_ratio_column = \"ratio\"\n";
+  EXPECT_HAS(error("si_no_outcome", file, ""), "no observed outcome: give the column energy_ratio");
+  EXPECT_HAS(error("si_run_column", file, ratio + "run_column = \"impact_id\"\n"),
+             "run_column: single_impacts name their runs by id_column");
+  EXPECT_HAS(error("si_angle", file, ratio,
+                   "impact_id,incoming_total_speed_mps,impact_angle_deg,ratio\ni1,20,91,0.4\n"),
+             "impacts.csv:2: column 'impact_angle_deg': impact angle 91 deg is outside (0, 90]");
+  EXPECT_HAS(error("si_key", "{ file = \"impacts.csv\", clearance = 0.1 }", ratio),
+             "release.single_impacts.clearance");
+  EXPECT_HAS(error("si_off", "{ file = \"impacts.csv\", at = [100, 0] }", ratio),
+             "release.single_impacts.at: (100, 0) is outside the DEM");
+  EXPECT_HAS(error("si_missing", "{ file = \"missing.csv\" }", ratio), "file not found");
+  EXPECT_HAS(error("si_height", file + "\nheight_m = 2", ratio),
+             "release.height_m: a single-impact table sets each run's start");
+  EXPECT_HAS(error("si_points", file + "\npoints = [[5, 0]]", ratio),
+             "release.single_impacts: a single-impact table cannot be combined with points");
+  // Over a DEM the point of the impacts must be given.
+  const auto dem = MakeEvent("si_dem", 32632);
+  testing::WriteText(dem / "impacts.csv", kImpacts);
+  testing::WriteText(dem / "scene.toml",
+                     "[terrain]\ndem = \"dem.tif\"\n[rock]\nshape = { box = [0.5, 0.5, 0.5] }\n"
+                     "[release]\nsingle_impacts = { file = \"impacts.csv\" }\n");
+  std::string dem_error;
+  try {
+    LoadScene((dem / "scene.toml").string());
+  } catch (const InputError& e) {
+    dem_error = e.what();
+  }
+  EXPECT_HAS(dem_error, "release.single_impacts.at: missing: give the point [x, y] of the DEM");
+  // An impact the scene does not release is not a run of it.
+  EXPECT_HAS(ErrorOf([&] {
+               const auto dir = MakeSingleImpacts("si_unknown", file, ratio, kImpacts);
+               testing::WriteText(dir / "observed.csv", "impact_id,ratio\ni3,0.5\n");
+               testing::WriteText(dir / "event.toml",
+                                  "scene = \"scene.toml\"\n[[observations]]\nkind = "
+                                  "\"single_impacts\"\nfile = \"observed.csv\"\n" +
+                                      ratio);
+               return dir / "event.toml";
+             }()),
+             "observed.csv:2: run 'i3' is not a run of the scene");
+}
+
+}  // namespace
+}  // namespace talus::io
