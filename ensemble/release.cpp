@@ -393,7 +393,8 @@ ReleasedRock Release(const Scene& scene, const ReleaseSpec& spec, long rock) {
 
   // The user's orientation rotates the shape as given; the state holds principal -> world.
   RockState& state = out.start;
-  const std::optional<Eigen::Quaterniond>& fixed = run ? run->orientation : spec.orientation;
+  const std::optional<Eigen::Quaterniond>& fixed =
+      run && run->orientation ? run->orientation : spec.orientation;
   const Eigen::Quaterniond user = fixed ? *fixed : random.Orientation();
   state.orientation = out.shape->PrincipalOrientation(user);
 

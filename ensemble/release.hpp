@@ -34,7 +34,8 @@ struct ReleaseRun {
   Eigen::Vector3d velocity_m_s = Eigen::Vector3d::Zero();
   Eigen::Vector3d angular_velocity_rad_s = Eigen::Vector3d::Zero();
   int block = -1;  // index into ReleaseSpec::blocks; -1: the scene's rock
-  // Measured orientation of the shape as given (w, x, y, z); nullopt: uniform on SO(3) per rock.
+  // Measured orientation of the shape as given (w, x, y, z); nullopt: the spec's orientation
+  // (uniform on SO(3) per rock unless it fixes one).
   std::optional<Eigen::Quaterniond> orientation;
 };
 

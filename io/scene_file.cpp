@@ -810,6 +810,9 @@ void LoadRelease(const Context& context, const Section& s, SceneFile& out) {
   if (s.Has("runs")) {
     if (!r.releases.empty())
       s.Fail("runs", "a run table cannot be combined with points, lines, polygons or a file");
+    for (const char* key : {"velocity_m_s", "angular_velocity_rad_s"})
+      if (s.Has(key))
+        s.Fail(key, "a run table gives each run's start velocities (columns vx_mps .. wz_radps)");
     LoadRuns(context, s, out);
   }
   if (s.Has("single_impacts")) {
@@ -865,9 +868,6 @@ void LoadRelease(const Context& context, const Section& s, SceneFile& out) {
       r.orientation = quat.normalized();
     }
   }
-  // Runs take their own orientation (Release): single impacts take the one given here.
-  if (s.Has("single_impacts"))
-    for (ensemble::ReleaseRun& run : r.runs) run.orientation = r.orientation;
   if (s.Has("velocity_m_s")) {
     const auto v = s.Numbers("velocity_m_s", 3);
     r.velocity_m_s = Eigen::Vector3d(v[0], v[1], v[2]);

@@ -42,6 +42,31 @@ TEST(Release, FixedOrientationRotatesTheShapeAsGiven) {
   EXPECT_TRUE((s.orientation * s.angular_velocity_rad_s).isApprox(Eigen::Vector3d(0, 0, 2), 1e-12));
 }
 
+// A run without an orientation of its own takes the spec's: a fixed one for every rock when given
+// (a measured orientation of a campaign), random per rock otherwise.
+TEST(Release, RunsWithoutOrientationTakeTheSpecs) {
+  const Scene scene = testing::SmallPlane(30, 20, 10);
+  ReleaseSpec spec;
+  spec.runs.resize(2);
+  spec.runs[0].id = "own";
+  spec.runs[0].xy_m = {5, 0};
+  spec.runs[0].orientation = Eigen::Quaterniond(Eigen::AngleAxisd(1.0, Eigen::Vector3d::UnitX()));
+  spec.runs[1].id = "spec's";
+  spec.runs[1].xy_m = {6, 0};
+  spec.rocks_per_release = 2;
+  std::string why;
+  ASSERT_TRUE(spec.IsValid(&why)) << why;
+  const auto shape_of = [&](long rock) {
+    return Release(scene, spec, rock).start.orientation * scene.rock.principal_to_input.conjugate();
+  };
+  EXPECT_NE(shape_of(2).coeffs(), shape_of(3).coeffs());  // random: the spec fixes none
+  const Eigen::Quaterniond fixed(Eigen::AngleAxisd(0.4, Eigen::Vector3d(1, 1, 0).normalized()));
+  spec.orientation = fixed;
+  for (long rock : {2, 3}) EXPECT_NEAR(std::abs(shape_of(rock).dot(fixed)), 1.0, 1e-12);
+  for (long rock : {0, 1})
+    EXPECT_NEAR(std::abs(shape_of(rock).dot(*spec.runs[0].orientation)), 1.0, 1e-12);
+}
+
 TEST(Release, LinesAndPolygonsSampleOnThem) {
   const Scene scene = testing::SmallPlane(30, 20, 10);
   ReleaseSpec spec;

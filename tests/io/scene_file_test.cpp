@@ -864,6 +864,9 @@ TEST(LoadScene, RunTableErrorsNameFileLineAndColumn) {
   EXPECT_HAS(error("trajectory_id,x_m,y_m,block_id\nv1,5,0,1\n",
                    Replace(kRunScene, "rocks = 3", "rocks = 3\npoints = [[1, 1]]")),
              "release.runs: a run table cannot be combined with points");
+  EXPECT_HAS(error("trajectory_id,x_m,y_m,block_id\nv1,5,0,1\n",
+                   Replace(kRunScene, "rocks = 3", "rocks = 3\nvelocity_m_s = [1, 0, 0]")),
+             "release.velocity_m_s: a run table gives each run's start velocities");
   testing::WriteText(dir / "blocks.csv",
                      "block_id,mass_kg,size_x_m,size_y_m,size_z_m\n1,69,0,1,1\n");
   EXPECT_HAS(error("trajectory_id,x_m,y_m,block_id\nv1,5,0,1\n"),
