@@ -222,6 +222,8 @@ void LoadBootstrap(const Section& s, CalibrationFile& out) {
   b.level = s.Checked(
       "bootstrap_level", b.level, [](double v) { return v > 0 && v < 1; }, "must be in (0, 1)");
   b.seed = out.optimizer.seed;
+  if (b.resamples > 0 && !out.uncertainty)
+    s.Fail("bootstrap", "needs enabled = true (it is estimated with the covariance)");
   std::string why;
   if (!b.IsValid(&why)) s.FailCheck(why);
 }

@@ -167,6 +167,9 @@ TEST(CalibrateCommand, BadFilesAreRefusedBeforeAnyRun) {
              "each a refit of the parameters)"},
       {"profile_points = 3", "profile_points = 3\n[uncertainty]\nbootstrap_level = 95",
        cal + ":15: uncertainty.bootstrap_level: 95 must be in (0, 1)"},
+      {"profile_points = 3", "profile_points = 3\n[uncertainty]\nenabled = false\nbootstrap = 20",
+       cal + ":16: uncertainty.bootstrap: needs enabled = true (it is estimated with the "
+             "covariance)"},
   };
   for (const auto& c : cases) {
     std::string text = kGood;

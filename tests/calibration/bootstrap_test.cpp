@@ -95,7 +95,12 @@ TEST(Bootstrap, IsBitIdenticalForAnyThreadCountAndWhateverIsKnown) {
 // uncertainty (docs/calibration.md, "Limits"). BOBYQA fits mu_min from 0.2; the bootstrap over
 // runs (B = 100, refits on a lattice of 0.01 of the range) must state a standard error within a
 // factor 2 of the data's (testing::MeasuredDataError, an independent estimate from the run-outs'
-// spread and sensitivity), and its 95 % percentile interval must cover the truth.
+// spread and sensitivity), and its 95 % percentile interval must cover the truth. Measured:
+// fitted 0.581 in 12 evaluations; data's standard error 0.049 (within-run sd 1.49 m, d mean /
+// d mu_min -6.8 m); bootstrap 0.035 from 21 evaluations (635 answered from the cache), interval
+// [0.489, 0.581]; sandwich 0.020. With 3 rocks per run instead of 5 the fit stopped at 0.506 in a
+// dip of the rough objective and the bootstrap stated 0.010 against the data's 0.028: its refits
+// stay in the dip they start from (docs/calibration.md, "Limits").
 TEST(Bootstrap, StatesTheDataErrorWhereTheSandwichUnderstatesIt) {
   constexpr double kTruth = 0.5;
   const testing::SyntheticRunouts p(24, 5, kTruth, 0.5, ViscousReading::kContactFriction);
