@@ -290,6 +290,16 @@ int RunCalibrate(const CalibrateArgs& args, const Processes& processes) {
       run.uncertainty =
           calibration::EstimateUncertainty(*objective, best.u, options, run.summary.history);
       std::printf("%s", run.uncertainty->Report().c_str());
+      if (file.bootstrap_options.resamples > 0) {
+        calibration::BootstrapOptions bootstrap = file.bootstrap_options;
+        bootstrap.resolution = file.bootstrap_resolution.value_or(options.fd_step);
+        bootstrap.profiles = run.profiles;
+        std::printf("Bootstrap over runs: %d resamples, each refitted...\n", bootstrap.resamples);
+        std::fflush(stdout);
+        run.bootstrap =
+            calibration::BootstrapOverRuns(*objective, best.u, bootstrap, run.summary.history);
+        std::printf("%s", run.bootstrap->Report().c_str());
+      }
     }
     const GroundTable fitted = objective->GroundOf(best.u);
     // The fitted runs scored before and after, for the observed-vs-simulated plots.

@@ -201,9 +201,38 @@ void LoadRoughness(const Context& context, const toml::table* table, Calibration
   if (!out.roughness_options.IsValid(&why)) s.Fail("steps", why);
 }
 
+// [uncertainty] bootstrap*: the bootstrap over runs (calibration/bootstrap.hpp).
+void LoadBootstrap(const Section& s, CalibrationFile& out) {
+  calibration::BootstrapOptions& b = out.bootstrap_options;
+  constexpr long kMax = calibration::BootstrapOptions::kMaxResamples;
+  const long resamples = s.Integer("bootstrap", b.resamples);
+  if (resamples != 0 && (resamples < 10 || resamples > kMax))
+    s.Fail("bootstrap", std::to_string(resamples) + " must be 0 (off) or in 10 .. " +
+                            std::to_string(kMax) + " (resamples, each a refit of the parameters)");
+  b.resamples = static_cast<int>(resamples);
+  const long evaluations = s.Integer("bootstrap_evaluations", b.refit_evaluations);
+  if (evaluations < 0 || evaluations > 100000)
+    s.Fail("bootstrap_evaluations",
+           std::to_string(evaluations) + " must be in 0 .. 100000 (per refit; 0: 10 (n + 2))");
+  b.refit_evaluations = static_cast<int>(evaluations);
+  if (s.Has("bootstrap_resolution"))
+    out.bootstrap_resolution = s.Checked(
+        "bootstrap_resolution", 0.0, [](double v) { return v >= 0 && v <= 0.25; },
+        "must be in [0, 0.25] (a fraction of each range; 0: the points BOBYQA asks for)");
+  b.level = s.Checked(
+      "bootstrap_level", b.level, [](double v) { return v > 0 && v < 1; }, "must be in (0, 1)");
+  b.seed = out.optimizer.seed;
+  if (b.resamples > 0 && !out.uncertainty)
+    s.Fail("bootstrap", "needs enabled = true (it is estimated with the covariance)");
+  std::string why;
+  if (!b.IsValid(&why)) s.FailCheck(why);
+}
+
 void LoadUncertainty(const Context& context, const toml::table* table, CalibrationFile& out) {
-  const Section s(context, table, "uncertainty",
-                  {"enabled", "fd_step", "min_reciprocal_condition_number", "weak_fraction"});
+  const Section s(
+      context, table, "uncertainty",
+      {"enabled", "fd_step", "min_reciprocal_condition_number", "weak_fraction", "bootstrap",
+       "bootstrap_evaluations", "bootstrap_resolution", "bootstrap_level"});
   calibration::UncertaintyOptions& o = out.uncertainty_options;
   out.uncertainty = s.Bool("enabled", true);
   o.fd_step = s.Checked(
@@ -215,6 +244,7 @@ void LoadUncertainty(const Context& context, const toml::table* table, Calibrati
   o.weak_fraction = s.Checked(
       "weak_fraction", o.weak_fraction, [](double v) { return v > 0; }, "must be > 0");
   o.profile = out.profile_options;
+  LoadBootstrap(s, out);
 }
 
 // 64-bit FNV-1a of `text`, as 16 hex digits.

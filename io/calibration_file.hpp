@@ -4,9 +4,11 @@
 // objective's weights and prior, the optimiser and its budget, and the roughness measurement.
 // Loading validates everything before any rock runs; errors are "<file>:<line>: <key>: <reason>".
 
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "calibration/bootstrap.hpp"
 #include "calibration/least_squares.hpp"
 #include "calibration/objective.hpp"
 #include "calibration/optimizer.hpp"
@@ -30,6 +32,10 @@ struct CalibrationFile {
   // step (Ceres), else the roughness measurement's recommendation, else 0.01.
   bool uncertainty = true;
   calibration::UncertaintyOptions uncertainty_options;
+  // The bootstrap over runs beside the covariance (resamples 0: off; seed: the optimiser's).
+  // Its resolution when the file does not give one: the covariance's finite-difference step.
+  calibration::BootstrapOptions bootstrap_options;
+  std::optional<double> bootstrap_resolution;
   std::vector<std::string> inputs;  // the calibration file and the event's inputs
   std::string inputs_hash;
   // What decides an optimiser's path -- the event's inputs, rocks and seed, the parameters, the

@@ -66,6 +66,33 @@ json Matrix(const Eigen::MatrixXd& m) {
   return out;
 }
 
+// The bootstrap over runs: its standard errors, percentile intervals, correlations and refits.
+json BootstrapJson(const calibration::Bootstrap& b) {
+  json identified = json::array();
+  for (bool i : b.identified) identified.push_back(i);
+  return {{"method",
+           "bootstrap over runs: resamples of the runs with replacement, each refitted by "
+           "BOBYQA from the optimum"},
+          {"resamples", b.resamples},
+          {"runs", b.groups},
+          {"seed", b.seed},
+          {"resolution_unit", b.resolution},
+          {"level", b.level},
+          {"names", b.names},
+          {"identified", identified},
+          {"standard_error", Vector(b.standard_error)},
+          {"standard_error_unit", Vector(b.standard_error_unit)},
+          {"lower", Vector(b.lower)},
+          {"upper", Vector(b.upper)},
+          {"correlation", Matrix(b.correlation)},
+          {"refits", Matrix(b.refits)},
+          {"refits_at_budget", b.refits_at_budget},
+          {"evaluations", b.evaluations},
+          {"from_cache", b.cached},
+          {"note", b.note},
+          {"wall_time_s", b.wall_time_s}};
+}
+
 json HeldOutKinds(const std::vector<calibration::HeldOutKind>& kinds) {
   json out = json::array();
   for (const auto& k : kinds)
@@ -231,6 +258,14 @@ std::string CalibrationJson(const CalibrationFile& file, const Objective& object
                         {"wall_time_s", u.wall_time_s}};
     for (std::size_t k = 0; k < u.names.size() && k < j["parameters"].size(); ++k)
       j["parameters"][k]["standard_error"] = Number(u.standard_error[static_cast<Eigen::Index>(k)]);
+    j["uncertainty"]["bootstrap"] = run.bootstrap ? BootstrapJson(*run.bootstrap) : json(nullptr);
+    if (run.bootstrap)
+      for (std::size_t k = 0; k < run.bootstrap->names.size() && k < j["parameters"].size(); ++k) {
+        const auto q = static_cast<Eigen::Index>(k);
+        j["parameters"][k]["bootstrap_standard_error"] = Number(run.bootstrap->standard_error[q]);
+        j["parameters"][k]["bootstrap_interval"] = {Number(run.bootstrap->lower[q]),
+                                                    Number(run.bootstrap->upper[q])};
+      }
   } else {
     j["uncertainty"] = nullptr;
   }

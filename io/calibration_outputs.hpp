@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "calibration/bootstrap.hpp"
 #include "calibration/holdout.hpp"
 #include "calibration/least_squares.hpp"
 #include "calibration/objective.hpp"
@@ -31,6 +32,7 @@ struct CalibrationRun {
   std::optional<calibration::RoughnessReport> roughness;
   std::vector<calibration::ParameterProfile> profiles;
   std::optional<calibration::Uncertainty> uncertainty;
+  std::optional<calibration::Bootstrap> bootstrap;  // with the uncertainty, when asked for
   std::optional<calibration::HeldOutScores> holdout;
   std::vector<FoldRun> folds;
 };

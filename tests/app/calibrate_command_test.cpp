@@ -159,6 +159,17 @@ TEST(CalibrateCommand, BadFilesAreRefusedBeforeAnyRun) {
        "\"mu_max\"\nlower = 0.01\nupper = 0.05",
        cal + ":2: parameters: medium_soft: mu_min >= 0.1 and mu_max <= 0.05 within the bounds: no "
              "parameter vector has mu_min <= mu_max"},
+      {"profile_points = 3", "profile_points = 3\n[uncertainty]\nbootstrap = -1",
+       cal + ":15: uncertainty.bootstrap: -1 must be 0 (off) or in 10 .. 100000 (resamples, each "
+             "a refit of the parameters)"},
+      {"profile_points = 3", "profile_points = 3\n[uncertainty]\nbootstrap = 1000000",
+       cal + ":15: uncertainty.bootstrap: 1000000 must be 0 (off) or in 10 .. 100000 (resamples, "
+             "each a refit of the parameters)"},
+      {"profile_points = 3", "profile_points = 3\n[uncertainty]\nbootstrap_level = 95",
+       cal + ":15: uncertainty.bootstrap_level: 95 must be in (0, 1)"},
+      {"profile_points = 3", "profile_points = 3\n[uncertainty]\nenabled = false\nbootstrap = 20",
+       cal + ":16: uncertainty.bootstrap: needs enabled = true (it is estimated with the "
+             "covariance)"},
   };
   for (const auto& c : cases) {
     std::string text = kGood;
@@ -213,6 +224,7 @@ TEST(CalibrateCommand, CeresWithAHeldOutRunAndCrossValidation) {
   EXPECT_EQ(json["cross_validation"]["kinds"][0]["scored"], 6);
   EXPECT_TRUE(json["uncertainty"].is_object());
   EXPECT_TRUE(json["uncertainty"]["note"].is_string());
+  EXPECT_TRUE(json["uncertainty"]["bootstrap"].is_null());  // off by default
   EXPECT_GT(json["finite_difference_step"].get<double>(), 0);
   // When a budget ended a fit (the main one or a fold's), the checkpoint stays for --resume.
   const auto budget = [](const nlohmann::json& t) {
@@ -229,7 +241,8 @@ TEST(CalibrateCommand, CeresWithAHeldOutRunAndCrossValidation) {
 
 // A calibration stopped by its budget (5 evaluations) and resumed from its checkpoint with a
 // budget of 10 ends exactly where an uninterrupted run with 10 does: the same evaluations, bit
-// for bit (history.csv without its wall times), the same fitted table.
+// for bit (history.csv without its wall times), the same fitted table, the same bootstrap (its
+// evaluations are not checkpointed but re-run, deterministically).
 TEST(CalibrateCommand, ResumedCalibrationEqualsAnUninterruptedOne) {
   const auto without_times = [](const std::string& csv) {
     std::string out;
@@ -241,7 +254,10 @@ TEST(CalibrateCommand, ResumedCalibrationEqualsAnUninterruptedOne) {
     }
     return out;
   };
-  std::string cal = kGood;
+  // Without the profiles, which find mu_min unidentified with these few rocks (the bootstrap then
+  // refits nothing).
+  std::string cal = std::string(kGood) + "[uncertainty]\nbootstrap = 10\n";
+  cal.replace(cal.find("[roughness]"), 11, "[roughness]\nenabled = false");
   cal.replace(cal.find("max_evaluations = 6"), 19, "max_evaluations = 10\nxtol_abs = 0");
   const fs::path whole = MakeEvent("whole");
   Write(whole / "cal.toml", cal);
@@ -266,6 +282,14 @@ TEST(CalibrateCommand, ResumedCalibrationEqualsAnUninterruptedOne) {
   EXPECT_EQ(a["parameters"], b["parameters"]);
   EXPECT_EQ(a["objective"], b["objective"]);
   EXPECT_EQ(a["evaluations"], b["evaluations"]);
+  auto bootstrap = a["uncertainty"]["bootstrap"], resumed = b["uncertainty"]["bootstrap"];
+  ASSERT_TRUE(bootstrap.is_object()) << a.dump(1);
+  EXPECT_EQ(bootstrap["resamples"], 10);
+  EXPECT_EQ(bootstrap["refits"].size(), 10u);
+  EXPECT_TRUE(bootstrap["standard_error"][0].is_number()) << bootstrap.dump(1);
+  bootstrap.erase("wall_time_s");
+  resumed.erase("wall_time_s");
+  EXPECT_EQ(bootstrap, resumed);
   EXPECT_EQ(Slurp(whole / "out" / "ground_table.csv"), Slurp(parts / "out" / "ground_table.csv"));
   EXPECT_EQ(without_times(Slurp(whole / "out" / "history.csv")),
             without_times(Slurp(parts / "out" / "history.csv")));

@@ -36,50 +36,12 @@ const testing::SyntheticRunouts& Problem() {
   return problem;
 }
 
-// The mean and mean within-run sd of the simulated runouts with mu_min = mu.
-struct Moments {
-  double mean = 0, sd = 0;
-};
-Moments RunoutMoments(double mu) {
-  const auto& p = Problem();
-  Scene scene = p.scene;
-  scene.ground.mutable_params(scene.ground.IndexOfName("medium_hard")).mu_min = mu;
-  fieldobs::EnsembleSamples samples(p.release);
-  ensemble::EnsembleOptions options;
-  options.threads = 2;
-  ensemble::RunEnsemble(scene, p.release, options, &samples);
-  Moments m;
-  for (const auto& run : p.release.runs) {
-    const std::vector<double> v = samples.Values(fieldobs::Quantity::kRunout, run.id);
-    double mean = 0, ss = 0;
-    for (double x : v) mean += x;
-    mean /= double(v.size());
-    for (double x : v) ss += (x - mean) * (x - mean);
-    m.mean += mean / kRuns;
-    m.sd += std::sqrt(ss / double(v.size() - 1)) / kRuns;
-  }
-  return m;
-}
-
-// The standard error of mu_min the data allow: one observation per run is one draw of a runout
-// whose within-run sd is sigma; the mean runout moves by dm/dmu per unit mu_min; so N runs locate
-// mu_min to about sigma / (|dm/dmu| sqrt(N)), and the model's own ensemble of R rocks per run adds
-// a factor sqrt(1 + 1/R). sigma and dm/dmu are measured (central difference over +-0.05 around
-// the truth), not assumed.
-struct DataError {
-  double sd = 0, slope = 0, se = 0;
-};
-DataError MeasuredDataError() {
-  static const DataError error = [] {
-    const Moments lo = RunoutMoments(kTruth - 0.05), hi = RunoutMoments(kTruth + 0.05),
-                  at = RunoutMoments(kTruth);
-    DataError e;
-    e.sd = at.sd;
-    e.slope = (hi.mean - lo.mean) / 0.1;
-    e.se = at.sd / (std::abs(e.slope) * std::sqrt(double(kRuns))) *
-           std::sqrt(1 + 1.0 / double(kRocks));
-    return e;
-  }();
+// The standard error of mu_min the data allow (testing::MeasuredDataError: within-run sd and
+// sensitivity of the run-outs, central difference over +-0.05 around the truth).
+testing::DataError MeasuredDataError() {
+  static const testing::DataError error =
+      testing::MeasuredDataError(Problem().scene, Problem().release, Problem().observations,
+                                 testing::SetMediumHardMuMin, kTruth, 0.05);
   return error;
 }
 
@@ -106,7 +68,7 @@ TEST(Calibrate, BobyqaRecoversMuMinFromADistantStart) {
   std::printf("%s", summary.FullReport().c_str());
   ASSERT_TRUE(summary.IsSolutionUsable());
 
-  const DataError data = MeasuredDataError();
+  const testing::DataError data = MeasuredDataError();
   const double se = data.se;
   const double tolerance = 3 * se + options.xtol_abs * 0.8;
   const double fitted = summary.best.values[0];
@@ -227,7 +189,7 @@ TEST(Calibrate, CeresRecoversMuMinAndItsUncertaintyCoversTheTruth) {
   const Uncertainty u =
       EstimateUncertainty(objective, summary.best.u, uncertainty_options, summary.history);
   std::printf("%s", u.Report().c_str());
-  const DataError data = MeasuredDataError();
+  const testing::DataError data = MeasuredDataError();
   const double fitted = summary.best.values[0];
   std::printf("fitted mu_min %.4f (truth %.2f), stated standard error %.4f, data's %.4f\n", fitted,
               kTruth, u.standard_error[0], data.se);
