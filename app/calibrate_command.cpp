@@ -257,6 +257,7 @@ int RunCalibrate(const CalibrateArgs& args, const Processes& processes) {
   try {
     io::CalibrationRun run;
     run.version = kVersion;
+    run.not_scored = event.not_scored;
     run.summary = optimise(*objective, "fit");
     std::printf("%s", run.summary.FullReport().c_str());
     if (!run.summary.IsSolutionUsable()) throw std::runtime_error(run.summary.message);

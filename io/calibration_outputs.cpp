@@ -269,6 +269,7 @@ std::string CalibrationJson(const CalibrationFile& file, const Objective& object
   } else {
     j["uncertainty"] = nullptr;
   }
+  j["not_scored"] = run.not_scored;  // observed values without a simulated counterpart
   j["holdout"] = run.holdout ? HeldOut(*run.holdout) : json(nullptr);
   if (!run.folds.empty()) {
     json folds = json::array();

@@ -35,6 +35,7 @@ struct CalibrationRun {
   std::optional<calibration::Bootstrap> bootstrap;  // with the uncertainty, when asked for
   std::optional<calibration::HeldOutScores> holdout;
   std::vector<FoldRun> folds;
+  std::vector<std::string> not_scored;  // observed values the event holds but cannot score
 };
 
 // Held-out scores per kind, fitted against reference, as a few lines for people.

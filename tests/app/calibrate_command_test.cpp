@@ -130,6 +130,39 @@ TEST(CalibrateCommand, WritesTheGroundTableJsonAndHistory) {
 
 // Each mistake is refused with exit code 2, naming the file, line and key, before any rock runs
 // (no output directory is created).
+// The six single impacts of Chant Sura: their scar depths have no simulated counterpart, and
+// calibration.json says so (as validate's scores.json does), beside the energy ratios it fitted.
+TEST(CalibrateCommand, ObservedValuesItCannotScoreAreListedInCalibrationJson) {
+  const fs::path dir = talus::app::testing::FreshDir("talus_calibrate_tests", "not_scored");
+  Write(dir / "cal.toml", "event = \"" + std::string(TALUS_SOURCE_DIR) +
+                              "/cases/chant_sura/event_impacts.toml\"\nrocks = 4\n"
+                              R"([[parameters]]
+category = "medium_hard"
+field = "mu_min"
+lower = 0.1
+upper = 1.5
+[optimizer]
+max_evaluations = 3
+[roughness]
+enabled = false
+[uncertainty]
+enabled = false
+)");
+  std::string output;
+  ASSERT_EQ(RunCommand(std::string(TALUS_BINARY) + " calibrate " + (dir / "cal.toml").string() +
+                           " --out " + (dir / "out").string() + " --threads 2",
+                       &output),
+            0)
+      << output;
+  const auto json = nlohmann::json::parse(Slurp(dir / "out" / "calibration.json"));
+  ASSERT_EQ(json["not_scored"].size(), 1u) << json["not_scored"];
+  const std::string line = json["not_scored"][0];
+  EXPECT_NE(line.find("impacts_esurf2019.csv: column 'observed_scarring_depth_m'"),
+            std::string::npos)
+      << line;
+  EXPECT_NE(output.find("Not scored: " + line), std::string::npos) << output;
+}
+
 TEST(CalibrateCommand, BadFilesAreRefusedBeforeAnyRun) {
   const fs::path dir = MakeEvent("bad");
   const std::string cal = (dir / "cal.toml").string();
