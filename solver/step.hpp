@@ -15,7 +15,7 @@ struct StepReport {
   bool converged = true;        // contact solve met its tolerance
   bool loaded = false;          // a contact carried load: the scar grew
   bool outside_domain = false;  // a vertex near the ground is outside the DEM or over nodata
-  bool clear = false;           // the bounding sphere cleared the terrain: no vertex needed a test
+  bool clear = false;           // no vertex needed a test (bounding sphere clear, or FlightStep)
 };
 
 // Wall-clock time spent in each stage, accumulated when a StageTimes is passed to Step.
