@@ -10,11 +10,12 @@ namespace talus {
 namespace {
 
 // Rounding allowance on every clearance and on the box, m: the scheme's positions depart from the
-// closed form below by a few units in the last place per step (6e-11 m at 4e5 m map coordinates,
-// 2e-9 m at 1e7 m), far below 0.1 mm over the longest window.
+// closed form below by at most a unit in the last place per half step (6e-11 m at 4e5 m map
+// coordinates, 2e-9 m at 1e7 m), under 1e-5 m over the longest window.
 constexpr double kMargin_m = 1e-4;
-// The longest window, s; the most DEM nodes a box may hold; the most boxes a look scans.
+// The longest window, s and steps; the most DEM nodes a box may hold; the most boxes a look scans.
 constexpr double kLongestWindow_s = 1.0;
+constexpr int kMostSteps = 2000;
 constexpr double kMostNodes = 4096;
 constexpr int kLooks = 3;
 
@@ -153,7 +154,8 @@ StepReport FlightStepper::Advance(const Scene& scene, const RockShape& rock, Roc
                                   StepWorkspace& workspace, StageTimes* times) {
   if (windows_ && left_ == 0 && wait_ == 0) {
     StageClock clock(times);
-    const int longest = std::max(1, static_cast<int>(kLongestWindow_s / scene.options.dt_s));
+    const int longest =
+        std::clamp(static_cast<int>(kLongestWindow_s / scene.options.dt_s), 1, kMostSteps);
     left_ = ClearFlightSteps(scene, rock, state, longest);
     clock.Lap(&StageTimes::contacts_s);
     if (left_ > 0) {

@@ -99,8 +99,8 @@ long ExpectSameBothWays(const Scene& scene, const RockState& start, const char* 
 }
 
 TEST(FlightWindows, RampRocksAreBitIdenticalToDetectionInEveryStep) {
-  // The benchmark ramp under both readings of the viscous term, 8 rocks each (measured: about a
-  // fifth of their steps are flight steps).
+  // The benchmark ramp under both readings of the viscous term, 8 rocks each (measured: 22 % of
+  // their steps are flight steps under contact friction, 12 % under the centre-of-mass drag).
   for (ViscousReading reading : {ViscousReading::kContactFriction, ViscousReading::kCentreOfMass}) {
     Scene scene = scenes::Ramp40();
     scene.options.viscous = reading;
@@ -114,8 +114,9 @@ TEST(FlightWindows, RampRocksAreBitIdenticalToDetectionInEveryStep) {
   }
 }
 
-// A rough slope over a cliff band: 300 x 300 m, 2 m cells, 35 degrees with bumps of up to 1.5 m
-// and a 25 m step at x = 120 m, a nodata hole and a flat runout that ends at the DEM's edge.
+// A rough slope over a cliff band: 300 x 300 m, 2 m cells, 35 degrees with bumps (waves of
+// +-0.8 m and up to 1.05 m of node noise), a 25 m step at x = 120 m, a nodata hole of 8 m radius
+// and a flat runout from x = 220 m to the DEM's edge.
 Scene RoughCliff(const RockShape& rock) {
   Scene scene = scenes::Incline(0, rock, kHard, 300, 2);
   Heightfield hf = scene.terrain.heights();
@@ -153,8 +154,8 @@ RockState RoughRelease(const Scene& scene, int rock) {
 
 TEST(FlightWindows, RoughTerrainRocksAreBitIdenticalToDetectionInEveryStep) {
   // 12 EOTA221 blocks down the rough cliff, once plain and once with a 3 m drag layer: jumps off
-  // the cliff, landings on bumps, the nodata hole and the DEM's edge (measured: 2 to 4 of them
-  // leave the domain).
+  // the cliff, landings on bumps, the nodata hole and the DEM's edge (measured: of the 12, 5
+  // leave the domain plain, 1 with the drag layer).
   for (bool drag : {false, true}) {
     Scene scene = RoughCliff(scenes::Eota221());
     if (drag) {
@@ -245,7 +246,8 @@ TEST(FlightWindows, RockThrownHighFliesTheParabolaAndLandsWhereTheClosedFormSays
   // (g dt^2 / 8 = 5e-6 m).
   EXPECT_NEAR(r.max_jump_height_m, 30 + v0.z() * v0.z() / (2 * kG), 1e-5);
   // Most of the flight took the lean path: all but the steps where the bounding sphere (radius
-  // 0.75 m) is within reach of the ground (measured: 96 %).
+  // 0.75 m) is within reach of the ground (measured: 1501 of the 1511 steps before the landing,
+  // which came at 3.0240 s for t* = 3.0246 s).
   EXPECT_GT(r.flight_steps, 0.9 * static_cast<double>(log.states.size()));
 }
 
@@ -277,7 +279,7 @@ TEST(FlightWindows, NoStepOfAWindowFindsAContact) {
       ASSERT_FALSE(r.outside_domain) << "state " << k << ", step " << step << " of " << clear;
     }
   }
-  EXPECT_GT(total, 1000);
+  EXPECT_GT(total, 1000);  // measured: 24 824 steps in windows
 }
 
 }  // namespace
