@@ -40,7 +40,7 @@ DetectResult DetectContacts(const Scene& scene, const RockShape& rock, const Roc
   const double lowest_rate = centre_rate - radius * m.norm() * omega_rad_s.norm();
   if (local && centre_height - radius * m.norm() + horizon_s * std::min(0.0, lowest_rate) >
                    plane.deviation_m)
-    return DetectResult::kOk;
+    return DetectResult::kClear;
   const Eigen::Vector3d m_body = rotation.transpose() * m;
   const Eigen::Vector3d rate_lever = m_body.cross(omega_rad_s);
 

@@ -10,7 +10,14 @@
 
 namespace talus {
 
-enum class DetectResult { kOk, kOutsideDomain };
+// kClear: the bounding sphere cleared the terrain over the horizon, no vertex was tested (no
+// contacts); kOk: the vertices that may touch were tested.
+enum class DetectResult { kClear, kOk, kOutsideDomain };
+
+// How far ahead contacts are predicted, s: one step with the plastic normal law, none otherwise.
+inline double PredictionHorizon(const SolverOptions& options) {
+  return options.normal_restitution == 0 ? options.dt_s : 0.0;
+}
 
 // Fills workspace.contacts with the vertices in contact, with their contact frame, ground index and
 // friction mu(scar_m):
@@ -23,9 +30,9 @@ enum class DetectResult { kOk, kOutsideDomain };
 //   allowed_depth_m (>= 0), so that the solver's law gap_m + horizon gamma_N,E >= 0 lets the
 //   vertex sink no deeper than allowed_depth_m by the next midpoint.
 // A rock whose bounding sphere clears the terrain's local plane, over the horizon, by more than
-// the terrain departs from that plane costs one test; otherwise only the vertices within that
-// departure of the plane are tested against the terrain itself.
-// Returns kOutsideDomain when a vertex that may touch lies outside the DEM or over nodata.
+// the terrain departs from that plane costs one test (kClear); otherwise only the vertices within
+// that departure of the plane are tested against the terrain itself. Returns kOutsideDomain when a
+// vertex that may touch lies outside the DEM or over nodata.
 DetectResult DetectContacts(const Scene& scene, const RockShape& rock, const RockState& mid,
                             const Eigen::Matrix3d& rotation, const Eigen::Vector3d& velocity_m_s,
                             const Eigen::Vector3d& omega_rad_s, double horizon_s,

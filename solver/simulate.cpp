@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include "solver/flight.hpp"
+
 namespace talus {
 
 const char* ToString(EndReason reason) {
@@ -82,9 +84,12 @@ RockResult SimulateRock(const Scene& scene, const RockShape& rock, const RockSta
   record(ground);
 
   const double end_time = start.time_s + opt.max_time_s;
+  FlightStepper stepper(workspace.flight_windows);
   while (true) {
     const Eigen::Vector3d previous = state.position_m;
-    const StepReport step = Step(scene, rock, state, workspace.step, workspace.stage_times);
+    const StepReport step =
+        stepper.Advance(scene, rock, state, workspace.step, workspace.stage_times);
+    result.flight_steps = stepper.flight_steps();
     if (step.outside_domain) return finish(EndReason::kLeftDomain);
     ++result.steps;
     if (!IsFinite(state)) {

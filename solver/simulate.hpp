@@ -33,6 +33,7 @@ struct RockResult {
   long contact_steps = 0;      // steps with at least one closed contact
   long solver_iterations = 0;  // Gauss-Seidel sweeps, summed over steps
   long unconverged_steps = 0;  // steps whose contact solve hit max_iterations
+  long flight_steps = 0;       // steps taken in flight windows, without contact detection
 
   // True when the centre of mass never got further from its start than the rock's length.
   bool StayedAtRelease(const RockShape& rock) const { return max_displacement_m <= rock.length_m; }
@@ -54,6 +55,9 @@ class StepObserver {
 struct SimulationWorkspace {
   StepWorkspace step;
   StageTimes* stage_times = nullptr;  // set to profile the step's stages
+  // Lean flight steps while the rock cannot touch the terrain (solver/flight.hpp); false: contact
+  // detection in every step, the reference that gives the same results bit for bit.
+  bool flight_windows = true;
 };
 
 // Runs the rock of shape `rock` from `start` until rest, leaving the domain, max_time or a

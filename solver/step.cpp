@@ -1,6 +1,5 @@
 #include "solver/step.hpp"
 
-#include <chrono>
 #include <cmath>
 
 #include "solver/contact_detection.hpp"
@@ -9,24 +8,6 @@
 
 namespace talus {
 namespace {
-
-// Accumulates the time since the last lap into a stage's counter; free when not profiling.
-class StageClock {
- public:
-  explicit StageClock(StageTimes* times) : times_(times) {
-    if (times_) last_ = std::chrono::steady_clock::now();
-  }
-  void Lap(double StageTimes::*stage) {
-    if (!times_) return;
-    const auto now = std::chrono::steady_clock::now();
-    times_->*stage += std::chrono::duration<double>(now - last_).count();
-    last_ = now;
-  }
-
- private:
-  StageTimes* times_;
-  std::chrono::steady_clock::time_point last_;
-};
 
 // Scar: grows with the speed while a contact carries load, decays as exp(-beta dt) otherwise.
 void UpdateScar(const Scene& scene, const StepReport& report, const StepWorkspace& workspace,
@@ -40,6 +21,21 @@ void UpdateScar(const Scene& scene, const StepReport& report, const StepWorkspac
     const int ground = state.scar_ground >= 0 ? state.scar_ground : scene.terrain.default_ground();
     state.scar_m *= std::exp(-scene.ground.params(ground).beta_1_s * dt);
   }
+}
+
+// End velocity under gravity alone.
+Eigen::Vector3d FreeVelocity(const SolverOptions& opt, const Eigen::Vector3d& v_begin) {
+  Eigen::Vector3d velocity = v_begin;
+  velocity.z() -= opt.dt_s * opt.gravity_m_s2;
+  return velocity;
+}
+
+// End point (drift the second half with the end velocities), time and scar.
+void EndStep(const Scene& scene, const StepReport& report, const StepWorkspace& workspace,
+             RockState& state) {
+  Drift(state, 0.5 * scene.options.dt_s);
+  state.time_s += scene.options.dt_s;
+  UpdateScar(scene, report, workspace, state);
 }
 
 // Centre-of-mass reading of the viscous term: implicit drag -m nu v_E with the mean nu of the
@@ -98,8 +94,7 @@ StepReport Step(const Scene& scene, const RockShape& rock, RockState& state,
   clock.Lap(&StageTimes::free_rotation_s);
 
   // 3. Free end velocities: gravity, and the drag layer where the centre of mass is inside one.
-  Eigen::Vector3d velocity = begin.velocity_m_s;
-  velocity.z() -= dt * opt.gravity_m_s2;
+  Eigen::Vector3d velocity = FreeVelocity(opt, begin.velocity_m_s);
   EffectiveInertia inertia{rock.mass_kg, 1.0};
   if (scene.ground.AnyDragLayer())
     DragLayer(scene, state.position_m, begin.velocity_m_s, velocity, omega, inertia);
@@ -107,15 +102,16 @@ StepReport Step(const Scene& scene, const RockShape& rock, RockState& state,
   // 4. Contact set at the midpoint: closed contacts and, with a plastic normal law, the vertices
   // that the free motion (no contacts) would carry deeper than the penetration tolerance below the
   // terrain by the next midpoint.
-  const double horizon = opt.normal_restitution == 0 ? dt : 0.0;
   const double allowed_depth = opt.penetration_tolerance * rock.thickness_m;
   const Eigen::Matrix3d rotation = state.orientation.toRotationMatrix();
-  if (DetectContacts(scene, rock, state, rotation, velocity, omega, horizon, allowed_depth,
-                     workspace) == DetectResult::kOutsideDomain) {
+  const DetectResult detected = DetectContacts(scene, rock, state, rotation, velocity, omega,
+                                               PredictionHorizon(opt), allowed_depth, workspace);
+  if (detected == DetectResult::kOutsideDomain) {
     state = begin;
     report.outside_domain = true;
     return report;
   }
+  report.clear = detected == DetectResult::kClear;
   clock.Lap(&StageTimes::contacts_s);
 
   // 5. Velocity update: the viscous term (centre-of-mass reading: implicit drag m (1 + nu dt) v_E
@@ -138,12 +134,27 @@ StepReport Step(const Scene& scene, const RockShape& rock, RockState& state,
   state.angular_velocity_rad_s = omega;
   clock.Lap(&StageTimes::solve_s);
 
-  // 6. End point: drift the second half with the end velocities.
-  Drift(state, 0.5 * dt);
-  state.time_s += dt;
+  // 6. End point: drift the second half with the end velocities; 7. scar evolution.
+  EndStep(scene, report, workspace, state);
+  clock.Lap(&StageTimes::end_s);
+  if (times) ++times->steps;
+  return report;
+}
 
-  // 7. Scar evolution.
-  UpdateScar(scene, report, workspace, state);
+StepReport FlightStep(const Scene& scene, const RockShape& rock, RockState& state,
+                      StepWorkspace& workspace, StageTimes* times) {
+  StepReport report;
+  report.clear = true;
+  StageClock clock(times);
+  Drift(state, 0.5 * scene.options.dt_s);
+  clock.Lap(&StageTimes::midpoint_s);
+  state.angular_velocity_rad_s =
+      FreeRotation(rock.inertia_kg_m2, state.angular_velocity_rad_s, scene.options.dt_s);
+  clock.Lap(&StageTimes::free_rotation_s);
+  state.velocity_m_s = FreeVelocity(scene.options, state.velocity_m_s);
+  workspace.contacts.clear();
+  workspace.ForgetPercussions();
+  EndStep(scene, report, workspace, state);
   clock.Lap(&StageTimes::end_s);
   if (times) ++times->steps;
   return report;

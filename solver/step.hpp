@@ -1,6 +1,8 @@
 #pragma once
 // One time step of the Moreau-type midpoint scheme (docs/model.md; Leine et al. 2014, 2021).
 
+#include <chrono>
+
 #include "solver/contact.hpp"
 #include "solver/scene.hpp"
 #include "solver/state.hpp"
@@ -13,12 +15,31 @@ struct StepReport {
   bool converged = true;        // contact solve met its tolerance
   bool loaded = false;          // a contact carried load: the scar grew
   bool outside_domain = false;  // a vertex near the ground is outside the DEM or over nodata
+  bool clear = false;           // no vertex needed a test (bounding sphere clear, or FlightStep)
 };
 
 // Wall-clock time spent in each stage, accumulated when a StageTimes is passed to Step.
 struct StageTimes {
   double midpoint_s = 0, free_rotation_s = 0, contacts_s = 0, solve_s = 0, end_s = 0;
   long steps = 0;
+};
+
+// Accumulates the time since the last lap into a stage's counter; free when not profiling.
+class StageClock {
+ public:
+  explicit StageClock(StageTimes* times) : times_(times) {
+    if (times_) last_ = std::chrono::steady_clock::now();
+  }
+  void Lap(double StageTimes::*stage) {
+    if (!times_) return;
+    const auto now = std::chrono::steady_clock::now();
+    times_->*stage += std::chrono::duration<double>(now - last_).count();
+    last_ = now;
+  }
+
+ private:
+  StageTimes* times_;
+  std::chrono::steady_clock::time_point last_;
 };
 
 // Advances state by one step of scene.options.dt_s. When outside_domain is reported the state is
@@ -31,5 +52,12 @@ inline StepReport Step(const Scene& scene, RockState& state, StepWorkspace& work
                        StageTimes* times = nullptr) {
   return Step(scene, scene.rock, state, workspace, times);
 }
+
+// The lean flight step: what Step does when no vertex touches or is predicted to touch the terrain
+// and the centre of mass is above every drag layer (drift, free rotation, gravity, scar decay),
+// without contact detection, bit for bit. The caller guarantees those conditions
+// (ClearFlightSteps, solver/flight.hpp); reports no contacts and clear.
+StepReport FlightStep(const Scene& scene, const RockShape& rock, RockState& state,
+                      StepWorkspace& workspace, StageTimes* times = nullptr);
 
 }  // namespace talus

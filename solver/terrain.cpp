@@ -114,6 +114,30 @@ bool Terrain::PlaneAround(double x_m, double y_m, double r_m, LocalPlane* out) c
   return !std::isnan(deviation);
 }
 
+bool Terrain::MaxAbovePlane(const Box& box, const Plane& plane, double* above_m) const {
+  const GridGeometry& g = grid_;
+  const double fx_lo = (box.x_lo_m - g.x0_m) * inv_dx_, fx_hi = (box.x_hi_m - g.x0_m) * inv_dx_;
+  const double fy_lo = (box.y_lo_m - g.y0_m) * inv_dy_, fy_hi = (box.y_hi_m - g.y0_m) * inv_dy_;
+  if (!(fx_lo >= 0 && fy_lo >= 0 && fx_hi <= g.nx - 1 && fy_hi <= g.ny - 1)) return false;
+  // The cell of a point is (floor(f), floor(f) + 1), the last one where f is the last node.
+  const int i_lo = std::min(static_cast<int>(fx_lo), g.nx - 2);
+  const int j_lo = std::min(static_cast<int>(fy_lo), g.ny - 2);
+  const int i_hi = std::min(static_cast<int>(fx_hi) + 1, g.nx - 1);
+  const int j_hi = std::min(static_cast<int>(fy_hi) + 1, g.ny - 1);
+  double above = -std::numeric_limits<double>::infinity();
+  for (int j = j_lo; j <= j_hi; ++j) {
+    const double* row = z_ + static_cast<std::size_t>(j) * g.nx;
+    const double plane_row = plane.z_m + plane.slope_y * (g.y0_m + j * g.dy_m - plane.y_m);
+    for (int i = i_lo; i <= i_hi; ++i) {
+      if (std::isnan(row[i])) return false;
+      above =
+          std::max(above, row[i] - (plane_row + plane.slope_x * (g.x0_m + i * g.dx_m - plane.x_m)));
+    }
+  }
+  *above_m = above;
+  return true;
+}
+
 bool Terrain::IsValid(std::string* why) const {
   const Heightfield& heights = *heights_;
   const GridGeometry& g = heights.grid;

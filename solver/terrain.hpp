@@ -79,6 +79,20 @@ class Terrain {
   };
   bool PlaneAround(double x_m, double y_m, double r_m, LocalPlane* out) const;
 
+  // A box of horizontal positions, m.
+  struct Box {
+    double x_lo_m, x_hi_m, y_lo_m, y_hi_m;
+  };
+  // The plane z = z_m + slope_x (x - x_m) + slope_y (y - y_m).
+  struct Plane {
+    double x_m, y_m, z_m, slope_x, slope_y;
+  };
+  // An upper bound of the terrain's height above `plane` over a box: the largest over the nodes of
+  // every cell that holds a point of the box (a bilinear patch's height above a plane lies between
+  // its values at the cell's corners). False when the box reaches beyond the grid or a cell that
+  // holds a point of it has a nodata corner.
+  bool MaxAbovePlane(const Box& box, const Plane& plane, double* above_m) const;
+
   const Heightfield& heights() const { return *heights_; }
   int default_ground() const { return default_ground_; }
   bool has_ground_grid() const { return !ground_->index.empty(); }

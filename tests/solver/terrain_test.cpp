@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -56,6 +57,59 @@ TEST(Terrain, LocalPlaneBoundsTheTerrainInTheBox) {
   EXPECT_NEAR(plane.slope_y, 0.11, 1e-14);
   EXPECT_NEAR(plane.deviation_m, 0.01, 1e-14);
   EXPECT_FALSE(t.PlaneAround(10.2, 21, 0.5, &plane));  // the box reaches beyond x0
+}
+
+TEST(Terrain, MaxAbovePlaneBoundsTheTerrainOverTheBox) {
+  // A rough 41 x 31 node grid (1.5 m spacing): the bound must be at least the terrain's height
+  // above the plane at every point of the box (sampled on a fine lattice, edges included), and at
+  // most the largest node value of the cells around the box (its definition). Exact arithmetic
+  // up to round-off: tolerance 1e-12 m.
+  Heightfield hf;
+  hf.grid = {41, 31, 100.0, -20.0, 1.5, 1.5};
+  for (int j = 0; j < 31; ++j)
+    for (int i = 0; i < 41; ++i)
+      hf.z_m.push_back(0.7 * i + 3 * std::sin(1.3 * i) * std::cos(0.7 * j) +
+                       0.2 * ((i * 7 + j * 13) % 5));
+  const Terrain t(hf, 0);
+  const Terrain::Plane plane{120.0, -5.0, 12.0, 0.4, -0.1};
+  auto plane_at = [&](double x, double y) {
+    return plane.z_m + plane.slope_x * (x - plane.x_m) + plane.slope_y * (y - plane.y_m);
+  };
+  const Terrain::Box boxes[] = {{103.0, 111.5, -14.0, -8.0},
+                                {130.0, 130.0, 0.0, 0.0},
+                                {101.5, 160.0, -20.0, 25.0},
+                                {150.7, 151.2, 10.1, 10.2}};
+  for (const Terrain::Box& box : boxes) {
+    double above = 0;
+    ASSERT_TRUE(t.MaxAbovePlane(box, plane, &above));
+    double sampled = -1e9;
+    for (int a = 0; a <= 40; ++a)
+      for (int b = 0; b <= 40; ++b) {
+        const double x = box.x_lo_m + a * (box.x_hi_m - box.x_lo_m) / 40;
+        const double y = box.y_lo_m + b * (box.y_hi_m - box.y_lo_m) / 40;
+        double h = 0;
+        ASSERT_TRUE(t.Height(x, y, &h));
+        sampled = std::max(sampled, h - plane_at(x, y));
+      }
+    EXPECT_GE(above, sampled - 1e-12);
+    double nodes = -1e9;
+    for (int j = 0; j < 31; ++j)
+      for (int i = 0; i < 41; ++i) {
+        const double x = 100.0 + 1.5 * i, y = -20.0 + 1.5 * j;
+        if (x >= box.x_lo_m - 1.5 && x <= box.x_hi_m + 1.5 && y >= box.y_lo_m - 1.5 &&
+            y <= box.y_hi_m + 1.5)
+          nodes = std::max(nodes, hf.z_m[j * 41 + i] - plane_at(x, y));
+      }
+    EXPECT_LE(above, nodes + 1e-12);
+  }
+  double above = 0;
+  EXPECT_FALSE(t.MaxAbovePlane({99.9, 105, 0, 1}, plane, &above));   // beyond x0
+  EXPECT_FALSE(t.MaxAbovePlane({150, 160.1, 0, 1}, plane, &above));  // beyond the last node
+  Heightfield holed = hf;
+  holed.z_m[10 * 41 + 20] = std::numeric_limits<double>::quiet_NaN();  // node (20, 10): (130, -5)
+  const Terrain h(holed, 0);
+  EXPECT_FALSE(h.MaxAbovePlane({128.6, 129.0, -6.0, -5.5}, plane, &above));  // a cell with it
+  EXPECT_TRUE(h.MaxAbovePlane({125.0, 128.4, -6.0, -5.5}, plane, &above));   // none
 }
 
 TEST(Terrain, GroundGridUsesNearestCellAndDefault) {
