@@ -21,6 +21,7 @@
 #include <fstream>
 #include <memory>
 #include <optional>
+#include <random>
 #include <string>
 #include <thread>
 #include <vector>
@@ -133,34 +134,73 @@ Run RunSetting(const Study& study, const talus::Scene& scene, std::uint64_t seed
 
 // ---- Statistics and their differences -----------------------------------------------------------
 
+// Scalar statistics (runout median and 95th percentile, the 95th percentile of the energy at each
+// evaluation line) with their bootstrap standard errors, and the reach probability per cell of
+// the comparison grid.
 struct Statistics {
-  double runout_median_m = 0, runout_p95_m = 0;
-  std::vector<double> reach;               // per comparison cell, fraction of rocks
-  std::vector<double> line_energy_p95_kj;  // per evaluation line, NaN when no rock crossed
+  std::vector<double> scalars, standard_errors;
+  std::vector<double> reach;  // per comparison cell, fraction of rocks
 };
 
-// The statistics of the first `n` rocks of a run (percentiles nearest-rank, as talus simulate's).
-Statistics Summarise(const std::vector<RockRecord>& rocks, std::size_t n, std::size_t cells,
-                     std::size_t lines) {
-  Statistics s;
+// The scalars of the rocks `picks` (nearest-rank percentiles, as talus simulate's; NaN for a line
+// no picked rock crossed).
+std::vector<double> Scalars(const std::vector<RockRecord>& rocks,
+                            const std::vector<std::size_t>& picks, std::size_t lines) {
   std::vector<double> runouts;
-  s.reach.assign(cells, 0.0);
   std::vector<std::vector<double>> energies(lines);
-  for (std::size_t k = 0; k < n; ++k) {
+  for (std::size_t k : picks) {
     runouts.push_back(rocks[k].runout_m);
-    for (int cell : rocks[k].cells) s.reach[static_cast<std::size_t>(cell)] += 1.0 / double(n);
     for (std::size_t l = 0; l < lines; ++l)
       if (std::isfinite(rocks[k].line_energy_kj[l]))
         energies[l].push_back(rocks[k].line_energy_kj[l]);
   }
-  s.runout_median_m = talus::io::NearestRankPercentile(runouts, 50);
-  s.runout_p95_m = talus::io::NearestRankPercentile(runouts, 95);
-  for (const auto& e : energies)
-    s.line_energy_p95_kj.push_back(talus::io::NearestRankPercentile(e, 95));
+  std::vector<double> out = {talus::io::NearestRankPercentile(runouts, 50),
+                             talus::io::NearestRankPercentile(runouts, 95)};
+  for (const auto& e : energies) out.push_back(talus::io::NearestRankPercentile(e, 95));
+  return out;
+}
+
+// Bootstrap standard errors of the scalars: 200 resamples of the rocks with replacement, drawn
+// from a fixed stream, so that the same run gives the same errors.
+std::vector<double> BootstrapErrors(const std::vector<RockRecord>& rocks,
+                                    const std::vector<std::size_t>& picks, std::size_t lines) {
+  constexpr int kResamples = 200;
+  std::mt19937_64 random(20261125);
+  std::vector<std::vector<double>> draws;
+  std::vector<std::size_t> resample(picks.size());
+  for (int b = 0; b < kResamples; ++b) {
+    for (std::size_t& k : resample) k = picks[random() % picks.size()];
+    draws.push_back(Scalars(rocks, resample, lines));
+  }
+  std::vector<double> errors;
+  for (std::size_t q = 0; q < draws.front().size(); ++q) {
+    double sum = 0, sum2 = 0;
+    int n = 0;
+    for (const auto& d : draws) {
+      if (!std::isfinite(d[q])) continue;
+      sum += d[q];
+      sum2 += d[q] * d[q];
+      ++n;
+    }
+    errors.push_back(n > 1 ? std::sqrt(std::max(0.0, (sum2 - sum * sum / n) / (n - 1)))
+                           : std::nan(""));
+  }
+  return errors;
+}
+
+// The statistics of the first `n` rocks of a run.
+Statistics Summarise(const std::vector<RockRecord>& rocks, std::size_t n, std::size_t cells,
+                     std::size_t lines) {
+  std::vector<std::size_t> picks(n);
+  for (std::size_t k = 0; k < n; ++k) picks[k] = k;
+  Statistics s{Scalars(rocks, picks, lines), BootstrapErrors(rocks, picks, lines),
+               std::vector<double>(cells, 0.0)};
+  for (std::size_t k = 0; k < n; ++k)
+    for (int cell : rocks[k].cells) s.reach[static_cast<std::size_t>(cell)] += 1.0 / double(n);
   return s;
 }
 
-// The compared quantities: signed differences of the scalar statistics, and the reach
+// The compared quantities: signed differences of the scalars (in their order), then the reach
 // probability's mean absolute difference over the cells reached in either run and its largest.
 struct Quantity {
   std::string name, unit;
@@ -168,15 +208,16 @@ struct Quantity {
 };
 
 std::vector<Quantity> Quantities(const std::vector<EvaluationLine>& lines) {
-  std::vector<Quantity> q = {{"runout median", "m", true},
-                             {"runout p95", "m", true},
-                             {"reach prob. mean abs. diff.", "", false},
-                             {"reach prob. largest diff.", "", false}};
+  std::vector<Quantity> q = {{"runout median", "m", true}, {"runout p95", "m", true}};
   for (const auto& line : lines) q.push_back({"energy p95 at " + line.name, "kJ", true});
+  q.push_back({"reach prob. mean abs. diff.", "", false});
+  q.push_back({"reach prob. largest diff.", "", false});
   return q;
 }
 
 std::vector<double> Differences(const Statistics& a, const Statistics& b) {
+  std::vector<double> out;
+  for (std::size_t q = 0; q < a.scalars.size(); ++q) out.push_back(a.scalars[q] - b.scalars[q]);
   double sum = 0, largest = 0;
   long reached = 0;
   for (std::size_t c = 0; c < a.reach.size(); ++c) {
@@ -186,10 +227,8 @@ std::vector<double> Differences(const Statistics& a, const Statistics& b) {
     largest = std::max(largest, d);
     ++reached;
   }
-  std::vector<double> out = {a.runout_median_m - b.runout_median_m, a.runout_p95_m - b.runout_p95_m,
-                             reached ? sum / double(reached) : 0.0, largest};
-  for (std::size_t l = 0; l < a.line_energy_p95_kj.size(); ++l)
-    out.push_back(a.line_energy_p95_kj[l] - b.line_energy_p95_kj[l]);
+  out.push_back(reached ? sum / double(reached) : 0.0);
+  out.push_back(largest);
   return out;
 }
 
@@ -483,18 +522,37 @@ Noise NoiseOf(const std::vector<Statistics>& reference) {
   return noise;
 }
 
-// Equal within standard errors: a signed statistic's mean difference over k seeds within two
-// standard errors of a mean of k differences between independent ensembles (rms / sqrt(k)); the
-// raster's mean absolute difference no larger than the noise's plus two standard errors.
-bool Within(const Quantity& q, std::size_t k, const Departure& d, const Noise& noise, int seeds) {
-  const double root = std::sqrt(double(seeds));
-  if (!std::isfinite(d.mean[k])) return true;
-  if (q.signed_difference) return std::abs(d.mean[k]) <= 2 * noise.rms[k] / root;
-  return d.mean_abs[k] <= noise.mean_abs[k] + 2 * noise.sd_abs[k] / root;
+// The standard error of a setting's mean difference from its reference over the seeds, per
+// scalar: sqrt(sum over seeds of both runs' bootstrap variances) / seeds (the runs' errors taken as
+// independent, which bounds it when they are correlated, as same-seed runs are).
+std::vector<double> ErrorOfMeanDifference(const std::vector<Statistics>& setting,
+                                          const std::vector<Statistics>& reference) {
+  std::vector<double> out;
+  for (std::size_t q = 0; q < reference.front().standard_errors.size(); ++q) {
+    double variance = 0;
+    for (std::size_t s = 0; s < reference.size(); ++s)
+      variance +=
+          std::pow(setting[s].standard_errors[q], 2) + std::pow(reference[s].standard_errors[q], 2);
+    out.push_back(std::sqrt(variance) / double(reference.size()));
+  }
+  return out;
 }
 
-// One point of a plot: a setting's CPU time for the whole ensemble and its errors in units of the
-// noise (mean absolute difference / the reference seeds' mean absolute difference).
+// Equal within standard errors: a scalar's mean difference over the seeds within two standard
+// errors of it; the raster's mean absolute difference from the reference of the same seed no
+// larger than two ensembles of the same setting differ (between seeds, of the setting and of the
+// reference pooled) plus two standard errors of that mean.
+bool Within(const Quantity& q, std::size_t k, const Departure& d, double error_of_mean,
+            const Noise& setting_noise, const Noise& reference_noise, int seeds) {
+  if (!std::isfinite(d.mean[k])) return true;
+  if (q.signed_difference) return std::abs(d.mean[k]) <= 2 * error_of_mean;
+  const double mean = 0.5 * (setting_noise.mean_abs[k] + reference_noise.mean_abs[k]);
+  const double sd = std::hypot(setting_noise.sd_abs[k], reference_noise.sd_abs[k]) / std::sqrt(2.0);
+  return d.mean_abs[k] <= mean + 2 * sd / std::sqrt(double(seeds));
+}
+
+// One point of a plot: a setting's CPU time for the whole ensemble and its mean absolute
+// difference from the reference, per quantity.
 struct Point {
   std::string label;
   double ensemble_cpu_s;
@@ -515,13 +573,6 @@ struct Context {
   int seeds;
 };
 
-std::vector<double> Normalised(const std::vector<double>& mean_abs, const Noise& noise) {
-  std::vector<double> out;
-  for (std::size_t k = 0; k < mean_abs.size(); ++k)
-    out.push_back(noise.mean_abs[k] > 0 ? mean_abs[k] / noise.mean_abs[k] : std::nan(""));
-  return out;
-}
-
 double CpuPerRockS(const Context& c, int setting, int seed) {
   return c.runs[std::size_t(setting)][std::size_t(seed)].cpu_s / double(c.rocks);
 }
@@ -529,8 +580,6 @@ double CpuPerRockS(const Context& c, int setting, int seed) {
 std::string Cell(double v, const char* format) {
   return std::isfinite(v) ? Format(format, v) : std::string("–");
 }
-
-const char* FormatOf(const Quantity& q) { return q.signed_difference ? "%+.2f" : "%.4f"; }
 
 void PrintHeader(const Context& c, const char* first) {
   std::printf(
@@ -544,7 +593,31 @@ void PrintHeader(const Context& c, const char* first) {
   std::printf("\n");
 }
 
-// The table of one knob and its curve for the plots.
+// The noise rows under a knob's table: how two seeds of the reference differ, and the scalars'
+// bootstrap standard errors (mean over the seeds).
+void PrintNoise(const Context& c, int ref, const Noise& noise) {
+  std::printf("| between seeds of the reference: mean abs. diff. | | | | |");
+  for (std::size_t q = 0; q < c.quantities.size(); ++q)
+    std::printf(
+        " %s |",
+        Cell(noise.mean_abs[q], c.quantities[q].signed_difference ? "%.2f" : "%.4f").c_str());
+  std::printf("\n| reference: bootstrap standard error of the statistic | | | | |");
+  const std::vector<Statistics>& stats = c.stats[std::size_t(ref)];
+  for (std::size_t q = 0; q < c.quantities.size(); ++q) {
+    if (!c.quantities[q].signed_difference) {
+      std::printf(" |");
+      continue;
+    }
+    double sum = 0;
+    for (const Statistics& s : stats) sum += s.standard_errors[q];
+    std::printf(" %s |", Cell(sum / double(stats.size()), "%.2f").c_str());
+  }
+  std::printf("\n");
+}
+
+// The table of one knob and its curve for the plots. Scalars: mean difference from the reference
+// of the same seed ± its standard error; the raster: mean over the seeds of the mean absolute
+// difference. **≠** marks a departure beyond the standard errors (Within).
 Curve ReportFamily(const Context& c, const Family& f, int base) {
   const int ref = f.settings.front();
   const Noise noise = NoiseOf(c.stats[std::size_t(ref)]);
@@ -566,32 +639,28 @@ Curve ReportFamily(const Context& c, const Family& f, int base) {
                                         c.stats[std::size_t(ref)][std::size_t(s)]));
     }
     const Departure d = Accumulate(differences);
+    const std::vector<double> errors =
+        ErrorOfMeanDifference(c.stats[std::size_t(k)], c.stats[std::size_t(ref)]);
+    const Noise own_noise = NoiseOf(c.stats[std::size_t(k)]);
     const double t = Median(times);
     std::printf("| %s%s | %d | %.2f | %.1f | %.2f |", f.values[i].c_str(),
                 k == base ? " (base)" : "", c.settings[std::size_t(k)].rock_vertices, 1000 * t,
                 1 / t, Median(speedups));
     for (std::size_t q = 0; q < c.quantities.size(); ++q) {
       const Quantity& quantity = c.quantities[q];
-      const double shown = quantity.signed_difference ? d.mean[q] : d.mean_abs[q];
-      std::printf(" %s%s |", i == 0 ? "0" : Cell(shown, FormatOf(quantity)).c_str(),
-                  i == 0 || Within(quantity, q, d, noise, c.seeds) ? "" : " **≠**");
+      std::string text = i == 0 ? "0"
+                         : quantity.signed_difference
+                             ? Cell(d.mean[q], "%+.2f") + " ± " + Cell(errors[q], "%.2f")
+                             : Cell(d.mean_abs[q], "%.4f");
+      if (i > 0 &&
+          !Within(quantity, q, d, q < errors.size() ? errors[q] : 0, own_noise, noise, c.seeds))
+        text += " **≠**";
+      std::printf(" %s |", text.c_str());
     }
     std::printf("\n");
-    curve.points.push_back({f.values[i], t * double(c.rocks), Normalised(d.mean_abs, noise)});
+    curve.points.push_back({f.values[i], t * double(c.rocks), d.mean_abs});
   }
-  std::printf("| noise: between seeds of the reference, mean abs. diff. | | | | |");
-  for (std::size_t q = 0; q < c.quantities.size(); ++q)
-    std::printf(
-        " %s |",
-        Cell(noise.mean_abs[q], c.quantities[q].signed_difference ? "%.2f" : "%.4f").c_str());
-  std::printf("\n| two standard errors of the mean over %d seeds | | | | |", c.seeds);
-  const double root = std::sqrt(double(c.seeds));
-  for (std::size_t q = 0; q < c.quantities.size(); ++q)
-    std::printf(" %s |",
-                c.quantities[q].signed_difference
-                    ? Cell(2 * noise.rms[q] / root, "±%.2f").c_str()
-                    : Cell(noise.mean_abs[q] + 2 * noise.sd_abs[q] / root, "≤ %.4f").c_str());
-  std::printf("\n");
+  PrintNoise(c, ref, noise);
   return curve;
 }
 
@@ -599,7 +668,6 @@ Curve ReportFamily(const Context& c, const Family& f, int base) {
 // run of every other seed (at n = all rocks, that is the noise itself).
 Curve ReportRocks(const Context& c, int base) {
   const std::vector<Statistics>& full = c.stats[std::size_t(base)];
-  const Noise noise = NoiseOf(full);
   std::vector<double> times;
   for (int s = 0; s < c.seeds; ++s) times.push_back(CpuPerRockS(c, base, s));
   const double t = Median(times);
@@ -627,17 +695,20 @@ Curve ReportRocks(const Context& c, int base) {
       std::printf(" %s |",
                   Cell(d.mean_abs[q], c.quantities[q].signed_difference ? "%.2f" : "%.4f").c_str());
     std::printf("\n");
-    curve.points.push_back({std::to_string(n), t * double(n), Normalised(d.mean_abs, noise)});
+    curve.points.push_back({std::to_string(n), t * double(n), d.mean_abs});
   }
   return curve;
 }
 
 // ---- Plots --------------------------------------------------------------------------------------
 
-std::string PlotSvg(const std::string& title, const std::vector<Curve>& curves, std::size_t q) {
+// Mean absolute difference from the reference against the ensemble's CPU time (log scale), one
+// curve per knob, with the base setting's sampling noise (between seeds) dashed.
+std::string PlotSvg(const std::string& title, const std::string& y_label,
+                    const std::vector<Curve>& curves, std::size_t q, double noise) {
   namespace svg = talus::io::svg;
   static const char* colours[] = {"#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b"};
-  double x_lo = 1e300, x_hi = 0, y_hi = 1;
+  double x_lo = 1e300, x_hi = 0, y_hi = std::isfinite(noise) ? noise : 0;
   for (const Curve& c : curves)
     for (const Point& p : c.points) {
       x_lo = std::min(x_lo, std::log10(p.ensemble_cpu_s));
@@ -650,9 +721,9 @@ std::string PlotSvg(const std::string& title, const std::vector<Curve>& curves, 
   const svg::Axis x{x_lo, x_hi, svg::kLeft, svg::kWidth - svg::kRight};
   const svg::Axis y{y_lo, y_hi, svg::kHeight - svg::kBottom, svg::kTop};
   std::string out = svg::Frame(svg::Escape(title), "log10 of CPU seconds for the ensemble",
-                               "error / sampling noise", x, y);
-  svg::Add(out, "<line x1=\"", svg::F(x(x_lo)), "\" y1=\"", svg::F(y(1)), "\" x2=\"",
-           svg::F(x(x_hi)), "\" y2=\"", svg::F(y(1)),
+                               svg::Escape(y_label), x, y);
+  svg::Add(out, "<line x1=\"", svg::F(x(x_lo)), "\" y1=\"", svg::F(y(noise)), "\" x2=\"",
+           svg::F(x(x_hi)), "\" y2=\"", svg::F(y(noise)),
            "\" stroke=\"grey\" stroke-dasharray=\"4 3\"/>\n");
   for (std::size_t k = 0; k < curves.size(); ++k) {
     const char* colour = colours[k % 6];
@@ -675,15 +746,19 @@ std::string PlotSvg(const std::string& title, const std::vector<Curve>& curves, 
   return out + "</svg>\n";
 }
 
-void WritePlots(const std::string& dir, const std::string& prefix, const std::string& scene_name,
-                const std::vector<Quantity>& quantities, const std::vector<Curve>& curves) {
+void WritePlots(const std::string& dir, const std::string& scene_name,
+                const std::vector<Quantity>& quantities, const std::vector<Curve>& curves,
+                const Noise& base_noise) {
   std::filesystem::create_directories(dir);
   for (std::size_t q = 0; q < quantities.size(); ++q) {
     std::string name = quantities[q].name;
     for (char& ch : name)
       if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '_';
-    const std::string path = dir + "/" + prefix + "_" + name + ".svg";
-    std::ofstream(path) << PlotSvg(scene_name + ": " + quantities[q].name, curves, q);
+    const std::string path = dir + "/" + scene_name + "_" + name + ".svg";
+    const std::string unit = quantities[q].unit.empty() ? "" : " (" + quantities[q].unit + ")";
+    std::ofstream(path) << PlotSvg(scene_name + ": " + quantities[q].name,
+                                   "mean abs. difference from the reference" + unit, curves, q,
+                                   base_noise.mean_abs[q]);
     std::fprintf(stderr, "wrote %s\n", path.c_str());
   }
 }
@@ -784,7 +859,7 @@ int main(int argc, char** argv) {
     std::vector<Curve> curves;
     for (const Family& f : families) curves.push_back(ReportFamily(c, f, 0));
     if (o.Has("rocks")) curves.push_back(ReportRocks(c, 0));
-    if (!plots.empty()) WritePlots(plots, name, name, c.quantities, curves);
+    if (!plots.empty()) WritePlots(plots, name, c.quantities, curves, NoiseOf(c.stats[0]));
   } catch (const std::exception& e) {
     std::fprintf(stderr, "work_precision: %s\n", e.what());
     return 1;
