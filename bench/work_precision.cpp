@@ -4,8 +4,8 @@
 // and its ensemble statistics are compared with those of the knob's tightest setting under the same
 // seed: runout median and 95th percentile, the reach-probability raster, and the 95th percentile of
 // the energy at each evaluation line. The differences between seeds of the reference are the
-// sampling noise. Prints the machine, the command and markdown tables; writes one SVG per
-// statistic (CPU time against error, one curve per knob) with --plots.
+// sampling noise. Prints the machine, the command and markdown tables, which
+// bench/plot_work_precision.py turns into plots.
 
 #include <gdal_priv.h>
 #include <gdal_utils.h>
@@ -17,7 +17,6 @@
 #include <cmath>
 #include <cstdio>
 #include <ctime>
-#include <filesystem>
 #include <fstream>
 #include <memory>
 #include <optional>
@@ -32,7 +31,6 @@
 #include "io/raster.hpp"
 #include "io/report_html.hpp"
 #include "io/scene_file.hpp"
-#include "io/svg_plot.hpp"
 #include "pointclouds/rock_source.hpp"
 
 namespace {
@@ -551,18 +549,6 @@ bool Within(const Quantity& q, std::size_t k, const Departure& d, double error_o
   return d.mean_abs[k] <= mean + 2 * sd / std::sqrt(double(seeds));
 }
 
-// One point of a plot: a setting's CPU time for the whole ensemble and its mean absolute
-// difference from the reference, per quantity.
-struct Point {
-  std::string label;
-  double ensemble_cpu_s;
-  std::vector<double> error;
-};
-struct Curve {
-  std::string knob;
-  std::vector<Point> points;
-};
-
 struct Context {
   const Study& study;
   const std::vector<Setting>& settings;
@@ -594,15 +580,25 @@ void PrintHeader(const Context& c, const char* first) {
 }
 
 // The noise rows under a knob's table: how two seeds of the reference differ, and the scalars'
-// bootstrap standard errors (mean over the seeds).
+// values and bootstrap standard errors (means over the seeds).
 void PrintNoise(const Context& c, int ref, const Noise& noise) {
   std::printf("| between seeds of the reference: mean abs. diff. | | | | |");
   for (std::size_t q = 0; q < c.quantities.size(); ++q)
     std::printf(
         " %s |",
         Cell(noise.mean_abs[q], c.quantities[q].signed_difference ? "%.2f" : "%.4f").c_str());
-  std::printf("\n| reference: bootstrap standard error of the statistic | | | | |");
   const std::vector<Statistics>& stats = c.stats[std::size_t(ref)];
+  std::printf("\n| reference: the statistic (mean over seeds) | | | | |");
+  for (std::size_t q = 0; q < c.quantities.size(); ++q) {
+    if (!c.quantities[q].signed_difference) {
+      std::printf(" |");
+      continue;
+    }
+    double sum = 0;
+    for (const Statistics& s : stats) sum += s.scalars[q];
+    std::printf(" %s |", Cell(sum / double(stats.size()), "%.2f").c_str());
+  }
+  std::printf("\n| reference: bootstrap standard error of the statistic | | | | |");
   for (std::size_t q = 0; q < c.quantities.size(); ++q) {
     if (!c.quantities[q].signed_difference) {
       std::printf(" |");
@@ -615,10 +611,10 @@ void PrintNoise(const Context& c, int ref, const Noise& noise) {
   std::printf("\n");
 }
 
-// The table of one knob and its curve for the plots. Scalars: mean difference from the reference
+// The table of one knob. Scalars: mean difference from the reference
 // of the same seed ± its standard error; the raster: mean over the seeds of the mean absolute
 // difference. **≠** marks a departure beyond the standard errors (Within).
-Curve ReportFamily(const Context& c, const Family& f, int base) {
+void ReportFamily(const Context& c, const Family& f, int base) {
   const int ref = f.settings.front();
   const Noise noise = NoiseOf(c.stats[std::size_t(ref)]);
   // Speed-up against the base setting, or against the reference when the knob never runs the base
@@ -627,7 +623,6 @@ Curve ReportFamily(const Context& c, const Family& f, int base) {
   const int yardstick = has_base ? base : ref;
   std::printf("\n#### Knob: %s (reference: %s)\n\n", f.knob.c_str(), f.values.front().c_str());
   PrintHeader(c, f.knob.c_str());
-  Curve curve{f.knob, {}};
   for (std::size_t i = 0; i < f.settings.size(); ++i) {
     const int k = f.settings[i];
     std::vector<double> times, speedups;
@@ -658,15 +653,13 @@ Curve ReportFamily(const Context& c, const Family& f, int base) {
       std::printf(" %s |", text.c_str());
     }
     std::printf("\n");
-    curve.points.push_back({f.values[i], t * double(c.rocks), d.mean_abs});
   }
   PrintNoise(c, ref, noise);
-  return curve;
 }
 
 // The rocks knob: the first n rocks of the base run of one seed against all rocks of the base
 // run of every other seed (at n = all rocks, that is the noise itself).
-Curve ReportRocks(const Context& c, int base) {
+void ReportRocks(const Context& c, int base) {
   const std::vector<Statistics>& full = c.stats[std::size_t(base)];
   std::vector<double> times;
   for (int s = 0; s < c.seeds; ++s) times.push_back(CpuPerRockS(c, base, s));
@@ -679,7 +672,6 @@ Curve ReportRocks(const Context& c, int base) {
   std::printf("\n|---|---|");
   for (std::size_t k = 0; k < c.quantities.size(); ++k) std::printf("---|");
   std::printf("\n");
-  Curve curve{"rocks", {}};
   for (long n : {c.rocks / 8, c.rocks / 4, c.rocks / 2, c.rocks}) {
     std::vector<std::vector<double>> differences;
     for (int a = 0; a < c.seeds; ++a) {
@@ -695,71 +687,6 @@ Curve ReportRocks(const Context& c, int base) {
       std::printf(" %s |",
                   Cell(d.mean_abs[q], c.quantities[q].signed_difference ? "%.2f" : "%.4f").c_str());
     std::printf("\n");
-    curve.points.push_back({std::to_string(n), t * double(n), d.mean_abs});
-  }
-  return curve;
-}
-
-// ---- Plots --------------------------------------------------------------------------------------
-
-// Mean absolute difference from the reference against the ensemble's CPU time (log scale), one
-// curve per knob, with the base setting's sampling noise (between seeds) dashed.
-std::string PlotSvg(const std::string& title, const std::string& y_label,
-                    const std::vector<Curve>& curves, std::size_t q, double noise) {
-  namespace svg = talus::io::svg;
-  static const char* colours[] = {"#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b"};
-  double x_lo = 1e300, x_hi = 0, y_hi = std::isfinite(noise) ? noise : 0;
-  for (const Curve& c : curves)
-    for (const Point& p : c.points) {
-      x_lo = std::min(x_lo, std::log10(p.ensemble_cpu_s));
-      x_hi = std::max(x_hi, std::log10(p.ensemble_cpu_s));
-      if (std::isfinite(p.error[q])) y_hi = std::max(y_hi, p.error[q]);
-    }
-  double y_lo = 0;
-  svg::Pad(x_lo, x_hi);
-  svg::Pad(y_lo, y_hi);
-  const svg::Axis x{x_lo, x_hi, svg::kLeft, svg::kWidth - svg::kRight};
-  const svg::Axis y{y_lo, y_hi, svg::kHeight - svg::kBottom, svg::kTop};
-  std::string out = svg::Frame(svg::Escape(title), "log10 of CPU seconds for the ensemble",
-                               svg::Escape(y_label), x, y);
-  svg::Add(out, "<line x1=\"", svg::F(x(x_lo)), "\" y1=\"", svg::F(y(noise)), "\" x2=\"",
-           svg::F(x(x_hi)), "\" y2=\"", svg::F(y(noise)),
-           "\" stroke=\"grey\" stroke-dasharray=\"4 3\"/>\n");
-  for (std::size_t k = 0; k < curves.size(); ++k) {
-    const char* colour = colours[k % 6];
-    std::string path;
-    for (const Point& p : curves[k].points) {
-      if (!std::isfinite(p.error[q])) continue;
-      const double px = x(std::log10(p.ensemble_cpu_s)), py = y(p.error[q]);
-      svg::Add(path, svg::F(px), ",", svg::F(py), " ");
-      svg::Add(out, "<circle cx=\"", svg::F(px), "\" cy=\"", svg::F(py), "\" r=\"3\" fill=\"",
-               colour, "\"><title>", svg::Escape(curves[k].knob + " " + p.label),
-               "</title></circle>\n");
-      svg::Add(out, "<text x=\"", svg::F(px + 4), "\" y=\"", svg::F(py - 4),
-               "\" font-size=\"8\" fill=\"", colour, "\">", svg::Escape(p.label), "</text>\n");
-    }
-    svg::Add(out, "<polyline points=\"", path, "\" fill=\"none\" stroke=\"", colour, "\"/>\n");
-    svg::Add(out, "<text x=\"", svg::F(svg::kWidth - svg::kRight - 6), "\" y=\"",
-             svg::F(svg::kTop + 14 + 13 * double(k)), "\" text-anchor=\"end\" fill=\"", colour,
-             "\">", svg::Escape(curves[k].knob), "</text>\n");
-  }
-  return out + "</svg>\n";
-}
-
-void WritePlots(const std::string& dir, const std::string& scene_name,
-                const std::vector<Quantity>& quantities, const std::vector<Curve>& curves,
-                const Noise& base_noise) {
-  std::filesystem::create_directories(dir);
-  for (std::size_t q = 0; q < quantities.size(); ++q) {
-    std::string name = quantities[q].name;
-    for (char& ch : name)
-      if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '_';
-    const std::string path = dir + "/" + scene_name + "_" + name + ".svg";
-    const std::string unit = quantities[q].unit.empty() ? "" : " (" + quantities[q].unit + ")";
-    std::ofstream(path) << PlotSvg(scene_name + ": " + quantities[q].name,
-                                   "mean abs. difference from the reference" + unit, curves, q,
-                                   base_noise.mean_abs[q]);
-    std::fprintf(stderr, "wrote %s\n", path.c_str());
   }
 }
 
@@ -809,7 +736,7 @@ Study LoadStudy(const std::string& path) {
 
 int main(int argc, char** argv) {
   CLI::App app{"Work against precision of every accuracy knob on one scene (one core)"};
-  std::string scene_path, plots, name;
+  std::string scene_path;
   long rocks = 200;
   int seeds = 3;
   StudyOptions o;
@@ -826,10 +753,7 @@ int main(int argc, char** argv) {
   app.add_option("--hull-points", o.hull_points, "Points of the many-point rock")
       ->check(CLI::Range(8, 100000));
   app.add_option("--cells", o.cells_m, "DEM cell sizes, m, the finest first (default: none)");
-  app.add_option("--plots", plots, "Directory for the SVG plots (default: none)");
-  app.add_option("--name", name, "Name of the scene in plot titles and file names");
   CLI11_PARSE(app, argc, argv);
-  if (name.empty()) name = std::filesystem::path(scene_path).parent_path().filename().string();
 
   try {
     PrintMachine(argc, argv);
@@ -856,10 +780,8 @@ int main(int argc, char** argv) {
                                            study.lines->size()));
     }
     std::printf("load average at the end: %s\n", FirstLine("/proc/loadavg", "").c_str());
-    std::vector<Curve> curves;
-    for (const Family& f : families) curves.push_back(ReportFamily(c, f, 0));
-    if (o.Has("rocks")) curves.push_back(ReportRocks(c, 0));
-    if (!plots.empty()) WritePlots(plots, name, c.quantities, curves, NoiseOf(c.stats[0]));
+    for (const Family& f : families) ReportFamily(c, f, 0);
+    if (o.Has("rocks")) ReportRocks(c, 0);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "work_precision: %s\n", e.what());
     return 1;
