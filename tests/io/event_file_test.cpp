@@ -309,8 +309,16 @@ TEST(LoadEvent, SingleImpactsAreRunsOnThePlaneAndObservationsOfTheirFirstEpisode
                                        "{ file = \"impacts.csv\" }\norientation = [0, 1, 0, 0]",
                                        "energy_ratio_column = \"ratio\"\n", kImpacts);
   const EventFile flipped = LoadEvent((fixed / "event.toml").string());
-  ASSERT_TRUE(flipped.scene.release.runs[1].orientation);
-  EXPECT_EQ(flipped.scene.release.runs[1].orientation->x(), 1);
+  // Every impact's rocks take [release] orientation (the runs have none of their own).
+  const ensemble::ReleaseSpec& f = flipped.scene.release;
+  EXPECT_FALSE(f.runs[1].orientation);
+  ASSERT_TRUE(f.orientation);
+  const ensemble::ReleasedRock rock =
+      ensemble::Release(flipped.scene.scene, f, f.rocks_per_release);
+  EXPECT_EQ(f.ReleaseOf(f.rocks_per_release), 1);
+  const Eigen::Quaterniond shape =
+      rock.start.orientation * rock.shape->principal_to_input.conjugate();
+  EXPECT_NEAR(std::abs(shape.dot(Eigen::Quaterniond(0, 1, 0, 0))), 1.0, 1e-12);
   EXPECT_TRUE(event.needs_episodes);
   ASSERT_EQ(event.observations.scalars.size(), 2u);
   EXPECT_EQ(event.observations.scalars[1].run, "i2");
