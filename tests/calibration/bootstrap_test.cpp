@@ -13,6 +13,7 @@
 
 #include "calibration/least_squares.hpp"
 #include "calibration/optimizer.hpp"
+#include "calibration/seeds.hpp"
 #include "tests/calibration/fixtures.hpp"
 
 namespace talus::calibration {
@@ -139,6 +140,17 @@ TEST(Bootstrap, StatesTheDataErrorWhereTheSandwichUnderstatesIt) {
   EXPECT_GT(b.standard_error[0], data.se / 2);
   EXPECT_LE(b.lower[0], kTruth);
   EXPECT_GE(b.upper[0], kTruth);
+
+  // The seed refits (seeds.hpp, S = 5) add the dependence on the particular rocks; the combined
+  // standard error must stay within a factor 2 of the data's and its interval cover the truth.
+  const SeedRefits seeds = RefitWithOtherSeeds(objective, b, options, {5});
+  std::printf("%s", seeds.Report().c_str());
+  std::printf("seeds' sd %.4f; combined standard error %.4f, interval [%.4f, %.4f]\n", seeds.sd[0],
+              seeds.combined_standard_error[0], seeds.lower[0], seeds.upper[0]);
+  EXPECT_LT(seeds.combined_standard_error[0], 2 * data.se);
+  EXPECT_GT(seeds.combined_standard_error[0], data.se / 2);
+  EXPECT_LE(seeds.lower[0], kTruth);
+  EXPECT_GE(seeds.upper[0], kTruth);
 }
 
 }  // namespace
