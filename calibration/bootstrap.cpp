@@ -252,10 +252,11 @@ Bootstrap BootstrapOverRuns(const Objective& objective, const Eigen::VectorXd& u
   if (k > 0 && out.groups > 1)
     for (int b = 0; b < options.resamples; ++b) {
       const Eigen::VectorXd weights = counts.row(b).transpose().cast<double>();
-      const std::function<double(const Eigen::VectorXd&)> resampled = [&](const Eigen::VectorXd& v) {
-        const GroupScores& s = cache.At(v);
-        return s.feasible ? weights.dot(s.sums) + s.prior : s.value;
-      };
+      const std::function<double(const Eigen::VectorXd&)> resampled =
+          [&](const Eigen::VectorXd& v) {
+            const GroupScores& s = cache.At(v);
+            return s.feasible ? weights.dot(s.sums) + s.prior : s.value;
+          };
       bool at_budget = false;
       out.refits_unit.row(b) =
           RefitFromOptimum(resampled, free, out.u, options, budget, &at_budget).transpose();

@@ -49,9 +49,9 @@ void Combine(const Objective& objective, const Bootstrap& bootstrap, SeedRefits&
   const Eigen::VectorXd low = objective.parameters().Values(Eigen::VectorXd::Zero(n));
   const Eigen::VectorXd high = objective.parameters().Values(Eigen::VectorXd::Ones(n));
   out.fitted = objective.parameters().Values(bootstrap.u);
-  for (Eigen::VectorXd* v : {&out.sd, &out.sd_unit, &out.seed_standard_error,
-                             &out.combined_standard_error, &out.combined_standard_error_unit,
-                             &out.lower, &out.upper})
+  for (Eigen::VectorXd* v :
+       {&out.sd, &out.sd_unit, &out.seed_standard_error, &out.combined_standard_error,
+        &out.combined_standard_error_unit, &out.lower, &out.upper})
     *v = Eigen::VectorXd::Constant(n, kNaN);
   for (Eigen::Index j = 0; j < n; ++j) {
     if (!out.identified[static_cast<std::size_t>(j)]) continue;
@@ -116,16 +116,19 @@ SeedRefits RefitWithOtherSeeds(const Objective& objective, const Bootstrap& boot
   }
   if (options.seeds > 0) Combine(objective, bootstrap, out);
   std::ostringstream note;
-  if (free.empty())
+  if (options.seeds == 0)
+    note << "no seed refits (seeds = 0).";
+  else if (free.empty())
     note << "no seed refits: no parameter is refitted by the bootstrap.";
   else
     note << options.seeds << " refits with the release seeds " << out.release_seeds.front()
          << " .. " << out.release_seeds.back() << ", each by BOBYQA from the optimum (at most "
          << budget << " evaluations); standard error sqrt(bootstrap's^2 + (seeds' sd x "
          << Num(1 + 1 / std::sqrt(2.0 * (options.seeds - 1)), "%.3g") << ")^2)";
-  if (!free.empty() && out.refits_at_budget > 0)
-    note << "; " << out.refits_at_budget << " ended at that budget";
-  if (!free.empty()) note << ".";
+  if (options.seeds > 0 && !free.empty()) {
+    if (out.refits_at_budget > 0) note << "; " << out.refits_at_budget << " ended at that budget";
+    note << ".";
+  }
   out.note = note.str();
   out.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return out;
@@ -133,8 +136,7 @@ SeedRefits RefitWithOtherSeeds(const Objective& objective, const Bootstrap& boot
 
 std::string SeedRefits::Report() const {
   std::string out = "Uncertainty (bootstrap and " + std::to_string(seeds) +
-                    " refits with other seeds, " + std::to_string(evaluations) +
-                    " evaluations):\n";
+                    " refits with other seeds, " + std::to_string(evaluations) + " evaluations):\n";
   char line[256];
   char interval[32];
   std::snprintf(interval, sizeof interval, "%g %% interval", 100 * level);
