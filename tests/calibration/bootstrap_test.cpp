@@ -147,8 +147,11 @@ TEST(Bootstrap, StatesTheDataErrorWhereTheSandwichUnderstatesIt) {
   // standard error must stay within a factor 2 of the data's and its interval cover the truth.
   const SeedRefits seeds = RefitWithOtherSeeds(objective, b, options, {5});
   std::printf("%s", seeds.Report().c_str());
-  std::printf("seeds' sd %.4f; combined standard error %.4f, interval [%.4f, %.4f]\n", seeds.sd[0],
-              seeds.combined_standard_error[0], seeds.lower[0], seeds.upper[0]);
+  std::printf(
+      "seeds' sd %.4f; combined standard error %.4f, interval [%.4f, %.4f]; %.1f s (bootstrap "
+      "%.1f s)\n",
+      seeds.sd[0], seeds.combined_standard_error[0], seeds.lower[0], seeds.upper[0],
+      seeds.wall_time_s, b.wall_time_s);
   EXPECT_LT(seeds.combined_standard_error[0], 2 * data.se);
   EXPECT_GT(seeds.combined_standard_error[0], data.se / 2);
   EXPECT_LE(seeds.lower[0], kTruth);

@@ -114,9 +114,10 @@ void ExpectRecovered(const Objective& objective, const Problem& p, const std::st
   std::printf(
       "%s: fitted mu_min %.4f (truth %.2f, tolerance %.4f), bootstrap standard error "
       "%.4f, interval [%.4f, %.4f]; seeds' sd %.4f, combined standard error %.4f (data's %.4f), "
-      "interval [%.4f, %.4f]\n",
+      "interval [%.4f, %.4f]; seed refits %.1f s\n",
       algorithm.c_str(), fitted, p.truth, tolerance, b.standard_error[0], b.lower[0], b.upper[0],
-      seeds.sd[0], seeds.combined_standard_error[0], p.data.se, seeds.lower[0], seeds.upper[0]);
+      seeds.sd[0], seeds.combined_standard_error[0], p.data.se, seeds.lower[0], seeds.upper[0],
+      seeds.wall_time_s);
   if (checks.start_outside_band) {
     EXPECT_GT(std::abs(p.start - p.truth), tolerance);
   }
