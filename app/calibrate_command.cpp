@@ -300,6 +300,13 @@ int RunCalibrate(const CalibrateArgs& args, const Processes& processes) {
         run.bootstrap =
             calibration::BootstrapOverRuns(*objective, best.u, bootstrap, run.summary.history);
         std::printf("%s", run.bootstrap->Report().c_str());
+        if (file.seed_options.seeds > 0) {
+          std::printf("Refits with %d other release seeds...\n", file.seed_options.seeds);
+          std::fflush(stdout);
+          run.seeds = calibration::RefitWithOtherSeeds(*objective, *run.bootstrap, bootstrap,
+                                                       file.seed_options);
+          std::printf("%s", run.seeds->Report().c_str());
+        }
       }
     }
     const GroundTable fitted = objective->GroundOf(best.u);

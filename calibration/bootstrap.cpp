@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <exception>
+#include <functional>
 #include <map>
 #include <random>
 #include <sstream>
@@ -73,14 +74,13 @@ class GroupScoreCache {
   int evaluations_ = 0, cached_ = 0;
 };
 
-// One resample's refit: NLopt's callback state.
+// One refit: NLopt's callback state.
 struct Refit {
-  GroupScoreCache& cache;
-  const Eigen::VectorXd& weights;  // m_g
-  const std::vector<int>& free;    // refitted coordinates
-  const Eigen::VectorXd& origin;   // the optimum: the lattice's origin
-  double resolution;               // the lattice's spacing; 0: none
-  Eigen::VectorXd u;               // the full point (held coordinates at the optimum)
+  const std::function<double(const Eigen::VectorXd&)>& f;
+  const std::vector<int>& free;   // refitted coordinates
+  const Eigen::VectorXd& origin;  // the optimum: the lattice's origin
+  double resolution;              // the lattice's spacing; 0: none
+  Eigen::VectorXd u;              // the full point (held coordinates at the optimum)
   std::exception_ptr error;
   nlopt_opt opt = nullptr;
 };
@@ -96,46 +96,12 @@ double RefitObjective(unsigned /*n*/, const double* x, double* /*grad*/, void* d
   for (std::size_t k = 0; k < r.free.size(); ++k)
     r.u[r.free[k]] = OnLattice(x[k], r.origin[r.free[k]], r.resolution);
   try {
-    const GroupScores& s = r.cache.At(r.u);
-    return s.feasible ? r.weights.dot(s.sums) + s.prior : s.value;
+    return r.f(r.u);
   } catch (...) {
     r.error = std::current_exception();
     nlopt_force_stop(r.opt);
     return HUGE_VAL;
   }
-}
-
-// One resample's refit by BOBYQA from the optimum `origin` over the coordinates `free` (the
-// others held), within `budget` evaluations; the refitted point, on the lattice.
-Eigen::VectorXd RefitResample(GroupScoreCache& cache, const Eigen::VectorXd& weights,
-                              const std::vector<int>& free, const Eigen::VectorXd& origin,
-                              const BootstrapOptions& options, int budget, bool* at_budget) {
-  const auto k = free.size();
-  const std::vector<double> lower(k, 0.0), upper(k, 1.0);
-  // Steps below half the lattice spacing would ask for the same point again.
-  const std::vector<double> step(k, std::max(options.initial_step, options.resolution));
-  const std::vector<double> xtol(k, std::max(options.xtol_abs, options.resolution / 2));
-  Refit refit{cache, weights, free, origin, options.resolution, origin, nullptr, nullptr};
-  refit.opt = nlopt_create(NLOPT_LN_BOBYQA, static_cast<unsigned>(k));
-  if (!refit.opt) throw std::runtime_error("BootstrapOverRuns: NLopt could not start");
-  nlopt_set_min_objective(refit.opt, RefitObjective, &refit);
-  nlopt_set_lower_bounds(refit.opt, lower.data());
-  nlopt_set_upper_bounds(refit.opt, upper.data());
-  nlopt_set_initial_step(refit.opt, step.data());
-  nlopt_set_xtol_abs(refit.opt, xtol.data());
-  nlopt_set_ftol_rel(refit.opt, options.ftol_rel);
-  nlopt_set_maxeval(refit.opt, budget);
-  std::vector<double> x(k);
-  for (std::size_t q = 0; q < k; ++q) x[q] = origin[free[q]];
-  double f = 0;
-  const nlopt_result result = nlopt_optimize(refit.opt, x.data(), &f);
-  nlopt_destroy(refit.opt);
-  if (refit.error) std::rethrow_exception(refit.error);
-  *at_budget = result == NLOPT_MAXEVAL_REACHED;
-  Eigen::VectorXd u = origin;
-  for (std::size_t q = 0; q < k; ++q)
-    u[free[q]] = OnLattice(x[q], origin[free[q]], options.resolution);
-  return u;
 }
 
 // The p-quantile of sorted values, interpolated between order statistics (Hyndman & Fan type 7).
@@ -144,11 +110,6 @@ double Quantile(const std::vector<double>& sorted, double p) {
   const auto lo = static_cast<std::size_t>(std::floor(h));
   if (lo + 1 >= sorted.size()) return sorted.back();
   return sorted[lo] + (h - double(lo)) * (sorted[lo + 1] - sorted[lo]);
-}
-
-double SampleSd(const Eigen::VectorXd& x) {
-  const double mean = x.mean();
-  return std::sqrt((x.array() - mean).square().sum() / double(x.size() - 1));
 }
 
 // Standard errors, intervals and correlations from the refits.
@@ -182,6 +143,46 @@ void Summarise(Bootstrap& out) {
 }
 
 }  // namespace
+
+double SampleSd(const Eigen::VectorXd& x) {
+  const double mean = x.mean();
+  return std::sqrt((x.array() - mean).square().sum() / double(x.size() - 1));
+}
+
+int RefitBudget(const BootstrapOptions& options, int refitted) {
+  return options.refit_evaluations > 0 ? options.refit_evaluations : 10 * (refitted + 2);
+}
+
+Eigen::VectorXd RefitFromOptimum(const std::function<double(const Eigen::VectorXd&)>& f,
+                                 const std::vector<int>& free, const Eigen::VectorXd& origin,
+                                 const BootstrapOptions& options, int budget, bool* at_budget) {
+  const auto k = free.size();
+  const std::vector<double> lower(k, 0.0), upper(k, 1.0);
+  // Steps below half the lattice spacing would ask for the same point again.
+  const std::vector<double> step(k, std::max(options.initial_step, options.resolution));
+  const std::vector<double> xtol(k, std::max(options.xtol_abs, options.resolution / 2));
+  Refit refit{f, free, origin, options.resolution, origin, nullptr, nullptr};
+  refit.opt = nlopt_create(NLOPT_LN_BOBYQA, static_cast<unsigned>(k));
+  if (!refit.opt) throw std::runtime_error("RefitFromOptimum: NLopt could not start");
+  nlopt_set_min_objective(refit.opt, RefitObjective, &refit);
+  nlopt_set_lower_bounds(refit.opt, lower.data());
+  nlopt_set_upper_bounds(refit.opt, upper.data());
+  nlopt_set_initial_step(refit.opt, step.data());
+  nlopt_set_xtol_abs(refit.opt, xtol.data());
+  nlopt_set_ftol_rel(refit.opt, options.ftol_rel);
+  nlopt_set_maxeval(refit.opt, budget);
+  std::vector<double> x(k);
+  for (std::size_t q = 0; q < k; ++q) x[q] = origin[free[q]];
+  double value = 0;
+  const nlopt_result result = nlopt_optimize(refit.opt, x.data(), &value);
+  nlopt_destroy(refit.opt);
+  if (refit.error) std::rethrow_exception(refit.error);
+  *at_budget = result == NLOPT_MAXEVAL_REACHED;
+  Eigen::VectorXd u = origin;
+  for (std::size_t q = 0; q < k; ++q)
+    u[free[q]] = OnLattice(x[q], origin[free[q]], options.resolution);
+  return u;
+}
 
 bool BootstrapOptions::IsValid(std::string* why) const {
   std::ostringstream msg;
@@ -244,16 +245,21 @@ Bootstrap BootstrapOverRuns(const Objective& objective, const Eigen::VectorXd& u
   for (int g : objective.residual_groups()) out.groups = std::max(out.groups, g + 1);
 
   const int k = static_cast<int>(free.size());
-  const int budget = options.refit_evaluations > 0 ? options.refit_evaluations : 10 * (k + 2);
+  const int budget = RefitBudget(options, k);
   const Eigen::MatrixXi counts = ResampleCounts(options.resamples, out.groups, options.seed);
   out.refits_unit = out.u.transpose().replicate(options.resamples, 1);
   GroupScoreCache cache(objective, known);
   if (k > 0 && out.groups > 1)
     for (int b = 0; b < options.resamples; ++b) {
       const Eigen::VectorXd weights = counts.row(b).transpose().cast<double>();
+      const std::function<double(const Eigen::VectorXd&)> resampled =
+          [&](const Eigen::VectorXd& v) {
+            const GroupScores& s = cache.At(v);
+            return s.feasible ? weights.dot(s.sums) + s.prior : s.value;
+          };
       bool at_budget = false;
       out.refits_unit.row(b) =
-          RefitResample(cache, weights, free, out.u, options, budget, &at_budget).transpose();
+          RefitFromOptimum(resampled, free, out.u, options, budget, &at_budget).transpose();
       out.refits_at_budget += at_budget ? 1 : 0;
     }
   out.refits = Eigen::MatrixXd(options.resamples, n);

@@ -26,6 +26,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -84,5 +85,19 @@ Eigen::MatrixXi ResampleCounts(int resamples, int groups, std::uint64_t seed);
 Bootstrap BootstrapOverRuns(const Objective& objective, const Eigen::VectorXd& u,
                             const BootstrapOptions& options,
                             const std::vector<Evaluation>& known = {});
+
+// A refit of f by BOBYQA from `origin` (unit coordinates) over the coordinates `free`, the others
+// held, with the options' first step and tolerances, on the lattice origin + resolution k (clamped
+// to [0, 1]), within `budget` evaluations of f; the refitted point, on the lattice. `at_budget`:
+// whether the budget ended it. The bootstrap's refits and the seed refits (seeds.hpp) are these.
+Eigen::VectorXd RefitFromOptimum(const std::function<double(const Eigen::VectorXd&)>& f,
+                                 const std::vector<int>& free, const Eigen::VectorXd& origin,
+                                 const BootstrapOptions& options, int budget, bool* at_budget);
+
+// The evaluations each refit of `refitted` coordinates may ask for: the options' or 10 (n + 2).
+int RefitBudget(const BootstrapOptions& options, int refitted);
+
+// The sample standard deviation (denominator size - 1) of at least two values.
+double SampleSd(const Eigen::VectorXd& x);
 
 }  // namespace talus::calibration

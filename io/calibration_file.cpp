@@ -228,11 +228,24 @@ void LoadBootstrap(const Section& s, CalibrationFile& out) {
   if (!b.IsValid(&why)) s.FailCheck(why);
 }
 
+// [uncertainty] seeds: refits with other release seeds, combined with the bootstrap
+// (calibration/seeds.hpp).
+void LoadSeedRefits(const Section& s, CalibrationFile& out) {
+  constexpr long kMax = calibration::SeedRefitOptions::kMaxSeeds;
+  const long seeds = s.Integer("seeds", out.seed_options.seeds);
+  if (seeds != 0 && (seeds < 2 || seeds > kMax))
+    s.Fail("seeds", std::to_string(seeds) + " must be 0 (off) or in 2 .. " + std::to_string(kMax) +
+                        " (refits with other release seeds; an sd needs 2)");
+  out.seed_options.seeds = static_cast<int>(seeds);
+  if (seeds > 0 && out.bootstrap_options.resamples == 0)
+    s.Fail("seeds", "needs bootstrap (its standard error is combined with the bootstrap's)");
+}
+
 void LoadUncertainty(const Context& context, const toml::table* table, CalibrationFile& out) {
   const Section s(
       context, table, "uncertainty",
       {"enabled", "fd_step", "min_reciprocal_condition_number", "weak_fraction", "bootstrap",
-       "bootstrap_evaluations", "bootstrap_resolution", "bootstrap_level"});
+       "bootstrap_evaluations", "bootstrap_resolution", "bootstrap_level", "seeds"});
   calibration::UncertaintyOptions& o = out.uncertainty_options;
   out.uncertainty = s.Bool("enabled", true);
   o.fd_step = s.Checked(
@@ -245,6 +258,7 @@ void LoadUncertainty(const Context& context, const toml::table* table, Calibrati
       "weak_fraction", o.weak_fraction, [](double v) { return v > 0; }, "must be > 0");
   o.profile = out.profile_options;
   LoadBootstrap(s, out);
+  LoadSeedRefits(s, out);
 }
 
 // 64-bit FNV-1a of `text`, as 16 hex digits.

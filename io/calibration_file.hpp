@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "calibration/bootstrap.hpp"
+#include "calibration/seeds.hpp"
 #include "calibration/least_squares.hpp"
 #include "calibration/objective.hpp"
 #include "calibration/optimizer.hpp"
@@ -36,6 +37,8 @@ struct CalibrationFile {
   // Its resolution when the file does not give one: the covariance's finite-difference step.
   calibration::BootstrapOptions bootstrap_options;
   std::optional<double> bootstrap_resolution;
+  // Refits with other release seeds after the bootstrap, combined with it (seeds 0: off).
+  calibration::SeedRefitOptions seed_options;
   std::vector<std::string> inputs;  // the calibration file and the event's inputs
   std::string inputs_hash;
   // What decides an optimiser's path -- the event's inputs, rocks and seed, the parameters, the

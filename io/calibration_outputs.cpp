@@ -93,6 +93,32 @@ json BootstrapJson(const calibration::Bootstrap& b) {
           {"wall_time_s", b.wall_time_s}};
 }
 
+// The seed refits: their spread and the standard errors and intervals combined with the bootstrap.
+json SeedRefitsJson(const calibration::SeedRefits& s) {
+  json seeds = json::array();
+  for (std::uint64_t seed : s.release_seeds) seeds.push_back(seed);
+  return {{"method",
+           "refits with other release seeds, each by BOBYQA from the optimum; combined standard "
+           "error sqrt(bootstrap^2 + (seed sd (1 + 1/sqrt(2 (S - 1))))^2); interval: each side "
+           "of the bootstrap's widened in quadrature by z times the seeds' part"},
+          {"seeds", s.seeds},
+          {"release_seeds", seeds},
+          {"level", s.level},
+          {"names", s.names},
+          {"refits", Matrix(s.refits)},
+          {"seed_sd", Vector(s.sd)},
+          {"seed_sd_unit", Vector(s.sd_unit)},
+          {"seed_standard_error", Vector(s.seed_standard_error)},
+          {"combined_standard_error", Vector(s.combined_standard_error)},
+          {"combined_standard_error_unit", Vector(s.combined_standard_error_unit)},
+          {"lower", Vector(s.lower)},
+          {"upper", Vector(s.upper)},
+          {"refits_at_budget", s.refits_at_budget},
+          {"evaluations", s.evaluations},
+          {"note", s.note},
+          {"wall_time_s", s.wall_time_s}};
+}
+
 json HeldOutKinds(const std::vector<calibration::HeldOutKind>& kinds) {
   json out = json::array();
   for (const auto& k : kinds)
@@ -259,6 +285,16 @@ std::string CalibrationJson(const CalibrationFile& file, const Objective& object
     for (std::size_t k = 0; k < u.names.size() && k < j["parameters"].size(); ++k)
       j["parameters"][k]["standard_error"] = Number(u.standard_error[static_cast<Eigen::Index>(k)]);
     j["uncertainty"]["bootstrap"] = run.bootstrap ? BootstrapJson(*run.bootstrap) : json(nullptr);
+    j["uncertainty"]["seeds"] = run.seeds ? SeedRefitsJson(*run.seeds) : json(nullptr);
+    if (run.seeds)
+      for (std::size_t k = 0; k < run.seeds->names.size() && k < j["parameters"].size(); ++k) {
+        const auto q = static_cast<Eigen::Index>(k);
+        j["parameters"][k]["seed_sd"] = Number(run.seeds->sd[q]);
+        j["parameters"][k]["combined_standard_error"] =
+            Number(run.seeds->combined_standard_error[q]);
+        j["parameters"][k]["combined_interval"] = {Number(run.seeds->lower[q]),
+                                                   Number(run.seeds->upper[q])};
+      }
     if (run.bootstrap)
       for (std::size_t k = 0; k < run.bootstrap->names.size() && k < j["parameters"].size(); ++k) {
         const auto q = static_cast<Eigen::Index>(k);

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "calibration/bootstrap.hpp"
+#include "calibration/seeds.hpp"
 #include "calibration/holdout.hpp"
 #include "calibration/least_squares.hpp"
 #include "calibration/objective.hpp"
@@ -33,6 +34,7 @@ struct CalibrationRun {
   std::vector<calibration::ParameterProfile> profiles;
   std::optional<calibration::Uncertainty> uncertainty;
   std::optional<calibration::Bootstrap> bootstrap;  // with the uncertainty, when asked for
+  std::optional<calibration::SeedRefits> seeds;     // after the bootstrap, when asked for
   std::optional<calibration::HeldOutScores> holdout;
   std::vector<FoldRun> folds;
   std::vector<std::string> not_scored;  // observed values the event holds but cannot score

@@ -203,6 +203,12 @@ TEST(CalibrateCommand, BadFilesAreRefusedBeforeAnyRun) {
       {"profile_points = 3", "profile_points = 3\n[uncertainty]\nenabled = false\nbootstrap = 20",
        cal + ":16: uncertainty.bootstrap: needs enabled = true (it is estimated with the "
              "covariance)"},
+      {"profile_points = 3", "profile_points = 3\n[uncertainty]\nbootstrap = 10\nseeds = 1",
+       cal + ":16: uncertainty.seeds: 1 must be 0 (off) or in 2 .. 1000 (refits with other "
+             "release seeds; an sd needs 2)"},
+      {"profile_points = 3", "profile_points = 3\n[uncertainty]\nseeds = 3",
+       cal + ":15: uncertainty.seeds: needs bootstrap (its standard error is combined with the "
+             "bootstrap's)"},
   };
   for (const auto& c : cases) {
     std::string text = kGood;
@@ -258,6 +264,7 @@ TEST(CalibrateCommand, CeresWithAHeldOutRunAndCrossValidation) {
   EXPECT_TRUE(json["uncertainty"].is_object());
   EXPECT_TRUE(json["uncertainty"]["note"].is_string());
   EXPECT_TRUE(json["uncertainty"]["bootstrap"].is_null());  // off by default
+  EXPECT_TRUE(json["uncertainty"]["seeds"].is_null());      // off by default
   EXPECT_GT(json["finite_difference_step"].get<double>(), 0);
   // When a budget ended a fit (the main one or a fold's), the checkpoint stays for --resume.
   const auto budget = [](const nlohmann::json& t) {
@@ -274,8 +281,8 @@ TEST(CalibrateCommand, CeresWithAHeldOutRunAndCrossValidation) {
 
 // A calibration stopped by its budget (5 evaluations) and resumed from its checkpoint with a
 // budget of 10 ends exactly where an uninterrupted run with 10 does: the same evaluations, bit
-// for bit (history.csv without its wall times), the same fitted table, the same bootstrap (its
-// evaluations are not checkpointed but re-run, deterministically).
+// for bit (history.csv without its wall times), the same fitted table, the same bootstrap and seed
+// refits (their evaluations are not checkpointed but re-run, deterministically).
 TEST(CalibrateCommand, ResumedCalibrationEqualsAnUninterruptedOne) {
   const auto without_times = [](const std::string& csv) {
     std::string out;
@@ -289,7 +296,7 @@ TEST(CalibrateCommand, ResumedCalibrationEqualsAnUninterruptedOne) {
   };
   // Without the profiles, which find mu_min unidentified with these few rocks (the bootstrap then
   // refits nothing).
-  std::string cal = std::string(kGood) + "[uncertainty]\nbootstrap = 10\n";
+  std::string cal = std::string(kGood) + "[uncertainty]\nbootstrap = 10\nseeds = 2\n";
   cal.replace(cal.find("[roughness]"), 11, "[roughness]\nenabled = false");
   cal.replace(cal.find("max_evaluations = 6"), 19, "max_evaluations = 10\nxtol_abs = 0");
   const fs::path whole = MakeEvent("whole");
@@ -323,6 +330,14 @@ TEST(CalibrateCommand, ResumedCalibrationEqualsAnUninterruptedOne) {
   bootstrap.erase("wall_time_s");
   resumed.erase("wall_time_s");
   EXPECT_EQ(bootstrap, resumed);
+  auto seeds = a["uncertainty"]["seeds"], seeds_resumed = b["uncertainty"]["seeds"];
+  ASSERT_TRUE(seeds.is_object()) << a.dump(1);
+  EXPECT_EQ(seeds["refits"].size(), 2u);
+  EXPECT_TRUE(seeds["combined_standard_error"][0].is_number()) << seeds.dump(1);
+  EXPECT_TRUE(a["parameters"][0]["combined_interval"][0].is_number()) << a.dump(1);
+  seeds.erase("wall_time_s");
+  seeds_resumed.erase("wall_time_s");
+  EXPECT_EQ(seeds, seeds_resumed);
   EXPECT_EQ(Slurp(whole / "out" / "ground_table.csv"), Slurp(parts / "out" / "ground_table.csv"));
   EXPECT_EQ(without_times(Slurp(whole / "out" / "history.csv")),
             without_times(Slurp(parts / "out" / "history.csv")));

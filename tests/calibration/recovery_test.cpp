@@ -3,9 +3,10 @@
 // Talus itself from known parameters under the default (contact-friction) reading and fitted back
 // from a distant start by NLopt (BOBYQA) and by Ceres. The fitted value must lie within 3 of the
 // data's standard errors (testing::MeasuredDataError: within-run spread and sensitivity of the
-// observed quantity, measured here) plus the optimiser's tolerance, and the bootstrap over runs'
-// 95 % interval must cover the truth; a parameter the data cannot see (nu, for rotation rates)
-// is reported unidentified.
+// observed quantity, measured here) plus the optimiser's tolerance, and the 95 % intervals of the
+// bootstrap over runs and of its combination with the seed refits (other rocks) must cover the
+// truth, where they do (each exception says what was measured); a parameter the data cannot see
+// (nu, for rotation rates) is reported unidentified.
 
 #include <gtest/gtest.h>
 
@@ -16,6 +17,7 @@
 #include "calibration/bootstrap.hpp"
 #include "calibration/optimizer.hpp"
 #include "calibration/roughness.hpp"
+#include "calibration/seeds.hpp"
 #include "io/scene_file.hpp"
 #include "tests/calibration/fixtures.hpp"
 
@@ -25,6 +27,7 @@ namespace {
 using fieldobs::Quantity;
 
 constexpr double kLower = 0.1, kUpper = 0.9;  // bounds of every mu_min fitted here
+constexpr int kSeeds = 5;                     // seed refits after each bootstrap
 
 ParameterSpec Free(const std::string& category, GroundField field, double lower, double upper,
                    const std::string& tie = "") {
@@ -68,13 +71,17 @@ Problem Draw(const Scene& scene, const ensemble::ReleaseSpec& release, Quantity 
 }
 
 // Fits coordinate 0 (mu_min) from p.start with `algorithm` and checks the value and the
-// bootstrap's interval against the truth; `profiles` (when measured) hold flat coordinates.
+// intervals against the truth; `profiles` (when measured) hold flat coordinates.
 // The checks a problem's data allow: `start_outside_band`, that the start lies farther from the
-// truth than the tolerance (not where the data's standard error is too large for that); and
-// `interval_covers`, that the bootstrap's interval covers the truth (to half its lattice step).
+// truth than the tolerance (not where the data's standard error is too large for that);
+// `bootstrap_covers` and `combined_covers`, that the bootstrap's interval and the combined one
+// (bootstrap and seed refits) cover the truth (to half the lattice step); and
+// `combined_se_as_data`, that the combined standard error lies within a factor 2 of the data's.
 struct Checks {
   bool start_outside_band = true;
-  bool interval_covers = true;
+  bool bootstrap_covers = true;
+  bool combined_covers = true;
+  bool combined_se_as_data = true;
 };
 
 void ExpectRecovered(const Objective& objective, const Problem& p, const std::string& algorithm,
@@ -99,23 +106,37 @@ void ExpectRecovered(const Objective& objective, const Problem& p, const std::st
   bootstrap.profiles = profiles;
   const Bootstrap b = BootstrapOverRuns(objective, summary.best.u, bootstrap, summary.history);
   std::printf("\n%s", b.Report().c_str());
+  const SeedRefits seeds = RefitWithOtherSeeds(objective, b, bootstrap, {kSeeds});
+  std::printf("%s", seeds.Report().c_str());
 
   const double fitted = summary.best.values[0];
   const double tolerance = 3 * p.data.se + options.xtol_abs * (kUpper - kLower);
   std::printf(
       "%s: fitted mu_min %.4f (truth %.2f, tolerance %.4f), bootstrap standard error "
-      "%.4f, interval [%.4f, %.4f]\n",
-      algorithm.c_str(), fitted, p.truth, tolerance, b.standard_error[0], b.lower[0], b.upper[0]);
+      "%.4f, interval [%.4f, %.4f]; seeds' sd %.4f, combined standard error %.4f (data's %.4f), "
+      "interval [%.4f, %.4f]; seed refits %.1f s\n",
+      algorithm.c_str(), fitted, p.truth, tolerance, b.standard_error[0], b.lower[0], b.upper[0],
+      seeds.sd[0], seeds.combined_standard_error[0], p.data.se, seeds.lower[0], seeds.upper[0],
+      seeds.wall_time_s);
   if (checks.start_outside_band) {
     EXPECT_GT(std::abs(p.start - p.truth), tolerance);
   }
   EXPECT_NEAR(fitted, p.truth, tolerance);
   EXPECT_LT(summary.best.value, summary.initial.value);
   ASSERT_TRUE(b.identified[0]);
-  if (!checks.interval_covers) return;
   const double half_step = bootstrap.resolution * (kUpper - kLower) / 2;
-  EXPECT_LE(b.lower[0], p.truth + half_step);
-  EXPECT_GE(b.upper[0], p.truth - half_step);
+  if (checks.bootstrap_covers) {
+    EXPECT_LE(b.lower[0], p.truth + half_step);
+    EXPECT_GE(b.upper[0], p.truth - half_step);
+  }
+  if (checks.combined_covers) {
+    EXPECT_LE(seeds.lower[0], p.truth + half_step);
+    EXPECT_GE(seeds.upper[0], p.truth - half_step);
+  }
+  if (checks.combined_se_as_data) {
+    EXPECT_LT(seeds.combined_standard_error[0], 2 * p.data.se);
+    EXPECT_GT(seeds.combined_standard_error[0], p.data.se / 2);
+  }
 }
 
 ObjectiveOptions TwoThreads() {
@@ -149,16 +170,18 @@ TEST(Recovery, BobyqaRecoversMuMinFromScarLengths) {
   ExpectRecovered(objective, p, "bobyqa");
 }
 
-// Ceres' fit lies within the tolerance, but the bootstrap understates its uncertainty here and
-// is not checked: measured, fitted 0.606 with a bootstrap standard error of 0.029 and interval
-// [0.558, 0.630], where the data's standard error is 0.067 (docs/calibration.md, "Limits": the
-// refits start in the dip of the rough objective where the fit stopped, and stay near it).
+// Ceres' fit lies within the tolerance, but the bootstrap alone understates its uncertainty here
+// and is not checked: measured, fitted 0.606 with a bootstrap standard error of 0.029 and
+// interval [0.558, 0.630], where the data's standard error is 0.067 (docs/calibration.md,
+// "Limits": the refits start in the dip of the rough objective where the fit stopped, and stay
+// near it). With the seed refits (sd 0.047 over 5 seeds) the combined standard error is 0.070
+// and its interval [0.472, 0.733] covers the truth.
 TEST(Recovery, CeresRecoversMuMinFromScarLengths) {
   const Problem& p = Scars();
   const Objective objective(p.scene, p.release, p.observations,
                             {Free("medium_hard", GroundField::kMuMin, kLower, kUpper)},
                             TwoThreads());
-  ExpectRecovered(objective, p, "ceres", {}, {true, false});
+  ExpectRecovered(objective, p, "ceres", {}, {true, false, true, true});
 }
 
 // --- rotation: mean angular speed over the first 2.5 s of each run -----------------------------
@@ -260,13 +283,25 @@ std::vector<ParameterSpec> TirolMuMin() {
 
 // The data's standard error from the mean run-outs (0.20 with 24 runs, the means turning
 // erratically) is too large for a tolerance band that excludes any start within the bounds; the
-// bootstrap's interval must cover the truth. Measured: fitted 0.580, bootstrap standard error
-// 0.042, interval [0.492, 0.660]. Ceres from the same start is not tested here: it stopped at
-// 0.686 with an interval of [0.678, 0.734] (docs/calibration.md, "Limits").
+// intervals must cover the truth. The combined standard error is not compared with the data's:
+// measured, 0.069 (bootstrap 0.042, seeds' sd 0.041 over 5 seeds) against 0.20, and the
+// intervals [0.492, 0.660] (bootstrap) and [0.440, 0.715] (combined) cover the truth at 0.50.
+// Ceres from the same start is not tested here: it stopped at 0.686 with a bootstrap interval of
+// [0.678, 0.734] and, with the seed refits (sd 0.026), a combined standard error of 0.038 and
+// interval [0.616, 0.771], which miss the truth too (docs/calibration.md, "Limits").
 TEST(Recovery, BobyqaRecoversMuMinFromRunoutsOnTheTyrolDem) {
   const Problem& p = Tirol();
   const Objective objective(p.scene, p.release, p.observations, TirolMuMin(), TwoThreads());
-  ExpectRecovered(objective, p, "bobyqa", {}, {false, true});
+  ExpectRecovered(objective, p, "bobyqa", {}, {false, true, true, false});
+}
+
+// Ceres from the same start: its intervals miss the truth (above), so only its fit is checked,
+// and the test is left out of the suite's run (19 s); it reproduces the figures of
+// docs/calibration.md with --gtest_also_run_disabled_tests.
+TEST(Recovery, DISABLED_CeresFitsMuMinFromRunoutsOnTheTyrolDem) {
+  const Problem& p = Tirol();
+  const Objective objective(p.scene, p.release, p.observations, TirolMuMin(), TwoThreads());
+  ExpectRecovered(objective, p, "ceres", {}, {false, false, false, false});
 }
 
 }  // namespace
