@@ -94,7 +94,8 @@ TEST(SimulateMpi, RanksWithDifferentEnsemblesAreRefused) {
   EXPECT_FALSE(fs::exists(out / "summary.json"));
 }
 
-// Rank 1 is killed (SIGKILL) in the middle of its rocks: the run ends within the time limit with a
+// Rank 1 is killed (SIGKILL) after 2 s, in the middle of its 2000 rocks (about 35 s of work on one
+// core, so a fast machine cannot finish them first): the run ends within the time limit with a
 // failure, --out holds neither outputs nor temporary files; the next run removes what the killed
 // rank left in its $TMPDIR.
 TEST(SimulateMpi, ALostRankEndsTheRunWithoutOutputs) {
@@ -106,8 +107,8 @@ TEST(SimulateMpi, ALostRankEndsTheRunWithoutOutputs) {
   const std::string run = " simulate " + kScene + " --threads 1 --out " + out.string();
   const std::string env = "TMPDIR=" + tmp.string() + " ";
   const int code =
-      RunCommand(env + MpiRun("-n 1 " + Talus() + run + " --rocks 200 : -n 1 timeout -s KILL 2 " +
-                              Talus() + run + " --rocks 200"),
+      RunCommand(env + MpiRun("-n 1 " + Talus() + run + " --rocks 4000 : -n 1 timeout -s KILL 2 " +
+                              Talus() + run + " --rocks 4000"),
                  &log);
   EXPECT_NE(code, 0) << log;
   EXPECT_NE(code, -1) << log;  // ended by itself, not by the test's time limit
