@@ -19,6 +19,11 @@ const char* Interrupted::what() const noexcept {
   return signal_ == SIGTERM ? "interrupted by SIGTERM" : "interrupted by SIGINT";
 }
 
+std::string InterruptedMessage(const Interrupted& e, const std::string& out) {
+  return std::string(e.what()) + "; removed this run's temporary files, " + out +
+         " is as it was before the run";
+}
+
 InterruptScope::InterruptScope() {
   g_signal = 0;
   struct sigaction action = {};

@@ -6,6 +6,7 @@
 // once (a later run removes what it left, RemoveStaleTemporaries).
 
 #include <exception>
+#include <string>
 
 namespace talus::app {
 
@@ -19,6 +20,10 @@ class Interrupted : public std::exception {
  private:
   int signal_;
 };
+
+// What a verb says when a signal ended it after it removed its temporary files: "interrupted by
+// SIGINT; removed this run's temporary files, <out> is as it was before the run".
+std::string InterruptedMessage(const Interrupted& e, const std::string& out);
 
 // Catches SIGINT and SIGTERM while alive; restores the previous handlers when destroyed.
 class InterruptScope {

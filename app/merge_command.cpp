@@ -72,8 +72,7 @@ int RunMerge(const MergeArgs& args) {
     return kExitOk;
   } catch (const Interrupted& e) {
     staging.reset();
-    std::cerr << "talus merge: " << e.what() << "; removed this run's temporary files, " << args.out
-              << " is as it was before\n";
+    std::cerr << "talus merge: " << InterruptedMessage(e, args.out) << "\n";
     return ExitCodeForSignal(e.signal());
   } catch (const std::exception& e) {
     const std::string message = staging ? staging->Describe(e.what()) : e.what();

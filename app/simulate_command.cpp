@@ -171,8 +171,7 @@ int RunSimulate(const SimulateArgs& args) {
   } catch (const Interrupted& e) {
     staging.reset();
     progress.Break();
-    std::cerr << "talus simulate: " << e.what() << "; removed this run's temporary files, "
-              << args.out << " is as it was before the run\n";
+    std::cerr << "talus simulate: " << InterruptedMessage(e, args.out) << "\n";
     return ExitCodeForSignal(e.signal());
   } catch (const std::exception& e) {
     const std::string message = staging ? staging->Describe(e.what()) : e.what();

@@ -193,8 +193,7 @@ int SimulateOnRanks(const MpiSession& mpi, const SimulateArgs& args) {
     RunIntoStaging(scene, args.threads, first, end, true, *part, show_progress, &report);
   } catch (const Interrupted& e) {
     code = ExitCodeForSignal(e.signal());
-    message = std::string(e.what()) + "; removed this run's temporary files, " + args.out +
-              " is as it was before the run";
+    message = InterruptedMessage(e, args.out);
   } catch (const std::exception& e) {
     code = kExitRunFailed;
     message =
@@ -239,8 +238,7 @@ int SimulateOnRanks(const MpiSession& mpi, const SimulateArgs& args) {
     code = kExitOk;
   } catch (const Interrupted& e) {
     code = ExitCodeForSignal(e.signal());
-    message = std::string(e.what()) + "; removed this run's temporary files, " + args.out +
-              " is as it was before the run";
+    message = InterruptedMessage(e, args.out);
   } catch (const std::exception& e) {
     code = kExitRunFailed;
     message = staging->Describe(e.what()) + " (no output written)";

@@ -126,8 +126,7 @@ int RunValidate(const ValidateArgs& args) {
     return kExitOk;
   } catch (const Interrupted& e) {
     staging.reset();
-    std::cerr << "talus validate: " << e.what() << "; removed this run's temporary files, "
-              << args.out << " is as it was before the run\n";
+    std::cerr << "talus validate: " << InterruptedMessage(e, args.out) << "\n";
     return ExitCodeForSignal(e.signal());
   } catch (const InputError& e) {  // a shape per rock that cannot be built, found late
     staging.reset();

@@ -389,6 +389,10 @@ void InterruptARun(int signal, const std::string& name) {
                      (signal == SIGINT ? "SIGINT" : "SIGTERM")),
             std::string::npos)
       << log;
+  EXPECT_NE(log.find("; removed this run's temporary files, " + out.string() +
+                     " is as it was before the run"),
+            std::string::npos)
+      << log;
   EXPECT_EQ(Temporaries(out), std::vector<std::string>());
   EXPECT_TRUE(Snapshot(out) == earlier) << "the earlier run's outputs changed";
 }
