@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "calibration/parameters.hpp"
 #include "ensemble/runner.hpp"
 #include "fieldobs/observations.hpp"
 #include "fieldobs/samples.hpp"
@@ -16,6 +17,18 @@
 #include "solver/shapes.hpp"
 
 namespace talus::calibration::testing {
+
+// A free parameter: `field` of `category` within [lower, upper], optionally tied to others.
+inline ParameterSpec Spec(const std::string& category, GroundField field, double lower,
+                          double upper, const std::string& tie = "") {
+  ParameterSpec s;
+  s.category = category;
+  s.field = field;
+  s.lower = lower;
+  s.upper = upper;
+  s.tie = tie;
+  return s;
+}
 
 // One observation of `quantity` per run of `release`, drawn from the model with the `truth` scene:
 // the value of one more rock of that run with another seed (release seed `seed`). Segment

@@ -7,20 +7,12 @@
 #include <cmath>
 
 #include "common/error.hpp"
+#include "fixtures.hpp"
 
 namespace talus::calibration {
 namespace {
 
-ParameterSpec Spec(const std::string& category, GroundField field, double lower, double upper,
-                   const std::string& tie = "") {
-  ParameterSpec s;
-  s.category = category;
-  s.field = field;
-  s.lower = lower;
-  s.upper = upper;
-  s.tie = tie;
-  return s;
-}
+using testing::Spec;
 
 std::string ErrorOf(std::vector<ParameterSpec> specs) {
   try {

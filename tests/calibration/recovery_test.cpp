@@ -29,16 +29,7 @@ using fieldobs::Quantity;
 constexpr double kLower = 0.1, kUpper = 0.9;  // bounds of every mu_min fitted here
 constexpr int kSeeds = 5;                     // seed refits after each bootstrap
 
-ParameterSpec Free(const std::string& category, GroundField field, double lower, double upper,
-                   const std::string& tie = "") {
-  ParameterSpec s;
-  s.category = category;
-  s.field = field;
-  s.lower = lower;
-  s.upper = upper;
-  s.tie = tie;
-  return s;
-}
+using testing::Spec;
 
 double UnitMu(double mu) { return (mu - kLower) / (kUpper - kLower); }
 
@@ -165,7 +156,7 @@ const Problem& Scars() {
 TEST(Recovery, BobyqaRecoversMuMinFromScarLengths) {
   const Problem& p = Scars();
   const Objective objective(p.scene, p.release, p.observations,
-                            {Free("medium_hard", GroundField::kMuMin, kLower, kUpper)},
+                            {Spec("medium_hard", GroundField::kMuMin, kLower, kUpper)},
                             TwoThreads());
   ExpectRecovered(objective, p, "bobyqa");
 }
@@ -179,7 +170,7 @@ TEST(Recovery, BobyqaRecoversMuMinFromScarLengths) {
 TEST(Recovery, CeresRecoversMuMinFromScarLengths) {
   const Problem& p = Scars();
   const Objective objective(p.scene, p.release, p.observations,
-                            {Free("medium_hard", GroundField::kMuMin, kLower, kUpper)},
+                            {Spec("medium_hard", GroundField::kMuMin, kLower, kUpper)},
                             TwoThreads());
   ExpectRecovered(objective, p, "ceres", {}, {true, false, true, true});
 }
@@ -208,8 +199,8 @@ const Problem& Rotation() {
 TEST(Recovery, BobyqaRecoversMuMinFromRotationRatesAndNuIsUnidentified) {
   const Problem& p = Rotation();
   const Objective objective(p.scene, p.release, p.observations,
-                            {Free("medium_hard", GroundField::kMuMin, kLower, kUpper),
-                             Free("medium_hard", GroundField::kNu, 0.1, 2.0)},
+                            {Spec("medium_hard", GroundField::kMuMin, kLower, kUpper),
+                             Spec("medium_hard", GroundField::kNu, 0.1, 2.0)},
                             TwoThreads());
   Eigen::VectorXd at_truth = objective.StartPoint();
   at_truth[0] = UnitMu(p.truth);
@@ -231,7 +222,7 @@ TEST(Recovery, BobyqaRecoversMuMinFromRotationRatesAndNuIsUnidentified) {
 TEST(Recovery, CeresRecoversMuMinFromRotationRates) {
   const Problem& p = Rotation();
   const Objective objective(p.scene, p.release, p.observations,
-                            {Free("medium_hard", GroundField::kMuMin, kLower, kUpper)},
+                            {Spec("medium_hard", GroundField::kMuMin, kLower, kUpper)},
                             TwoThreads());
   ExpectRecovered(objective, p, "ceres");
 }
@@ -277,7 +268,7 @@ const Problem& Tirol() {
 std::vector<ParameterSpec> TirolMuMin() {
   std::vector<ParameterSpec> specs;
   for (const char* category : kTirolCategories)
-    specs.push_back(Free(category, GroundField::kMuMin, kLower, kUpper, "mu_min"));
+    specs.push_back(Spec(category, GroundField::kMuMin, kLower, kUpper, "mu_min"));
   return specs;
 }
 
