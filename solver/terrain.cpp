@@ -107,11 +107,12 @@ bool Terrain::PlaneAround(double x_m, double y_m, double r_m, LocalPlane* out) c
       const double dx = g.x0_m + i * g.dx_m - x_m;
       const double d =
           std::abs(row[i] - (out->at.height_m + out->slope_x * dx + out->slope_y * dy));
-      if (!(d <= deviation)) deviation = d;  // also takes NaN (nodata), which fails below
+      if (std::isnan(d)) return false;  // a nodata node in the box: no bound
+      deviation = std::max(deviation, d);
     }
   }
   out->deviation_m = deviation;
-  return !std::isnan(deviation);
+  return true;
 }
 
 bool Terrain::MaxAbovePlane(const Box& box, const Plane& plane, double* above_m) const {

@@ -44,6 +44,15 @@ TEST(Terrain, OutsideAndNodataAreReported) {
   EXPECT_FALSE(holed.Sample(13, 23, &s));  // cell (1, 1) touches node (2, 2)
   Terrain::LocalPlane plane;
   EXPECT_FALSE(holed.PlaneAround(12.5, 22.5, 0.2, &plane));  // cell (1, 1) is in the box
+  // A nodata node anywhere in the box, also before finite nodes in the scan and away from the
+  // centre's cell: 5 x 5 flat nodes 2 m apart, the box of (5, 5) +- 2.9 m spans nodes 1 .. 4, and
+  // node (2, 1) is nodata.
+  Heightfield flat;
+  flat.grid = {5, 5, 0.0, 0.0, 2.0, 2.0};
+  flat.z_m.assign(25, 0.0);
+  ASSERT_TRUE(Terrain(flat, 0).PlaneAround(5, 5, 2.9, &plane));
+  flat.z_m[1 * 5 + 2] = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_FALSE(Terrain(flat, 0).PlaneAround(5, 5, 2.9, &plane));
 }
 
 TEST(Terrain, LocalPlaneBoundsTheTerrainInTheBox) {
