@@ -26,7 +26,7 @@ rasters = ["speed", "energy", "jump_height", "passages", "deposits", "reach_prob
 percentiles = [50, 95, 99]
 geopackage = true
 )",
-                                                                    R"([evaluation_lines]
+                                                                R"([evaluation_lines]
 lines = [[[5, -6], [5, 6]], [[6, -6], [6, 0], [6, 6]]]
 names = ["barrier A", "net, lower"]
 )");
@@ -66,17 +66,22 @@ class MergeCommand : public ::testing::Test {
     for (const fs::path& p : parts) command.append(" ").append(p.string());
     return RunCommand(Talus(command + " --out " + (dir_ / out).string()), log);
   }
+  // The whole run in one process (2 threads) into <dir>/single; its outputs without timings.
+  std::map<std::string, std::string> SingleRun() {
+    std::string log;
+    EXPECT_EQ(RunCommand(Talus("simulate " + scene_.string() + " --out " +
+                               (dir_ / "single").string() + " --threads 2"),
+                         &log),
+              0)
+        << log;
+    return OutputsWithoutTimings(dir_ / "single");
+  }
   fs::path dir_, scene_;
 };
 
 TEST_F(MergeCommand, AnySplitInAnyOrderGivesTheSingleRunsBytes) {
   std::string log;
-  ASSERT_EQ(RunCommand(Talus("simulate " + scene_.string() + " --out " +
-                             (dir_ / "single").string() + " --threads 2"),
-                       &log),
-            0)
-      << log;
-  const auto single = OutputsWithoutTimings(dir_ / "single");
+  const auto single = SingleRun();
   // 3 x (max, mean, p50, p95, p99) + 3 count rasters + 8 files: every output is compared
   ASSERT_EQ(single.size(), 26u);
   // Some rocks cross, and not every one: the rows to merge are not trivial.
@@ -119,12 +124,7 @@ rasters = ["speed", "passages", "reach_probability"]
 raster_format = "cog"
 )");
   std::string log;
-  ASSERT_EQ(RunCommand(Talus("simulate " + scene_.string() + " --out " +
-                             (dir_ / "single").string() + " --threads 2"),
-                       &log),
-            0)
-      << log;
-  const auto single = OutputsWithoutTimings(dir_ / "single");
+  const auto single = SingleRun();
   EXPECT_NE(single.at("summary.json").find("\"rocks\": 9"), std::string::npos)
       << single.at("summary.json");
   ASSERT_EQ(Merge({Part("4:9"), Part("0:4", 2)}, &log), 0) << log;

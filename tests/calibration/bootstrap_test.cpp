@@ -20,12 +20,7 @@ namespace talus::calibration {
 namespace {
 
 ParameterSpec MuMin(double lower, double upper) {
-  ParameterSpec s;
-  s.category = "medium_hard";
-  s.field = GroundField::kMuMin;
-  s.lower = lower;
-  s.upper = upper;
-  return s;
+  return testing::Spec("medium_hard", GroundField::kMuMin, lower, upper);
 }
 
 TEST(ResampleCounts, EachResampleDrawsEveryGroupCountOnceOnAverageAndIsSeeded) {

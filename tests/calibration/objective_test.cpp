@@ -14,12 +14,7 @@ namespace talus::calibration {
 namespace {
 
 ParameterSpec MuMin(double lower = 0.1, double upper = 0.9) {
-  ParameterSpec s;
-  s.category = "medium_hard";
-  s.field = GroundField::kMuMin;
-  s.lower = lower;
-  s.upper = upper;
-  return s;
+  return testing::Spec("medium_hard", GroundField::kMuMin, lower, upper);
 }
 
 ObjectiveOptions Threads(int threads) {

@@ -23,12 +23,7 @@ constexpr int kRuns = 24;
 constexpr long kRocks = 5;
 
 ParameterSpec Free(GroundField field, double lower, double upper) {
-  ParameterSpec s;
-  s.category = "medium_hard";
-  s.field = field;
-  s.lower = lower;
-  s.upper = upper;
-  return s;
+  return testing::Spec("medium_hard", field, lower, upper);
 }
 
 const testing::SyntheticRunouts& Problem() {

@@ -7,7 +7,7 @@
 #include <cmath>
 
 #include "common/error.hpp"
-#include "fixtures.hpp"
+#include "tests/calibration/fixtures.hpp"
 
 namespace talus::calibration {
 namespace {
