@@ -436,6 +436,25 @@ TEST(CalibrateMpi, TwoRanksGiveTheOneProcessCalibration) {
   EXPECT_EQ(WithoutTimings(one), WithoutTimings(two));
 }
 
+// The bootstrap over runs and the refits with other release seeds under mpirun -n 2: every refit's
+// evaluations are divided between the ranks as the fit's are, so the intervals, standard errors and
+// the combined uncertainty equal the one-process calibration's.
+TEST(CalibrateMpi, TwoRanksGiveTheOneProcessBootstrapAndSeedRefits) {
+  const fs::path dir = MakeEvent("mpi_uncertainty");
+  Write(dir / "cal.toml", std::string(kGood) + "[uncertainty]\nbootstrap = 10\nseeds = 2\n");
+  std::string output;
+  const std::string args = " calibrate " + (dir / "cal.toml").string() + " --threads 1 --out ";
+  ASSERT_EQ(RunCommand(TALUS_BINARY + args + (dir / "one").string(), &output), 0) << output;
+  ASSERT_EQ(RunCommand(MpiRun("-n 2 ") + TALUS_BINARY + args + (dir / "two").string(), &output), 0)
+      << output;
+  EXPECT_NE(output.find("2 MPI ranks"), std::string::npos) << output;
+  const auto one = nlohmann::json::parse(Slurp(dir / "one" / "calibration.json"));
+  const auto two = nlohmann::json::parse(Slurp(dir / "two" / "calibration.json"));
+  ASSERT_TRUE(one["uncertainty"]["bootstrap"].is_object()) << one.dump(2);
+  ASSERT_TRUE(one["uncertainty"]["seeds"].is_object()) << one.dump(2);
+  EXPECT_EQ(WithoutTimings(one), WithoutTimings(two));
+}
+
 // A rank that cannot load the calibration ends every rank with one message, before any rock runs;
 // ranks started with different calibrations are refused.
 TEST(CalibrateMpi, ARankThatFailsOrDiffersEndsTheRunWithOneMessage) {
