@@ -411,17 +411,25 @@ nlohmann::json WithoutTimings(nlohmann::json j) {
   return j;
 }
 
+// Runs CALIBRATION (the calibration file's text) in one process into dir/one and with mpirun -n 2
+// into dir/two, both on one thread per process; returns the two-rank run's output.
+std::string RunInOneProcessAndOnTwoRanks(const fs::path& dir, const std::string& calibration) {
+  Write(dir / "cal.toml", calibration);
+  std::string output;
+  const std::string args = " calibrate " + (dir / "cal.toml").string() + " --threads 1 --out ";
+  EXPECT_EQ(RunCommand(TALUS_BINARY + args + (dir / "one").string(), &output), 0) << output;
+  EXPECT_EQ(RunCommand(MpiRun("-n 2 ") + TALUS_BINARY + args + (dir / "two").string(), &output), 0)
+      << output;
+  EXPECT_NE(output.find("2 MPI ranks"), std::string::npos) << output;
+  return output;
+}
+
 // mpirun -n 2 talus calibrate: each evaluation's rocks divided between the ranks give the
 // one-process calibration: the same evaluations, optimum, profiles and files (timings aside).
 TEST(CalibrateMpi, TwoRanksGiveTheOneProcessCalibration) {
   const fs::path dir = MakeEvent("mpi");
-  Write(dir / "cal.toml", kGood);
-  std::string output;
-  const std::string args = " calibrate " + (dir / "cal.toml").string() + " --threads 1 --out ";
-  ASSERT_EQ(RunCommand(TALUS_BINARY + args + (dir / "one").string(), &output), 0) << output;
-  ASSERT_EQ(RunCommand(MpiRun("-n 2 ") + TALUS_BINARY + args + (dir / "two").string(), &output), 0)
-      << output;
-  EXPECT_NE(output.find("2 MPI ranks"), std::string::npos) << output;
+  const std::string output = RunInOneProcessAndOnTwoRanks(dir, kGood);
+  ASSERT_FALSE(HasFailure());
   // Rank 0 alone tells the story.
   std::size_t reports = 0;
   for (std::size_t at = output.find("Calibration report"); at != std::string::npos;
@@ -441,13 +449,9 @@ TEST(CalibrateMpi, TwoRanksGiveTheOneProcessCalibration) {
 // the combined uncertainty equal the one-process calibration's.
 TEST(CalibrateMpi, TwoRanksGiveTheOneProcessBootstrapAndSeedRefits) {
   const fs::path dir = MakeEvent("mpi_uncertainty");
-  Write(dir / "cal.toml", std::string(kGood) + "[uncertainty]\nbootstrap = 10\nseeds = 2\n");
-  std::string output;
-  const std::string args = " calibrate " + (dir / "cal.toml").string() + " --threads 1 --out ";
-  ASSERT_EQ(RunCommand(TALUS_BINARY + args + (dir / "one").string(), &output), 0) << output;
-  ASSERT_EQ(RunCommand(MpiRun("-n 2 ") + TALUS_BINARY + args + (dir / "two").string(), &output), 0)
-      << output;
-  EXPECT_NE(output.find("2 MPI ranks"), std::string::npos) << output;
+  RunInOneProcessAndOnTwoRanks(dir,
+                               std::string(kGood) + "[uncertainty]\nbootstrap = 10\nseeds = 2\n");
+  ASSERT_FALSE(HasFailure());
   const auto one = nlohmann::json::parse(Slurp(dir / "one" / "calibration.json"));
   const auto two = nlohmann::json::parse(Slurp(dir / "two" / "calibration.json"));
   ASSERT_TRUE(one["uncertainty"]["bootstrap"].is_object()) << one.dump(2);
