@@ -2,6 +2,7 @@
 
 #include <ceres/ceres.h>
 
+#include <Eigen/QR>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -13,7 +14,9 @@
 #include <optional>
 #include <sstream>
 #include <stdexcept>
+#include <utility>
 
+#include "calibration/designs.hpp"
 #include "calibration/evaluator.hpp"
 #include "calibration/report_text.hpp"
 
@@ -21,7 +24,16 @@ namespace talus::calibration {
 namespace {
 
 using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+constexpr double kInf = std::numeric_limits<double>::infinity();
 using EvaluateFn = std::function<std::optional<Evaluation>(const Eigen::VectorXd&)>;
+
+// The pair u -+ h e_j of a central difference, moved inside [0, 1] at a bound.
+std::pair<Eigen::VectorXd, Eigen::VectorXd> CentralPair(const Eigen::VectorXd& u, int j, double h) {
+  Eigen::VectorXd lo = u, hi = u;
+  lo[j] = std::max(0.0, u[j] - h);
+  hi[j] = std::min(1.0, u[j] + h);
+  return {lo, hi};
+}
 
 // The residual vector with central differences of absolute step h in unit coordinates. A point
 // that cannot be evaluated (infeasible, budget spent, interrupted) makes Ceres reject the step.
@@ -42,10 +54,8 @@ class ResidualCost final : public ceres::CostFunction {
     if (!jacobians || !jacobians[0]) return true;
     Eigen::Map<RowMajor> jacobian(jacobians[0], m_, n_);
     for (int j = 0; j < n_; ++j) {
-      // The pair u -+ h e_j, moved inside [0, 1] at a bound; u itself where a side is infeasible.
-      Eigen::VectorXd lo = u, hi = u;
-      lo[j] = std::max(0.0, u[j] - h_);
-      hi[j] = std::min(1.0, u[j] + h_);
+      // u itself where a side is infeasible.
+      auto [lo, hi] = CentralPair(u, j, h_);
       std::optional<Evaluation> a = lo[j] == u[j] ? e : evaluate_(lo);
       std::optional<Evaluation> b = hi[j] == u[j] ? e : evaluate_(hi);
       if (!a && !b) return false;
@@ -62,6 +72,29 @@ class ResidualCost final : public ceres::CostFunction {
   int n_, m_;
   double h_;
 };
+
+// (J^T J)_jj of the central difference of step h at u, and the stencil's width w (2h inside the
+// box; u itself stands in for an infeasible side). `at` is the evaluation at u.
+struct Difference {
+  double width = 0, jtj = 0;
+};
+Difference MeasureDifference(const Objective& objective, const Evaluation& at, int j, double h,
+                             int* evaluations) {
+  auto [lo, hi] = CentralPair(at.u, j, h);
+  const auto side = [&](Eigen::VectorXd& v) {
+    if (v[j] == at.u[j]) return at.residuals;
+    ++*evaluations;
+    const Evaluation e = objective.Evaluate(v);
+    if (e.feasible) return e.residuals;
+    v = at.u;
+    return at.residuals;
+  };
+  const Eigen::VectorXd a = side(lo), b = side(hi);
+  Difference d;
+  d.width = hi[j] - lo[j];
+  if (d.width > 0) d.jtj = ((b - a) / d.width).squaredNorm();
+  return d;
+}
 
 // Stops Ceres once the evaluator has stopped (budget, time, an exception to rethrow).
 class BudgetCallback final : public ceres::IterationCallback {
@@ -88,6 +121,56 @@ class QuietCeresLog {
   int level_;
 };
 
+// The fit is the best point where a start's Levenberg-Marquardt ended (its accepted iterates only
+// decrease the cost), not the best evaluation: the difference points around an iterate were
+// evaluated to estimate a derivative, and on a rough objective the lowest of them is the lowest
+// draw of its noise, not a better fit (on the Tyrol DEM one such point, a step below where Ceres
+// stopped, was reported as the fit).
+void KeepBestIterate(Summary& summary) {
+  std::optional<Evaluation> best;
+  for (const StartRecord& start : summary.starts)
+    for (const Evaluation& e : summary.history)
+      if (e.u == start.best_u && e.feasible && (!best || e.value < best->value)) best = e;
+  if (best) summary.best = *best;
+}
+
+// Where Levenberg-Marquardt starts when the Jacobian is noise-dominated (StepChoice): the
+// minimiser in the box of the residuals' linear model r(u) ~ a + B (u - c) fitted by least squares
+// to a design -- `start` and 4 (n + 1) - 1 points of the optimiser's start design --, a response
+// surface (Box & Wilson 1951) in Gauss-Newton form. A difference quotient over one stencil sees
+// the noise of two points; the regression's slope averages it over the design and the box, so the
+// model sees a trend that no local difference resolves. Ceres then goes on from there. The design's
+// evaluations are in the history (and the budget); `start` when too few are feasible.
+Eigen::VectorXd ResponseSurfaceStart(const Objective& objective, const OptimizerOptions& options,
+                                     const Eigen::VectorXd& start, Evaluator& evaluate) {
+  const int n = objective.dimension();
+  OptimizerOptions design = options;
+  design.start = start;
+  design.starts = 4 * (n + 1);
+  if (n > kMaxSobolDimension) design.start_design = "lhs";
+  std::vector<Evaluation> points;
+  for (const Eigen::VectorXd& u : StartPoints(objective, design)) {
+    const std::optional<Evaluation> e = evaluate.TryEvaluate(u);
+    if (e && e->feasible) points.push_back(*e);
+  }
+  const auto k = static_cast<Eigen::Index>(points.size());
+  if (k < n + 2) return start;
+  Eigen::VectorXd centre = Eigen::VectorXd::Zero(n);
+  for (const Evaluation& e : points) centre += e.u / double(k);
+  Eigen::MatrixXd x(k, n + 1), y(k, objective.residual_count());
+  for (Eigen::Index i = 0; i < k; ++i) {
+    const Evaluation& e = points[static_cast<std::size_t>(i)];
+    x(i, 0) = 1;
+    x.row(i).tail(n) = (e.u - centre).transpose();
+    y.row(i) = e.residuals.transpose();
+  }
+  const Eigen::MatrixXd model = x.colPivHouseholderQr().solve(y);  // (n + 1) x m
+  const Eigen::VectorXd a = model.row(0).transpose();
+  const Eigen::MatrixXd b = model.bottomRows(n).transpose();
+  const Eigen::VectorXd step = b.colPivHouseholderQr().solve(-a);
+  return (centre + step).cwiseMax(0.0).cwiseMin(1.0);
+}
+
 }  // namespace
 
 Summary CalibrateLeastSquares(const Objective& objective, const OptimizerOptions& options) {
@@ -101,10 +184,14 @@ Summary CalibrateLeastSquares(const Objective& objective, const OptimizerOptions
   evaluate(starts.front());
 
   summary.fd_step = options.fd_step;
+  Eigen::VectorXd first = starts.front();
   if (!(summary.fd_step > 0)) {
-    RoughnessOptions roughness;
-    roughness.seeds = 0;
-    summary.fd_step = MeasureRoughness(objective, starts.front(), roughness).fd_step;
+    const StepChoice step = ChooseFiniteDifferenceStep(objective, starts.front());
+    summary.fd_step = step.step;
+    if (step.noise_dominated) {
+      summary.fd_shrink = step.shrink();
+      first = ResponseSurfaceStart(objective, options, starts.front(), evaluate);
+    }
   }
 
   ceres::TerminationType last = ceres::CONVERGENCE;
@@ -112,7 +199,8 @@ Summary CalibrateLeastSquares(const Objective& objective, const OptimizerOptions
   for (std::size_t s = 0; s < starts.size() && !evaluate.stopped(); ++s) {
     evaluate.set_start(static_cast<int>(s));
     const int before = summary.evaluations();
-    std::vector<double> x(starts[s].data(), starts[s].data() + n);
+    const Eigen::VectorXd& x0 = s == 0 ? first : starts[s];
+    std::vector<double> x(x0.data(), x0.data() + n);
     ceres::Problem problem;
     problem.AddResidualBlock(
         new ResidualCost([&](const Eigen::VectorXd& u) { return evaluate.TryEvaluate(u); }, n, m,
@@ -140,7 +228,7 @@ Summary CalibrateLeastSquares(const Objective& objective, const OptimizerOptions
     last_message = result.message;
 
     StartRecord record;
-    record.u0 = starts[s];
+    record.u0 = x0;
     record.best_u = Eigen::Map<const Eigen::VectorXd>(x.data(), n);
     record.best_value = 2 * result.final_cost;  // Ceres' cost is half the sum of squares
     record.evaluations = summary.evaluations() - before;
@@ -149,10 +237,83 @@ Summary CalibrateLeastSquares(const Objective& objective, const OptimizerOptions
     summary.starts.push_back(record);
   }
 
+  KeepBestIterate(summary);
   evaluate.Finish(evaluate.out_of_evaluations(),
                   last == ceres::CONVERGENCE || last == ceres::USER_SUCCESS, last_message,
                   "Ceres stopped: " + last_message);
   return summary;
+}
+
+bool StepChoiceOptions::IsValid(std::string* why) const {
+  std::ostringstream msg;
+  if (!(small > 0 && small < large && large <= 0.5))
+    msg << "steps small = " << small << " and large = " << large
+        << " must satisfy 0 < small < large <= 0.5";
+  else if (!(noise_share > 0))
+    msg << "noise_share = " << noise_share << " must be > 0";
+  else if (!(max_step >= small && max_step <= 0.5))
+    msg << "max_step = " << max_step << " must be in [small, 0.5]";
+  if (msg.str().empty()) return true;
+  if (why) *why = msg.str();
+  return false;
+}
+
+StepChoice ChooseFiniteDifferenceStep(const Objective& objective, const Eigen::VectorXd& u,
+                                      const StepChoiceOptions& options) {
+  std::string why;
+  if (!options.IsValid(&why)) throw std::invalid_argument("ChooseFiniteDifferenceStep: " + why);
+  StepChoice out;
+  const Evaluation at = objective.Evaluate(u);
+  out.evaluations = 1;
+  out.step = options.small;
+  if (!at.feasible) {  // nothing to measure: Ceres cannot start here either
+    out.step = options.large;
+    return out;
+  }
+  for (int j = 0; j < objective.dimension(); ++j) {
+    const Difference d1 = MeasureDifference(objective, at, j, options.small, &out.evaluations);
+    const Difference d2 = MeasureDifference(objective, at, j, options.large, &out.evaluations);
+    // D(w) = S + N / w^2 through the two points.
+    double noise = 0, signal = d2.jtj;
+    const double x1 = d1.width > 0 ? 1 / (d1.width * d1.width) : 0;
+    const double x2 = d2.width > 0 ? 1 / (d2.width * d2.width) : 0;
+    if (x1 > x2) {
+      noise = std::max(0.0, (d1.jtj - d2.jtj) / (x1 - x2));
+      signal = d2.jtj - noise * x2;
+    }
+    out.noise.push_back(noise);
+    out.signal.push_back(signal);
+    if (noise == 0) continue;  // the smaller step sees no noise: it will do
+    const double h = signal > 0 ? std::sqrt(noise / (options.noise_share * signal)) / 2 : kInf;
+    if (h > options.max_step) out.noise_dominated = true;
+    out.step = std::max(out.step, std::min(h, options.max_step));
+  }
+  return out;
+}
+
+double StepChoice::shrink() const {
+  double out = 1;
+  const double w = 2 * step;
+  for (std::size_t j = 0; j < signal.size(); ++j)
+    out = std::min(out, signal[j] > 0 ? 1 / (1 + noise[j] / (signal[j] * w * w)) : 0.0);
+  return out;
+}
+
+std::string StepChoice::Report() const {
+  std::string out;
+  char line[256];
+  std::snprintf(line, sizeof line,
+                "Finite-difference step %.3g (%d evaluations); Gauss-Newton steps shortened to "
+                "%.2g%s\n",
+                step, evaluations, shrink(),
+                noise_dominated ? " (noise-dominated at every step within the box)" : "");
+  out += line;
+  for (std::size_t j = 0; j < signal.size(); ++j) {
+    std::snprintf(line, sizeof line, "  coordinate %zu: J^T J = %.4g + %.4g / w^2\n", j, signal[j],
+                  noise[j]);
+    out += line;
+  }
+  return out;
 }
 
 bool UncertaintyOptions::IsValid(std::string* why) const {

@@ -31,10 +31,54 @@
 
 namespace talus::calibration {
 
+// The central-difference step of the Gauss-Newton Jacobian on a rough objective. With residuals
+// r(u) = r_smooth(u) + e(u), e the noise of which way rocks turn (variance s_i^2, independent
+// between points a step apart), the difference quotient over a stencil of width w (2h inside the
+// box) has E[(J^T J)_jj] = S_j + N_j / w^2: S_j = |d r_smooth / d u_j|^2 is the curvature
+// Gauss-Newton needs (f'' ~ 2 S), N_j = 2 sum_i s_i^2 the noise. The noise term inflates J^T J, so
+// the Gauss-Newton step -(J^T J)^-1 J^T r shrinks by 1 / (1 + N / (S w^2)) and Levenberg-Marquardt
+// stalls where the step falls below its parameter tolerance. Measuring (J^T J)_jj at two widths
+// gives S_j and N_j (two equations); the step is the smallest h with N_j / (2h)^2 <= noise_share *
+// S_j for every coordinate, within [small, max_step]. The model needs the noise of the stencil's
+// two points to be independent, which common random numbers break at small steps (few rocks turn
+// otherwise): measured on the Tyrol run-outs, S was 0.45 from h = 0.05 and 0.2 (a scan along the
+// coordinate gave 0.4 to 0.6) but 1.2 from 0.01 and 0.2. When even max_step leaves the noise term
+// above that share, the step is max_step and `noise_dominated` is set: Gauss-Newton steps are
+// shortened by shrink() and Ceres may stop short of the optimum by its parameter tolerance; more
+// rocks per run lower N.
+struct StepChoiceOptions {
+  double small = 0.05, large = 0.2;  // the two measured steps h (unit coordinates)
+  double noise_share = 0.25;         // largest N / (S w^2) accepted: the step shrinks to 0.8
+  double max_step = 0.25;            // as OptimizerOptions::fd_step allows
+  bool IsValid(std::string* why) const;
+};
+
+struct StepChoice {
+  double step = kNaN;                 // the chosen h, unit coordinates
+  std::vector<double> signal, noise;  // per coordinate: S_j and N_j as above
+  bool noise_dominated = false;       // even max_step leaves the noise above its share
+  int evaluations = 0;
+  // The factor 1 / (1 + N_j / (S_j w^2)) by which the Gauss-Newton step along coordinate j is
+  // shortened at the chosen step (w = 2 step), the smallest over the coordinates.
+  double shrink() const;
+  std::string Report() const;  // a few lines for people
+};
+
+// The step at u, from 1 + 4n evaluations of the objective (not a calibration's history). Throws
+// what the objective throws, and std::invalid_argument for invalid options.
+StepChoice ChooseFiniteDifferenceStep(const Objective& objective, const Eigen::VectorXd& u,
+                                      const StepChoiceOptions& options = {});
+
 // options.algorithm == "ceres": Levenberg-Marquardt with bounds [0, 1] on every coordinate, from
 // each start in turn (StartPoints), within the budget of evaluations (each Jacobian costs 2n) and
-// time. options.fd_step = 0: the step is MeasureRoughness's recommendation at the first start
-// (its evaluations are not in the history). Called by Calibrate, which checks the options.
+// time. options.fd_step = 0: the step is ChooseFiniteDifferenceStep's at the first start (its
+// evaluations are not in the history); where it finds the Jacobian noise-dominated, the first
+// start's Levenberg-Marquardt begins at the minimiser of a response surface (the residuals' linear
+// model fitted by least squares to the start and 4 (n + 1) - 1 points of the start design, whose
+// evaluations are in the history): a trend that no local difference resolves is resolved there.
+// The fit (Summary::best) is the best point where a start's Levenberg-Marquardt ended, not the
+// best evaluation: on a rough objective the lowest difference point is the lowest draw of noise.
+// Called by Calibrate, which checks the options.
 Summary CalibrateLeastSquares(const Objective& objective, const OptimizerOptions& options);
 
 struct UncertaintyOptions {

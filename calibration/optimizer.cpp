@@ -217,6 +217,13 @@ std::string Summary::FullReport() const {
                   fd_step);
     out += line;
   }
+  if (!std::isnan(fd_shrink)) {
+    std::snprintf(line, sizeof line,
+                  "  %-28s noise-dominated: Gauss-Newton steps shortened to %.2g (more rocks per "
+                  "run lower the noise)\n",
+                  "Jacobian", fd_shrink);
+    out += line;
+  }
   out += "\n  start  evaluations  best objective  result\n";
   for (std::size_t s = 0; s < starts.size(); ++s) {
     std::snprintf(line, sizeof line, "  %5zu  %11d  %14s  %s\n", s, starts[s].evaluations,

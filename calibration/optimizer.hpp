@@ -42,8 +42,8 @@ struct OptimizerOptions {
   std::string start_design = "sobol";    // or "lhs"
   std::uint64_t seed = 1;                // designs and the stochastic methods (CRS2-LM, ISRES)
   std::optional<Eigen::VectorXd> start;  // unit coordinates; default: the scene's table, clamped
-  // Ceres: the central-difference step in unit coordinates (fraction of each range); 0: measured
-  // at the start point (MeasureRoughness's recommended step, above the objective's roughness).
+  // Ceres: the central-difference step in unit coordinates (fraction of each range); 0: chosen at
+  // the start point from the Jacobian's measured noise and curvature (ChooseFiniteDifferenceStep).
   double fd_step = 0;
   // Evaluations of an earlier, interrupted run of the same calibration (a checkpoint), served in
   // order instead of running rocks: the optimiser retraces its path bit for bit and goes on from
@@ -86,6 +86,10 @@ struct Summary {
   int cache_hits = 0;     // points asked for twice (answered from the history, not re-run)
   int replayed = 0;       // evaluations served from OptimizerOptions::replay
   double fd_step = kNaN;  // Ceres: the central-difference step used (unit coordinates)
+  // Ceres with the step chosen (fd_step = 0) when even the largest step left the Jacobian
+  // noise-dominated (least_squares.hpp, StepChoice): the factor its Gauss-Newton steps were
+  // shortened by (below 0.8); NaN otherwise.
+  double fd_shrink = kNaN;
   double wall_time_s = 0;
 
   int evaluations() const { return static_cast<int>(history.size()); }

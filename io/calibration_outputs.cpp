@@ -248,6 +248,7 @@ std::string CalibrationJson(const CalibrationFile& file, const Objective& object
             {"cache_hits", s.cache_hits},
             {"replayed_from_checkpoint", s.replayed},
             {"finite_difference_step", Number(s.fd_step)},
+            {"finite_difference_shrink", Number(s.fd_shrink)},
             {"starts", starts},
             {"timings",
              {{"calibration_s", s.wall_time_s},

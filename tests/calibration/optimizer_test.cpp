@@ -48,6 +48,23 @@ testing::DataError MeasuredDataError() {
 // (1e-3 of the 0.1 .. 0.9 range). sigma and dm/dmu are measured here (central difference over
 // +-0.05 around the truth), not assumed. Measured: fitted 0.5215 in 12 evaluations; sigma 0.97 m,
 // dm/dmu -8.1 m, standard error 0.027, tolerance 0.081.
+TEST(Calibrate, TheStepChoiceDefaultsAreValidAndBadOnesNamed) {
+  std::string why;
+  EXPECT_TRUE(StepChoiceOptions().IsValid(&why)) << why;
+  StepChoiceOptions o;
+  o.small = 0.3;  // above large
+  EXPECT_FALSE(o.IsValid(&why));
+  EXPECT_NE(why.find("small = 0.3"), std::string::npos) << why;
+  o = StepChoiceOptions();
+  o.noise_share = 0;
+  EXPECT_FALSE(o.IsValid(&why));
+  EXPECT_NE(why.find("noise_share"), std::string::npos) << why;
+  o = StepChoiceOptions();
+  o.max_step = 0.01;  // below small
+  EXPECT_FALSE(o.IsValid(&why));
+  EXPECT_NE(why.find("max_step"), std::string::npos) << why;
+}
+
 TEST(Calibrate, BobyqaRecoversMuMinFromADistantStart) {
   const auto& p = Problem();
   ObjectiveOptions objective_options;
