@@ -32,8 +32,10 @@ DetectResult DetectContacts(const Scene& scene, const RockShape& rock, const Roc
   // Vertical height of a point above the local plane is m . x + offset with m = (-h_x, -h_y, 1).
   // Over the horizon it changes at the rate m . (v + w x arm) = m . v + b . (m_body x W): the
   // prediction is linear in time, as the solver's contact velocities are.
+  // The box holds every vertex at the midpoint and at its predicted end point.
+  const double reach = radius + horizon_s * (velocity_m_s.norm() + radius * omega_rad_s.norm());
   Terrain::LocalPlane plane;
-  const bool local = terrain.PlaneAround(r.x(), r.y(), radius, &plane);
+  const bool local = terrain.PlaneAround(r.x(), r.y(), reach, &plane);
   const Eigen::Vector3d m(-plane.slope_x, -plane.slope_y, 1.0);
   const double centre_height = r.z() - plane.at.height_m;  // m . (r - (x, y, h)) as x, y match
   const double centre_rate = m.dot(velocity_m_s);

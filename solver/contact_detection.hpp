@@ -30,8 +30,9 @@ inline double PredictionHorizon(const SolverOptions& options) {
 //   allowed_depth_m (>= 0), so that the solver's law gap_m + horizon gamma_N,E >= 0 lets the
 //   vertex sink no deeper than allowed_depth_m by the next midpoint.
 // A rock whose bounding sphere clears the terrain's local plane, over the horizon, by more than
-// the terrain departs from that plane costs one test (kClear); otherwise only the vertices within
-// that departure of the plane are tested against the terrain itself. Returns kOutsideDomain when a
+// the terrain departs from that plane (Terrain::PlaneAround, over the box that the sphere reaches
+// within the horizon) costs one test (kClear); otherwise only the vertices within that departure
+// of the plane are tested against the terrain itself. Returns kOutsideDomain when a
 // vertex that may touch lies outside the DEM or over nodata.
 DetectResult DetectContacts(const Scene& scene, const RockShape& rock, const RockState& mid,
                             const Eigen::Matrix3d& rotation, const Eigen::Vector3d& velocity_m_s,

@@ -6,6 +6,13 @@
 #include <sstream>
 
 namespace talus {
+namespace {
+
+// Allowance on LocalPlane::deviation_m for the rounding of heights evaluated at different points
+// (a few units in the last place of heights up to 1e4 m), m.
+constexpr double kPlaneRounding_m = 1e-6;
+
+}  // namespace
 
 bool GridGeometry::IsValid(std::string* why) const {
   std::ostringstream msg;
@@ -88,30 +95,43 @@ int Terrain::GroundAt(double x_m, double y_m) const {
   return index == GroundGrid::kNoGround ? default_ground_ : index;
 }
 
+// The bilinear height of a cell, less a plane, is bilinear in the cell's coordinates: over a
+// rectangle of the cell it is largest and smallest at the rectangle's corners.
 bool Terrain::PlaneAround(double x_m, double y_m, double r_m, LocalPlane* out) const {
   const GridGeometry& g = grid_;
-  const double i_lo = std::floor((x_m - r_m - g.x0_m) * inv_dx_);
-  const double i_hi = std::ceil((x_m + r_m - g.x0_m) * inv_dx_);
-  const double j_lo = std::floor((y_m - r_m - g.y0_m) * inv_dy_);
-  const double j_hi = std::ceil((y_m + r_m - g.y0_m) * inv_dy_);
-  if (!(i_lo >= 0 && j_lo >= 0 && i_hi <= g.nx - 1 && j_hi <= g.ny - 1)) return false;
+  const double fx_lo = (x_m - r_m - g.x0_m) * inv_dx_, fx_hi = (x_m + r_m - g.x0_m) * inv_dx_;
+  const double fy_lo = (y_m - r_m - g.y0_m) * inv_dy_, fy_hi = (y_m + r_m - g.y0_m) * inv_dy_;
+  if (!(fx_lo >= 0 && fy_lo >= 0 && fx_hi <= g.nx - 1 && fy_hi <= g.ny - 1)) return false;
   if (!Sample(x_m, y_m, &out->at)) return false;
   const Eigen::Vector3d& n = out->at.normal;
   out->slope_x = -n.x() / n.z();
   out->slope_y = -n.y() / n.z();
+  const int i_lo = std::min(static_cast<int>(fx_lo), g.nx - 2);
+  const int i_hi = std::min(static_cast<int>(fx_hi), g.nx - 2);
+  const int j_lo = std::min(static_cast<int>(fy_lo), g.ny - 2);
+  const int j_hi = std::min(static_cast<int>(fy_hi), g.ny - 2);
   double deviation = 0;
-  for (int j = static_cast<int>(j_lo); j <= static_cast<int>(j_hi); ++j) {
-    const double* row = z_ + static_cast<std::size_t>(j) * g.nx;
-    const double dy = g.y0_m + j * g.dy_m - y_m;
-    for (int i = static_cast<int>(i_lo); i <= static_cast<int>(i_hi); ++i) {
-      const double dx = g.x0_m + i * g.dx_m - x_m;
-      const double d =
-          std::abs(row[i] - (out->at.height_m + out->slope_x * dx + out->slope_y * dy));
-      if (std::isnan(d)) return false;  // a nodata node in the box: no bound
-      deviation = std::max(deviation, d);
+  for (int j = j_lo; j <= j_hi; ++j) {
+    const double* row0 = z_ + static_cast<std::size_t>(j) * g.nx;
+    const double* row1 = row0 + g.nx;
+    const double w_corners[2] = {std::max(fy_lo - j, 0.0), std::min(fy_hi - j, 1.0)};
+    for (int i = i_lo; i <= i_hi; ++i) {
+      const double z00 = row0[i], z10 = row0[i + 1], z01 = row1[i], z11 = row1[i + 1];
+      if (std::isnan(z00 + z10 + z01 + z11)) return false;  // a nodata corner: no bound
+      const double u_corners[2] = {std::max(fx_lo - i, 0.0), std::min(fx_hi - i, 1.0)};
+      for (double w : w_corners) {
+        const double dy = g.y0_m + (j + w) * g.dy_m - y_m;
+        for (double u : u_corners) {
+          const double lower = z00 + u * (z10 - z00);
+          const double upper = z01 + u * (z11 - z01);
+          const double dx = g.x0_m + (i + u) * g.dx_m - x_m;
+          const double plane = out->at.height_m + out->slope_x * dx + out->slope_y * dy;
+          deviation = std::max(deviation, std::abs(lower + w * (upper - lower) - plane));
+        }
+      }
     }
   }
-  out->deviation_m = deviation;
+  out->deviation_m = deviation + kPlaneRounding_m;
   return true;
 }
 

@@ -69,8 +69,10 @@ class Terrain {
 
   // The tangent plane of the terrain at (x, y) and how far the terrain departs from it, vertically,
   // anywhere in the box [x - r, x + r] x [y - r, y + r]: |h(p) - plane(p)| <= deviation_m there.
-  // (h - plane is the bilinear interpolant of its node values, so the largest node deviation of
-  // the cells covering the box bounds it.) False when the box reaches beyond the grid or nodata.
+  // In each cell that holds a point of the box, h - plane is bilinear, so its extremes over the
+  // part of the box in that cell are at that part's corners: deviation_m is the largest of those,
+  // the tightest such bound, plus 1e-6 m for rounding. False when the box reaches beyond the grid
+  // or a cell that holds a point of it has a nodata corner.
   struct LocalPlane {
     TerrainSample at;    // height and normal at (x, y)
     double slope_x = 0;  // dh/dx

@@ -13,7 +13,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <numbers>
+#include <vector>
 
 #include "scenes/scenes.hpp"
 #include "solver/random.hpp"
@@ -201,6 +203,78 @@ TEST(Burial, ThinSlabLandingFlatStopsAtTheSurface) {
     EXPECT_LT(run.max_depth_m, 0.05 * thickness) << "tilt " << tilt_deg;
     EXPECT_LT(run.energy_rise, EnergySlack(0.002)) << "tilt " << tilt_deg;
   }
+}
+
+// The vertices the contract of DetectContacts names, found by testing every vertex against the
+// terrain: closed (at or below it at the midpoint) or predicted (its end point after the horizon
+// deeper than allowed_depth_m along the terrain's normal there). In hull order.
+std::vector<int> VerticesThatTouch(const Scene& scene, const RockState& mid,
+                                   const Eigen::Matrix3d& rotation, const Eigen::Vector3d& v,
+                                   const Eigen::Vector3d& omega, double horizon_s,
+                                   double allowed_depth_m) {
+  std::vector<int> touching;
+  for (int k = 0; k < static_cast<int>(scene.rock.vertices_m.size()); ++k) {
+    const Eigen::Vector3d& b = scene.rock.vertices_m[k];
+    const Eigen::Vector3d x = mid.position_m + rotation * b;
+    double h = 0;
+    EXPECT_TRUE(scene.terrain.Height(x.x(), x.y(), &h));
+    const Eigen::Vector3d x_end = x + horizon_s * (v + rotation * omega.cross(b));
+    TerrainSample end;
+    if (x.z() <= h || (scene.terrain.Sample(x_end.x(), x_end.y(), &end) &&
+                       (x_end.z() - end.height_m) * end.normal.z() < -allowed_depth_m))
+      touching.push_back(k);
+  }
+  return touching;
+}
+
+TEST(Detection, SkipsOnlyVerticesThatCannotTouch) {
+  // DetectContacts tests only the vertices within the terrain's departure from its local plane
+  // (Terrain::PlaneAround over the box the rock reaches within the horizon). On rough terrain
+  // (5 m cells, heights varying by metres from node to node), for rocks near the ground, fast (up
+  // to 52 m/s) and spinning, with a 20 ms horizon (the prediction of a 20 ms step), so that
+  // predicted end points leave the bounding sphere's box by up to a metre, it must find exactly
+  // the vertices that testing every one finds. (With the box of the bounding sphere alone, 19 of
+  // these 4000 states missed a predicted contact.)
+  Heightfield hf;
+  hf.grid = {60, 60, 0.0, 0.0, 5.0, 5.0};
+  for (int j = 0; j < 60; ++j)
+    for (int i = 0; i < 60; ++i)
+      hf.z_m.push_back(-2.0 * i + 4 * std::sin(1.3 * i) * std::cos(0.7 * j) +
+                       0.8 * ((i * 7 + j * 13) % 5));
+  Scene scene;
+  scene.terrain = Terrain(hf, 0);
+  scene.rock = MakeRockShape(MakeBox(1.0, 0.8, 0.6), 2700);
+  const double horizon_s = 0.02, allowed_depth_m = 0.006;
+  StepWorkspace ws;
+  ws.Reset(scene.rock.vertices_m.size());
+  long contacts = 0, untouched = 0;
+  for (int k = 0; k < 4000; ++k) {
+    RockRandom random(11, k);
+    RockState mid;
+    mid.orientation = random.Orientation();
+    const double x = 20 + 250 * random.Uniform(), y = 20 + 250 * random.Uniform();
+    double h = 0;
+    ASSERT_TRUE(scene.terrain.Height(x, y, &h));
+    mid.position_m = {x, y, h + 1.5 * random.Uniform()};
+    const Eigen::Vector3d v = 60 * Eigen::Vector3d(random.Uniform() - 0.5, random.Uniform() - 0.5,
+                                                   random.Uniform() - 0.5);
+    const Eigen::Vector3d omega =
+        30 *
+        Eigen::Vector3d(random.Uniform() - 0.5, random.Uniform() - 0.5, random.Uniform() - 0.5);
+    const Eigen::Matrix3d rotation = mid.orientation.toRotationMatrix();
+    ASSERT_NE(
+        DetectContacts(scene, scene.rock, mid, rotation, v, omega, horizon_s, allowed_depth_m, ws),
+        DetectResult::kOutsideDomain);
+    std::vector<int> found;
+    for (const Contact& c : ws.contacts) found.push_back(c.vertex);
+    EXPECT_EQ(found, VerticesThatTouch(scene, mid, rotation, v, omega, horizon_s, allowed_depth_m))
+        << "state " << k;
+    contacts += static_cast<long>(found.size());
+    untouched += found.empty();
+  }
+  std::printf("%ld contacts; %ld of 4000 states without one\n", contacts, untouched);
+  EXPECT_GT(contacts, 1000);  // measured: 6975
+  EXPECT_GT(untouched, 400);  // measured: 1575
 }
 
 TEST(Prediction, PredictedContactsNeverPushOutAndDoNoPositiveWork) {

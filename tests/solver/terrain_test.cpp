@@ -56,16 +56,55 @@ TEST(Terrain, OutsideAndNodataAreReported) {
 }
 
 TEST(Terrain, LocalPlaneBoundsTheTerrainInTheBox) {
-  // z = x y / 100 departs from its tangent plane at (11, 21) by (x - 11)(y - 21)/100, which is
-  // largest, 0.01 m, at the nodes (10|12, 20|22) of the one cell covering the box.
+  // z = x y / 100 departs from its tangent plane at (x0, y0) by (x - x0)(y - y0)/100 everywhere
+  // (the grid reproduces it exactly), which over the box of half-width r is largest, r^2 / 100, at
+  // the box's corners: 0.0025 m for r = 0.5 m inside one cell, 0.0225 m for r = 1.5 m across four.
+  // The bound adds 1e-6 m for rounding; exact arithmetic up to round-off: tolerance 1e-14 m.
   const Terrain t = Saddle();
   Terrain::LocalPlane plane;
   ASSERT_TRUE(t.PlaneAround(11, 21, 0.5, &plane));
   EXPECT_NEAR(plane.at.height_m, 2.31, 1e-14);
   EXPECT_NEAR(plane.slope_x, 0.21, 1e-14);
   EXPECT_NEAR(plane.slope_y, 0.11, 1e-14);
-  EXPECT_NEAR(plane.deviation_m, 0.01, 1e-14);
+  EXPECT_NEAR(plane.deviation_m, 0.0025 + 1e-6, 1e-14);
+  ASSERT_TRUE(t.PlaneAround(12.3, 21.8, 1.5, &plane));
+  EXPECT_NEAR(plane.deviation_m, 0.0225 + 1e-6, 1e-14);
   EXPECT_FALSE(t.PlaneAround(10.2, 21, 0.5, &plane));  // the box reaches beyond x0
+}
+
+TEST(Terrain, LocalPlaneBoundIsTheLargestDepartureOverTheBox) {
+  // A rough grid (41 x 31 nodes, 1.5 m spacing) and boxes inside a cell, across cell edges and
+  // over many cells: the bound is at least |h - plane| at every point of a fine lattice over the
+  // box (edges included), and it is tight: at most that lattice's largest value plus the 1e-6 m
+  // rounding allowance and what a lattice of 200 x 200 can miss between its points (the slope of
+  // h - plane, below 10 here, times the lattice's spacing).
+  Heightfield hf;
+  hf.grid = {41, 31, 100.0, -20.0, 1.5, 1.5};
+  for (int j = 0; j < 31; ++j)
+    for (int i = 0; i < 41; ++i)
+      hf.z_m.push_back(0.7 * i + 3 * std::sin(1.3 * i) * std::cos(0.7 * j) +
+                       0.2 * ((i * 7 + j * 13) % 5));
+  const Terrain t(hf, 0);
+  const double boxes[][3] = {{120.4, -5.3, 0.3}, {121.4, -4.6, 0.8}, {130.0, 0.0, 0.7},
+                             {140.2, 10.9, 4.0}, {103.0, -17.0, 2.9}};
+  for (const auto& [x0, y0, r] : boxes) {
+    Terrain::LocalPlane plane;
+    ASSERT_TRUE(t.PlaneAround(x0, y0, r, &plane));
+    double sampled = 0;
+    constexpr int kPoints = 200;
+    for (int a = 0; a <= kPoints; ++a)
+      for (int b = 0; b <= kPoints; ++b) {
+        const double x = x0 - r + 2 * r * a / kPoints, y = y0 - r + 2 * r * b / kPoints;
+        double h = 0;
+        ASSERT_TRUE(t.Height(x, y, &h));
+        const double on_plane =
+            plane.at.height_m + plane.slope_x * (x - x0) + plane.slope_y * (y - y0);
+        sampled = std::max(sampled, std::abs(h - on_plane));
+      }
+    EXPECT_GE(plane.deviation_m, sampled) << "box at " << x0 << ", " << y0 << " +- " << r;
+    EXPECT_LE(plane.deviation_m, sampled + 1e-6 + 10 * 2 * r / kPoints)
+        << "box at " << x0 << ", " << y0 << " +- " << r;
+  }
 }
 
 TEST(Terrain, MaxAbovePlaneBoundsTheTerrainOverTheBox) {
