@@ -1072,6 +1072,15 @@ void LoadSolver(const Section& s, SolverOptions& o, SolverPreset& preset,
                                   "; known: gauss_seidel, block");
     }
   }
+  if (s.Has("predicted_lever")) {
+    const std::string name = s.String("predicted_lever", "");
+    if (!ParsePredictedLever(name, &o.predicted_lever)) {
+      const std::string hint = ClosestName(name, {"midpoint", "touch"});
+      s.Fail("predicted_lever", "unknown lever '" + name + "'" +
+                                    (hint.empty() ? "" : " (did you mean '" + hint + "'?)") +
+                                    "; known: midpoint, touch");
+    }
+  }
   o.tolerance_m_s = s.Number("tolerance_m_s", o.tolerance_m_s);
   const long max_iterations = s.Integer("max_iterations", o.max_iterations);
   if (max_iterations != static_cast<int>(max_iterations))
@@ -1230,9 +1239,9 @@ SceneFile LoadScene(const std::string& path) {
                       out);
   LoadSolver(Section(context, SubTable(context, root, "solver"), "solver",
                      {"preset", "dt_s", "max_time_s", "gravity_m_s2", "normal_restitution",
-                      "tangential_restitution", "viscous", "contact_solve", "tolerance_m_s",
-                      "max_iterations", "prox_alpha", "rest_speed_m_s", "rest_angular_speed_rad_s",
-                      "rest_hold_s"}),
+                      "tangential_restitution", "viscous", "contact_solve", "predicted_lever",
+                      "tolerance_m_s", "max_iterations", "prox_alpha", "rest_speed_m_s",
+                      "rest_angular_speed_rad_s", "rest_hold_s"}),
              out.scene.options, out.solver_preset, out.solver_keys_given);
   LoadOutput(Section(context, SubTable(context, root, "output"), "output",
                      {"trajectories", "trajectory_interval_s", "rasters", "percentiles",

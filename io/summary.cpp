@@ -18,6 +18,7 @@ nlohmann::ordered_json SolverJson(const SolverOptions& o) {
           {"max_iterations", o.max_iterations},
           {"prox_alpha", o.prox_alpha},
           {"penetration_tolerance", o.penetration_tolerance},
+          {"predicted_lever", ToString(o.predicted_lever)},
           {"rest_speed_m_s", o.rest_speed_m_s},
           {"rest_angular_speed_rad_s", o.rest_angular_speed_rad_s},
           {"rest_hold_s", o.rest_hold_s}};

@@ -9,9 +9,12 @@ namespace talus {
 // One vertex contact of the step: closed at the midpoint configuration (gap_m = 0), or open there
 // and predicted to close before the next midpoint (gap_m > 0, see DetectContacts).
 struct Contact {
-  int vertex = 0;              // hull vertex index
-  double gap_m = 0;            // open contact's gap along n at the midpoint; 0 for a closed one
-  int ground = 0;              // ground index at the contact point
+  int vertex = 0;    // hull vertex index
+  double gap_m = 0;  // open contact's gap along n at the midpoint; 0 for a closed one
+  int ground = 0;    // ground index at the contact point
+  // Body frame: where the percussion acts; the vertex itself, or for a predicted contact with
+  // SolverOptions::predicted_lever = kTouch the vertex turned to where it touches.
+  Eigen::Vector3d lever_m = Eigen::Vector3d::Zero();
   double mu = 0;               // friction coefficient mu(s) for this step
   Eigen::Matrix3d directions;  // world: columns n, t1, t2
   Eigen::Matrix3d arms;        // body: columns b x (R' d) for d = n, t1, t2 (rotational Jacobian)

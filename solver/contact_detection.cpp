@@ -1,5 +1,6 @@
 #include "solver/contact_detection.hpp"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 
@@ -16,6 +17,19 @@ void SetFrame(const Scene& scene, const RockState& mid, const Eigen::Vector3d& x
   c.directions.col(0) = n;
   c.directions.col(1) = t1;
   c.directions.col(2) = n.cross(t1);
+}
+
+// Body-frame point where a predicted contact's percussion acts (SolverOptions::predicted_lever):
+// the vertex b, or the vertex turned by the body angular velocity omega over the time its linear
+// path takes from the midpoint (height gap_mid_m above the contact plane) to that plane (height
+// gap_end_m < 0 after horizon_s).
+Eigen::Vector3d PredictedLeverArm(PredictedLever lever, const Eigen::Vector3d& b,
+                                  const Eigen::Vector3d& omega, double horizon_s, double gap_mid_m,
+                                  double gap_end_m) {
+  if (lever == PredictedLever::kMidpoint || gap_mid_m <= 0) return b;
+  const double angle = omega.norm() * horizon_s * gap_mid_m / (gap_mid_m - gap_end_m);
+  if (angle == 0) return b;
+  return Eigen::AngleAxisd(angle, omega.normalized()) * b;
 }
 
 }  // namespace
@@ -64,6 +78,7 @@ DetectResult DetectContacts(const Scene& scene, const RockShape& rock, const Roc
       terrain.Sample(x.x(), x.y(), &sample);
       Contact& c = workspace.contacts.emplace_back();
       c.vertex = k;
+      c.lever_m = b;
       c.gap_m = 0;
       SetFrame(scene, mid, x, sample.normal, c);
       continue;
@@ -81,7 +96,10 @@ DetectResult DetectContacts(const Scene& scene, const RockShape& rock, const Roc
     const Eigen::Vector3d on_plane(x_end.x(), x_end.y(), end.height_m);
     Contact& c = workspace.contacts.emplace_back();
     c.vertex = k;
-    c.gap_m = std::max(0.0, n.dot(x - on_plane) + allowed_depth_m);  // never a push out
+    const double gap_mid = n.dot(x - on_plane);
+    c.gap_m = std::max(0.0, gap_mid + allowed_depth_m);  // never a push out
+    c.lever_m = PredictedLeverArm(scene.options.predicted_lever, b, omega_rad_s, horizon_s, gap_mid,
+                                  n.dot(x_end - on_plane));
     SetFrame(scene, mid, x_end, n, c);
   }
   return DetectResult::kOk;

@@ -252,7 +252,7 @@ ContactSolveReport SolveContacts(const Scene& scene, const RockShape& rock,
 
   // Per-contact Jacobians, step lengths and warm start.
   for (Contact& c : workspace.contacts) {
-    const Eigen::Vector3d& b = rock.vertices_m[c.vertex];
+    const Eigen::Vector3d& b = c.lever_m;
     const Eigen::Matrix3d body_dirs = rotation.transpose() * c.directions;
     for (int k = 0; k < 3; ++k) c.arms.col(k) = b.cross(body_dirs.col(k));
     c.inv_inertia_arms = inv_inertia.asDiagonal() * c.arms;

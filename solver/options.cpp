@@ -45,6 +45,26 @@ bool ParseContactSolveMethod(std::string_view name, ContactSolveMethod* method) 
   return false;
 }
 
+const char* ToString(PredictedLever lever) {
+  switch (lever) {
+    case PredictedLever::kMidpoint:
+      return "midpoint";
+    case PredictedLever::kTouch:
+      return "touch";
+  }
+  return "unknown";
+}
+
+bool ParsePredictedLever(std::string_view name, PredictedLever* lever) {
+  for (PredictedLever l : {PredictedLever::kMidpoint, PredictedLever::kTouch}) {
+    if (name == ToString(l)) {
+      *lever = l;
+      return true;
+    }
+  }
+  return false;
+}
+
 const char* ToString(SolverPreset preset) {
   switch (preset) {
     case SolverPreset::kFast:
@@ -111,6 +131,8 @@ bool SolverOptions::IsValid(std::string* why) const {
   check(prox_alpha > 0 && prox_alpha < 2, "prox_alpha", prox_alpha, "0 < prox_alpha < 2");
   check(penetration_tolerance > 0 && penetration_tolerance <= 0.5, "penetration_tolerance",
         penetration_tolerance, "0 < penetration_tolerance <= 0.5");
+  check(predicted_lever == PredictedLever::kMidpoint || predicted_lever == PredictedLever::kTouch,
+        "predicted_lever", static_cast<double>(predicted_lever), "a PredictedLever value");
   check(rest_speed_m_s >= 0 && std::isfinite(rest_speed_m_s), "rest_speed_m_s", rest_speed_m_s,
         "rest_speed_m_s >= 0");
   check(rest_angular_speed_rad_s >= 0 && std::isfinite(rest_angular_speed_rad_s),

@@ -37,6 +37,19 @@ enum class ContactSolveMethod {
 const char* ToString(ContactSolveMethod method);  // "gauss_seidel", "block"
 bool ParseContactSolveMethod(std::string_view name, ContactSolveMethod* method);
 
+// Where the percussion of a predicted contact (a vertex open at the midpoint that the step's free
+// motion would carry into the terrain) acts. Scene files name them "midpoint" and "touch".
+enum class PredictedLever {
+  // At the vertex as it is at the step's midpoint, up to one step before it touches.
+  kMidpoint,
+  // At the vertex as it will be when it touches: turned by the free angular velocity over the time
+  // its predicted path takes to reach the contact plane (docs/model.md, "Where a predicted
+  // contact acts").
+  kTouch,
+};
+const char* ToString(PredictedLever lever);  // "midpoint", "touch"
+bool ParsePredictedLever(std::string_view name, PredictedLever* lever);
+
 struct SolverOptions {
   double dt_s = 0.002;                  // time step
   double max_time_s = 300;              // a rock still moving then ends as max_time
@@ -57,6 +70,8 @@ struct SolverOptions {
   // fraction of the rock's thickness by the next midpoint joins the contact set early and is
   // stopped at that depth. In (0, 0.5].
   double penetration_tolerance = 0.01;
+  // Where a predicted contact's percussion acts.
+  PredictedLever predicted_lever = PredictedLever::kMidpoint;
   // Rest: speed and angular speed below these thresholds, in contact, for rest_hold_s.
   double rest_speed_m_s = 0.02;
   double rest_angular_speed_rad_s = 0.05;

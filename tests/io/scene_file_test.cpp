@@ -223,6 +223,21 @@ TEST(LoadScene, ContactSolveMethodIsChosenByNameWithDidYouMean) {
       "scene.toml:23: solver.contact_solve: unknown method 'blok' (did you mean 'block'?)");
 }
 
+TEST(LoadScene, PredictedLeverIsChosenByNameWithDidYouMean) {
+  const auto dir = testing::FreshDir("predicted_lever");
+  testing::WriteText(dir / "scene.toml", kPlaneScene);
+  EXPECT_EQ(LoadScene((dir / "scene.toml").string()).scene.options.predicted_lever,
+            PredictedLever::kMidpoint);  // the default
+  testing::WriteText(dir / "scene.toml", Replace(kPlaneScene, "max_time_s = 20",
+                                                 "max_time_s = 20\npredicted_lever = \"touch\""));
+  EXPECT_EQ(LoadScene((dir / "scene.toml").string()).scene.options.predicted_lever,
+            PredictedLever::kTouch);
+  EXPECT_HAS(ErrorOf(Replace(kPlaneScene, "max_time_s = 20",
+                             "max_time_s = 20\npredicted_lever = \"tuch\""),
+                     dir),
+             "scene.toml:23: solver.predicted_lever: unknown lever 'tuch' (did you mean 'touch'?)");
+}
+
 // [solver] preset sets the accuracy knobs (solver/options.hpp); keys the scene gives win, also
 // when talus simulate --preset (UseSolverPreset) changes the preset afterwards.
 TEST(LoadScene, SolverPresetSetsTheKnobsTheSceneDoesNotGive) {

@@ -87,6 +87,7 @@ Solved SolveEdge(const EdgeCase& e, ContactSolveMethod method, double tolerance,
   for (int i = 0; i < 2; ++i) {
     Contact& c = ws.contacts.emplace_back();
     c.vertex = e.vertices[i];
+    c.lever_m = scene.rock.vertices_m[c.vertex];
     c.gap_m = e.gaps[i];
     c.ground = scene.terrain.default_ground();
     c.mu = scene.ground.params(c.ground).Friction(0);

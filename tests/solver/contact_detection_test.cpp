@@ -305,5 +305,162 @@ TEST(Prediction, PredictedContactsNeverPushOutAndDoNoPositiveWork) {
   EXPECT_GT(loaded_predicted, 6);  // measured: 75
 }
 
+// The energy a rod keeps from a plastic impact on one end, in closed form: a 2 x 0.2 x 0.2 m rod,
+// tilted 30 degrees with its +x end down, falling at 4 m/s and spinning at 15 rad/s about y (its
+// low end sweeping down at about 15 m/s), lands on that end on flat ground with mu = 2 (sticking).
+// Both end vertices touch at once; the planar impact keeps the angular momentum about the touch
+// point P: omega+ = L_P / (I_y + m |S - P|^2), T+ = L_P^2 / (2 I_P). After it the rod pivots on
+// its end, sticking, which does no work, so its mechanical energy stays E0 - T- + T+ until the
+// other end lands (about 0.3 s later).
+struct RodLanding {
+  double expected_j = 0;  // mechanical energy after the impact, closed form
+  double scheme_j = 0;    // the scheme's, 20 ms after the touch
+  double release_j = 0;   // mechanical energy at release (z = 0 on the ground)
+};
+
+RodLanding LandRod(double dt_s, PredictedLever lever, double phase) {
+  const GroundParams stick{2.0, 2.0, 185, 0.0, 0.0};
+  Scene scene = Flat(MakeRockShape(MakeBox(2, 0.2, 0.2), 2700), dt_s);
+  scene = scenes::Incline(0, scene.rock, stick);
+  scene.options.dt_s = dt_s;
+  scene.options.predicted_lever = lever;
+  const RockShape& rock = scene.rock;
+  const double m = rock.mass_kg, g = scene.options.gravity_m_s2;
+  const Eigen::Vector3d y = Eigen::Vector3d::UnitY();
+  const Eigen::Quaterniond q0 =
+      rock.PrincipalOrientation(Eigen::Quaterniond(Eigen::AngleAxisd(30 * kDeg, y)));
+  const double omega = 15;
+  const double i_y = (q0.toRotationMatrix().transpose() * y).cwiseAbs().dot(rock.inertia_kg_m2);
+  const Eigen::Vector3d v0(0, 0, -4);
+  TerrainSample ground;
+  scene.terrain.Sample(100, 0, &ground);
+  // Exact flight: parabola and steady rotation about the principal axis y (so is the scheme's).
+  auto centre = [&](double t) -> Eigen::Vector3d {
+    return Eigen::Vector3d(100, 0, 2) + t * v0 - 0.5 * g * t * t * Eigen::Vector3d::UnitZ();
+  };
+  auto rotation = [&](double t) { return Eigen::Matrix3d(Eigen::AngleAxisd(omega * t, y) * q0); };
+  // Height of the lowest vertices above the ground and their mean position (the two end vertices
+  // are at the same height).
+  auto lowest = [&](double t, Eigen::Vector3d* point) {
+    double low = 1e9;
+    for (const Eigen::Vector3d& b : rock.vertices_m) low = std::min(low, (rotation(t) * b).z());
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    int count = 0;
+    for (const Eigen::Vector3d& b : rock.vertices_m) {
+      const Eigen::Vector3d arm = rotation(t) * b;
+      if (arm.z() > low + 1e-9) continue;
+      sum += centre(t) + arm;
+      ++count;
+    }
+    *point = sum / count;
+    return point->z() - ground.height_m;
+  };
+  // Touch time by bisection, then the start shifted so that it falls at `phase` within a step.
+  double lo = 0, hi = 2;
+  Eigen::Vector3d p = Eigen::Vector3d::Zero();
+  for (int k = 0; k < 100; ++k) (lowest(0.5 * (lo + hi), &p) > 0 ? lo : hi) = 0.5 * (lo + hi);
+  const double touch = hi;
+  lowest(touch, &p);
+  const double start = touch - (std::floor(touch / dt_s) + phase) * dt_s + dt_s;
+  RockState s;
+  s.position_m = centre(start);
+  s.orientation = Eigen::Quaterniond(rotation(start));
+  s.velocity_m_s = v0 - g * start * Eigen::Vector3d::UnitZ();
+  s.angular_velocity_rad_s = s.orientation.conjugate() * (omega * y);
+  auto energy = [&](const RockState& r) {
+    return KineticEnergy(rock, r) + m * g * (r.position_m.z() - ground.height_m);
+  };
+  RodLanding out;
+  out.release_j = energy(s);
+  // Closed form at the touch.
+  const Eigen::Vector3d arm = centre(touch) - p;
+  const Eigen::Vector3d v_in = v0 - g * touch * Eigen::Vector3d::UnitZ();
+  const double l_p = i_y * omega + m * arm.cross(v_in).y();
+  const double i_p = i_y + m * (arm.x() * arm.x() + arm.z() * arm.z());
+  const double t_in = 0.5 * m * v_in.squaredNorm() + 0.5 * i_y * omega * omega;
+  out.expected_j = out.release_j - t_in + 0.5 * l_p * l_p / i_p;
+  // Sticking: the impact's percussion lies in the friction cone.
+  const Eigen::Vector3d v_out = (l_p / i_p) * y.cross(arm);
+  const Eigen::Vector3d percussion = m * (v_out - v_in);
+  EXPECT_LT(std::abs(percussion.x()), stick.mu_min * percussion.z());
+  StepWorkspace ws;
+  ws.Reset(rock.vertices_m.size());
+  while (s.time_s < touch - start + 0.02) Step(scene, s, ws);
+  out.scheme_j = energy(s);
+  return out;
+}
+
+TEST(Prediction, TouchLeverIsWhereTheVertexTouches) {
+  // A 1 m cube spinning at 60 rad/s about a tilted axis falls at 10 m/s onto flat ground; a step
+  // of 4 ms turns it by 0.24 rad. For each predicted contact of its first contact step, the
+  // vertex's arm when it touches (exact flight: parabola and, for a cube, steady rotation;
+  // touch time by bisection) is compared with the lever the contact uses. With the midpoint
+  // lever the arm is off by up to omega s |b| (s: time to touch, up to one step); with the touch
+  // lever only by the error of s taken from the vertex's linear path (its arc turns by up to
+  // 0.24 rad). Measured: largest distance 0.157 m (midpoint) and 0.026 m (touch). Tolerance:
+  // touch below a quarter of midpoint's.
+  const double dt = 0.004;
+  Scene scene = Flat(MakeRockShape(MakeBox(1, 1, 1), 2700), dt);
+  const RockShape& rock = scene.rock;
+  const double g = scene.options.gravity_m_s2;
+  const Eigen::Vector3d omega_world = 60 * Eigen::Vector3d(0.3, 1, 0.2).normalized();
+  const Eigen::Vector3d v0(3, 0, -10);
+  RockState s;
+  s.orientation = RockRandom(60, 1).Orientation();
+  s.position_m = {100, 0, 1.6};
+  s.velocity_m_s = v0;
+  s.angular_velocity_rad_s = s.orientation.conjugate() * omega_world;
+  TerrainSample ground;
+  scene.terrain.Sample(100, 0, &ground);
+  double farthest[2] = {0, 0};
+  for (PredictedLever lever : {PredictedLever::kMidpoint, PredictedLever::kTouch}) {
+    scene.options.predicted_lever = lever;
+    RockState state = s;
+    StepWorkspace ws;
+    ws.Reset(rock.vertices_m.size());
+    while (ws.contacts.empty()) Step(scene, state, ws);
+    // Midpoint of that step on the exact flight from s.
+    const double t_mid = state.time_s - 0.5 * dt;
+    const Eigen::Quaterniond q_mid = Eigen::Quaterniond(Eigen::AngleAxisd(
+                                         omega_world.norm() * t_mid, omega_world.normalized())) *
+                                     s.orientation;
+    for (const Contact& c : ws.contacts) {
+      if (c.gap_m == 0) continue;
+      const Eigen::Vector3d& b = rock.vertices_m[c.vertex];
+      auto arm_at = [&](double t) -> Eigen::Vector3d {
+        return Eigen::AngleAxisd(omega_world.norm() * t, omega_world.normalized()) *
+               (s.orientation * b);
+      };
+      auto height = [&](double t) {
+        return s.position_m.z() + v0.z() * t - 0.5 * g * t * t + arm_at(t).z() - ground.height_m;
+      };
+      double lo = t_mid, hi = t_mid + dt;
+      if (height(hi) > 0) continue;  // does not touch within the horizon on the exact flight
+      for (int k = 0; k < 60; ++k) (height(0.5 * (lo + hi)) > 0 ? lo : hi) = 0.5 * (lo + hi);
+      const Eigen::Vector3d lever_world = q_mid * c.lever_m;
+      farthest[lever == PredictedLever::kTouch] =
+          std::max(farthest[lever == PredictedLever::kTouch], (lever_world - arm_at(hi)).norm());
+    }
+  }
+  EXPECT_GT(farthest[0], 0.1);
+  EXPECT_LT(farthest[1], 0.25 * farthest[0]);
+}
+
+TEST(Prediction, RodLandingOnOneEndKeepsTheClosedFormEnergy) {
+  // The touch falls at five phases of a step, so that the end vertices are closed at a midpoint
+  // (found late) or predicted 0.2-0.8 steps before they touch. Measured, largest error of the
+  // energy after the impact relative to the energy the impact takes (12.3 kJ of 14.1 kJ), with
+  // either lever: 3e-4 at 0.5 ms, 1.2e-3 at 2 ms, 2.3e-3 at 4 ms. Tolerance: 1e-3 per ms of dt.
+  for (PredictedLever lever : {PredictedLever::kMidpoint, PredictedLever::kTouch}) {
+    for (double dt : {0.0005, 0.002, 0.004}) {
+      for (double phase : {0.1, 0.3, 0.5, 0.7, 0.9}) {
+        const RodLanding r = LandRod(dt, lever, phase);
+        EXPECT_NEAR(r.scheme_j, r.expected_j, 1.0 * dt * (r.release_j - r.expected_j))
+            << ToString(lever) << " dt " << dt << " phase " << phase;
+      }
+    }
+  }
+}
+
 }  // namespace
 }  // namespace talus

@@ -150,6 +150,10 @@ TEST(Options, DefaultsAreValidAndBadValuesAreNamed) {
   EXPECT_FALSE(o.IsValid(&why));
   EXPECT_NE(why.find("penetration_tolerance"), std::string::npos) << why;
   o = SolverOptions{};
+  o.predicted_lever = static_cast<PredictedLever>(7);
+  EXPECT_FALSE(o.IsValid(&why));
+  EXPECT_NE(why.find("predicted_lever"), std::string::npos) << why;
+  o = SolverOptions{};
   o.normal_restitution = std::nan("");
   EXPECT_FALSE(o.IsValid(&why));
   EXPECT_NE(why.find("normal_restitution"), std::string::npos) << why;
@@ -165,6 +169,18 @@ TEST(Options, ViscousReadingNamesRoundTrip) {
   }
   ViscousReading parsed = ViscousReading::kCentreOfMass;
   EXPECT_FALSE(ParseViscousReading("drag", &parsed));
+}
+
+TEST(Options, PredictedLeverNamesRoundTrip) {
+  EXPECT_EQ(SolverOptions{}.predicted_lever, PredictedLever::kMidpoint);
+  for (PredictedLever l : {PredictedLever::kMidpoint, PredictedLever::kTouch}) {
+    PredictedLever parsed = PredictedLever::kMidpoint;
+    EXPECT_TRUE(ParsePredictedLever(ToString(l), &parsed));
+    EXPECT_EQ(parsed, l);
+  }
+  PredictedLever parsed = PredictedLever::kTouch;
+  EXPECT_FALSE(ParsePredictedLever("contact", &parsed));
+  EXPECT_EQ(parsed, PredictedLever::kTouch);
 }
 
 TEST(Random, StreamsDependOnSeedAndRockOnlyAndOrientationsAreUniform) {
