@@ -143,7 +143,7 @@ TEST(Objective, ScaleIsTheClimatologyScoreAndResidualsSquareToTheValue) {
   fieldobs::EnsembleSamples samples(p.release);
   ensemble::EnsembleOptions run;
   run.threads = 2;
-  Scene scene = p.scene;
+  Scene scene = objective.scene();  // the objective's contact-solve tolerance
   scene.ground = objective.GroundOf(e.u);
   ensemble::RunEnsemble(scene, p.release, run, &samples);
   const fieldobs::ValidationReport report = fieldobs::Validate(p.observations, samples, nullptr);
