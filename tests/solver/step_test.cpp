@@ -463,10 +463,11 @@ TEST(Energy, ContactFrictionReadingAddsNoEnergyBeyondTheSchemesOwnDrift) {
   // adds nothing (checked below), the rise comes from the midpoint scheme's position update, at
   // order dt^2 per step. The centre-of-mass drag dissipates m nu v^2 dt per step in every contact
   // step and hides it; viscous friction at a contact that does not slip removes nothing, so it
-  // shows. Measured: 1.9e-6 (contact friction), 3.2e-6 (nu = 0). Tolerance 1e-5 for both.
+  // shows. Measured: 1.9e-6 (contact friction), 3.2e-6 (nu = 0), at 1e-3 and 1e-7 m/s alike.
+  // Tolerance 1e-5 for both.
   // What the reading must guarantee exactly is checked too: after every contact solve the kinetic
-  // energy is at most that of the free motion, P . gamma_E <= 0 (tolerance 1e-9 relative: the
-  // solver's 1e-7 m/s velocity tolerance; measured: 7e-16, round-off).
+  // energy is at most that of the free motion, P . gamma_E <= 0 (tolerance 1e-9 relative;
+  // measured: 7e-16, round-off, at the default 1e-3 m/s as at 1e-7 m/s).
   for (double nu_scale : {1.0, 0.0}) {
     const EnergyCheck check = CheckEnergy(RampWith(ViscousReading::kContactFriction, nu_scale));
     std::printf(
