@@ -205,10 +205,12 @@ int RunCalibrate(const CalibrateArgs& args, const Processes& processes) {
   const io::EventFile& event = file.event;
   const ensemble::ReleaseSpec& release = objective->release();
   std::printf(
-      "Calibration %s: %d parameters, %zu observations of %ld runs x %ld rocks, %s%s\n",
+      "Calibration %s: %d parameters, %zu observations of %ld runs x %ld rocks, %s%s\n"
+      "Contact solve: tolerance %g m/s (%s)\n",
       args.file.c_str(), objective->dimension(), fit.observations.size(), release.release_count(),
       release.rocks_per_release, file.optimizer.algorithm.c_str(),
-      processes.mpi() ? (", " + std::to_string(processes.size) + " MPI ranks").c_str() : "");
+      processes.mpi() ? (", " + std::to_string(processes.size) + " MPI ranks").c_str() : "",
+      objective->options().tolerance_m_s, file.tolerance_source.c_str());
   if (!holdout.empty())
     std::printf("Holding out %zu runs: %s\n", holdout.size(), Join(holdout).c_str());
   if (!checkpoint.stages.empty()) std::printf("Resuming from %s\n", checkpoint_path.c_str());
@@ -310,20 +312,21 @@ int RunCalibrate(const CalibrateArgs& args, const Processes& processes) {
       }
     }
     const GroundTable fitted = objective->GroundOf(best.u);
-    // The fitted runs scored before and after, for the observed-vs-simulated plots.
+    // The fitted runs scored before and after, for the observed-vs-simulated plots. Every scoring
+    // runs the scene as the objective does (its contact-solve tolerance).
     std::printf("Scoring the observations before and after for the plots...\n");
     std::fflush(stdout);
     const calibration::HeldOutScores before = calibration::ScoreRuns(
-        event.scene.scene, fit, objective->GroundOf(run.summary.initial.u), nullptr, args.threads,
+        objective->scene(), fit, objective->GroundOf(run.summary.initial.u), nullptr, args.threads,
         objective->needs_episodes(), processes.runner);
     const calibration::HeldOutScores after =
-        calibration::ScoreRuns(event.scene.scene, fit, fitted, nullptr, args.threads,
+        calibration::ScoreRuns(objective->scene(), fit, fitted, nullptr, args.threads,
                                objective->needs_episodes(), processes.runner);
     if (!holdout.empty()) {
       std::printf("Scoring the %zu held-out runs...\n", holdout.size());
       std::fflush(stdout);
       run.holdout = calibration::ScoreRuns(
-          event.scene.scene,
+          objective->scene(),
           calibration::SelectRuns(event.scene.release, event.observations, holdout, false), fitted,
           reference ? &*reference : nullptr, args.threads, objective->needs_episodes(),
           processes.runner);
@@ -344,7 +347,7 @@ int RunCalibrate(const CalibrateArgs& args, const Processes& processes) {
       if (!fold.summary.IsSolutionUsable())
         throw std::runtime_error("fold " + std::to_string(f + 1) + ": " + fold.summary.message);
       fold.scores = calibration::ScoreRuns(
-          event.scene.scene,
+          objective->scene(),
           calibration::SelectRuns(fit.release, fit.observations, folds[f], false),
           fold_objective.GroundOf(fold.summary.best.u), reference ? &*reference : nullptr,
           args.threads, objective->needs_episodes(), processes.runner);

@@ -35,6 +35,8 @@ bool ObjectiveOptions::IsValid(std::string* why) const {
   if (msg.str().empty() && prior_weight > 0 && !prior_reference)
     msg << "prior_weight = " << prior_weight << " needs a prior_reference table";
   if (msg.str().empty() && threads < 0) msg << "threads = " << threads << " must be >= 0";
+  if (msg.str().empty() && !(tolerance_m_s > 0 && tolerance_m_s < 1))
+    msg << "tolerance_m_s = " << tolerance_m_s << " must be in (0, 1) m/s";
   if (msg.str().empty() && !(infeasible_value > 0 && std::isfinite(infeasible_value)))
     msg << "infeasible_value = " << infeasible_value << " must be > 0 and finite";
   if (msg.str().empty()) return true;
@@ -52,6 +54,7 @@ Objective::Objective(const Scene& scene, const ensemble::ReleaseSpec& release,
       options_(std::move(options)) {
   std::string why;
   if (!options_.IsValid(&why)) throw InputError(why);
+  scene_.options.tolerance_m_s = options_.tolerance_m_s;
   if (!scene_.IsValid(&why)) throw InputError("scene: " + why);
   if (!release_.IsValid(&why)) throw InputError("release: " + why);
   if (observations_.size() == 0) throw InputError("no observation to calibrate against");

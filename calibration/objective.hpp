@@ -14,8 +14,9 @@
 // kind. The prior pulls in unit coordinates towards a reference table (Table 1 by default).
 //
 // The objective owns a copy of the scene whose terrain and shapes are shared, immutable
-// (solver/terrain.hpp); each evaluation copies that scene (cheap), edits only its ground table and
-// runs the ensemble. Evaluate is const and may be called from several threads at once; its
+// (solver/terrain.hpp), with the contact-solve tolerance of ObjectiveOptions in place of the
+// scene's; each evaluation copies that scene (cheap), edits only its ground table and runs the
+// ensemble. Evaluate is const and may be called from several threads at once; its
 // result does not depend on the number of threads.
 
 #include <Eigen/Core>
@@ -38,6 +39,13 @@
 namespace talus::calibration {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// The contact solve's tolerance (m/s) of every evaluation unless the calibration asks for another.
+// Finite differences through the ensemble see the solver's stopping rule: at 1e-4 m/s and looser
+// the Ceres recovery test's stated standard error falls to 0.2-0.3 of the data's, at 1e-7 m/s it
+// is 0.5 (bench/README.md, "Default tolerance"), so calibration keeps a tight solve whatever the
+// simulations' default.
+constexpr double kCalibrationTolerance_m_s = 1e-7;
 
 // Runs every rock of `release` into `samples`, in rock order, and returns the counts of all of
 // them. Empty (the default): ensemble::RunEnsemble in this process. A caller may divide the rocks
@@ -63,6 +71,9 @@ struct ObjectiveOptions {
   double prior_weight = 0;
   std::optional<GroundTable> prior_reference;
   int threads = 0;  // worker threads of each evaluation; 0: all cores
+  // Contact-solve tolerance (m/s) of every evaluation: replaces the scene's
+  // SolverOptions::tolerance_m_s. In (0, 1) as that is.
+  double tolerance_m_s = kCalibrationTolerance_m_s;
   // Value of an infeasible vector (mu_min > mu_max, outside the box): no rock runs and the value
   // is infeasible_value * (1 + violation), finite so that every NLopt algorithm can use it.
   double infeasible_value = 1e3;
@@ -132,6 +143,7 @@ class Objective {
   const ObjectiveOptions& options() const { return options_; }
   const fieldobs::ObservationSet& observations() const { return observations_; }
   const ensemble::ReleaseSpec& release() const { return release_; }
+  // The scene as every evaluation runs it: the given one with options().tolerance_m_s.
   const Scene& scene() const { return scene_; }
   std::optional<Eigen::VectorXd> prior_center() const { return prior_center_; }
   bool needs_episodes() const { return episodes_; }

@@ -132,6 +132,29 @@ void LoadObjective(const Context& context, const toml::table* table, Calibration
   if (!any) s.Fail("weights", "every kind has weight 0: nothing to fit");
 }
 
+// [solver] tolerance_m_s: the contact solve of every evaluation. When the file does not give it,
+// the tighter of the default (1e-7 m/s) and the scene's own [solver] tolerance_m_s: a scene's
+// looser tolerance is for its simulations, a tighter one is honoured.
+void LoadSolver(const Context& context, const toml::table* table, CalibrationFile& out) {
+  const Section s(context, table, "solver", {"tolerance_m_s"});
+  const SceneFile& scene = out.event.scene;
+  const std::vector<std::string>& given = scene.solver_keys_given;
+  double& tolerance = out.objective.tolerance_m_s;
+  tolerance = calibration::kCalibrationTolerance_m_s;
+  out.tolerance_source = "default";
+  if (std::find(given.begin(), given.end(), "tolerance_m_s") != given.end() &&
+      scene.scene.options.tolerance_m_s < tolerance) {
+    tolerance = scene.scene.options.tolerance_m_s;
+    out.tolerance_source = "scene";
+  }
+  if (s.Has("tolerance_m_s")) {
+    tolerance = s.Checked(
+        "tolerance_m_s", tolerance, [](double v) { return v > 0 && v < 1; },
+        "must be in (0, 1) m/s (the contact solve's tolerance of every evaluation)");
+    out.tolerance_source = "calibration file";
+  }
+}
+
 void LoadOptimizer(const Context& context, const toml::table* table, CalibrationFile& out) {
   const Section s(context, table, "optimizer",
                   {"algorithm", "max_evaluations", "max_time_s", "ftol_rel", "ftol_abs", "xtol_abs",
@@ -279,8 +302,8 @@ CalibrationFile LoadCalibration(const std::string& path) {
   const Context context(path);
   const toml::table root = ParseTomlFile(path, "calibration file");
   const Section top(context, &root, "",
-                    {"event", "rocks", "seed", "parameters", "objective", "optimizer", "roughness",
-                     "uncertainty"});
+                    {"event", "rocks", "seed", "parameters", "objective", "solver", "optimizer",
+                     "roughness", "uncertainty"});
   CalibrationFile out;
   out.path = path;
   if (!top.Has("event"))
@@ -305,6 +328,7 @@ CalibrationFile LoadCalibration(const std::string& path) {
 
   LoadParameters(context, root, out);
   LoadObjective(context, SubTable(context, root, "objective"), out);
+  LoadSolver(context, SubTable(context, root, "solver"), out);
   LoadOptimizer(context, SubTable(context, root, "optimizer"), out);
   LoadRoughness(context, SubTable(context, root, "roughness"), out);
   LoadUncertainty(context, SubTable(context, root, "uncertainty"), out);
@@ -323,7 +347,8 @@ CalibrationFile LoadCalibration(const std::string& path) {
               << p.tie;
   const calibration::ObjectiveOptions& ob = out.objective;
   for (const auto& [kind, weight] : ob.weights) path_text << ' ' << kind << ' ' << weight;
-  path_text << ' ' << ob.normalise << ' ' << ob.prior_weight << ' ' << out.prior_reference;
+  path_text << ' ' << ob.normalise << ' ' << ob.prior_weight << ' ' << out.prior_reference << ' '
+            << ob.tolerance_m_s;
   const calibration::OptimizerOptions& o = out.optimizer;
   path_text << ' ' << o.algorithm << ' ' << o.ftol_rel << ' ' << o.ftol_abs << ' ' << o.xtol_abs
             << ' ' << o.initial_step << ' ' << o.population << ' ' << o.starts << ' '

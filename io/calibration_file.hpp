@@ -1,7 +1,8 @@
 #pragma once
 // Calibration files (CAL.toml, docs/calibration.md): an event (the EVENT.toml of talus validate,
 // which names the scene and the observations), the free parameters with bounds and ties, the
-// objective's weights and prior, the optimiser and its budget, and the roughness measurement.
+// objective's weights and prior, the contact-solve tolerance of every evaluation, the optimiser and
+// its budget, and the roughness measurement.
 // Loading validates everything before any rock runs; errors are "<file>:<line>: <key>: <reason>".
 
 #include <optional>
@@ -25,6 +26,10 @@ struct CalibrationFile {
   std::vector<calibration::ParameterSpec> parameters;
   calibration::ObjectiveOptions objective;  // threads left at 0: the command sets them
   std::string prior_reference = "table1";   // "table1" or "scene"
+  // Where objective.tolerance_m_s comes from ([solver] tolerance_m_s): "calibration file", "scene"
+  // (the scene's own [solver] tolerance_m_s, tighter than the default) or "default"
+  // (calibration::kCalibrationTolerance_m_s).
+  std::string tolerance_source = "default";
   calibration::OptimizerOptions optimizer;
   bool roughness = true;  // measure roughness and profile every parameter at the optimum
   calibration::RoughnessOptions roughness_options;

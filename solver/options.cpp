@@ -100,6 +100,7 @@ void ApplyPreset(SolverPreset preset, SolverOptions* options) {
       break;
     case SolverPreset::kAccurate:
       options->dt_s = 0.001;
+      options->tolerance_m_s = 1e-7;
       options->max_iterations = 1000;
       break;
   }

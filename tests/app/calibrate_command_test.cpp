@@ -110,6 +110,11 @@ TEST(CalibrateCommand, WritesTheGroundTableJsonAndHistory) {
   EXPECT_LE(json["evaluations"].get<int>(), 6);
   EXPECT_TRUE(json["roughness"].is_object());
   EXPECT_TRUE(json["parameters"][0]["identified"].is_boolean());
+  // Every evaluation ran the tight contact solve, whatever the simulations' default.
+  EXPECT_EQ(json["solver"]["tolerance_m_s"].get<double>(), 1e-7);
+  EXPECT_EQ(json["solver"]["tolerance_source"], "default");
+  EXPECT_NE(output.find("Contact solve: tolerance 1e-07 m/s (default)\n"), std::string::npos)
+      << output;
   const std::string csv = Slurp(dir / "out" / "ground_table.csv");
   EXPECT_EQ(csv.rfind("category,code,mu_min,mu_max,beta,kappa,nu\nmedium_soft,3,", 0), 0u) << csv;
   // One header line and one line per evaluation.
@@ -206,6 +211,9 @@ TEST(CalibrateCommand, BadFilesAreRefusedBeforeAnyRun) {
       {"profile_points = 3", "profile_points = 3\n[uncertainty]\nbootstrap = 10\nseeds = 1",
        cal + ":16: uncertainty.seeds: 1 must be 0 (off) or in 2 .. 1000 (refits with other "
              "release seeds; an sd needs 2)"},
+      {"[optimizer]", "[solver]\ntolerance_m_s = 0\n[optimizer]",
+       cal + ":8: solver.tolerance_m_s: 0 must be in (0, 1) m/s (the contact solve's tolerance "
+             "of every evaluation)"},
       {"profile_points = 3", "profile_points = 3\n[uncertainty]\nseeds = 3",
        cal + ":15: uncertainty.seeds: needs bootstrap (its standard error is combined with the "
              "bootstrap's)"},

@@ -270,7 +270,7 @@ TEST(SimulateCommand, OverridesRocksAndSeed) {
   EXPECT_EQ(summary["rocks"], 2);
   EXPECT_EQ(summary["seed"], 9);
   EXPECT_EQ(summary["solver"]["preset"], "default");
-  EXPECT_EQ(summary["solver"]["tolerance_m_s"], 1e-7);
+  EXPECT_EQ(summary["solver"]["tolerance_m_s"], 1e-3);
 
   // --preset fast: the solver options the run used, recorded in summary.json; a bad name is a
   // bad input.

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "calibration/objective.hpp"
 #include "calibration/parameters.hpp"
 #include "ensemble/runner.hpp"
 #include "fieldobs/observations.hpp"
@@ -30,7 +31,16 @@ inline ParameterSpec Spec(const std::string& category, GroundField field, double
   return s;
 }
 
-// One observation of `quantity` per run of `release`, drawn from the model with the `truth` scene:
+// `scene` with the contact-solve tolerance every calibration evaluation runs with: synthetic data
+// and their measured errors come from the model the objective fits, whatever the simulations'
+// default tolerance.
+inline Scene AsCalibrationRuns(Scene scene) {
+  scene.options.tolerance_m_s = kCalibrationTolerance_m_s;
+  return scene;
+}
+
+// One observation of `quantity` per run of `release`, drawn from the model with the `truth` scene
+// (at the calibration's contact-solve tolerance):
 // the value of one more rock of that run with another seed (release seed `seed`). Segment
 // quantities cover the first `window_s` seconds of each run. A run whose rock gives no value (no
 // loaded contact episode for a scar) has no observation.
@@ -49,7 +59,7 @@ inline fieldobs::ObservationSet DrawObservations(const Scene& truth,
   options.episodes = quantity != fieldobs::Quantity::kRunout;
   fieldobs::AddRecordersFor(wanted, truth.terrain, drawn_release, options);
   fieldobs::EnsembleSamples drawn(drawn_release);
-  ensemble::RunEnsemble(truth, drawn_release, options, &drawn);
+  ensemble::RunEnsemble(AsCalibrationRuns(truth), drawn_release, options, &drawn);
   fieldobs::ObservationSet observations;
   for (fieldobs::ScalarObservation o : wanted.scalars) {
     const std::vector<double> values = drawn.Values(quantity, o.run);
@@ -119,7 +129,7 @@ struct SyntheticRunouts : PlaneRuns {
 };
 
 // The mean over runs of each run's simulated mean and standard deviation of `quantity` (runs
-// with fewer than 2 values are left out).
+// with fewer than 2 values are left out), at the calibration's contact-solve tolerance.
 struct Moments {
   double mean = 0, sd = 0;
 };
@@ -131,7 +141,7 @@ inline Moments QuantityMoments(const Scene& scene, const ensemble::ReleaseSpec& 
   options.episodes = quantity != fieldobs::Quantity::kRunout;
   fieldobs::AddRecordersFor(observations, scene.terrain, release, options);
   fieldobs::EnsembleSamples samples(release);
-  ensemble::RunEnsemble(scene, release, options, &samples);
+  ensemble::RunEnsemble(AsCalibrationRuns(scene), release, options, &samples);
   Moments m;
   int runs = 0;
   for (const auto& run : release.runs) {

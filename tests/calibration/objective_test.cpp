@@ -1,9 +1,12 @@
 // The calibration objective: common random numbers, no state carried between evaluations,
-// thread-count independence, infeasible vectors, residuals and the climatology scale.
+// thread-count independence, the contact-solve tolerance, infeasible vectors, residuals and the
+// climatology scale.
 
 #include "calibration/objective.hpp"
 
 #include <gtest/gtest.h>
+
+#include <cmath>
 
 #include "calibration/holdout.hpp"
 #include "common/error.hpp"
@@ -28,6 +31,20 @@ const testing::SyntheticRunouts& Problem() {
   return problem;
 }
 
+// The mean run-out score of `scene` run directly with `ground` and the contact-solve tolerance
+// `tolerance_m_s`.
+double DirectRunoutScore(const Scene& scene, const GroundTable& ground, double tolerance_m_s) {
+  const auto& p = Problem();
+  Scene direct = scene;
+  direct.ground = ground;
+  direct.options.tolerance_m_s = tolerance_m_s;
+  fieldobs::EnsembleSamples samples(p.release);
+  ensemble::EnsembleOptions options;
+  options.threads = 2;
+  ensemble::RunEnsemble(direct, p.release, options, &samples);
+  return fieldobs::Validate(p.observations, samples, nullptr).kinds[0].mean_score;
+}
+
 // Scene copies share the DEM: a copy costs reference counts, not the heights.
 TEST(Objective, SceneCopiesShareTheTerrain) {
   const Scene copy = Problem().scene;
@@ -50,14 +67,8 @@ TEST(Objective, EditEvaluateRestoreIsBitIdenticalToNeverEditing) {
   EXPECT_EQ(a.residuals, b.residuals);
   EXPECT_EQ(a.kind_scores, b.kind_scores);
 
-  Scene direct = p.scene;
-  direct.ground = objective.GroundOf(u0);
-  fieldobs::EnsembleSamples samples(p.release);
-  ensemble::EnsembleOptions options;
-  options.threads = 2;
-  ensemble::RunEnsemble(direct, p.release, options, &samples);
-  const fieldobs::ValidationReport report = fieldobs::Validate(p.observations, samples, nullptr);
-  EXPECT_EQ(a.kind_scores[0], report.kinds[0].mean_score);
+  EXPECT_EQ(a.kind_scores[0],
+            DirectRunoutScore(p.scene, objective.GroundOf(u0), objective.options().tolerance_m_s));
 
   // A ground table edited and restored runs exactly as one never edited.
   Scene edited = p.scene;
@@ -66,10 +77,49 @@ TEST(Objective, EditEvaluateRestoreIsBitIdenticalToNeverEditing) {
   objective.parameters().Apply(Eigen::VectorXd::Constant(1, 0.9), edited.ground, nullptr);
   edited.ground.mutable_params(g) = saved;
   fieldobs::EnsembleSamples restored(p.release), never(p.release);
+  ensemble::EnsembleOptions options;
+  options.threads = 2;
   ensemble::RunEnsemble(edited, p.release, options, &restored);
   ensemble::RunEnsemble(p.scene, p.release, options, &never);
   EXPECT_EQ(restored.Values(fieldobs::Quantity::kRunout, ""),
             never.Values(fieldobs::Quantity::kRunout, ""));
+}
+
+// Every evaluation runs the contact solve at the objective's tolerance (1e-7 m/s unless asked
+// otherwise), whatever the scene's: an evaluation of a scene set to 1e-3 m/s equals a direct run
+// at 1e-7 m/s bit for bit and differs from one at 1e-3 m/s; asked for 1e-3 m/s, it equals that.
+TEST(Objective, RunsEveryEvaluationAtItsOwnTolerance) {
+  const auto& p = Problem();
+  Scene loose = p.scene;
+  loose.options.tolerance_m_s = 1e-3;
+  const Objective objective(loose, p.release, p.observations, {MuMin()}, Threads(2));
+  EXPECT_EQ(objective.options().tolerance_m_s, 1e-7);
+  EXPECT_EQ(objective.scene().options.tolerance_m_s, 1e-7);
+  const Eigen::VectorXd u = Eigen::VectorXd::Constant(1, 0.3);
+  const double tight = DirectRunoutScore(loose, objective.GroundOf(u), 1e-7);
+  const double at_loose = DirectRunoutScore(loose, objective.GroundOf(u), 1e-3);
+  ASSERT_NE(tight, at_loose);  // the tolerance changes this problem's scores
+  EXPECT_EQ(objective.Evaluate(u).kind_scores[0], tight);
+
+  ObjectiveOptions options = Threads(2);
+  options.tolerance_m_s = 1e-3;
+  const Objective asked(p.scene, p.release, p.observations, {MuMin()}, options);
+  EXPECT_EQ(asked.Evaluate(u).kind_scores[0], at_loose);
+}
+
+// A tolerance outside (0, 1) m/s (or not finite) is refused, naming the option.
+TEST(Objective, RejectsAToleranceOutsideZeroToOne) {
+  const auto& p = Problem();
+  for (double tolerance : {0.0, -1e-7, 1.0, std::nan(""), HUGE_VAL}) {
+    ObjectiveOptions options = Threads(2);
+    options.tolerance_m_s = tolerance;
+    try {
+      const Objective objective(p.scene, p.release, p.observations, {MuMin()}, options);
+      ADD_FAILURE() << "accepted tolerance_m_s = " << tolerance;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("tolerance_m_s"), std::string::npos) << e.what();
+    }
+  }
 }
 
 TEST(Objective, IsTheSameForOneAndTwoThreads) {
@@ -93,7 +143,7 @@ TEST(Objective, ScaleIsTheClimatologyScoreAndResidualsSquareToTheValue) {
   fieldobs::EnsembleSamples samples(p.release);
   ensemble::EnsembleOptions run;
   run.threads = 2;
-  Scene scene = p.scene;
+  Scene scene = objective.scene();  // the objective's contact-solve tolerance
   scene.ground = objective.GroundOf(e.u);
   ensemble::RunEnsemble(scene, p.release, run, &samples);
   const fieldobs::ValidationReport report = fieldobs::Validate(p.observations, samples, nullptr);

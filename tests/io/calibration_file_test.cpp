@@ -1,0 +1,120 @@
+// Calibration files: the contact-solve tolerance every evaluation runs with ([solver]
+// tolerance_m_s), which of the calibration's and the scene's wins, and bad values refused with
+// file, line and key before any rock runs.
+
+#include "io/calibration_file.hpp"
+
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "common/error.hpp"
+#include "test_files.hpp"
+
+namespace talus::io {
+namespace {
+
+// A plane scene whose [solver] table is `solver`, four runs with observed run-outs, and a
+// calibration file of that event ending with `calibration_tail`; returns the calibration file.
+std::string MakeCalibration(const std::string& name, const std::string& solver,
+                            const std::string& calibration_tail) {
+  const auto dir = testing::FreshDir(name);
+  testing::WriteText(dir / "scene.toml", R"([terrain]
+plane = { slope_deg = 35, slope_length_m = 20, runout_m = 10, width_m = 12, cell_m = 1 }
+default_ground = "medium_soft"
+[rock]
+shape = { box = [0.4, 0.4, 0.3] }
+[release]
+runs = "runs.csv"
+rocks = 4
+[solver]
+max_time_s = 3
+)" + solver);
+  testing::WriteText(dir / "runs.csv",
+                     "trajectory_id,x_m,y_m,height_m\nr1,3,0,1\nr2,3,2,1\nr3,4,-2,1\nr4,4,3,1\n");
+  testing::WriteText(dir / "observed.csv",
+                     "trajectory_id,observed_runout_m\nr1,17\nr2,19\nr3,14\nr4,16\n");
+  testing::WriteText(dir / "event.toml",
+                     "scene = \"scene.toml\"\n[[observations]]\nkind = \"runout\"\n"
+                     "file = \"observed.csv\"\n");
+  testing::WriteText(dir / "cal.toml", R"(event = "event.toml"
+[[parameters]]
+category = "medium_soft"
+field = "mu_min"
+lower = 0.1
+upper = 0.9
+)" + calibration_tail);
+  return (dir / "cal.toml").string();
+}
+
+std::string ErrorOf(const std::string& path) {
+  try {
+    LoadCalibration(path);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// Neither file sets it: 1e-7 m/s, whatever the scene's preset (the simulations' default and the
+// `fast` preset are looser).
+TEST(LoadCalibration, ToleranceDefaultsToTheTightSolve) {
+  for (const std::string preset : {"", "preset = \"fast\"\n", "preset = \"accurate\"\n"}) {
+    const CalibrationFile file = LoadCalibration(MakeCalibration("default", preset, ""));
+    EXPECT_EQ(file.objective.tolerance_m_s, calibration::kCalibrationTolerance_m_s) << preset;
+    EXPECT_EQ(file.tolerance_source, "default");
+  }
+}
+
+// The scene's own [solver] tolerance_m_s counts when it is tighter than 1e-7 m/s; a looser one is
+// for the scene's simulations and is not used.
+TEST(LoadCalibration, TheTighterOfTheScenesToleranceAndTheDefault) {
+  const CalibrationFile looser =
+      LoadCalibration(MakeCalibration("looser", "tolerance_m_s = 1e-3\n", ""));
+  EXPECT_EQ(looser.objective.tolerance_m_s, 1e-7);
+  EXPECT_EQ(looser.tolerance_source, "default");
+  const CalibrationFile tighter =
+      LoadCalibration(MakeCalibration("tighter", "tolerance_m_s = 1e-9\n", ""));
+  EXPECT_EQ(tighter.objective.tolerance_m_s, 1e-9);
+  EXPECT_EQ(tighter.tolerance_source, "scene");
+}
+
+// The calibration file's [solver] tolerance_m_s wins over the scene's, looser or tighter, and
+// enters the hash that ties a checkpoint to its calibration.
+TEST(LoadCalibration, TheCalibrationsToleranceWins) {
+  const CalibrationFile loose = LoadCalibration(
+      MakeCalibration("loose", "tolerance_m_s = 1e-9\n", "[solver]\ntolerance_m_s = 1e-5\n"));
+  EXPECT_EQ(loose.objective.tolerance_m_s, 1e-5);
+  EXPECT_EQ(loose.tolerance_source, "calibration file");
+  const CalibrationFile tight = LoadCalibration(
+      MakeCalibration("tight", "tolerance_m_s = 1e-3\n", "[solver]\ntolerance_m_s = 1e-8\n"));
+  EXPECT_EQ(tight.objective.tolerance_m_s, 1e-8);
+  const CalibrationFile plain = LoadCalibration(MakeCalibration("plain", "", ""));
+  EXPECT_NE(loose.path_hash, plain.path_hash);
+  const CalibrationFile same =
+      LoadCalibration(MakeCalibration("same", "", "[solver]\ntolerance_m_s = 1e-7\n"));
+  EXPECT_EQ(same.path_hash, plain.path_hash);
+}
+
+TEST(LoadCalibration, BadTolerancesAreRefusedNamingFileLineAndKey) {
+  const struct {
+    std::string value, reason;
+  } cases[] = {
+      {"0", "0 must be in (0, 1) m/s (the contact solve's tolerance of every evaluation)"},
+      {"-1e-7", "-1e-07 must be in (0, 1) m/s (the contact solve's tolerance of every evaluation)"},
+      {"1", "1 must be in (0, 1) m/s (the contact solve's tolerance of every evaluation)"},
+      {"nan", "nan must be in (0, 1) m/s (the contact solve's tolerance of every evaluation)"},
+      {"inf", "inf must be in (0, 1) m/s (the contact solve's tolerance of every evaluation)"},
+      {"\"tight\"", "expected a number"},
+  };
+  for (const auto& c : cases) {
+    const std::string path =
+        MakeCalibration("bad", "", "[solver]\ntolerance_m_s = " + c.value + "\n");
+    EXPECT_EQ(ErrorOf(path), path + ":8: solver.tolerance_m_s: " + c.reason);
+  }
+  const std::string path = MakeCalibration("unknown", "", "[solver]\ndt_s = 0.001\n");
+  EXPECT_EQ(ErrorOf(path).rfind(path + ":8: solver.dt_s: unknown key", 0), 0u) << ErrorOf(path);
+}
+
+}  // namespace
+}  // namespace talus::io
