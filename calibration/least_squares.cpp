@@ -217,6 +217,7 @@ Summary CalibrateLeastSquares(const Objective& objective, const OptimizerOptions
     solver.num_threads = 1;             // the evaluations use the threads
     solver.max_num_iterations = 10000;  // the evaluation budget stops it
     solver.function_tolerance = std::max(options.ftol_rel, 1e-16);
+    // Ceres' test is relative: |step| <= (|u| + tol) tol, with |u| <= sqrt(n) in unit coordinates.
     solver.parameter_tolerance = std::max(options.xtol_abs, 1e-16);
     solver.logging_type = ceres::SILENT;
     BudgetCallback callback(evaluate);
