@@ -135,7 +135,9 @@ void KeepBestIterate(Summary& summary) {
 }
 
 // Where Levenberg-Marquardt starts when the Jacobian is noise-dominated (StepChoice): the
-// minimiser in the box of the residuals' linear model r(u) ~ a + B (u - c) fitted by least squares
+// minimiser of the residuals' linear model r(u) ~ a + B (u - c), clamped to the box coordinate by
+// coordinate (the box's minimiser of the model for one parameter, a start near it for more), with
+// the model fitted by least squares
 // to a design -- `start` and 4 (n + 1) - 1 points of the optimiser's start design --, a response
 // surface (Box & Wilson 1951) in Gauss-Newton form. A difference quotient over one stencil sees
 // the noise of two points; the regression's slope averages it over the design and the box, so the
@@ -274,6 +276,12 @@ StepChoice ChooseFiniteDifferenceStep(const Objective& objective, const Eigen::V
   for (int j = 0; j < objective.dimension(); ++j) {
     const Difference d1 = MeasureDifference(objective, at, j, options.small, &out.evaluations);
     const Difference d2 = MeasureDifference(objective, at, j, options.large, &out.evaluations);
+    if (d1.width == 0 || d2.width == 0) {  // a stencil with no feasible side: nothing measured
+      out.noise.push_back(0);
+      out.signal.push_back(0);
+      out.step = std::max(out.step, options.large);
+      continue;
+    }
     // D(w) = S + N / w^2 through the two points.
     double noise = 0, signal = d2.jtj;
     const double x1 = d1.width > 0 ? 1 / (d1.width * d1.width) : 0;
@@ -295,8 +303,10 @@ StepChoice ChooseFiniteDifferenceStep(const Objective& objective, const Eigen::V
 double StepChoice::shrink() const {
   double out = 1;
   const double w = 2 * step;
-  for (std::size_t j = 0; j < signal.size(); ++j)
+  for (std::size_t j = 0; j < signal.size(); ++j) {
+    if (noise[j] == 0) continue;  // no noise seen (or nothing measured): no shortening
     out = std::min(out, signal[j] > 0 ? 1 / (1 + noise[j] / (signal[j] * w * w)) : 0.0);
+  }
   return out;
 }
 

@@ -3,8 +3,9 @@
 // nonlinear least squares in the unit cube, and the covariance of the fitted parameters.
 //
 // Derivatives are central differences with an absolute step h in unit coordinates (a fraction of
-// each parameter's range), chosen above the objective's measured roughness (roughness.hpp): a
-// smaller step would differentiate the noise of which way rocks turn. At a bound the pair of
+// each parameter's range), chosen from the Jacobian's measured noise and curvature
+// (ChooseFiniteDifferenceStep below): a smaller step would differentiate the noise of which way
+// rocks turn. At a bound the pair of
 // points moves inside the box (one-sided there). Ceres' own NumericDiffCostFunction steps relative
 // to |x| and knows no bounds, hence a cost function of our own.
 //

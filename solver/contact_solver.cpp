@@ -157,8 +157,8 @@ Eigen::Vector3d SolveViscous(const Contact& c, const Eigen::Vector3d& xi0, doubl
 // G' = (I + G H)^-1 G and xi0' = (I + G H)^-1 (xi0 + G H bias), with h_i from the load shares of
 // the previous solution; repeated until the shares agree with the solution's own to the
 // tolerance. False, with nothing changed, when the block solve finds no verified case.
-bool SolvePairBlock(const RockShape& rock, const Eigen::Matrix3d& rotation, double inv_mass,
-                    double tolerance, Eigen::Vector3d& velocity_m_s, Eigen::Vector3d& omega_rad_s,
+bool SolvePairBlock(const Eigen::Matrix3d& rotation, double inv_mass, double tolerance,
+                    Eigen::Vector3d& velocity_m_s, Eigen::Vector3d& omega_rad_s,
                     std::vector<Contact>& contacts) {
   Contact& c0 = contacts[0];
   Contact& c1 = contacts[1];
@@ -176,9 +176,10 @@ bool SolvePairBlock(const RockShape& rock, const Eigen::Matrix3d& rotation, doub
       c1.directions.transpose() * velocity_m_s + c1.arms.transpose() * omega_rad_s;
   xi += bias;
   const Vector6d xi0 = xi - pr.g * now;
-  // Internal force: +e at contact 0, -e at contact 1, e along the line through the two vertices.
-  const Eigen::Vector3d e =
-      (rotation * (rock.vertices_m[c0.vertex] - rock.vertices_m[c1.vertex])).normalized();
+  // Internal force: +e at contact 0, -e at contact 1, e along the line through the two points
+  // where the percussions act (the levers: a predicted contact's may be its touch point), so that
+  // the pair exerts no net force or torque and z stays G's null vector.
+  const Eigen::Vector3d e = (rotation * (c0.lever_m - c1.lever_m)).normalized();
   pr.null << c0.directions.transpose() * e, -(c1.directions.transpose() * e);
   pr.null.normalize();
   pr.mu[0] = c0.mu;
@@ -344,7 +345,7 @@ ContactSolveReport SolveContacts(const Scene& scene, const RockShape& rock,
     }
     // Block method: after the first sweep, the two contacts of an edge as one exact block solve.
     if (pair_block && iter == 1 &&
-        SolvePairBlock(rock, rotation, inv_mass, opt.tolerance_m_s, velocity_m_s, omega_rad_s,
+        SolvePairBlock(rotation, inv_mass, opt.tolerance_m_s, velocity_m_s, omega_rad_s,
                        workspace.contacts)) {
       report.iterations = iter + 1;
       report.converged = true;
