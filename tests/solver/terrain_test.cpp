@@ -72,18 +72,24 @@ TEST(Terrain, LocalPlaneBoundsTheTerrainInTheBox) {
   EXPECT_FALSE(t.PlaneAround(10.2, 21, 0.5, &plane));  // the box reaches beyond x0
 }
 
-TEST(Terrain, LocalPlaneBoundIsTheLargestDepartureOverTheBox) {
-  // A rough grid (41 x 31 nodes, 1.5 m spacing) and boxes inside a cell, across cell edges and
-  // over many cells: the bound is at least |h - plane| at every point of a fine lattice over the
-  // box (edges included), and it is tight: at most that lattice's largest value plus the 1e-6 m
-  // rounding allowance and what a lattice of 200 x 200 can miss between its points (the slope of
-  // h - plane, below 10 here, times the lattice's spacing).
+// A rough grid of 41 x 31 nodes at 1.5 m spacing (slopes of h below 10).
+Heightfield RoughHeights() {
   Heightfield hf;
   hf.grid = {41, 31, 100.0, -20.0, 1.5, 1.5};
   for (int j = 0; j < 31; ++j)
     for (int i = 0; i < 41; ++i)
       hf.z_m.push_back(0.7 * i + 3 * std::sin(1.3 * i) * std::cos(0.7 * j) +
                        0.2 * ((i * 7 + j * 13) % 5));
+  return hf;
+}
+
+TEST(Terrain, LocalPlaneBoundIsTheLargestDepartureOverTheBox) {
+  // A rough grid (41 x 31 nodes, 1.5 m spacing) and boxes inside a cell, across cell edges and
+  // over many cells: the bound is at least |h - plane| at every point of a fine lattice over the
+  // box (edges included), and it is tight: at most that lattice's largest value plus the 1e-6 m
+  // rounding allowance and what a lattice of 200 x 200 can miss between its points (the slope of
+  // h - plane, below 10 here, times the lattice's spacing).
+  const Heightfield hf = RoughHeights();
   const Terrain t(hf, 0);
   const double boxes[][3] = {{120.4, -5.3, 0.3}, {121.4, -4.6, 0.8}, {130.0, 0.0, 0.7},
                              {140.2, 10.9, 4.0}, {103.0, -17.0, 2.9}};
@@ -112,12 +118,7 @@ TEST(Terrain, MaxAbovePlaneBoundsTheTerrainOverTheBox) {
   // above the plane at every point of the box (sampled on a fine lattice, edges included), and at
   // most the largest node value of the cells around the box (its definition). Exact arithmetic
   // up to round-off: tolerance 1e-12 m.
-  Heightfield hf;
-  hf.grid = {41, 31, 100.0, -20.0, 1.5, 1.5};
-  for (int j = 0; j < 31; ++j)
-    for (int i = 0; i < 41; ++i)
-      hf.z_m.push_back(0.7 * i + 3 * std::sin(1.3 * i) * std::cos(0.7 * j) +
-                       0.2 * ((i * 7 + j * 13) % 5));
+  const Heightfield hf = RoughHeights();
   const Terrain t(hf, 0);
   const Terrain::Plane plane{120.0, -5.0, 12.0, 0.4, -0.1};
   auto plane_at = [&](double x, double y) {
