@@ -1,7 +1,9 @@
 #include "ensemble/runner.hpp"
 
 #include <algorithm>
+#include <cassert>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <memory>
 #include <optional>
@@ -82,6 +84,9 @@ void EnsembleReport::AddCounts(const EnsembleReport& other) {
 
 EnsembleReport RunEnsemble(const Scene& scene, const ReleaseSpec& release,
                            const EnsembleOptions& options, RockSink* sink) {
+  // Callers check scenes and releases (bad input is reported before any work starts).
+  assert(scene.IsValid(nullptr) && "RunEnsemble needs a valid scene");
+  assert(release.IsValid(nullptr) && "RunEnsemble needs a valid release");
   const auto t0 = std::chrono::steady_clock::now();
   const long first = options.first_rock;
   const long end = options.end_rock < 0 ? release.total_rocks() : options.end_rock;
@@ -102,6 +107,9 @@ EnsembleReport RunEnsemble(const Scene& scene, const ReleaseSpec& release,
       out.rock = rock;
       out.release = release.ReleaseOf(rock);
       ReleasedRock released = Release(scene, release, rock);
+      assert(released.shape && released.shape->IsValid(nullptr) &&
+             std::abs(released.start.orientation.squaredNorm() - 1) <= 1e-12 &&
+             "Release gave an invalid shape or a non-unit orientation");
       out.shape = std::move(released.shape);
       out.start = released.start;
       out.lift_m = released.lift_m;

@@ -1,6 +1,7 @@
 #include "solver/simulate.hpp"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <cstdio>
 
@@ -45,6 +46,14 @@ bool IsFinite(const RockState& s) {
          s.angular_velocity_rad_s.allFinite() && s.orientation.coeffs().allFinite() &&
          std::isfinite(s.scar_m);
 }
+
+// What every finite state after a step holds (debug builds check it): the drift renormalises the
+// orientation, the scar only grows or decays towards 0, and time has moved on by one step.
+[[maybe_unused]] bool IsConsistentAfterStep(const RockState& s, double previous_time_s,
+                                            double dt_s) {
+  return std::abs(s.orientation.squaredNorm() - 1) <= 1e-12 && s.scar_m >= 0 &&
+         std::abs(s.time_s - previous_time_s - dt_s) <= 1e-9 * (1 + std::abs(s.time_s));
+}
 }  // namespace
 
 RockResult SimulateRock(const Scene& scene, const RockShape& rock, const RockState& start,
@@ -87,15 +96,20 @@ RockResult SimulateRock(const Scene& scene, const RockShape& rock, const RockSta
   FlightStepper stepper(workspace.flight_windows);
   while (true) {
     const Eigen::Vector3d previous = state.position_m;
+    [[maybe_unused]] const double previous_time_s = state.time_s;  // for the assertion
     const StepReport step =
         stepper.Advance(scene, rock, state, workspace.step, workspace.stage_times);
     result.flight_steps = stepper.flight_steps();
     if (step.outside_domain) return finish(EndReason::kLeftDomain);
     ++result.steps;
+    // A non-finite state is numerical trouble: the rock fails, the run goes on.
     if (!IsFinite(state)) {
       result.message = "state became non-finite at t = " + std::to_string(state.time_s) + " s";
       return finish(EndReason::kFailed);
     }
+    assert(
+        IsConsistentAfterStep(state, previous_time_s, opt.dt_s) &&
+        "a step left a finite state with a non-unit quaternion, a negative scar or a wrong time");
     if (!scene.terrain.Sample(state.position_m.x(), state.position_m.y(), &ground))
       return finish(EndReason::kLeftDomain);
 

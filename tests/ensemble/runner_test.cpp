@@ -202,5 +202,21 @@ TEST(RunEnsemble, RocksThatStayAtTheirReleaseAreCounted) {
   EXPECT_EQ(moved.rocks, 3);
 }
 
+// A scene or release that was not checked is a programming error: debug builds stop at the
+// entry, before any rock runs (release builds trust the caller, at no cost).
+TEST(RunEnsembleDeathTest, AnUncheckedSceneOrReleaseStopsADebugBuild) {
+#ifdef NDEBUG
+  GTEST_SKIP() << "assertions are compiled out";
+#else
+  GTEST_FLAG_SET(death_test_style, "threadsafe");
+  Scene scene = testing::SmallPlane(0, 0, 10, 10);
+  const ReleaseSpec release = testing::PointRelease({{5, 0}}, 1);
+  scene.options.dt_s = 0;
+  EXPECT_DEATH(RunEnsemble(scene, release, EnsembleOptions{}), "RunEnsemble needs a valid scene");
+  EXPECT_DEATH(RunEnsemble(testing::SmallPlane(0, 0, 10, 10), ReleaseSpec{}, EnsembleOptions{}),
+               "RunEnsemble needs a valid release");
+#endif
+}
+
 }  // namespace
 }  // namespace talus::ensemble
