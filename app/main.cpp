@@ -2,12 +2,16 @@
 // share the exit codes there: 0 done, 1 the run failed, 2 bad input or usage, 128 + signal.
 
 #include <CLI/CLI.hpp>
+#include <cstdio>
+#include <exception>
 #include <vector>
 
 #include "app/commands.hpp"
 #include "talus/version.hpp"
 
-int main(int argc, char** argv) {
+namespace {
+
+int Run(int argc, char** argv) {
   CLI::App app{"Talus: rockfall simulation with non-smooth contact mechanics"};
   app.set_version_flag("--version", std::string("talus ") + talus::kVersion);
   app.require_subcommand(1);
@@ -34,4 +38,17 @@ int main(int argc, char** argv) {
     if (status >= 0) return status;
   }
   return talus::app::kExitOk;
+}
+
+}  // namespace
+
+// The verbs report their own failures; anything that still escapes (out of memory outside a run)
+// is a failed run, reported on one line.
+int main(int argc, char** argv) {
+  try {
+    return Run(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "talus: %s\n", e.what());
+    return talus::app::kExitRunFailed;
+  }
 }

@@ -11,6 +11,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <exception>
 #include <fstream>
 #include <map>
 #include <memory>
@@ -177,7 +178,7 @@ CellValues RunCellStatistics(const talus::Scene& scene, int rocks, std::uint64_t
 
 }  // namespace
 
-int main(int argc, char** argv) {
+int RunBenchmark(int argc, char** argv) {
   CLI::App app{"Ramp benchmark: EOTA221 block trajectories down a 40 degree plane, one core"};
   int rocks = 200, repeats = 5;
   double dt_s = 0.002, tolerance = -1;
@@ -331,4 +332,14 @@ int main(int argc, char** argv) {
                 1e9 * seconds / times.steps);
   (void)profiled;
   return 0;
+}
+
+// What the benchmark throws (a bad scene file, a full disk) ends it with one line on stderr.
+int main(int argc, char** argv) {
+  try {
+    return RunBenchmark(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "%s: %s\n", argv[0], e.what());
+    return 1;
+  }
 }

@@ -10,6 +10,7 @@
 #include <CLI/CLI.hpp>
 #include <chrono>
 #include <cstdio>
+#include <exception>
 #include <string>
 
 #include "ensemble/runner.hpp"
@@ -34,7 +35,7 @@ class PassageCounter : public talus::ensemble::RockSink {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+int RunBenchmark(int argc, char** argv) {
   CLI::App app{"Memory of the raster statistics for growing numbers of rocks"};
   std::string scene_path = std::string(TALUS_SOURCE_DIR) + "/cases/tirol/scene.toml";
   std::vector<long> counts = {100, 1000, 4000};
@@ -78,4 +79,14 @@ int main(int argc, char** argv) {
       "(*) computed for the layout the summaries replaced (every passing rock's value per "
       "cell), without std::vector's spare capacity\n");
   return 0;
+}
+
+// What the benchmark throws (a bad scene file, a full disk) ends it with one line on stderr.
+int main(int argc, char** argv) {
+  try {
+    return RunBenchmark(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "%s: %s\n", argv[0], e.what());
+    return 1;
+  }
 }

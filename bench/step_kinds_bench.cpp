@@ -11,6 +11,7 @@
 #include <array>
 #include <chrono>
 #include <cstdio>
+#include <exception>
 #include <string>
 #include <vector>
 
@@ -148,7 +149,7 @@ void PrintStageProfile(const talus::StageTimes& t) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+int RunBenchmark(int argc, char** argv) {
   CLI::App app{"Step kinds: contact, flight, flight windows, over a scene's rocks on one core"};
   std::string scene_path;
   long rocks = 0;
@@ -197,4 +198,14 @@ int main(int argc, char** argv) {
   RunRocks(file, rocks, true, &times);
   PrintStageProfile(times);
   return 0;
+}
+
+// What the benchmark throws (a bad scene file, a full disk) ends it with one line on stderr.
+int main(int argc, char** argv) {
+  try {
+    return RunBenchmark(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "%s: %s\n", argv[0], e.what());
+    return 1;
+  }
 }

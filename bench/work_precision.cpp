@@ -17,6 +17,7 @@
 #include <cmath>
 #include <cstdio>
 #include <ctime>
+#include <exception>
 #include <fstream>
 #include <memory>
 #include <optional>
@@ -735,7 +736,7 @@ Study LoadStudy(const std::string& path) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+int RunBenchmark(int argc, char** argv) {
   CLI::App app{"Work against precision of every accuracy knob on one scene (one core)"};
   std::string scene_path;
   long rocks = 200;
@@ -788,4 +789,14 @@ int main(int argc, char** argv) {
     return 1;
   }
   return 0;
+}
+
+// What the benchmark throws (a bad scene file, a full disk) ends it with one line on stderr.
+int main(int argc, char** argv) {
+  try {
+    return RunBenchmark(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "%s: %s\n", argv[0], e.what());
+    return 1;
+  }
 }
