@@ -45,7 +45,7 @@ CLI::Validator ThreadCount() {
   const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   const CLI::Validator range = IntegerRange(0, max);
   return CLI::Validator(
-      [range, max, cores](std::string& text) -> std::string {
+      [range, cores](std::string& text) -> std::string {
         std::string why = range(text);
         if (why.rfind("must be <=", 0) == 0)
           why += " (this machine has " + std::to_string(cores) + " cores; at most " +

@@ -1,6 +1,6 @@
 #include "app/interrupt.hpp"
 
-#include <signal.h>
+#include <signal.h>  // NOLINT(modernize-deprecated-headers): POSIX sigaction is declared here
 
 #include <csignal>
 

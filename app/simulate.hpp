@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <optional>
@@ -63,7 +64,7 @@ class ProgressBar {
     const int filled = static_cast<int>(kWidth * done / total);
     std::fprintf(stderr, "\r[%-*.*s] %ld/%ld rocks  %.1f/s  %s left   ", kWidth, filled,
                  "##############################", done, total, rate,
-                 done > 0 ? (std::to_string(static_cast<long>(left + 0.5)) + " s").c_str() : "?");
+                 done > 0 ? (std::to_string(std::lround(left)) + " s").c_str() : "?");
     shown_ = done < total;
     if (done == total) std::fprintf(stderr, "\n");
     std::fflush(stderr);

@@ -1,6 +1,6 @@
 #include "common/atomic_file.hpp"
 
-#include <signal.h>
+#include <signal.h>  // NOLINT(modernize-deprecated-headers): POSIX sigaction is declared here
 #include <unistd.h>
 
 #include <cerrno>

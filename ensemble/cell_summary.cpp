@@ -7,7 +7,8 @@
 namespace talus::ensemble {
 namespace {
 
-__extension__ typedef unsigned __int128 UInt128;
+// `using` would not take __extension__, which keeps -Wpedantic quiet.
+__extension__ typedef unsigned __int128 UInt128;  // NOLINT(modernize-use-using)
 
 constexpr int kShift = 23 - ValueSummary::kMantissaBits;  // float mantissa bits dropped
 constexpr double kQuantum = 0x1p24;                       // fixed-point scale of the sum

@@ -189,7 +189,8 @@ std::vector<RasterLayer> RasterAccumulator::Finish(const Heightfield& dem) const
     }
     for (std::size_t c = 0; c < cells; ++c) {
       if (slot_[c] < 0) continue;
-      const ValueSummary& s = summaries_[static_cast<std::size_t>(slot_[c] + quantity)];
+      const ValueSummary& s =
+          summaries_[static_cast<std::size_t>(slot_[c]) + static_cast<std::size_t>(quantity)];
       if (s.count() == 0) continue;
       out[first].values[c] = s.max();
       out[first + 1].values[c] = static_cast<float>(s.mean());
@@ -285,7 +286,9 @@ void RasterAccumulator::Serialize(ByteWriter& out) const {
   out.PutVector(passed);
   for (std::int32_t c : passed)
     for (int k = 0; k < quantities(); ++k)
-      summaries_[static_cast<std::size_t>(slot_[static_cast<std::size_t>(c)] + k)].Serialize(out);
+      summaries_[static_cast<std::size_t>(slot_[static_cast<std::size_t>(c)]) +
+                 static_cast<std::size_t>(k)]
+          .Serialize(out);
 }
 
 RasterAccumulator RasterAccumulator::Deserialize(const RasterRequest& request, ByteReader& in) {

@@ -69,7 +69,7 @@ Eigen::Vector2d PointInPolygon(const std::vector<std::vector<Eigen::Vector2d>>& 
   // attempts fail with probability (1 - 1e-3)^1e5 < 1e-43.
   for (int attempt = 0; attempt < 100000; ++attempt) {
     const double u = random.Uniform(), v = random.Uniform();
-    const Eigen::Vector2d p(lo.x() + u * (hi.x() - lo.x()), lo.y() + v * (hi.y() - lo.y()));
+    Eigen::Vector2d p(lo.x() + u * (hi.x() - lo.x()), lo.y() + v * (hi.y() - lo.y()));
     if (InsidePolygon(rings, p) && keep(p)) return p;
   }
   return rings[0][0];
@@ -181,14 +181,14 @@ bool ReleaseSpec::IsValid(std::string* why) const {
   if (releases.empty() && runs.empty()) return Fail(why, "no release point, line, polygon or run");
   if (!releases.empty() && !runs.empty())
     return Fail(why, "release geometries and runs cannot be combined");
-  for (std::size_t b = 0; b < blocks.size(); ++b) {
+  for (const Block& block : blocks) {
     std::string shape_why;
-    if (!blocks[b].shape) {
-      s << "block " << blocks[b].id << " has no shape";
+    if (!block.shape) {
+      s << "block " << block.id << " has no shape";
       return Fail(why, s.str());
     }
-    if (!blocks[b].shape->IsValid(&shape_why)) {
-      s << "block " << blocks[b].id << ": " << shape_why;
+    if (!block.shape->IsValid(&shape_why)) {
+      s << "block " << block.id << ": " << shape_why;
       return Fail(why, s.str());
     }
   }

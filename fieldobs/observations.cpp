@@ -72,7 +72,7 @@ namespace {
 
 std::string RunOf(const CsvTable& t, const TableColumns& c, int row) {
   if (!t.Has(c.run)) return "";
-  const std::string run = t.Text(row, c.run);
+  std::string run = t.Text(row, c.run);
   if (run.empty()) throw InputError(t.Where(row, c.run) + ": empty run id");
   return run;
 }
@@ -106,21 +106,22 @@ void ReadDeposits(const CsvTable& t, const TableColumns& c, ObservationSet& out)
 }
 
 std::vector<std::pair<std::string, std::optional<double>>> FirstAngularSpeeds(
-    const CsvTable& t, const TableColumns& c) {
-  t.Require({c.run, "time_s", "omega_x_radps", "omega_y_radps", "omega_z_radps"});
+    const CsvTable& samples, const TableColumns& columns) {
+  samples.Require({columns.run, "time_s", "omega_x_radps", "omega_y_radps", "omega_z_radps"});
   std::vector<std::pair<std::string, std::optional<double>>> out;
   std::unordered_map<std::string, std::size_t> index;
   std::vector<double> first_time_s;
-  for (int row = 0; row < t.rows(); ++row) {
-    const std::string run = RunOf(t, c, row);
-    const double time_s = t.Number(row, "time_s");
+  for (int row = 0; row < samples.rows(); ++row) {
+    const std::string run = RunOf(samples, columns, row);
+    const double time_s = samples.Number(row, "time_s");
     const auto [it, added] = index.emplace(run, out.size());
     if (!added && time_s >= first_time_s[it->second]) continue;
     std::optional<double> speed;
-    if (!t.Empty(row, "omega_x_radps") || !t.Empty(row, "omega_y_radps") ||
-        !t.Empty(row, "omega_z_radps"))
-      speed = Eigen::Vector3d(t.Number(row, "omega_x_radps"), t.Number(row, "omega_y_radps"),
-                              t.Number(row, "omega_z_radps"))
+    if (!samples.Empty(row, "omega_x_radps") || !samples.Empty(row, "omega_y_radps") ||
+        !samples.Empty(row, "omega_z_radps"))
+      speed = Eigen::Vector3d(samples.Number(row, "omega_x_radps"),
+                              samples.Number(row, "omega_y_radps"),
+                              samples.Number(row, "omega_z_radps"))
                   .norm();
     if (added) {
       out.emplace_back(run, speed);

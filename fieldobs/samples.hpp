@@ -42,7 +42,7 @@ class EnsembleSamples : public ensemble::RockSink {
   // `release` names the runs; it must outlive this object. The runner must record episodes
   // (EnsembleOptions::episodes) for the impact and scar quantities to have values.
   explicit EnsembleSamples(const ensemble::ReleaseSpec& release);
-  void OnRock(const ensemble::RockOutcome& rock) override;
+  void OnRock(const ensemble::RockOutcome& outcome) override;
 
   // True when `run` is a run (or release) of the ensemble; "" (the whole scene) always is.
   bool HasRun(const std::string& run) const;

@@ -13,8 +13,6 @@
 namespace talus::io {
 namespace {
 
-namespace fs = std::filesystem;
-using calibration::GroundField;
 using calibration::ParameterSpec;
 
 const std::vector<std::string> kFields = {"mu_min", "mu_max", "beta", "kappa", "nu"};

@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <memory>
 #include <numbers>
+#include <ranges>
 #include <stdexcept>
 
 #include "common/atomic_file.hpp"
@@ -57,7 +58,7 @@ bool StartsWith(const std::string& s, const char* prefix) { return s.rfind(prefi
 // The statistic of a layer name such as "speed_p95", for the legend's title.
 std::string StatisticOf(const std::string& name) {
   const std::size_t underscore = name.rfind('_');
-  const std::string statistic = underscore == std::string::npos ? "" : name.substr(underscore + 1);
+  std::string statistic = underscore == std::string::npos ? "" : name.substr(underscore + 1);
   if (statistic == "max") return "largest";
   if (statistic == "mean") return "mean";
   if (statistic.size() > 1 && statistic[0] == 'p') {
@@ -199,15 +200,15 @@ void DrawLegend(cairo_t* cr, const ensemble::RasterLayer* layer, const QuickLook
   if (layer) {
     Text(cr, x, y, 14, legend.title, true);
     y += 12;
-    for (auto it = legend.classes.rbegin(); it != legend.classes.rend(); ++it) {
-      SetColour(cr, it->rgb);
+    for (const ColourClass& colour : std::views::reverse(legend.classes)) {
+      SetColour(cr, colour.rgb);
       cairo_rectangle(cr, x, y + 4, 24, 16);
       cairo_fill_preserve(cr);
       cairo_set_source_rgb(cr, 0.3, 0.3, 0.3);
       cairo_set_line_width(cr, 1);
       cairo_stroke(cr);
       cairo_set_source_rgb(cr, 0, 0, 0);
-      Text(cr, x + 32, y + 17, 12, it->label);
+      Text(cr, x + 32, y + 17, 12, colour.label);
       y += 22;
     }
     Text(cr, x, y + 16, 11, "no colour: no rock passed");

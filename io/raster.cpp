@@ -153,7 +153,7 @@ std::string DescribeCrs(const std::string& crs_wkt) {
   OGRSpatialReference srs;
   if (srs.importFromWkt(crs_wkt.c_str()) != OGRERR_NONE) return "an unreadable CRS";
   const char* name = srs.GetName();
-  const std::string named = name ? name : "an unnamed CRS";
+  std::string named = name ? name : "an unnamed CRS";
   const char* authority = srs.GetAuthorityName(nullptr);
   const char* code = srs.GetAuthorityCode(nullptr);
   if (!authority || !code) return named;

@@ -201,6 +201,7 @@ void LoadGroundPolygons(const Context& context, const Section& terrain, SceneFil
       grid.index[k] = static_cast<std::uint8_t>(burnt[k]);
     } else if (raster) {
       const double x = d.x0_m + d.dx_m * static_cast<double>(k % static_cast<std::size_t>(d.nx));
+      // NOLINTNEXTLINE(bugprone-integer-division): k / nx is the row, an integer on purpose
       const double y = d.y0_m + d.dy_m * static_cast<double>(k / static_cast<std::size_t>(d.nx));
       grid.index[k] = static_cast<std::uint8_t>(scene.terrain.GroundAt(x, y));
     } else {

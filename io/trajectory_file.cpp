@@ -406,7 +406,7 @@ std::string ReadStringAttribute(hid_t object, const char* name) {
     throw Hdf5Failure{std::string(name) + " is not a string"};
   char* text = nullptr;
   Check(H5Aread(attribute.get(), type.get(), &text), name);
-  const std::string out = text ? text : "";
+  std::string out = text ? text : "";
   const Handle space(Check(H5Aget_space(attribute.get()), name), H5Sclose);
   H5Dvlen_reclaim(type.get(), space.get(), H5P_DEFAULT, &text);
   return out;
@@ -424,7 +424,7 @@ struct TrajectoryReader::Impl {
   hsize_t block_first = 0;
   std::vector<std::int64_t> block_rock, block_first_sample, block_count;
 
-  Handle Open(const char* name) {
+  Handle Open(const char* name) const {
     return Handle(Check(H5Dopen2(file.get(), name, H5P_DEFAULT), name), H5Dclose);
   }
   // Loads the index block holding `row`.

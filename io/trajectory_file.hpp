@@ -48,7 +48,7 @@ class TrajectoryWriter {
   // Rocks come in increasing order (else std::logic_error).
   void Write(const ensemble::RockOutcome& rock);
   // Writes a rock read from another file: the same bytes as Write of the rock it came from.
-  void Write(long rock, const StoredTrajectory& trajectory);
+  void Write(long rock, const StoredTrajectory& stored);
   void Commit();  // closes and renames into place
 
  private:

@@ -84,9 +84,9 @@ std::vector<Eigen::Vector2d> Hull2d(std::vector<Eigen::Vector2d> p) {
   };
   std::vector<Eigen::Vector2d> h(2 * p.size());
   std::size_t k = 0;
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    while (k >= 2 && cross(h[k - 2], h[k - 1], p[i]) <= 0) --k;
-    h[k++] = p[i];
+  for (const Eigen::Vector2d& point : p) {
+    while (k >= 2 && cross(h[k - 2], h[k - 1], point) <= 0) --k;
+    h[k++] = point;
   }
   for (std::size_t i = p.size() - 1, lower = k + 1; i-- > 0;) {
     while (k >= lower && cross(h[k - 2], h[k - 1], p[i]) <= 0) --k;

@@ -2,7 +2,7 @@
 // with mistakes, each refused with its file, line, key and reason before any rock runs.
 
 #include <gtest/gtest.h>
-#include <signal.h>
+#include <signal.h>  // NOLINT(modernize-deprecated-headers): POSIX kill is declared here
 #include <sys/wait.h>
 
 #include <algorithm>
@@ -34,7 +34,7 @@ using talus::app::testing::Write;
 
 // Four (or seven) runs of a block on a short 35 degree slope with observed run-outs.
 fs::path MakeEvent(const std::string& name, bool seven = false) {
-  const fs::path dir = FreshDir(name);
+  fs::path dir = FreshDir(name);
   Write(dir / "scene.toml", R"([terrain]
 plane = { slope_deg = 35, slope_length_m = 20, runout_m = 10, width_m = 12, cell_m = 1 }
 default_ground = "medium_soft"

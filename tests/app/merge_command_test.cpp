@@ -49,7 +49,7 @@ class MergeCommand : public ::testing::Test {
   fs::path Part(const std::string& range, int threads = 1, const std::string& extra = "") {
     std::string name = "part-" + range;
     name[name.find(':')] = '-';
-    const fs::path out = dir_ / name;
+    fs::path out = dir_ / name;
     std::string log;
     EXPECT_EQ(RunCommand(Talus("simulate " + scene_.string() + " --out " + out.string() +
                                " --rock-range " + range + " --threads " + std::to_string(threads) +

@@ -3,7 +3,7 @@
 // command with its output and exit status, reading and writing files.
 
 #include <fcntl.h>
-#include <signal.h>
+#include <signal.h>  // NOLINT(modernize-deprecated-headers): POSIX kill is declared here
 #include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -14,11 +14,11 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
-#include <nlohmann/json.hpp>
 
 #include "tests/test_tmp.hpp"
 
@@ -26,7 +26,7 @@ namespace talus::app::testing {
 
 // An empty directory <tmp>/<group>/<name>.
 inline std::filesystem::path FreshDir(const std::string& group, const std::string& name) {
-  const std::filesystem::path dir = talus::testing::TestTmpRoot() / group / name;
+  std::filesystem::path dir = talus::testing::TestTmpRoot() / group / name;
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir;

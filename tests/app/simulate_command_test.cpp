@@ -4,7 +4,7 @@
 #include <fcntl.h>
 #include <gdal_priv.h>
 #include <gtest/gtest.h>
-#include <signal.h>
+#include <signal.h>  // NOLINT(modernize-deprecated-headers): POSIX kill is declared here
 #include <spawn.h>
 #include <sys/mount.h>
 #include <sys/wait.h>
@@ -24,8 +24,6 @@
 #include <string>
 #include <thread>
 #include <vector>
-
-extern char** environ;
 
 #include "run_talus.hpp"
 
@@ -238,7 +236,8 @@ report = false
     long passed = 0, untouched = 0;
     for (int row = 0; row < 12; ++row)
       for (int column = 0; column < 30; ++column) {
-        const float value = v[static_cast<std::size_t>(row * 30 + column)];
+        const float value =
+            v[static_cast<std::size_t>(row) * 30 + static_cast<std::size_t>(column)];
         if (column >= 14 && column < 17 && row >= 4 && row < 7) {
           EXPECT_EQ(value, -9999.0f) << name << " in the hole at " << column << ", " << row;
         } else if (value == (count ? 0.0f : -9999.0f)) {

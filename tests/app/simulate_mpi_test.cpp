@@ -15,7 +15,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using talus::app::testing::RunCommand;
-using talus::app::testing::Slurp;
 
 const std::string kScene = std::string(TALUS_SOURCE_DIR) + "/cases/tirol/scene.toml";
 

@@ -30,7 +30,7 @@ using talus::app::testing::Write;
 // Three runs of two blocks on a short 35 degree slope, observed rest positions and run-outs, and
 // impacts (each run starts 2 m above the ground, so its first contact episode is an impact).
 fs::path MakeEvent(const std::string& name, const std::string& event_extra = "") {
-  const fs::path dir = FreshDir(name);
+  fs::path dir = FreshDir(name);
   Write(dir / "scene.toml", R"([terrain]
 plane = { slope_deg = 35, slope_length_m = 20, runout_m = 10, width_m = 12, cell_m = 1 }
 default_ground = "medium_soft"

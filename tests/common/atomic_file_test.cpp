@@ -18,7 +18,7 @@ namespace fs = std::filesystem;
 
 // An empty directory of its own under the system's temporary directory.
 fs::path FreshDir(const std::string& name) {
-  const auto dir = talus::testing::TestTmpRoot() / ("talus_common_test_" + name);
+  auto dir = talus::testing::TestTmpRoot() / ("talus_common_test_" + name);
   fs::remove_all(dir);
   fs::create_directories(dir);
   return dir;

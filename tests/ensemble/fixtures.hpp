@@ -18,7 +18,7 @@ inline Scene SmallPlane(double slope_deg, double slope_length_m, double runout_m
   return scene;
 }
 
-inline ReleaseSpec PointRelease(std::vector<Eigen::Vector2d> points, long rocks) {
+inline ReleaseSpec PointRelease(const std::vector<Eigen::Vector2d>& points, long rocks) {
   ReleaseSpec spec;
   for (const Eigen::Vector2d& p : points)
     spec.releases.push_back({ReleaseGeometry::Kind::kPoint, {{p}}});

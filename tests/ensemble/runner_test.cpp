@@ -15,9 +15,10 @@ class Collect : public RockSink {
   std::vector<RockOutcome> rocks;
 };
 
+// Bit-identical, as the thread-count contract says: -0 and 0 differ, a NaN equals itself.
 template <class T>
 bool SameBits(const T& a, const T& b) {
-  return std::memcmp(&a, &b, sizeof(T)) == 0;
+  return std::memcmp(&a, &b, sizeof(T)) == 0;  // NOLINT(bugprone-suspicious-memory-comparison)
 }
 
 // Runs with their own blocks, start states and a shape of their own per rock (from a seeded

@@ -28,7 +28,7 @@ std::string ErrorOf(const std::filesystem::path& event) {
 
 // A 20 x 20 cell DEM of 10 m cells in UTM 32N (EPSG:32632) near Innsbruck, flat, and two runs.
 std::filesystem::path MakeEvent(const std::string& name, int dem_epsg) {
-  const auto dir = testing::FreshDir(name);
+  auto dir = testing::FreshDir(name);
   std::vector<std::vector<double>> rows(20, std::vector<double>(20, 600.0));
   testing::WriteGdalRaster(dir / "dem.tif", rows, {680000, 10, 0, 5240200, 0, -10}, dem_epsg,
                            std::nullopt);
@@ -190,7 +190,7 @@ TEST(ReferenceGround, Table1ValuesForBuiltInCategoriesOnly) {
 
 // Two flight segments of one block on a plane; the impact ends segment s0 and starts s1.
 std::filesystem::path MakeEventDir(const std::string& name, const std::string& observations) {
-  const auto dir = testing::FreshDir(name);
+  auto dir = testing::FreshDir(name);
   testing::WriteText(dir / "scene.toml",
                      "[terrain]\nplane = {}\n[rock]\nshape = { box = [0.4, 0.4, 0.4] }\n"
                      "[release]\nruns = \"runs.csv\"\n");
@@ -274,7 +274,7 @@ namespace {
 // single_impacts table) and an event scoring them (`observation`: extra keys).
 std::filesystem::path MakeSingleImpacts(const std::string& name, const std::string& release,
                                         const std::string& observation, const std::string& table) {
-  const auto dir = testing::FreshDir(name);
+  auto dir = testing::FreshDir(name);
   testing::WriteText(dir / "scene.toml",
                      "[terrain]\nplane = { slope_deg = 30, slope_length_m = 40, runout_m = 10, "
                      "width_m = 20, cell_m = 1 }\n[rock]\nshape = { box = [0.5, 0.5, 0.5] }\n"

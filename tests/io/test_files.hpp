@@ -18,7 +18,7 @@ namespace talus::io::testing {
 
 inline std::filesystem::path FreshDir(const std::string& name) {
   const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-  const std::filesystem::path dir =
+  std::filesystem::path dir =
       talus::testing::TestTmpRoot() / "talus_io_tests" /
       (std::string(info->test_suite_name()) + "." + info->name() + "." + name);
   std::filesystem::remove_all(dir);
