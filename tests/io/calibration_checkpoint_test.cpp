@@ -1,0 +1,141 @@
+#include "io/calibration_checkpoint.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <string>
+
+#include "common/error.hpp"
+#include "test_files.hpp"
+
+namespace talus::io {
+namespace {
+
+using calibration::Evaluation;
+
+// Bits of a double: "bit for bit" means that, not ==, which NaN never meets.
+bool SameBits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+Evaluation Sample(double seed) {
+  Evaluation e;
+  e.u = Eigen::Vector2d(0.1 + seed, 1.0 / 3.0);
+  e.values = Eigen::Vector2d(0.55 * (1 + seed), std::nextafter(2.0, 3.0));
+  e.value = 1.0 / 7.0 + seed;
+  e.data = 0.1 + 0.2;  // 0.30000000000000004: needs all 17 digits
+  e.prior = 1e-300;
+  e.kind_scores = {12.345678901234567, 6.02214076e23};
+  e.kind_scored = {7, 0};
+  e.residuals = Eigen::Vector3d(-0.5, 1e-17, 3);
+  e.rocks = 1234567;
+  e.failed_rocks = 2;
+  e.wall_time_s = 0.123456789;
+  return e;
+}
+
+std::string WriteCheckpoint(const std::string& name, const std::string& text) {
+  const auto dir = testing::FreshDir(name);
+  const std::string path = (dir / "checkpoint.json").string();
+  testing::WriteText(path, text);
+  return path;
+}
+
+void ExpectSameVector(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
+  ASSERT_EQ(a.size(), b.size());
+  for (Eigen::Index k = 0; k < a.size(); ++k) EXPECT_TRUE(SameBits(a[k], b[k])) << k;
+}
+
+TEST(CalibrationCheckpoint, EveryNumberComesBackBitForBit) {
+  CalibrationCheckpoint c;
+  c.path_hash = "abc123";
+  c.holdout = {"run 2", "run\"7\""};
+  c.folds = 3;
+  c.stages["fit"] = {Sample(0), Sample(0.25)};
+  c.stages["fold1"] = {Sample(0.5)};
+  const CalibrationCheckpoint back = ReadCheckpoint(WriteCheckpoint("round", CheckpointJson(c)));
+  EXPECT_EQ(back.path_hash, "abc123");
+  EXPECT_EQ(back.holdout, c.holdout);
+  EXPECT_EQ(back.folds, 3);
+  ASSERT_EQ(back.stages.size(), 2u);
+  for (const auto& [name, evaluations] : c.stages) {
+    ASSERT_EQ(back.stages.at(name).size(), evaluations.size()) << name;
+    for (std::size_t k = 0; k < evaluations.size(); ++k) {
+      const Evaluation& a = evaluations[k];
+      const Evaluation& b = back.stages.at(name)[k];
+      ExpectSameVector(a.u, b.u);
+      ExpectSameVector(a.values, b.values);
+      ExpectSameVector(a.residuals, b.residuals);
+      EXPECT_TRUE(SameBits(a.value, b.value));
+      EXPECT_TRUE(SameBits(a.data, b.data));
+      EXPECT_TRUE(SameBits(a.prior, b.prior));
+      EXPECT_TRUE(SameBits(a.wall_time_s, b.wall_time_s));
+      ASSERT_EQ(b.kind_scores.size(), 2u);
+      EXPECT_TRUE(SameBits(a.kind_scores[1], b.kind_scores[1]));
+      EXPECT_EQ(b.kind_scored, a.kind_scored);
+      EXPECT_EQ(b.rocks, a.rocks);
+      EXPECT_EQ(b.failed_rocks, a.failed_rocks);
+      EXPECT_TRUE(b.feasible);
+    }
+  }
+  // Writing what was read gives the same bytes.
+  EXPECT_EQ(CheckpointJson(back), CheckpointJson(c));
+}
+
+TEST(CalibrationCheckpoint, AnInfeasibleEvaluationKeepsItsReasonAndItsNaNs) {
+  Evaluation e = Sample(0);
+  e.feasible = false;
+  e.infeasible = "mu_min 2.1 > mu_max 2";
+  e.value = std::numeric_limits<double>::quiet_NaN();
+  e.data = std::numeric_limits<double>::quiet_NaN();
+  e.kind_scores[0] = std::numeric_limits<double>::quiet_NaN();
+  CalibrationCheckpoint c;
+  c.stages["fit"] = {e};
+  const std::string json = CheckpointJson(c);
+  EXPECT_NE(json.find("\"value\":null"), std::string::npos) << json;
+  const Evaluation back = ReadCheckpoint(WriteCheckpoint("nan", json)).stages.at("fit").at(0);
+  EXPECT_FALSE(back.feasible);
+  EXPECT_EQ(back.infeasible, e.infeasible);
+  EXPECT_TRUE(std::isnan(back.value));
+  EXPECT_TRUE(std::isnan(back.data));
+  EXPECT_TRUE(std::isnan(back.kind_scores[0]));
+  EXPECT_EQ(back.kind_scores[1], e.kind_scores[1]);
+}
+
+TEST(CalibrationCheckpoint, AnEmptyCheckpointHasNoStages) {
+  const CalibrationCheckpoint back =
+      ReadCheckpoint(WriteCheckpoint("empty", CheckpointJson(CalibrationCheckpoint{})));
+  EXPECT_TRUE(back.stages.empty());
+  EXPECT_TRUE(back.holdout.empty());
+  EXPECT_EQ(back.folds, 0);
+}
+
+// The message names the file and says what is wrong with it.
+void ExpectRefused(const std::string& path, const std::string& says) {
+  try {
+    ReadCheckpoint(path);
+    ADD_FAILURE() << path << " was read";
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(what.rfind(path + ": ", 0), 0u) << what;
+    EXPECT_NE(what.find(says), std::string::npos) << what;
+  }
+}
+
+TEST(CalibrationCheckpoint, AMissingTruncatedOrForeignFileIsAnInputErrorNamingIt) {
+  const auto dir = testing::FreshDir("missing");
+  ExpectRefused((dir / "checkpoint.json").string(), "cannot read the checkpoint");
+  CalibrationCheckpoint c;
+  c.stages["fit"] = {Sample(0)};
+  const std::string json = CheckpointJson(c);
+  ExpectRefused(WriteCheckpoint("truncated", json.substr(0, json.size() / 2)),
+                "not a calibration checkpoint");
+  ExpectRefused(WriteCheckpoint("foreign", "{\"rocks\": 3}"), "not a calibration checkpoint");
+  ExpectRefused(WriteCheckpoint("wrong_type",
+                                "{\"path_hash\": 1, \"holdout\": [], \"folds\": 0, "
+                                "\"stages\": {}}"),
+                "not a calibration checkpoint");
+}
+
+}  // namespace
+}  // namespace talus::io

@@ -1,0 +1,87 @@
+#include "io/svg_plot.hpp"
+
+#include <gtest/gtest.h>
+
+#include <string>
+
+namespace talus::io::svg {
+namespace {
+
+int Count(const std::string& text, const std::string& what) {
+  int n = 0;
+  for (auto at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+  return n;
+}
+
+TEST(SvgPlot, NumbersHaveFixedDigitsSoTheSameDataGiveTheSameBytes) {
+  EXPECT_EQ(F(1.0 / 3), "0.33");
+  EXPECT_EQ(F(-2.005), "-2.00");  // -2.00499... in binary
+  EXPECT_EQ(F(480), "480.00");
+  EXPECT_EQ(Label(1.0 / 3), "0.3333");
+  EXPECT_EQ(Label(123456), "1.235e+05");
+  EXPECT_EQ(Label(0), "0");
+}
+
+TEST(SvgPlot, AnAxisMapsItsEndsOntoItsPixelsAndMayRunBackwards) {
+  const Axis x{10, 20, kLeft, kWidth - kRight};
+  EXPECT_DOUBLE_EQ(x(10), kLeft);
+  EXPECT_DOUBLE_EQ(x(20), kWidth - kRight);
+  EXPECT_DOUBLE_EQ(x(15), (kLeft + kWidth - kRight) / 2);
+  const Axis y{0, 1, kHeight - kBottom, kTop};  // values grow upwards, pixels downwards
+  EXPECT_DOUBLE_EQ(y(0), kHeight - kBottom);
+  EXPECT_DOUBLE_EQ(y(1), kTop);
+}
+
+TEST(SvgPlot, PadWidensByFivePercentOnEachSide) {
+  double lo = 0, hi = 10;
+  Pad(lo, hi);
+  EXPECT_DOUBLE_EQ(lo, -0.5);
+  EXPECT_DOUBLE_EQ(hi, 10.5);
+}
+
+TEST(SvgPlot, PadGivesAnEmptyOrReversedRangeAWidthBeforeWidening) {
+  double lo = 5, hi = 5;  // one value: +-10 % of it, then 5 %
+  Pad(lo, hi);
+  EXPECT_DOUBLE_EQ(lo, 4.5 - 0.05);
+  EXPECT_DOUBLE_EQ(hi, 5.5 + 0.05);
+  double zlo = 0, zhi = 0;  // zero: a tiny range, never a division by zero on the axis
+  Pad(zlo, zhi);
+  EXPECT_LT(zlo, 0);
+  EXPECT_GT(zhi, 0);
+  const Axis a{zlo, zhi, 0, 100};
+  EXPECT_DOUBLE_EQ(a(0), 50);
+}
+
+TEST(SvgPlot, EscapeReplacesTheFourMarkupCharactersAndNothingElse) {
+  EXPECT_EQ(Escape("a < b && c > \"d\" 'e' μ"), "a &lt; b &amp;&amp; c &gt; &quot;d&quot; 'e' μ");
+  EXPECT_EQ(Escape(""), "");
+}
+
+TEST(SvgPlot, FrameHasTitleLabelsAndFiveTicksPerAxis) {
+  const Axis x{0, 4, kLeft, kWidth - kRight};
+  const Axis y{-1, 1, kHeight - kBottom, kTop};
+  const std::string svg = Frame("Convergence", "evaluation", "objective", x, y);
+  EXPECT_EQ(svg.rfind("<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"480.00\"", 0), 0u);
+  EXPECT_NE(svg.find(">Convergence</text>"), std::string::npos);
+  EXPECT_NE(svg.find(">evaluation</text>"), std::string::npos);
+  EXPECT_NE(svg.find("rotate(-90)\" text-anchor=\"middle\">objective</text>"), std::string::npos);
+  // Ticks at 0, 1, 2, 3, 4 on x and -1, -0.5, 0, 0.5, 1 on y, placed by the axes.
+  for (const char* tick : {">0</text>", ">1</text>", ">2</text>", ">3</text>", ">4</text>",
+                           ">-1</text>", ">-0.5</text>", ">0.5</text>"})
+    EXPECT_GE(Count(svg, tick), 1) << tick;
+  EXPECT_EQ(Count(svg, "text-anchor=\"end\">"), 5);  // the y ticks
+  EXPECT_NE(svg.find("<text x=\"" + F(x(2)) + "\" y=\"" + F(kHeight - kBottom + 14) + "\""),
+            std::string::npos);
+  EXPECT_NE(svg.find("y=\"" + F(y(0) + 4) + "\" text-anchor=\"end\">0</text>"), std::string::npos);
+  // The caller closes the plot.
+  EXPECT_EQ(svg.find("</svg>"), std::string::npos);
+}
+
+TEST(SvgPlot, FrameIsByteIdenticalForTheSameInput) {
+  const Axis x{0.1, 0.7, kLeft, kWidth - kRight};
+  const Axis y{3, 9, kHeight - kBottom, kTop};
+  EXPECT_EQ(Frame("t", "x", "y", x, y), Frame("t", "x", "y", x, y));
+}
+
+}  // namespace
+}  // namespace talus::io::svg
