@@ -1,0 +1,145 @@
+// The roughness measurement and the parameter profiles: what each number of the report is made
+// of, checked against direct evaluations of a small objective.
+
+#include "calibration/roughness.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "tests/calibration/fixtures.hpp"
+
+namespace talus::calibration {
+namespace {
+
+const testing::SyntheticRunouts& Problem() {
+  static const testing::SyntheticRunouts problem(3, 3, 0.5);
+  return problem;
+}
+
+// mu_min (identified by run-outs) and beta (scar decay in flight: these rocks barely fly).
+const Objective& TwoParameterObjective() {
+  static const Objective objective(Problem().scene, Problem().release, Problem().observations,
+                                   {testing::Spec("medium_hard", GroundField::kMuMin, 0.1, 0.9),
+                                    testing::Spec("medium_hard", GroundField::kBeta, 100, 200)},
+                                   ObjectiveOptions{});
+  return objective;
+}
+
+TEST(RoughnessOptions, DefaultsAreValidAndBadValuesNamed) {
+  std::string why;
+  EXPECT_TRUE(RoughnessOptions().IsValid(&why)) << why;
+  RoughnessOptions o;
+  o.steps = {};
+  EXPECT_FALSE(o.IsValid(&why));
+  EXPECT_NE(why.find("at least one step"), std::string::npos) << why;
+  o.steps = {1e-3, 0.6};
+  EXPECT_FALSE(o.IsValid(&why));
+  EXPECT_NE(why.find("steps: 0.6"), std::string::npos) << why;
+  o = RoughnessOptions();
+  o.seeds = -1;
+  EXPECT_FALSE(o.IsValid(&why));
+  EXPECT_NE(why.find("seeds = -1"), std::string::npos) << why;
+  o = RoughnessOptions();
+  o.signal_to_noise = 0.5;
+  EXPECT_FALSE(o.IsValid(&why));
+  EXPECT_NE(why.find("signal_to_noise = 0.5"), std::string::npos) << why;
+}
+
+TEST(MeasureRoughness, EveryNumberIsTheStatedFunctionOfDirectEvaluations) {
+  const Objective& objective = TwoParameterObjective();
+  const Eigen::Vector2d u(0.5, 1.0);  // beta at its upper bound: its steps go inwards
+  RoughnessOptions options;
+  options.steps = {1e-1, 1e-3};  // unsorted on purpose
+  options.seeds = 2;
+  const RoughnessReport r = MeasureRoughness(objective, u, options);
+
+  EXPECT_EQ(r.steps, (std::vector<double>{1e-3, 1e-1}));
+  EXPECT_EQ(r.evaluations, 1 + 2 * 2 + 2);
+  const double f = objective.Evaluate(u).value;
+  EXPECT_EQ(r.value, f);
+  ASSERT_EQ(r.change.size(), 2u);
+  for (std::size_t s = 0; s < 2; ++s) {
+    const double h = r.steps[s];
+    ASSERT_EQ(r.change[s].size(), 2u);
+    EXPECT_EQ(r.change[s][0], std::abs(objective.Evaluate(Eigen::Vector2d(0.5 + h, 1)).value - f));
+    EXPECT_EQ(r.change[s][1], std::abs(objective.Evaluate(Eigen::Vector2d(0.5, 1 - h)).value - f));
+  }
+  EXPECT_EQ(r.noise, std::max(r.change[0][0], r.change[0][1]));
+  EXPECT_EQ(r.ftol_abs, 2 * r.noise);
+
+  // Other seeds: other rocks, and the standard deviation of all three values.
+  ASSERT_EQ(r.seed_values.size(), 2u);
+  const std::uint64_t seed = objective.release().seed;
+  EXPECT_EQ(r.seed_values[0], objective.EvaluateWithSeed(u, seed + 1).value);
+  EXPECT_EQ(r.seed_values[1], objective.EvaluateWithSeed(u, seed + 2).value);
+  const double mean = (f + r.seed_values[0] + r.seed_values[1]) / 3;
+  const double sd = std::sqrt((std::pow(f - mean, 2) + std::pow(r.seed_values[0] - mean, 2) +
+                               std::pow(r.seed_values[1] - mean, 2)) /
+                              2);
+  EXPECT_NEAR(r.seed_sd, sd, 1e-12 * std::max(1.0, sd));
+  EXPECT_EQ(r.level(), std::max(r.noise, r.seed_sd));
+
+  // The finite-difference step: the smallest step whose median change clears signal_to_noise x
+  // the noise, else the largest. With two coordinates the median at the smallest step is the
+  // noise itself, which never clears 10 x itself: the larger step, picked or by default.
+  EXPECT_EQ(r.fd_step, r.steps[1]);
+  const std::string report = r.Report();
+  EXPECT_NE(report.find("7 evaluations"), std::string::npos) << report;
+  EXPECT_NE(report.find("sd over 2 other seeds"), std::string::npos) << report;
+}
+
+TEST(MeasureRoughness, WithoutOtherSeedsTheLevelIsTheRoughness) {
+  RoughnessOptions options;
+  options.steps = {1e-2};
+  options.seeds = 0;
+  const RoughnessReport r =
+      MeasureRoughness(TwoParameterObjective(), Eigen::Vector2d(0.3, 0.3), options);
+  EXPECT_EQ(r.evaluations, 3);
+  EXPECT_TRUE(r.seed_values.empty());
+  EXPECT_TRUE(std::isnan(r.seed_sd));
+  EXPECT_EQ(r.level(), r.noise);
+  EXPECT_EQ(r.fd_step, 1e-2);
+}
+
+TEST(ProfileParameters, WalksEachCoordinateAcrossItsRangeAndJudgesItsRangeAgainstTheNoise) {
+  const Objective& objective = TwoParameterObjective();
+  const Eigen::Vector2d u(0.5, 0.5);
+  const double f = objective.Evaluate(u).value;
+  ProfileOptions options;
+  options.points = 3;
+  options.noise_multiple = 3;
+  const double noise = 1e-3;
+  const std::vector<ParameterProfile> profiles = ProfileParameters(objective, u, f, noise, options);
+  ASSERT_EQ(profiles.size(), 2u);
+  EXPECT_EQ(profiles[0].name, objective.parameters().coordinates()[0].name);
+  for (int j = 0; j < 2; ++j) {
+    const ParameterProfile& p = profiles[static_cast<std::size_t>(j)];
+    EXPECT_EQ(p.u, (std::vector<double>{0, 0.5, 1}));
+    double lo = f, hi = f;
+    for (std::size_t k = 0; k < 3; ++k) {
+      Eigen::Vector2d v = u;
+      v[j] = p.u[k];
+      const Evaluation e = objective.Evaluate(v);
+      EXPECT_EQ(p.f[k], e.value);
+      EXPECT_EQ(p.values[k], e.values[j]);
+      lo = std::min(lo, e.value);
+      hi = std::max(hi, e.value);
+    }
+    EXPECT_EQ(p.range, hi - lo);
+    EXPECT_EQ(p.threshold, std::max(3 * noise, 1e-6 * std::abs(f)));
+    EXPECT_EQ(p.identified, p.range > p.threshold);
+  }
+  // The run-outs see mu_min: from 0.1 to 0.9 they change by far more than the noise given.
+  EXPECT_TRUE(profiles[0].identified);
+  EXPECT_NEAR(profiles[0].values.front(), 0.1, 1e-12);
+  EXPECT_NEAR(profiles[0].values.back(), 0.9, 1e-12);
+  // A noise level above any change leaves every parameter unidentified.
+  for (const ParameterProfile& p : ProfileParameters(objective, u, f, 1e9, options))
+    EXPECT_FALSE(p.identified) << p.name;
+}
+
+}  // namespace
+}  // namespace talus::calibration
