@@ -9,7 +9,6 @@
 #include <cstdio>
 #include <memory>
 #include <numbers>
-#include <ranges>
 #include <stdexcept>
 
 #include "common/atomic_file.hpp"
@@ -200,7 +199,8 @@ void DrawLegend(cairo_t* cr, const ensemble::RasterLayer* layer, const QuickLook
   if (layer) {
     Text(cr, x, y, 14, legend.title, true);
     y += 12;
-    for (const ColourClass& colour : std::views::reverse(legend.classes)) {
+    for (std::size_t k = legend.classes.size(); k-- > 0;) {  // highest class on top
+      const ColourClass& colour = legend.classes[k];
       SetColour(cr, colour.rgb);
       cairo_rectangle(cr, x, y + 4, 24, 16);
       cairo_fill_preserve(cr);

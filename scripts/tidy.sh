@@ -22,7 +22,7 @@ status=0
   "$files" >"$log" 2>&1 || status=$?
 # The findings only: no colours, command lines or counts of suppressed third-party warnings.
 sed -e 's/\x1b\[[0-9;]*m//g' "$log" |
-  grep -v -e '^clang-tidy' -e 'warnings\? generated\.$' -e '^Suppressed [0-9]* warnings' \
+  grep -v -e 'clang-tidy[-0-9]* --use-color' -e 'warnings\? generated\.$' -e '^Suppressed [0-9]* warnings' \
     -e '^Use -header-filter=' -e '^Running clang-tidy' -e '^Error while processing' || true
 if ((status == 0)); then echo "tidy: clean"; else echo "tidy: findings above" >&2; fi
 exit "$status"

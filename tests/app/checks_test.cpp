@@ -53,7 +53,7 @@ TEST(ThreadCount, AllowsZeroToFourThreadsPerCoreAndSaysWhyNotMore) {
 }
 
 std::filesystem::path Fresh(const std::string& name) {
-  const auto dir = talus::testing::TestTmpRoot() / "talus_app_checks" / name;
+  auto dir = talus::testing::TestTmpRoot() / "talus_app_checks" / name;
   std::filesystem::remove_all(dir);
   return dir;
 }

@@ -4,7 +4,7 @@
 #include "app/interrupt.hpp"
 
 #include <gtest/gtest.h>
-#include <signal.h>
+#include <signal.h>  // NOLINT(modernize-deprecated-headers): POSIX sigaction is declared here
 
 #include <csignal>
 #include <string>

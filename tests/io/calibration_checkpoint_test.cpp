@@ -3,7 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <cstring>
+#include <bit>
+#include <cstdint>
 #include <limits>
 #include <string>
 
@@ -16,7 +17,9 @@ namespace {
 using calibration::Evaluation;
 
 // Bits of a double: "bit for bit" means that, not ==, which NaN never meets.
-bool SameBits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+bool SameBits(double a, double b) {
+  return std::bit_cast<std::uint64_t>(a) == std::bit_cast<std::uint64_t>(b);
+}
 
 Evaluation Sample(double seed) {
   Evaluation e;
@@ -36,7 +39,7 @@ Evaluation Sample(double seed) {
 
 std::string WriteCheckpoint(const std::string& name, const std::string& text) {
   const auto dir = testing::FreshDir(name);
-  const std::string path = (dir / "checkpoint.json").string();
+  std::string path = (dir / "checkpoint.json").string();
   testing::WriteText(path, text);
   return path;
 }
