@@ -245,7 +245,7 @@ int RunCalibrate(const CalibrateArgs& args, const Processes& processes) {
                   terminal ? "   " : "\n");
       std::fflush(stdout);
     };
-    calibration::Summary summary = calibration::Calibrate(target, options);
+    calibration::OptimizerSummary summary = calibration::Optimize(target, options);
     save_checkpoint();
     if (terminal) std::printf("\n");
     return summary;

@@ -126,7 +126,7 @@ class QuietCeresLog {
 // evaluated to estimate a derivative, and on a rough objective the lowest of them is the lowest
 // draw of its noise, not a better fit (on the Tyrol DEM one such point, a step below where Ceres
 // stopped, was reported as the fit).
-void KeepBestIterate(Summary& summary) {
+void KeepBestIterate(OptimizerSummary& summary) {
   std::optional<Evaluation> best;
   for (const StartRecord& start : summary.starts)
     for (const Evaluation& e : summary.history)
@@ -175,11 +175,11 @@ Eigen::VectorXd ResponseSurfaceStart(const Objective& objective, const Optimizer
 
 }  // namespace
 
-Summary CalibrateLeastSquares(const Objective& objective, const OptimizerOptions& options) {
+OptimizerSummary OptimizeLeastSquares(const Objective& objective, const OptimizerOptions& options) {
   const int n = objective.dimension();
   const int m = objective.residual_count();
   const std::vector<Eigen::VectorXd> starts = StartPoints(objective, options);
-  Summary summary;
+  OptimizerSummary summary;
   summary.algorithm = options.algorithm;
   for (const Coordinate& c : objective.parameters().coordinates()) summary.names.push_back(c.name);
   Evaluator evaluate(objective, options, summary);

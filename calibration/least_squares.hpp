@@ -77,10 +77,10 @@ StepChoice ChooseFiniteDifferenceStep(const Objective& objective, const Eigen::V
 // start's Levenberg-Marquardt begins at the minimiser of a response surface (the residuals' linear
 // model fitted by least squares to the start and 4 (n + 1) - 1 points of the start design, whose
 // evaluations are in the history): a trend that no local difference resolves is resolved there.
-// The fit (Summary::best) is the best point where a start's Levenberg-Marquardt ended, not the
-// best evaluation: on a rough objective the lowest difference point is the lowest draw of noise.
-// Called by Calibrate, which checks the options.
-Summary CalibrateLeastSquares(const Objective& objective, const OptimizerOptions& options);
+// The fit (OptimizerSummary::best) is the best point where a start's Levenberg-Marquardt ended, not
+// the best evaluation: on a rough objective the lowest difference point is the lowest draw of
+// noise. Called by Optimize, which checks the options.
+OptimizerSummary OptimizeLeastSquares(const Objective& objective, const OptimizerOptions& options);
 
 struct UncertaintyOptions {
   double fd_step = 0.01;  // central-difference step, unit coordinates

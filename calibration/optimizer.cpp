@@ -97,9 +97,9 @@ std::vector<Eigen::VectorXd> StartPoints(const Objective& objective,
                                          const OptimizerOptions& options) {
   const int n = objective.dimension();
   if (options.start_design == "sobol" && options.starts > 1 && n > kMaxSobolDimension)
-    throw std::invalid_argument("Calibrate: Sobol starts for more than 16 parameters; use lhs");
+    throw std::invalid_argument("Optimize: Sobol starts for more than 16 parameters; use lhs");
   Eigen::VectorXd x0 = options.start ? *options.start : objective.StartPoint();
-  if (x0.size() != n) throw std::invalid_argument("Calibrate: start has the wrong dimension");
+  if (x0.size() != n) throw std::invalid_argument("Optimize: start has the wrong dimension");
   std::vector<Eigen::VectorXd> starts = {x0.cwiseMax(0.0).cwiseMin(1.0)};
   if (options.starts > 1) {
     const Eigen::MatrixXd design = options.start_design == "sobol"
@@ -110,14 +110,14 @@ std::vector<Eigen::VectorXd> StartPoints(const Objective& objective,
   return starts;
 }
 
-Summary Calibrate(const Objective& objective, const OptimizerOptions& options) {
+OptimizerSummary Optimize(const Objective& objective, const OptimizerOptions& options) {
   std::string why;
-  if (!options.IsValid(&why)) throw std::invalid_argument("Calibrate: " + why);
-  if (options.algorithm == "ceres") return CalibrateLeastSquares(objective, options);
+  if (!options.IsValid(&why)) throw std::invalid_argument("Optimize: " + why);
+  if (options.algorithm == "ceres") return OptimizeLeastSquares(objective, options);
   const int n = objective.dimension();
   const std::vector<Eigen::VectorXd> starts = StartPoints(objective, options);
 
-  Summary summary;
+  OptimizerSummary summary;
   summary.algorithm = options.algorithm;
   for (const Coordinate& c : objective.parameters().coordinates()) summary.names.push_back(c.name);
   Evaluator evaluate(objective, options, summary);
@@ -138,7 +138,7 @@ Summary Calibrate(const Objective& objective, const OptimizerOptions& options) {
       break;
     evaluate.set_start(static_cast<int>(s));
     run.opt = nlopt_create(AlgorithmOf(options.algorithm), static_cast<unsigned>(n));
-    if (!run.opt) throw std::runtime_error("Calibrate: NLopt could not create its optimiser");
+    if (!run.opt) throw std::runtime_error("Optimize: NLopt could not create its optimiser");
     nlopt_set_min_objective(run.opt, Callback, &run);
     nlopt_set_lower_bounds(run.opt, lower.data());
     nlopt_set_upper_bounds(run.opt, upper.data());
@@ -178,7 +178,7 @@ Summary Calibrate(const Objective& objective, const OptimizerOptions& options) {
   return summary;
 }
 
-std::string Summary::BriefReport() const {
+std::string OptimizerSummary::BriefReport() const {
   char line[512];
   std::snprintf(line, sizeof line,
                 "%s %s: %s after %d evaluations in %.1f s; objective %s -> %s (%d starts)",
@@ -188,7 +188,7 @@ std::string Summary::BriefReport() const {
   return line;
 }
 
-std::string Summary::FullReport() const {
+std::string OptimizerSummary::FullReport() const {
   std::string out = "\nCalibration report\n";
   char line[512];
   std::snprintf(line, sizeof line,

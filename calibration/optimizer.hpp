@@ -4,8 +4,8 @@
 // bounded nonlinear least squares on the residual vector ("ceres", least_squares.hpp), chosen by
 // name; optionally from several starts (the given start, then Sobol or Latin-hypercube points).
 // Every evaluation is kept, and a checkpoint's evaluations can be replayed so that an interrupted
-// calibration resumes to the identical result. The result is a Summary with a termination type, a
-// brief and a full report (Ceres style).
+// calibration resumes to the identical result. The result is an OptimizerSummary with a termination
+// type, a brief and a full report (Ceres style).
 //
 // Infeasible vectors (mu_min > mu_max where both are free; NLopt keeps to the box itself) run no
 // rock and get the finite penalty ObjectiveOptions::infeasible_value * (1 + violation), far above
@@ -51,7 +51,7 @@ struct OptimizerOptions {
   // is an error (the checkpoint belongs to another calibration).
   std::vector<Evaluation> replay;
   // Called after every evaluation (on the calling thread); may throw to stop (e.g. interrupted):
-  // the optimiser stops and the exception comes out of Calibrate.
+  // the optimiser stops and the exception comes out of Optimize.
   std::function<void(const Evaluation&, int evaluation)> on_evaluation;
 
   bool IsValid(std::string* why) const;
@@ -73,7 +73,7 @@ struct StartRecord {
   std::string result;  // NLopt's result (e.g. "FTOL_REACHED") or Ceres' termination message
 };
 
-struct Summary {
+struct OptimizerSummary {
   std::string algorithm;
   Termination termination = Termination::kFailure;
   std::string message;
@@ -105,6 +105,6 @@ std::vector<Eigen::VectorXd> StartPoints(const Objective& objective,
 
 // Minimises the objective. Throws what options.on_evaluation throws; std::invalid_argument for
 // invalid options (validate them first).
-Summary Calibrate(const Objective& objective, const OptimizerOptions& options);
+OptimizerSummary Optimize(const Objective& objective, const OptimizerOptions& options);
 
 }  // namespace talus::calibration

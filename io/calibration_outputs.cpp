@@ -181,7 +181,7 @@ std::string GroundTableCsv(const Objective& objective, const GroundTable& fitted
 
 std::string CalibrationJson(const CalibrationFile& file, const Objective& objective,
                             const CalibrationRun& run) {
-  const calibration::Summary& s = run.summary;
+  const calibration::OptimizerSummary& s = run.summary;
   json parameters = json::array();
   const auto& coordinates = objective.parameters().coordinates();
   for (std::size_t j = 0; j < coordinates.size(); ++j) {
@@ -346,7 +346,7 @@ std::string CalibrationJson(const CalibrationFile& file, const Objective& object
   return j.dump(2) + "\n";
 }
 
-std::string HistoryCsv(const Objective& objective, const calibration::Summary& summary) {
+std::string HistoryCsv(const Objective& objective, const calibration::OptimizerSummary& summary) {
   std::string out = "evaluation,start,feasible,objective,data,prior";
   // Cells appended one by one (GCC 12 warns wrongly about chains of std::string operator+).
   const auto cell = [&out](const std::string& text) {

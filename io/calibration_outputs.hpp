@@ -8,19 +8,19 @@
 #include <vector>
 
 #include "calibration/bootstrap.hpp"
-#include "calibration/seeds.hpp"
 #include "calibration/holdout.hpp"
 #include "calibration/least_squares.hpp"
 #include "calibration/objective.hpp"
 #include "calibration/optimizer.hpp"
 #include "calibration/roughness.hpp"
+#include "calibration/seeds.hpp"
 #include "io/calibration_file.hpp"
 
 namespace talus::io {
 
 // One fold of a cross-validation: the fit without it, and its runs' scores.
 struct FoldRun {
-  calibration::Summary summary;
+  calibration::OptimizerSummary summary;
   calibration::HeldOutScores scores;
 };
 
@@ -29,7 +29,7 @@ struct CalibrationRun {
   std::string version;
   int threads = 1;
   double wall_time_s = 0;
-  calibration::Summary summary;
+  calibration::OptimizerSummary summary;
   std::optional<calibration::RoughnessReport> roughness;
   std::vector<calibration::ParameterProfile> profiles;
   std::optional<calibration::Uncertainty> uncertainty;
@@ -51,6 +51,6 @@ std::string GroundTableCsv(const calibration::Objective& objective, const Ground
 std::string CalibrationJson(const CalibrationFile& file, const calibration::Objective& objective,
                             const CalibrationRun& run);
 std::string HistoryCsv(const calibration::Objective& objective,
-                       const calibration::Summary& summary);
+                       const calibration::OptimizerSummary& summary);
 
 }  // namespace talus::io
