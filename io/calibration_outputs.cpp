@@ -140,20 +140,6 @@ json HeldOut(const calibration::HeldOutScores& s) {
 
 }  // namespace
 
-std::string HeldOutReport(const calibration::HeldOutScores& scores) {
-  std::string out;
-  char line[256];
-  std::snprintf(line, sizeof line, "  %-24s %8s %14s %14s\n", "kind", "scored", "fitted",
-                "reference");
-  out += line;
-  for (const auto& k : scores.kinds) {
-    std::snprintf(line, sizeof line, "  %-24s %8d %11.4g %-2s %11.4g %-2s\n", k.kind.c_str(),
-                  k.scored, k.fitted, k.unit.c_str(), k.reference, k.unit.c_str());
-    out += line;
-  }
-  return out;
-}
-
 std::string GroundTableToml(const CalibrationFile& file, const Objective& objective,
                             const GroundTable& fitted) {
   std::string out = "# Ground table fitted by talus calibrate " + file.path +
@@ -180,8 +166,9 @@ std::string GroundTableCsv(const Objective& objective, const GroundTable& fitted
 }
 
 std::string CalibrationJson(const CalibrationFile& file, const Objective& objective,
-                            const CalibrationRun& run) {
-  const calibration::OptimizerSummary& s = run.summary;
+                            const calibration::CalibrationSummary& run,
+                            const std::string& version) {
+  const calibration::OptimizerSummary& s = run.fit;
   json parameters = json::array();
   const auto& coordinates = objective.parameters().coordinates();
   for (std::size_t j = 0; j < coordinates.size(); ++j) {
@@ -221,7 +208,7 @@ std::string CalibrationJson(const CalibrationFile& file, const Objective& object
                       {"evaluations", r.evaluations},
                       {"result", r.result}});
   const ensemble::ReleaseSpec& release = objective.release();
-  json j = {{"version", run.version},
+  json j = {{"version", version},
             {"calibration_file", file.path},
             {"event", file.event.path},
             {"inputs", file.inputs},
@@ -309,22 +296,19 @@ std::string CalibrationJson(const CalibrationFile& file, const Objective& object
   } else {
     j["uncertainty"] = nullptr;
   }
-  j["not_scored"] = run.not_scored;  // observed values without a simulated counterpart
+  j["not_scored"] = file.event.not_scored;  // observed values without a simulated counterpart
   j["holdout"] = run.holdout ? HeldOut(*run.holdout) : json(nullptr);
   if (!run.folds.empty()) {
     json folds = json::array();
-    std::vector<calibration::HeldOutScores> sets;
-    for (const FoldRun& f : run.folds) {
+    for (const calibration::FoldRun& f : run.folds) {
       json fold = HeldOut(f.scores);
       fold["fitted"] = Vector(f.summary.best.values);
       fold["objective"] = Number(f.summary.best.value);
       fold["evaluations"] = f.summary.evaluations();
       fold["termination"] = calibration::ToString(f.summary.termination);
       folds.push_back(fold);
-      sets.push_back(f.scores);
     }
-    j["cross_validation"] = {{"folds", folds},
-                             {"kinds", HeldOutKinds(calibration::PoolKinds(sets))}};
+    j["cross_validation"] = {{"folds", folds}, {"kinds", HeldOutKinds(run.cross_validated)}};
   } else {
     j["cross_validation"] = nullptr;
   }
