@@ -4,9 +4,9 @@
 // (it checks its inputs and throws before any rock runs), call Calibrate with CalibrationOptions,
 // read the CalibrationSummary.
 //
-// The stages, in order: the fit (Optimize, optimizer.hpp); at the optimum the objective's
+// The stages, in order: the fit (Optimize, optimize.hpp); at the optimum the objective's
 // roughness and each parameter's profile (roughness.hpp), the sandwich covariance
-// (least_squares.hpp), the bootstrap over runs (bootstrap.hpp) and the refits with other release
+// (covariance.hpp), the bootstrap over runs (bootstrap.hpp) and the refits with other release
 // seeds (seeds.hpp); the fitted runs scored before and after the fit (the observed-vs-simulated
 // plots); the held-out runs scored; and a k-fold cross-validation by run, each fold an
 // optimisation of its own (holdout.hpp).
@@ -25,9 +25,10 @@
 #include <vector>
 
 #include "calibration/bootstrap.hpp"
+#include "calibration/covariance.hpp"
 #include "calibration/holdout.hpp"
-#include "calibration/least_squares.hpp"
 #include "calibration/objective.hpp"
+#include "calibration/optimize.hpp"
 #include "calibration/optimizer.hpp"
 #include "calibration/roughness.hpp"
 #include "calibration/seeds.hpp"

@@ -1,9 +1,12 @@
 #pragma once
-// The bookkeeping every optimiser shares (optimizer.cpp, least_squares.cpp): runs the objective
-// for the optimiser and keeps the record in an OptimizerSummary -- every evaluation in order, its
-// start, the best feasible one --, answers a point asked for again from the history (the objective
-// is deterministic), serves the evaluations of a checkpoint (OptimizerOptions::replay) in order
-// without running a rock, calls OptimizerOptions::on_evaluation, and watches the budget.
+// The bookkeeping every optimiser shares (nlopt_optimizer.cpp, least_squares.cpp), on the
+// vocabulary of optimizer.hpp: runs the objective for the optimiser and keeps the record in an
+// OptimizerSummary -- every evaluation in order, its start, the best feasible one --, answers a
+// point asked for again from the history (the objective is deterministic; evaluations already in
+// the summary's history when it starts are answered too), serves the evaluations of a checkpoint
+// (OptimizerOptions::replay) in order without running a rock, calls
+// OptimizerOptions::on_evaluation, and watches the budget. The covariance (covariance.cpp) uses it
+// as its cache of a calibration's evaluations.
 
 #include <Eigen/Core>
 #include <chrono>

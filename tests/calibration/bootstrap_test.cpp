@@ -11,8 +11,8 @@
 #include <cmath>
 #include <cstdio>
 
-#include "calibration/least_squares.hpp"
-#include "calibration/optimizer.hpp"
+#include "calibration/covariance.hpp"
+#include "calibration/optimize.hpp"
 #include "calibration/seeds.hpp"
 #include "tests/calibration/fixtures.hpp"
 

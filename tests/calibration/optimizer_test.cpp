@@ -4,14 +4,14 @@
 // parameter the data cannot see has a flat profile and is reported unidentified; an interrupted
 // calibration resumed from its evaluations ends bit for bit where an uninterrupted one does.
 
-#include "calibration/optimizer.hpp"
-
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>
 
+#include "calibration/covariance.hpp"
 #include "calibration/least_squares.hpp"
+#include "calibration/optimize.hpp"
 #include "calibration/roughness.hpp"
 #include "tests/calibration/fixtures.hpp"
 

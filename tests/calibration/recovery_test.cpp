@@ -18,7 +18,7 @@
 
 #include "calibration/bootstrap.hpp"
 #include "calibration/least_squares.hpp"
-#include "calibration/optimizer.hpp"
+#include "calibration/optimize.hpp"
 #include "calibration/roughness.hpp"
 #include "calibration/seeds.hpp"
 #include "io/scene_file.hpp"
