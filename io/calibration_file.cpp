@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "calibration/designs.hpp"
+#include "common/closest_name.hpp"
 #include "common/error.hpp"
 #include "io/toml_section.hpp"
 

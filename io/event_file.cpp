@@ -8,6 +8,7 @@
 #include <optional>
 #include <set>
 
+#include "common/closest_name.hpp"
 #include "common/csv_table.hpp"
 #include "common/error.hpp"
 #include "fieldobs/single_impacts.hpp"

@@ -492,12 +492,6 @@ TEST(LoadScene, OutOfRangeIntegersAreErrors) {
              "has the value 1e+20");
 }
 
-TEST(ClosestName, OnlySuggestsCloseNames) {
-  EXPECT_EQ(ClosestName("sead", {"seed", "rocks"}), "seed");
-  EXPECT_EQ(ClosestName("trajectory", {"trajectories", "rasters"}), "trajectories");
-  EXPECT_EQ(ClosestName("xyz", {"seed", "rocks"}), "");
-}
-
 // The built-in rock: { rock = [a, b, c] } with its knobs; given dimensions and a mass, the
 // dimensions stay and the density follows (mass / volume, to rounding: 1e-12 relative).
 TEST(LoadScene, BuiltInRockWithItsKnobs) {
