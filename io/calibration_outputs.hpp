@@ -46,7 +46,7 @@ std::string HeldOutReport(const calibration::HeldOutScores& scores);
 // The categories the calibration touched, with every field, as [ground.<name>] blocks.
 std::string GroundTableToml(const CalibrationFile& file, const calibration::Objective& objective,
                             const GroundTable& fitted);
-// category, code, mu_min, mu_max, beta, kappa, nu: one row per touched category.
+// category, code[, model], then the fields of kGroundFields that apply: one row per touched category.
 std::string GroundTableCsv(const calibration::Objective& objective, const GroundTable& fitted);
 std::string CalibrationJson(const CalibrationFile& file, const calibration::Objective& objective,
                             const CalibrationRun& run);
