@@ -23,19 +23,6 @@
 
 namespace {
 
-struct Impact {
-  double vx, vy, vz, omega;         // Table 2: m/s, rad/s
-  double observed_depth, observed_length;
-  double soil_strength, compaction_drag;  // Table 3: MN/m^2, 1
-  double paper_depth, paper_length;       // Table 3: simulated, m
-};
-constexpr Impact kImpacts[] = {
-    {5.56, -14.62, -11.20, 23.85, 0.13, 1.40, 25, 4.0, 0.14, 1.80},
-    {5.30, -12.70, -10.74, 26.30, 0.15, 1.80, 15, 1.5, 0.16, 1.64},
-    {5.34, -12.31, -10.36, 29.33, 0.18, 1.55, 10, 0.1, 0.18, 1.26},
-    {5.34, -14.19, -8.52, 28.69, 0.21, 1.52, 10, 0.5, 0.18, 1.77},
-};
-
 struct Quartiles {
   double q1 = NAN, median = NAN, q3 = NAN;
 };
@@ -79,41 +66,21 @@ int main(int argc, char** argv) {
               "scar depth (m)", "paper", "obs", "scar extent (m)", "paper", "obs",
               "E_trans out/in", "E_rot out/in", "duration (s)");
   for (int i = 0; i < 4; ++i) {
-    const Impact& im = kImpacts[i];
-    talus::GroundParams soil{0.55, 2.0, 185, 3.0, 0.0};  // the paper's rebound plane, no nu
-    talus::GroundModel ground_model;
-    if (!talus::ParseGroundModel(model, &ground_model)) return 2;
-    soil.model = ground_model;
-    soil.soil_strength_mn_m2 = im.soil_strength;
-    soil.compaction_drag = im.compaction_drag;
-    talus::Scene scene = talus::scenes::Incline(slope_deg, talus::scenes::Eota221(), soil, 60, 0.5);
+    const talus::scenes::Lu2019Impact& im = talus::scenes::Lu2019Impacts()[i];
+    talus::Scene scene = talus::scenes::Lu2019ImpactScene(i, slope_deg);
+    talus::GroundParams& soil = scene.ground.mutable_params(scene.terrain.default_ground());
+    if (!talus::ParseGroundModel(model, &soil.model)) return 2;
     scene.options.dt_s = dt_s;
-    scene.options.max_time_s = 1.0;
     if (!talus::ParseSoilDragPoint(drag, &scene.options.soil_drag)) return 2;
     const talus::RockShape& rock = scene.rock;
-    const double theta = slope_deg * std::numbers::pi / 180;
-    const Eigen::Vector3d n(std::sin(theta), 0, std::cos(theta));  // the plane falls along +x
-    const Eigen::Vector3d d(std::cos(theta), 0, -std::sin(theta));
-    const Eigen::Vector3d axis = n.cross(d);  // rolling forward
-    const Eigen::Vector3d velocity(std::hypot(im.vx, im.vy), 0, im.vz);
 
     std::vector<double> depth, extent, trans, rot, duration;
     talus::SimulationWorkspace workspace;
     talus::EpisodeRecorder episodes(scene.terrain);
     for (int k = 0; k < rocks; ++k) {
       talus::RockRandom random(1, static_cast<std::uint64_t>(k));
-      const double angle = 2 * std::numbers::pi * random.Uniform();
-      talus::RockState s;
-      s.orientation = Eigen::AngleAxisd(angle, axis) *
-                      Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), axis);
-      s.velocity_m_s = velocity;
-      s.angular_velocity_rad_s = s.orientation.conjugate() * (im.omega * axis);
-      // The lowest vertex 1 mm above the plane at x = 20 m.
-      talus::TerrainSample ground;
-      scene.terrain.Sample(20, 0, &ground);
-      double lowest = 1e9;
-      for (const Eigen::Vector3d& b : rock.vertices_m) lowest = std::min(lowest, n.dot(s.orientation * b));
-      s.position_m = Eigen::Vector3d(20, 0, ground.height_m) + (0.001 - lowest) * n;
+      const talus::RockState s = talus::scenes::Lu2019ImpactStart(
+          scene, i, slope_deg, 2 * std::numbers::pi * random.Uniform());
       episodes.Begin(s);
       talus::SimulateRock(scene, s, workspace, &episodes);
       const std::vector<talus::ContactEpisode> list = episodes.Finish();
@@ -131,8 +98,8 @@ int main(int argc, char** argv) {
     std::printf(
         "%-3d %6.3f | %5.3f %5.3f %5.3f %5.2f %5.2f | %5.2f %5.2f %5.2f %5.2f %5.2f | %5.2f %5.2f "
         "%5.2f | %5.2f %5.2f %5.2f | %5.3f %5.3f %5.3f\n",
-        i + 1, d_max, qd.q1, qd.median, qd.q3, im.paper_depth, im.observed_depth, qe.q1, qe.median,
-        qe.q3, im.paper_length, im.observed_length, qt.q1, qt.median, qt.q3, qr.q1, qr.median,
+        i + 1, d_max, qd.q1, qd.median, qd.q3, im.paper_depth_m, im.observed_depth_m, qe.q1, qe.median,
+        qe.q3, im.paper_length_m, im.observed_length_m, qt.q1, qt.median, qt.q3, qr.q1, qr.median,
         qr.q3, qu.q1, qu.median, qu.q3);
   }
   std::printf("(each: first quartile, median, third quartile over the rocks; E_rot out/in is "

@@ -5,11 +5,14 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <numbers>
+#include <vector>
 
 #include "scenes/scenes.hpp"
+#include "solver/episodes.hpp"
 #include "solver/kinematics.hpp"
 #include "solver/shapes.hpp"
 #include "solver/simulate.hpp"
@@ -269,6 +272,63 @@ TEST(SoilEnergy, TheLayerNeverAddsEnergyBeyondTheSchemesOwnDrift) {
                 ToString(point), worst, soil_steps);
     EXPECT_GT(soil_steps, 5000);
     EXPECT_LT(worst, 1e-5);
+  }
+}
+
+}  // namespace
+}  // namespace talus
+
+namespace talus {
+namespace {
+
+TEST(Lu2019Table2, ImpactsScarToTheReboundPlaneAndLastTensOfMilliseconds) {
+  // The four single impacts of Lu et al. 2019 (Table 2) with their Table 3 soils, on a 25 deg plane
+  // (the impact points' slope is not published), eight angles about the spin axis each. The scar
+  // depth is the deepest penetration normal to the surface: on the rebound plane, d_max (eq. 11,
+  // vertical) times cos 25 deg, to 2 mm above and twice the contact prediction's allowance (1 % of
+  // the 0.47 m thickness, met at the next midpoint, not at every vertex's deepest) below (measured
+  // medians 0.105, 0.124, 0.140, 0.121 m: up to 4.9 mm below the plane). The paper's simulated
+  // depths are 0.14-0.18 m: eq. 11 with the centre of mass's vertical speed gives 0.111-0.150 m,
+  // and the paper does not say how it measured depth; ours are within 35 % of its. Its simulated
+  // scar lengths are 1.26-1.80 m: our scar extents' medians 1.30-1.75 m, asserted within a factor
+  // 1.8. The seed's hard contact ends such an impact in 5-8 ms (measured with
+  // talus_bench_lu2019_impacts --model hard); on the soil it lasts 90-121 ms (measured medians),
+  // asserted above 40 ms (the field: about 0.2 s).
+  const double slope_deg = 25;
+  for (int i = 0; i < 4; ++i) {
+    Scene scene = scenes::Lu2019ImpactScene(i, slope_deg);
+    const scenes::Lu2019Impact& impact = scenes::Lu2019Impacts()[i];
+    const double d_max =
+        scene.ground.params(scene.terrain.default_ground()).PenetrationDepth(780, impact.vz);
+    std::vector<double> depth, extent, duration;
+    SimulationWorkspace workspace;
+    EpisodeRecorder episodes(scene.terrain);
+    for (int k = 0; k < 8; ++k) {
+      const RockState start =
+          scenes::Lu2019ImpactStart(scene, i, slope_deg, 2 * std::numbers::pi * k / 8);
+      episodes.Begin(start);
+      SimulateRock(scene, start, workspace, &episodes);
+      const std::vector<ContactEpisode> list = episodes.Finish();
+      ASSERT_FALSE(list.empty());
+      depth.push_back(list.front().max_scar_depth_m);
+      extent.push_back(list.front().scar_extent_m);
+      duration.push_back(list.front().duration_s());
+    }
+    for (auto* v : {&depth, &extent, &duration}) std::sort(v->begin(), v->end());
+    const double median_depth = 0.5 * (depth[3] + depth[4]);
+    const double median_extent = 0.5 * (extent[3] + extent[4]);
+    const double median_duration = 0.5 * (duration[3] + duration[4]);
+    std::printf("impact %d: d_max %.3f m, scar depth %.3f m (paper %.2f), extent %.2f m (paper "
+                "%.2f), duration %.3f s\n",
+                i + 1, d_max, median_depth, impact.paper_depth_m, median_extent,
+                impact.paper_length_m, median_duration);
+    const double normal = d_max * std::cos(slope_deg * std::numbers::pi / 180);
+    EXPECT_GT(median_depth, normal - 0.002);
+    EXPECT_LT(median_depth, normal + 2 * 0.01 * 0.47);
+    EXPECT_NEAR(median_depth, impact.paper_depth_m, 0.35 * impact.paper_depth_m);
+    EXPECT_GT(median_extent, impact.paper_length_m / 1.8);
+    EXPECT_LT(median_extent, impact.paper_length_m * 1.8);
+    EXPECT_GT(median_duration, 0.04);
   }
 }
 
