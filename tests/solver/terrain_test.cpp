@@ -84,6 +84,22 @@ Heightfield RoughHeights() {
   return hf;
 }
 
+// The largest |h - plane| on a lattice of (points + 1)^2 points over the box (x0, y0) +- r.
+double LatticeDeparture(const Terrain& t, const Terrain::LocalPlane& plane, double x0, double y0,
+                        double r, int points) {
+  double sampled = 0;
+  for (int a = 0; a <= points; ++a)
+    for (int b = 0; b <= points; ++b) {
+      const double x = x0 - r + 2 * r * a / points, y = y0 - r + 2 * r * b / points;
+      double h = 0;
+      EXPECT_TRUE(t.Height(x, y, &h));
+      const double on_plane =
+          plane.at.height_m + plane.slope_x * (x - x0) + plane.slope_y * (y - y0);
+      sampled = std::max(sampled, std::abs(h - on_plane));
+    }
+  return sampled;
+}
+
 TEST(Terrain, LocalPlaneBoundIsTheLargestDepartureOverTheBox) {
   // A rough grid (41 x 31 nodes, 1.5 m spacing) and boxes inside a cell, across cell edges and
   // over many cells: the bound is at least |h - plane| at every point of a fine lattice over the
@@ -98,17 +114,8 @@ TEST(Terrain, LocalPlaneBoundIsTheLargestDepartureOverTheBox) {
   for (const auto& [x0, y0, r] : boxes) {
     Terrain::LocalPlane plane;
     ASSERT_TRUE(t.PlaneAround(x0, y0, r, &plane));
-    double sampled = 0;
     constexpr int kPoints = 200;
-    for (int a = 0; a <= kPoints; ++a)
-      for (int b = 0; b <= kPoints; ++b) {
-        const double x = x0 - r + 2 * r * a / kPoints, y = y0 - r + 2 * r * b / kPoints;
-        double h = 0;
-        ASSERT_TRUE(t.Height(x, y, &h));
-        const double on_plane =
-            plane.at.height_m + plane.slope_x * (x - x0) + plane.slope_y * (y - y0);
-        sampled = std::max(sampled, std::abs(h - on_plane));
-      }
+    const double sampled = LatticeDeparture(t, plane, x0, y0, r, kPoints);
     EXPECT_GE(plane.deviation_m, sampled) << "box at " << x0 << ", " << y0 << " +- " << r;
     EXPECT_LE(plane.deviation_m, sampled + 1e-6 + 10 * 2 * r / kPoints)
         << "box at " << x0 << ", " << y0 << " +- " << r;
@@ -147,17 +154,7 @@ TEST(Terrain, LocalPlaneBoundOfALargeBoxHoldsFromThePyramidsBlocks) {
         const double y0 = hf.grid.y0_m + r + (1 - fx) * (hf.grid.y_max_m() - hf.grid.y0_m - 2 * r);
         Terrain::LocalPlane plane;
         ASSERT_TRUE(t.PlaneAround(x0, y0, r, &plane));
-        double sampled = 0;
-        constexpr int kPoints = 120;
-        for (int a = 0; a <= kPoints; ++a)
-          for (int b = 0; b <= kPoints; ++b) {
-            const double x = x0 - r + 2 * r * a / kPoints, y = y0 - r + 2 * r * b / kPoints;
-            double h = 0;
-            ASSERT_TRUE(t.Height(x, y, &h));
-            const double on_plane =
-                plane.at.height_m + plane.slope_x * (x - x0) + plane.slope_y * (y - y0);
-            sampled = std::max(sampled, std::abs(h - on_plane));
-          }
+        const double sampled = LatticeDeparture(t, plane, x0, y0, r, 120);
         EXPECT_GE(plane.deviation_m, sampled)
             << "cell " << cell << ", box at " << x0 << ", " << y0 << " +- " << r;
         // The exact bound over the nodes of the cells the box touches, and the residuals.
