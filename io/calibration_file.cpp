@@ -18,7 +18,14 @@ namespace fs = std::filesystem;
 using calibration::GroundField;
 using calibration::ParameterSpec;
 
-const std::vector<std::string> kFields = {"mu_min", "mu_max", "beta", "kappa", "nu"};
+// The fields a calibration may free (kGroundFields' calibrated rows).
+std::vector<std::string> CalibratedFields() {
+  std::vector<std::string> fields;
+  for (const GroundFieldInfo& f : kGroundFields)
+    if (f.calibrated) fields.emplace_back(f.key);
+  return fields;
+}
+const std::vector<std::string> kFields = CalibratedFields();
 
 std::string Hint(const std::string& word, const std::vector<std::string>& known) {
   const std::string hint = ClosestName(word, known);
@@ -66,11 +73,11 @@ void LoadParameters(const Context& context, const toml::table& root, Calibration
       s.Fail("category", "unknown ground category '" + spec.category + "'" +
                              Hint(spec.category, categories) + "; the scene has " +
                              Join(categories));
-    if (!s.Has("field")) s.Fail("field", "missing: one of mu_min, mu_max, beta, kappa, nu");
+    if (!s.Has("field")) s.Fail("field", "missing: one of " + Join(kFields));
     const std::string field = s.String("field", "");
     if (!calibration::ParseGroundField(field, &spec.field))
-      s.Fail("field", "unknown parameter '" + field + "'" + Hint(field, kFields) +
-                          "; known: mu_min, mu_max, beta, kappa, nu");
+      s.Fail("field",
+             "unknown parameter '" + field + "'" + Hint(field, kFields) + "; known: " + Join(kFields));
     for (const char* bound : {"lower", "upper"})
       if (!s.Has(bound))
         s.Fail(bound, std::string("missing: the ") + bound + " bound, in " +

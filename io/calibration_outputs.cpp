@@ -140,27 +140,42 @@ json HeldOut(const calibration::HeldOutScores& s) {
 
 }  // namespace
 
+// The fields written for a fitted category: every row of kGroundFields that applies to it, with
+// its model when that is not the default.
 std::string GroundTableToml(const CalibrationFile& file, const Objective& objective,
                             const GroundTable& fitted) {
   std::string out = "# Ground table fitted by talus calibrate " + file.path +
                     " (docs/calibration.md).\n# Paste into a scene file, or append to one.\n";
   for (int k : Touched(objective, fitted)) {
     const GroundCategory& c = fitted.category(k);
-    out += "\n[ground." + c.name + "]\ncode = " + std::to_string(c.code) +
-           "\nmu_min = " + G(c.params.mu_min) + "\nmu_max = " + G(c.params.mu_max) +
-           "\nbeta = " + G(c.params.beta_1_s) + "\nkappa = " + G(c.params.kappa_1_m) +
-           "\nnu = " + G(c.params.nu_1_s) + "\n";
+    out += "\n[ground." + c.name + "]\ncode = " + std::to_string(c.code) + "\n";
+    if (c.params.IsSoil()) out.append("model = \"").append(ToString(c.params.model)).append("\"\n");
+    for (const GroundFieldInfo& f : kGroundFields)
+      if (f.group != GroundFieldInfo::Group::kDragLayer && GroundFieldApplies(f, c.params))
+        out.append(f.key).append(" = ").append(G(c.params.*f.member)).append("\n");
   }
   return out;
 }
 
+// One row per fitted category; the soil's columns when some fitted category has the soil.
 std::string GroundTableCsv(const Objective& objective, const GroundTable& fitted) {
-  std::string out = "category,code,mu_min,mu_max,beta,kappa,nu\n";
-  for (int k : Touched(objective, fitted)) {
+  const std::vector<int> touched = Touched(objective, fitted);
+  bool soil = false;
+  for (int k : touched) soil = soil || fitted.params(k).IsSoil();
+  std::vector<const GroundFieldInfo*> columns;
+  for (const GroundFieldInfo& f : kGroundFields)
+    if (f.group == GroundFieldInfo::Group::kFriction ||
+        (soil && f.group == GroundFieldInfo::Group::kSoil))
+      columns.push_back(&f);
+  std::string out = soil ? "category,code,model" : "category,code";
+  for (const GroundFieldInfo* f : columns) out.append(",").append(f->key);
+  out += "\n";
+  for (int k : touched) {
     const GroundCategory& c = fitted.category(k);
-    out += c.name + "," + std::to_string(c.code) + "," + G(c.params.mu_min) + "," +
-           G(c.params.mu_max) + "," + G(c.params.beta_1_s) + "," + G(c.params.kappa_1_m) + "," +
-           G(c.params.nu_1_s) + "\n";
+    out += c.name + "," + std::to_string(c.code);
+    if (soil) out.append(",").append(ToString(c.params.model));
+    for (const GroundFieldInfo* f : columns) out.append(",").append(G(c.params.*f->member));
+    out += "\n";
   }
   return out;
 }

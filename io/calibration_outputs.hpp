@@ -15,7 +15,7 @@ namespace talus::io {
 // The categories the calibration touched, with every field, as [ground.<name>] blocks.
 std::string GroundTableToml(const CalibrationFile& file, const calibration::Objective& objective,
                             const GroundTable& fitted);
-// category, code, mu_min, mu_max, beta, kappa, nu: one row per touched category.
+// category, code[, model], then the fields of kGroundFields that apply: one row per touched category.
 std::string GroundTableCsv(const calibration::Objective& objective, const GroundTable& fitted);
 // Everything the run gave, with the version of the program that ran it.
 std::string CalibrationJson(const CalibrationFile& file, const calibration::Objective& objective,

@@ -62,49 +62,51 @@ std::string TooFast(const Eigen::Vector3d& v, double max, const std::string& uni
   return "|v| = " + Fmt(v.norm()) + " " + unit + " is more than " + Fmt(max) + " " + unit;
 }
 
+// The keys of a [ground.<name>] table: code, model and every field of kGroundFields.
+std::vector<std::string> GroundKeys() {
+  std::vector<std::string> keys = {"code", "model"};
+  for (const GroundFieldInfo& f : kGroundFields) keys.emplace_back(f.key);
+  return keys;
+}
+
 // [ground.<name>]: user categories, or overrides of built-in ones.
 void LoadGround(const Context& context, const toml::table* ground, GroundTable& table) {
   if (!ground) return;
+  const std::vector<std::string> builtin(GroundTable::BuiltInNames().begin(),
+                                         GroundTable::BuiltInNames().end());
   for (const auto& [key, node] : *ground) {
     const std::string name(key.str());
     if (!node.is_table())
       context.Fail(&node, "ground." + name, "expected a table ([ground." + name + "])");
-    const Section s(context, node.as_table(), "ground." + name,
-                    {"code", "mu_min", "mu_max", "beta", "kappa", "nu", "drag_height_m",
-                     "drag_translational", "drag_rotational"});
+    const Section s(context, node.as_table(), "ground." + name, GroundKeys());
     const int existing = table.IndexOfName(name);
     GroundCategory category;
     category.name = name;
     if (existing >= 0) {
       category = table.category(existing);
     } else {
+      const std::string hint = ClosestName(name, builtin);
       for (const char* required : {"code", "mu_min", "mu_max", "beta", "kappa", "nu"})
         if (!s.Has(required))
-          s.Fail(
-              required,
-              std::string(
-                  "missing: a new ground category needs code, mu_min, mu_max, beta, kappa and nu") +
-                  (ClosestName(name, {"extra_soft", "soft", "medium_soft", "medium", "medium_hard",
-                                      "hard", "extra_hard", "snow"})
-                           .empty()
-                       ? ""
-                       : " (or did you mean the built-in '" +
-                             ClosestName(name, {"extra_soft", "soft", "medium_soft", "medium",
-                                                "medium_hard", "hard", "extra_hard", "snow"}) +
-                             "'?)"));
+          s.Fail(required,
+                 std::string(
+                     "missing: a new ground category needs code, mu_min, mu_max, beta, kappa and nu") +
+                     (hint.empty() ? "" : " (or did you mean the built-in '" + hint + "'?)"));
     }
     const long code = s.Integer("code", category.code);
     if (code < 0 || code > 254) s.Fail("code", std::to_string(code) + " must be in 0..254");
     category.code = static_cast<int>(code);
     GroundParams& p = category.params;
-    p.mu_min = s.Number("mu_min", p.mu_min);
-    p.mu_max = s.Number("mu_max", p.mu_max);
-    p.beta_1_s = s.Number("beta", p.beta_1_s);
-    p.kappa_1_m = s.Number("kappa", p.kappa_1_m);
-    p.nu_1_s = s.Number("nu", p.nu_1_s);
-    p.drag_height_m = s.Number("drag_height_m", p.drag_height_m);
-    p.drag_translational_1_s = s.Number("drag_translational", p.drag_translational_1_s);
-    p.drag_rotational_1_s = s.Number("drag_rotational", p.drag_rotational_1_s);
+    if (s.Has("model")) {
+      const std::string model = s.String("model", "");
+      if (!ParseGroundModel(model, &p.model))
+        s.Fail("model", "unknown ground model '" + model + "'; known: hard, lu2019");
+    }
+    for (const GroundFieldInfo& f : kGroundFields) {
+      p.*f.member = s.Number(f.key, p.*f.member);
+      if (f.group == GroundFieldInfo::Group::kSoil && s.Has(f.key) && !p.IsSoil())
+        s.Fail(f.key, std::string(f.key) + " acts only in a category with model = \"lu2019\"");
+    }
     std::string why;
     if (!p.IsValid(&why)) s.FailCheck(why);
     const int other = table.IndexOfCode(category.code);
@@ -1019,6 +1021,22 @@ void LoadEvaluationLines(const Context& context, const Section& s, SceneFile& ou
   }
 }
 
+// A key naming one value of an enum: parsed by `parse` into *out when given; else an error naming
+// the known names and the closest one.
+template <class Enum>
+void Choice(const Section& s, const std::string& key, const std::string& what,
+            const std::vector<std::string>& known, bool (*parse)(std::string_view, Enum*),
+            Enum* out) {
+  if (!s.Has(key)) return;
+  const std::string name = s.String(key, "");
+  if (parse(name, out)) return;
+  const std::string hint = ClosestName(name, known);
+  std::string list;
+  for (const std::string& k : known) list += (list.empty() ? "" : ", ") + k;
+  s.Fail(key, "unknown " + what + " '" + name + "'" +
+                  (hint.empty() ? "" : " (did you mean '" + hint + "'?)") + "; known: " + list);
+}
+
 void LoadSolver(const Section& s, SolverOptions& o, SolverPreset& preset,
                 std::vector<std::string>& given) {
   // The preset sets the accuracy knobs' defaults; keys given here override them.
@@ -1040,33 +1058,14 @@ void LoadSolver(const Section& s, SolverOptions& o, SolverPreset& preset,
   RequireWithin(s, "gravity_m_s2", o.gravity_m_s2, kMinGravity_m_s2, kMaxGravity_m_s2, "m/s2");
   o.normal_restitution = s.Number("normal_restitution", o.normal_restitution);
   o.tangential_restitution = s.Number("tangential_restitution", o.tangential_restitution);
-  if (s.Has("viscous")) {
-    const std::string name = s.String("viscous", "");
-    if (!ParseViscousReading(name, &o.viscous)) {
-      const std::string hint = ClosestName(name, {"centre_of_mass", "contact_friction"});
-      s.Fail("viscous", "unknown reading '" + name + "'" +
-                            (hint.empty() ? "" : " (did you mean '" + hint + "'?)") +
-                            "; known: centre_of_mass, contact_friction");
-    }
-  }
-  if (s.Has("contact_solve")) {
-    const std::string name = s.String("contact_solve", "");
-    if (!ParseContactSolveMethod(name, &o.contact_solve)) {
-      const std::string hint = ClosestName(name, {"gauss_seidel", "block"});
-      s.Fail("contact_solve", "unknown method '" + name + "'" +
-                                  (hint.empty() ? "" : " (did you mean '" + hint + "'?)") +
-                                  "; known: gauss_seidel, block");
-    }
-  }
-  if (s.Has("predicted_lever")) {
-    const std::string name = s.String("predicted_lever", "");
-    if (!ParsePredictedLever(name, &o.predicted_lever)) {
-      const std::string hint = ClosestName(name, {"midpoint", "touch"});
-      s.Fail("predicted_lever", "unknown lever '" + name + "'" +
-                                    (hint.empty() ? "" : " (did you mean '" + hint + "'?)") +
-                                    "; known: midpoint, touch");
-    }
-  }
+  Choice(s, "viscous", "reading", {"centre_of_mass", "contact_friction"}, ParseViscousReading,
+         &o.viscous);
+  Choice(s, "contact_solve", "method", {"gauss_seidel", "block"}, ParseContactSolveMethod,
+         &o.contact_solve);
+  Choice(s, "predicted_lever", "lever", {"midpoint", "touch"}, ParsePredictedLever,
+         &o.predicted_lever);
+  Choice(s, "soil_drag", "drag point", {"centre_of_mass", "submerged_centroid"},
+         ParseSoilDragPoint, &o.soil_drag);
   o.tolerance_m_s = s.Number("tolerance_m_s", o.tolerance_m_s);
   const long max_iterations = s.Integer("max_iterations", o.max_iterations);
   if (max_iterations != static_cast<int>(max_iterations))
@@ -1212,7 +1211,7 @@ SceneFile LoadScene(const std::string& path) {
   LoadSolver(Section(context, SubTable(context, root, "solver"), "solver",
                      {"preset", "dt_s", "max_time_s", "gravity_m_s2", "normal_restitution",
                       "tangential_restitution", "viscous", "contact_solve", "predicted_lever",
-                      "tolerance_m_s", "max_iterations", "prox_alpha", "rest_speed_m_s",
+                      "soil_drag", "tolerance_m_s", "max_iterations", "prox_alpha", "rest_speed_m_s",
                       "rest_angular_speed_rad_s", "rest_hold_s"}),
              out.scene.options, out.solver_preset, out.solver_keys_given);
   LoadOutput(Section(context, SubTable(context, root, "output"), "output",
