@@ -1,11 +1,10 @@
-// talus calibrate: fit ground parameters to an event's observations (docs/calibration.md). Loads
-// and checks the calibration file, its event, scene and observations before any rock runs; runs
-// the optimiser on the same rocks again and again (common random numbers); measures the
-// objective's roughness, each parameter's profile and the covariance at the optimum; scores
-// held-out runs (--holdout) and cross-validates by run (--folds); writes the fitted ground table,
-// calibration.json and history.csv, all complete or none. Every evaluation goes to
-// DIR/checkpoint.json as it comes, so that an interrupted calibration resumes (--resume) to the
-// result an uninterrupted one gives.
+// talus calibrate: fit ground parameters to an event's observations (docs/calibration.md). The
+// calibration itself is one library call (calibration::Calibrate, calibration/calibrate.hpp); this
+// verb loads and checks the calibration file, its event, scene and observations before any rock
+// runs, divides the rocks among MPI ranks, prints the run's progress, keeps DIR/checkpoint.json
+// (every evaluation as it comes, so that an interrupted calibration resumes (--resume) to the
+// result an uninterrupted one gives) and writes the fitted ground table, calibration.json,
+// history.csv and the plots, all complete or none.
 
 #include <unistd.h>
 
@@ -28,11 +27,7 @@
 #include "app/interrupt.hpp"
 #include "app/mpi_session.hpp"
 #include "app/simulate.hpp"
-#include "calibration/holdout.hpp"
-#include "calibration/least_squares.hpp"
-#include "calibration/objective.hpp"
-#include "calibration/optimizer.hpp"
-#include "calibration/roughness.hpp"
+#include "calibration/calibrate.hpp"
 #include "common/atomic_file.hpp"
 #include "common/error.hpp"
 #include "io/calibration_checkpoint.hpp"
@@ -56,17 +51,6 @@ struct CalibrateArgs {
 const char* kCheckpoint = "checkpoint.json";
 // Seconds between two writes of the checkpoint during an optimisation.
 constexpr double kCheckpointEvery_s = 10;
-
-// Writes the checkpoint on the way out of a failed or interrupted run; a failure to write it is
-// reported but does not replace the reason the run ended.
-template <class Save>
-void SaveBeforeLeaving(const Save& save) {
-  try {
-    save();
-  } catch (const std::exception& e) {
-    std::cerr << "talus calibrate: the checkpoint could not be written: " << e.what() << "\n";
-  }
-}
 
 // The held-out runs of --holdout: K runs drawn by the optimiser's seed, or the listed ids.
 std::vector<std::string> HoldoutRuns(const std::string& text, const ensemble::ReleaseSpec& release,
@@ -120,78 +104,220 @@ struct Processes {
   }
 };
 
-int RunCalibrate(const CalibrateArgs& args, const Processes& processes) {
-  namespace fs = std::filesystem;
-  const auto t0 = std::chrono::steady_clock::now();
-  const bool root = processes.root();
+// The calibration as loaded and checked, and the checkpoint it goes on from.
+struct Loaded {
   io::CalibrationFile file;
-  std::unique_ptr<calibration::Objective> objective;
-  calibration::ObjectiveOptions objective_options;
-  calibration::RunSubset fit;
-  std::vector<std::string> holdout;
-  std::vector<std::vector<std::string>> folds;
+  std::unique_ptr<calibration::CalibrationProblem> problem;
   io::CalibrationCheckpoint checkpoint;
-  const std::string checkpoint_path = (fs::path(args.out) / kCheckpoint).string();
-  int code = kExitOk;
-  std::string message;
+  std::string checkpoint_path;
+};
+
+// Loads the calibration file, its event, scene and observations, splits the runs (--holdout,
+// --folds) and checks the checkpoint in --out against --resume. kExitOk, or the exit code with the
+// reason in *message.
+int Load(const CalibrateArgs& args, const Processes& processes, Loaded* loaded,
+         std::string* message) {
+  namespace fs = std::filesystem;
+  loaded->checkpoint_path = (fs::path(args.out) / kCheckpoint).string();
   try {
+    io::CalibrationFile& file = loaded->file;
     file = io::LoadCalibration(args.file);
-    objective_options = file.objective;
-    objective_options.threads = args.threads;
-    objective_options.progress = [](long, long) { ThrowIfInterrupted(); };
-    objective_options.run_ensemble = processes.runner;
+    calibration::ObjectiveOptions objective = file.objective;
+    objective.threads = args.threads;
+    objective.progress = [](long, long) { ThrowIfInterrupted(); };
+    objective.run_ensemble = processes.runner;
     const io::EventFile& event = file.event;
-    if (root) PrintSceneWarnings(event.scene, "calibrate");
-    if (root) PrintNotScored(event.not_scored);
-    holdout = HoldoutRuns(args.holdout, event.scene.release, file.optimizer.seed);
-    fit = calibration::SelectRuns(event.scene.release, event.observations,
-                                  calibration::OtherRuns(event.scene.release, holdout), true);
-    if (args.folds > 0) {
-      if (fit.release.runs.empty())
-        throw InputError("--folds: the event's scene releases no runs ([release] runs)");
-      folds = calibration::Folds(fit.release, args.folds, file.optimizer.seed);
-    }
-    objective = std::make_unique<calibration::Objective>(
-        event.scene.scene, fit.release, fit.observations, file.parameters, objective_options);
+    if (processes.root()) PrintSceneWarnings(event.scene, "calibrate");
+    if (processes.root()) PrintNotScored(event.not_scored);
+    calibration::HeldOutChecks checks;
+    checks.seed = file.options.optimizer.seed;
+    checks.holdout = HoldoutRuns(args.holdout, event.scene.release, checks.seed);
+    if (args.folds > 0 && event.scene.release.runs.empty())
+      throw InputError("--folds: the event's scene releases no runs ([release] runs)");
+    checks.folds = args.folds;
+    if (event.reference == "table1")
+      checks.reference = io::ReferenceGround(event.scene.scene.ground, nullptr);
+    loaded->problem = std::make_unique<calibration::CalibrationProblem>(
+        event.scene.scene, event.scene.release, event.observations, file.parameters, objective,
+        checks);
+    io::CalibrationCheckpoint& checkpoint = loaded->checkpoint;
     checkpoint.path_hash = file.path_hash;
-    checkpoint.holdout = holdout;
+    checkpoint.holdout = checks.holdout;
     checkpoint.folds = args.folds;
-    const bool exists = fs::exists(checkpoint_path);
+    const std::string& path = loaded->checkpoint_path;
+    const bool exists = fs::exists(path);
     if (args.resume) {
-      if (!exists) throw InputError("--resume: no " + checkpoint_path + " to resume from");
-      const io::CalibrationCheckpoint saved = io::ReadCheckpoint(checkpoint_path);
-      if (saved.path_hash != checkpoint.path_hash || saved.holdout != holdout ||
+      if (!exists) throw InputError("--resume: no " + path + " to resume from");
+      const io::CalibrationCheckpoint saved = io::ReadCheckpoint(path);
+      if (saved.path_hash != checkpoint.path_hash || saved.holdout != checkpoint.holdout ||
           saved.folds != args.folds)
-        throw InputError(checkpoint_path +
+        throw InputError(path +
                          ": the checkpoint belongs to another calibration (other inputs, "
                          "parameters, optimiser options, --holdout or --folds)");
       checkpoint.stages = saved.stages;
     } else if (exists) {
-      throw InputError(checkpoint_path +
+      throw InputError(path +
                        " holds the evaluations of an unfinished calibration: resume it with "
                        "--resume, or remove it");
     }
   } catch (const InputError& e) {
-    code = kExitBadInput;
-    message = e.what();
+    *message = e.what();
+    return kExitBadInput;
   } catch (const std::exception& e) {
-    code = kExitRunFailed;
-    message = "cannot load " + args.file + ": " + e.what();
+    *message = "cannot load " + args.file + ": " + e.what();
+    return kExitRunFailed;
   }
-  if (const int failed = processes.Step(code, message)) return failed;
-  if (processes.mpi()) {
-    // Every rank must run the same calibration as rank 0 (same files, options and splits).
-    const std::string identity = "calibration " +
-                                 fs::absolute(args.file).lexically_normal().string() +
-                                 " (inputs hash " + file.inputs_hash + "), --holdout '" +
-                                 args.holdout + "', --folds " + std::to_string(args.folds) +
-                                 ", --out " + fs::absolute(args.out).lexically_normal().string();
-    if (const std::string of_root = processes.broadcast(identity); of_root != identity) {
-      code = kExitBadInput;
-      message =
-          "started with another calibration than rank 0: " + identity + " instead of " + of_root;
+  return kExitOk;
+}
+
+// Under MPI, every rank must run the same calibration as rank 0 (same files, options and splits).
+int AgreeOnTheCalibration(const CalibrateArgs& args, const Loaded& loaded,
+                          const Processes& processes, std::string* message) {
+  namespace fs = std::filesystem;
+  if (!processes.mpi()) return kExitOk;
+  const std::string identity =
+      "calibration " + fs::absolute(args.file).lexically_normal().string() + " (inputs hash " +
+      loaded.file.inputs_hash + "), --holdout '" + args.holdout + "', --folds " +
+      std::to_string(args.folds) + ", --out " + fs::absolute(args.out).lexically_normal().string();
+  if (const std::string of_root = processes.broadcast(identity); of_root != identity) {
+    *message =
+        "started with another calibration than rank 0: " + identity + " instead of " + of_root;
+    return kExitBadInput;
+  }
+  return kExitOk;
+}
+
+void PrintHeader(const CalibrateArgs& args, const Loaded& loaded, const Processes& processes) {
+  const calibration::Objective& objective = loaded.problem->objective();
+  const ensemble::ReleaseSpec& release = objective.release();
+  const std::vector<std::string>& holdout = loaded.problem->holdout();
+  std::printf(
+      "Calibration %s: %d parameters, %zu observations of %ld runs x %ld rocks, %s%s\n"
+      "Contact solve: tolerance %g m/s (%s)\n",
+      args.file.c_str(), objective.dimension(), loaded.problem->fitted_runs().observations.size(),
+      release.release_count(), release.rocks_per_release,
+      loaded.file.options.optimizer.algorithm.c_str(),
+      processes.mpi() ? (", " + std::to_string(processes.size) + " MPI ranks").c_str() : "",
+      objective.options().tolerance_m_s, loaded.file.tolerance_source.c_str());
+  if (!holdout.empty())
+    std::printf("Holding out %zu runs: %s\n", holdout.size(), Join(holdout).c_str());
+  if (!loaded.checkpoint.stages.empty())
+    std::printf("Resuming from %s\n", loaded.checkpoint_path.c_str());
+  std::fflush(stdout);
+}
+
+// The checkpoint holds every evaluation so far; rewriting it after each one would cost time and
+// disk quadratic in the evaluations, so it is written at most every kCheckpointEvery_s, at the
+// end of each optimisation, and when the run is interrupted or fails. A process killed outright
+// loses at most that interval's evaluations, which --resume computes again, identically. Only
+// rank 0 writes it.
+class CheckpointKeeper {
+ public:
+  CheckpointKeeper(Loaded& loaded, bool root) : loaded_(loaded), root_(root) {}
+
+  // An optimisation begins: it is in the checkpoint from now on, if only with no evaluation.
+  void Begin(const std::string& stage) { loaded_.checkpoint.stages[stage]; }
+  // Keeps a new evaluation (a replayed one is there already); writes when the interval is over.
+  void Keep(const std::string& stage, const calibration::Evaluation& e, int index) {
+    std::vector<calibration::Evaluation>& kept = loaded_.checkpoint.stages[stage];
+    if (index < static_cast<int>(kept.size())) return;
+    kept.push_back(e);
+    if (std::chrono::steady_clock::now() - last_save_ >
+        std::chrono::duration<double>(kCheckpointEvery_s))
+      Save();
+  }
+  void Save() {
+    if (!root_ || loaded_.checkpoint.stages.empty()) return;
+    WriteFileAtomically(loaded_.checkpoint_path, io::CheckpointJson(loaded_.checkpoint));
+    last_save_ = std::chrono::steady_clock::now();
+  }
+  // On the way out of a failed or interrupted run: a failure to write is reported but does not
+  // replace the reason the run ended.
+  void SaveBeforeLeaving() {
+    try {
+      Save();
+    } catch (const std::exception& e) {
+      std::cerr << "talus calibrate: the checkpoint could not be written: " << e.what() << "\n";
     }
   }
+
+ private:
+  Loaded& loaded_;
+  bool root_;
+  std::chrono::steady_clock::time_point last_save_ = std::chrono::steady_clock::now();
+};
+
+// The library's options with this run's callbacks: the checkpoint, interrupts and printing.
+calibration::CalibrationOptions RunOptions(const Loaded& loaded, const Processes& processes,
+                                           CheckpointKeeper& keeper) {
+  calibration::CalibrationOptions options = loaded.file.options;
+  options.replay = loaded.checkpoint.stages;
+  const bool terminal = ::isatty(STDOUT_FILENO) != 0;
+  options.on_optimization_begins = [&keeper](const std::string& stage) { keeper.Begin(stage); };
+  options.on_evaluation = [&keeper, &processes, terminal](const std::string& stage,
+                                                          const calibration::Evaluation& e,
+                                                          int index) {
+    keeper.Keep(stage, e, index);
+    // Under MPI the ranks stop together, inside an evaluation (the runner agrees on it).
+    if (!processes.mpi()) ThrowIfInterrupted();
+    std::printf("%s  %s evaluation %4d  objective %-12.6g %s%s", terminal ? "\r" : "",
+                stage.c_str(), index, e.value, e.feasible ? "" : "(infeasible)",
+                terminal ? "   " : "\n");
+    std::fflush(stdout);
+  };
+  options.on_optimization_ends = [&keeper, terminal](const std::string&) {
+    keeper.Save();
+    if (terminal) std::printf("\n");
+  };
+  options.on_progress = [](const std::string& text) {
+    std::printf("%s", text.c_str());
+    std::fflush(stdout);
+  };
+  return options;
+}
+
+// Writes the outputs into --out through `staging`, calibration.json last; removes the checkpoint
+// unless a budget ended a fit (a later --resume with a larger budget goes on from it).
+void WriteOutputs(const CalibrateArgs& args, const Loaded& loaded,
+                  const calibration::CalibrationSummary& run,
+                  std::optional<StagingDirectory>& staging) {
+  const io::CalibrationFile& file = loaded.file;
+  const calibration::Objective& objective = loaded.problem->objective();
+  ThrowIfInterrupted();
+  staging.emplace(args.out);
+  WriteFileAtomically(staging->path("ground_table.toml"),
+                      io::GroundTableToml(file, objective, run.fitted));
+  WriteFileAtomically(staging->path("ground_table.csv"), io::GroundTableCsv(objective, run.fitted));
+  WriteFileAtomically(staging->path("history.csv"), io::HistoryCsv(objective, run.fit));
+  std::vector<std::string> outputs = {"ground_table.toml", "ground_table.csv", "history.csv",
+                                      "convergence.svg"};
+  WriteFileAtomically(staging->path("convergence.svg"), io::ConvergenceSvg(run.fit));
+  for (const std::string& kind : objective.kinds()) {
+    if (kind == "deposit") continue;
+    const std::string name = "observed_vs_simulated_" + kind + ".svg";
+    WriteFileAtomically(staging->path(name), io::ObservedSimulatedSvg(kind, run.before.observations,
+                                                                      run.after.observations));
+    outputs.push_back(name);
+  }
+  outputs.push_back("calibration.json");
+  WriteFileAtomically(staging->path("calibration.json"),
+                      io::CalibrationJson(file, objective, run, kVersion));
+  ThrowIfInterrupted();
+  staging->Commit(outputs);  // calibration.json last
+  const bool budget = run.BudgetEndedAFit();
+  if (!budget) std::filesystem::remove(loaded.checkpoint_path);
+  std::printf("Wrote %zu files to %s in %.1f s%s\n", outputs.size(), args.out.c_str(),
+              run.wall_time_s,
+              budget ? " (a budget ended a fit: checkpoint.json kept for --resume)" : "");
+}
+
+int RunCalibrate(const CalibrateArgs& args, const Processes& processes) {
+  const bool root = processes.root();
+  Loaded loaded;
+  std::string message;
+  int code = Load(args, processes, &loaded, &message);
+  if (const int failed = processes.Step(code, message)) return failed;
+  code = AgreeOnTheCalibration(args, loaded, processes, &message);
   if (const int failed = processes.Step(code, message)) return failed;
   if (root) {
     message = PrepareOutputDirectory(args.out);
@@ -201,208 +327,18 @@ int RunCalibrate(const CalibrateArgs& args, const Processes& processes) {
   const InterruptScope interrupts;
   std::signal(SIGXFSZ, SIG_IGN);
   if (root) RemoveStaleTemporaries(args.out);
+  PrintHeader(args, loaded, processes);
 
-  const io::EventFile& event = file.event;
-  const ensemble::ReleaseSpec& release = objective->release();
-  std::printf(
-      "Calibration %s: %d parameters, %zu observations of %ld runs x %ld rocks, %s%s\n"
-      "Contact solve: tolerance %g m/s (%s)\n",
-      args.file.c_str(), objective->dimension(), fit.observations.size(), release.release_count(),
-      release.rocks_per_release, file.optimizer.algorithm.c_str(),
-      processes.mpi() ? (", " + std::to_string(processes.size) + " MPI ranks").c_str() : "",
-      objective->options().tolerance_m_s, file.tolerance_source.c_str());
-  if (!holdout.empty())
-    std::printf("Holding out %zu runs: %s\n", holdout.size(), Join(holdout).c_str());
-  if (!checkpoint.stages.empty()) std::printf("Resuming from %s\n", checkpoint_path.c_str());
-  std::fflush(stdout);
-  const bool terminal = ::isatty(STDOUT_FILENO) != 0;
-  // The checkpoint holds every evaluation so far; rewriting it after each one would cost time and
-  // disk quadratic in the evaluations, so it is written at most every kCheckpointEvery_s, at the
-  // end of each optimisation, and when the run is interrupted or fails. A process killed outright
-  // loses at most that interval's evaluations, which --resume computes again, identically.
-  auto last_save = std::chrono::steady_clock::now();
-  const auto save_checkpoint = [&]() {
-    if (!root || checkpoint.stages.empty()) return;
-    WriteFileAtomically(checkpoint_path, io::CheckpointJson(checkpoint));
-    last_save = std::chrono::steady_clock::now();
-  };
-  // One optimisation, its evaluations replayed from and kept in the checkpoint.
-  const auto optimise = [&](const calibration::Objective& target, const std::string& stage) {
-    calibration::OptimizerOptions options = file.optimizer;
-    options.replay = checkpoint.stages[stage];
-    options.on_evaluation = [&, stage](const calibration::Evaluation& e, int index) {
-      std::vector<calibration::Evaluation>& kept = checkpoint.stages[stage];
-      if (index >= static_cast<int>(kept.size())) {
-        kept.push_back(e);
-        if (std::chrono::steady_clock::now() - last_save >
-            std::chrono::duration<double>(kCheckpointEvery_s))
-          save_checkpoint();
-      }
-      // Under MPI the ranks stop together, inside an evaluation (the runner agrees on it).
-      if (!processes.mpi()) ThrowIfInterrupted();
-      std::printf("%s  %s evaluation %4d  objective %-12.6g %s%s", terminal ? "\r" : "",
-                  stage.c_str(), index, e.value, e.feasible ? "" : "(infeasible)",
-                  terminal ? "   " : "\n");
-      std::fflush(stdout);
-    };
-    calibration::Summary summary = calibration::Calibrate(target, options);
-    save_checkpoint();
-    if (terminal) std::printf("\n");
-    return summary;
-  };
-  const std::optional<GroundTable> reference =
-      event.reference == "table1"
-          ? std::optional<GroundTable>(io::ReferenceGround(event.scene.scene.ground, nullptr))
-          : std::nullopt;
-
+  CheckpointKeeper keeper(loaded, root);
   std::optional<StagingDirectory> staging;
   try {
-    io::CalibrationRun run;
-    run.version = kVersion;
-    run.not_scored = event.not_scored;
-    run.summary = optimise(*objective, "fit");
-    std::printf("%s", run.summary.FullReport().c_str());
-    if (!run.summary.IsSolutionUsable()) throw std::runtime_error(run.summary.message);
-    const calibration::Evaluation& best = run.summary.best;
-    if (file.roughness) {
-      std::printf("Measuring the roughness and the profiles at the optimum...\n");
-      std::fflush(stdout);
-      run.roughness = calibration::MeasureRoughness(*objective, best.u, file.roughness_options);
-      const auto t1 = std::chrono::steady_clock::now();
-      run.profiles = calibration::ProfileParameters(*objective, best.u, best.value,
-                                                    run.roughness->level(), file.profile_options);
-      run.roughness->wall_time_s +=
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
-      std::printf("%s", run.roughness->Report().c_str());
-      for (const calibration::ParameterProfile& p : run.profiles)
-        std::printf(
-            "  %-28s profile range %-10.3g threshold %-10.3g %s\n", p.name.c_str(), p.range,
-            p.threshold,
-            p.identified ? "identified" : "UNIDENTIFIED: the observations do not constrain it");
-    }
-    if (file.uncertainty) {
-      calibration::UncertaintyOptions options = file.uncertainty_options;
-      if (!(options.fd_step > 0))
-        options.fd_step = run.summary.fd_step > 0 ? run.summary.fd_step
-                          : run.roughness         ? run.roughness->fd_step
-                                                  : 0.01;
-      options.noise = run.roughness ? run.roughness->level() : 0;
-      options.profiles = run.profiles;
-      std::printf("Estimating the covariance at the optimum...\n");
-      std::fflush(stdout);
-      run.uncertainty =
-          calibration::EstimateUncertainty(*objective, best.u, options, run.summary.history);
-      std::printf("%s", run.uncertainty->Report().c_str());
-      if (file.bootstrap_options.resamples > 0) {
-        calibration::BootstrapOptions bootstrap = file.bootstrap_options;
-        bootstrap.resolution = file.bootstrap_resolution.value_or(options.fd_step);
-        bootstrap.profiles = run.profiles;
-        std::printf("Bootstrap over runs: %d resamples, each refitted...\n", bootstrap.resamples);
-        std::fflush(stdout);
-        run.bootstrap =
-            calibration::BootstrapOverRuns(*objective, best.u, bootstrap, run.summary.history);
-        std::printf("%s", run.bootstrap->Report().c_str());
-        if (file.seed_options.seeds > 0) {
-          std::printf("Refits with %d other release seeds...\n", file.seed_options.seeds);
-          std::fflush(stdout);
-          run.seeds = calibration::RefitWithOtherSeeds(*objective, *run.bootstrap, bootstrap,
-                                                       file.seed_options);
-          std::printf("%s", run.seeds->Report().c_str());
-        }
-      }
-    }
-    const GroundTable fitted = objective->GroundOf(best.u);
-    // The fitted runs scored before and after, for the observed-vs-simulated plots. Every scoring
-    // runs the scene as the objective does (its contact-solve tolerance).
-    std::printf("Scoring the observations before and after for the plots...\n");
-    std::fflush(stdout);
-    const calibration::HeldOutScores before = calibration::ScoreRuns(
-        objective->scene(), fit, objective->GroundOf(run.summary.initial.u), nullptr, args.threads,
-        objective->needs_episodes(), processes.runner);
-    const calibration::HeldOutScores after =
-        calibration::ScoreRuns(objective->scene(), fit, fitted, nullptr, args.threads,
-                               objective->needs_episodes(), processes.runner);
-    if (!holdout.empty()) {
-      std::printf("Scoring the %zu held-out runs...\n", holdout.size());
-      std::fflush(stdout);
-      run.holdout = calibration::ScoreRuns(
-          objective->scene(),
-          calibration::SelectRuns(event.scene.release, event.observations, holdout, false), fitted,
-          reference ? &*reference : nullptr, args.threads, objective->needs_episodes(),
-          processes.runner);
-      std::printf("%s", io::HeldOutReport(*run.holdout).c_str());
-    }
-    for (std::size_t f = 0; f < folds.size(); ++f) {
-      const std::string stage = "fold" + std::to_string(f + 1);
-      std::printf("Cross-validation: fold %zu of %zu (%zu runs held out)\n", f + 1, folds.size(),
-                  folds[f].size());
-      std::fflush(stdout);
-      const calibration::RunSubset train = calibration::SelectRuns(
-          fit.release, fit.observations, calibration::OtherRuns(fit.release, folds[f]), true);
-      const calibration::Objective fold_objective(
-          event.scene.scene, train.release, train.observations, file.parameters, objective_options);
-      io::FoldRun fold;
-      fold.summary = optimise(fold_objective, stage);
-      std::printf("%s\n", fold.summary.BriefReport().c_str());
-      if (!fold.summary.IsSolutionUsable())
-        throw std::runtime_error("fold " + std::to_string(f + 1) + ": " + fold.summary.message);
-      fold.scores = calibration::ScoreRuns(
-          objective->scene(),
-          calibration::SelectRuns(fit.release, fit.observations, folds[f], false),
-          fold_objective.GroundOf(fold.summary.best.u), reference ? &*reference : nullptr,
-          args.threads, objective->needs_episodes(), processes.runner);
-      run.folds.push_back(std::move(fold));
-    }
-    if (!run.folds.empty()) {
-      std::vector<calibration::HeldOutScores> sets;
-      for (const io::FoldRun& f : run.folds) sets.push_back(f.scores);
-      calibration::HeldOutScores pooled;
-      pooled.kinds = calibration::PoolKinds(sets);
-      std::printf("Cross-validated (%zu folds), every run scored by the fit without it:\n%s",
-                  run.folds.size(), io::HeldOutReport(pooled).c_str());
-    }
-    run.threads = args.threads;
-    run.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-
+    const calibration::CalibrationSummary run =
+        calibration::Calibrate(*loaded.problem, RunOptions(loaded, processes, keeper));
     // Rank 0 writes; the other ranks only agree on how it went (below).
-    if (root) {
-      ThrowIfInterrupted();
-      staging.emplace(args.out);
-      WriteFileAtomically(staging->path("ground_table.toml"),
-                          io::GroundTableToml(file, *objective, fitted));
-      WriteFileAtomically(staging->path("ground_table.csv"),
-                          io::GroundTableCsv(*objective, fitted));
-      WriteFileAtomically(staging->path("history.csv"), io::HistoryCsv(*objective, run.summary));
-      std::vector<std::string> outputs = {"ground_table.toml", "ground_table.csv", "history.csv",
-                                          "convergence.svg"};
-      WriteFileAtomically(staging->path("convergence.svg"), io::ConvergenceSvg(run.summary));
-      for (const std::string& kind : objective->kinds()) {
-        if (kind == "deposit") continue;
-        const std::string name = "observed_vs_simulated_" + kind + ".svg";
-        WriteFileAtomically(staging->path(name), io::ObservedSimulatedSvg(kind, before.observations,
-                                                                          after.observations));
-        outputs.push_back(name);
-      }
-      outputs.push_back("calibration.json");
-      WriteFileAtomically(staging->path("calibration.json"),
-                          io::CalibrationJson(file, *objective, run));
-      ThrowIfInterrupted();
-      staging->Commit(outputs);  // calibration.json last
-      // The run is complete: its checkpoint is no longer needed, unless a budget ended a fit
-      // (a later --resume with a larger budget goes on from it).
-      bool budget = run.summary.termination == calibration::Termination::kMaxEvaluations ||
-                    run.summary.termination == calibration::Termination::kMaxTime;
-      for (const io::FoldRun& f : run.folds)
-        budget = budget || f.summary.termination == calibration::Termination::kMaxEvaluations ||
-                 f.summary.termination == calibration::Termination::kMaxTime;
-      if (!budget) fs::remove(checkpoint_path);
-      std::printf("Wrote %zu files to %s in %.1f s%s\n", outputs.size(), args.out.c_str(),
-                  run.wall_time_s,
-                  budget ? " (a budget ended a fit: checkpoint.json kept for --resume)" : "");
-    }
+    if (root) WriteOutputs(args, loaded, run, staging);
   } catch (const Interrupted& e) {
     staging.reset();
-    SaveBeforeLeaving(save_checkpoint);
+    keeper.SaveBeforeLeaving();
     code = ExitCodeForSignal(e.signal());
     message = std::string(e.what()) + "; no output written, " + args.out +
               " is as it was before the run but for " + kCheckpoint + " (resume with --resume)";
@@ -412,7 +348,7 @@ int RunCalibrate(const CalibrateArgs& args, const Processes& processes) {
     message =
         (staging ? staging->Describe(e.what()) : std::string(e.what())) + " (no output written)";
     staging.reset();
-    SaveBeforeLeaving(save_checkpoint);
+    keeper.SaveBeforeLeaving();
   }
   return processes.Step(code, message);
 }

@@ -206,6 +206,16 @@ int RunBenchmark(int argc, char** argv) {
                "Skip the stage profile and the per-cell statistics runs (for instruction counts "
                "of exactly --rocks trajectories)");
   app.add_flag("--no-cells", no_cells, "Skip the per-cell statistics run");
+  // The scarring soil (Lu et al. 2019) under the ramp's medium_hard ground: its model, M_E and C_s
+  // (the paper's whole-trajectory soil by default), and where its drag acts.
+  std::string ground_model = "hard", soil_drag = "centre_of_mass";
+  double soil_strength = 15, compaction_drag = 1.5;
+  app.add_option("--ground-model", ground_model, "hard (the seed's) or lu2019 (scarring soil)")
+      ->check(CLI::IsMember({"hard", "lu2019"}));
+  app.add_option("--soil-strength", soil_strength, "lu2019: M_E, MN/m^2");
+  app.add_option("--compaction-drag", compaction_drag, "lu2019: C_s");
+  app.add_option("--soil-drag", soil_drag, "lu2019: where the drag acts")
+      ->check(CLI::IsMember({"centre_of_mass", "submerged_centroid"}));
   bool detect_every_step = false;
   app.add_flag("--detect-every-step", detect_every_step,
                "Contact detection in every step, no flight windows (same results, bit for bit)");
@@ -217,6 +227,13 @@ int RunBenchmark(int argc, char** argv) {
   if (max_iterations > 0) scene.options.max_iterations = max_iterations;
   talus::ParseViscousReading(viscous, &scene.options.viscous);
   talus::ParseContactSolveMethod(contact_solve, &scene.options.contact_solve);
+  talus::ParseSoilDragPoint(soil_drag, &scene.options.soil_drag);
+  for (int i = 0; i < scene.ground.size(); ++i) {
+    talus::GroundParams& p = scene.ground.mutable_params(i);
+    talus::ParseGroundModel(ground_model, &p.model);
+    p.soil_strength_mn_m2 = soil_strength;
+    p.compaction_drag = compaction_drag;
+  }
   std::string why;
   if (!scene.IsValid(&why)) {
     std::fprintf(stderr, "ramp_bench: %s\n", why.c_str());
@@ -237,10 +254,15 @@ int RunBenchmark(int argc, char** argv) {
   std::printf(
       "scene: EOTA221 %.0f kg, %zu hull vertices; 40 deg ramp 200 m + 150 m runout, 2 m cells, "
       "medium_hard; dt %.4f s, tolerance %.1e m/s, at most %d sweeps; viscous term: %s; "
-      "contact solve: %s\n",
+      "contact solve: %s; ground model: %s",
       scene.rock.mass_kg, scene.rock.vertices_m.size(), scene.options.dt_s,
       scene.options.tolerance_m_s, scene.options.max_iterations,
-      talus::ToString(scene.options.viscous), talus::ToString(scene.options.contact_solve));
+      talus::ToString(scene.options.viscous), talus::ToString(scene.options.contact_solve),
+      ground_model.c_str());
+  if (ground_model == "lu2019")
+    std::printf(" (M_E %g MN/m^2, C_s %g, drag at %s)", soil_strength, compaction_drag,
+                soil_drag.c_str());
+  std::printf("\n");
 
   std::vector<double> rates, step_rates;
   Batch last;

@@ -27,6 +27,7 @@
 #include <vector>
 
 #include "common/error.hpp"
+#include "common/statistics.hpp"
 #include "ensemble/rasters.hpp"
 #include "ensemble/runner.hpp"
 #include "io/raster.hpp"
@@ -153,9 +154,9 @@ std::vector<double> Scalars(const std::vector<RockRecord>& rocks,
       if (std::isfinite(rocks[k].line_energy_kj[l]))
         energies[l].push_back(rocks[k].line_energy_kj[l]);
   }
-  std::vector<double> out = {talus::io::NearestRankPercentile(runouts, 50),
-                             talus::io::NearestRankPercentile(runouts, 95)};
-  for (const auto& e : energies) out.push_back(talus::io::NearestRankPercentile(e, 95));
+  std::vector<double> out = {talus::NearestRankPercentile(runouts, 50),
+                             talus::NearestRankPercentile(runouts, 95)};
+  for (const auto& e : energies) out.push_back(talus::NearestRankPercentile(e, 95));
   return out;
 }
 

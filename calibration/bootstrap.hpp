@@ -1,6 +1,6 @@
 #pragma once
 // The bootstrap over runs: a second estimate of the fitted parameters' uncertainty, beside the
-// sandwich covariance (least_squares.hpp), which can understate it on a rough objective.
+// sandwich covariance (covariance.hpp), which can understate it on a rough objective.
 //
 // The objective is a sum over independent groups -- the runs, and each observation of the whole
 // scene --, f(u) = sum_g S_g(u) + prior(u), S_g the sum of the squared residuals of group g

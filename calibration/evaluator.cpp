@@ -5,7 +5,8 @@
 
 namespace talus::calibration {
 
-Evaluator::Evaluator(const Objective& objective, const OptimizerOptions& options, Summary& summary)
+Evaluator::Evaluator(const Objective& objective, const OptimizerOptions& options,
+                     OptimizerSummary& summary)
     : objective_(objective),
       options_(options),
       summary_(summary),

@@ -1,9 +1,12 @@
 #pragma once
-// The bookkeeping every optimiser shares (optimizer.cpp, least_squares.cpp): runs the objective
-// for the optimiser and keeps the record in a Summary -- every evaluation in order, its start, the
-// best feasible one --, answers a point asked for again from the history (the objective is
-// deterministic), serves the evaluations of a checkpoint (OptimizerOptions::replay) in order
-// without running a rock, calls OptimizerOptions::on_evaluation, and watches the budget.
+// The bookkeeping every optimiser shares (nlopt_optimizer.cpp, least_squares.cpp), on the
+// vocabulary of optimizer.hpp: runs the objective for the optimiser and keeps the record in an
+// OptimizerSummary -- every evaluation in order, its start, the best feasible one --, answers a
+// point asked for again from the history (the objective is deterministic; evaluations already in
+// the summary's history when it starts are answered too), serves the evaluations of a checkpoint
+// (OptimizerOptions::replay) in order without running a rock, calls
+// OptimizerOptions::on_evaluation, and watches the budget. The covariance (covariance.cpp) uses it
+// as its cache of a calibration's evaluations.
 
 #include <Eigen/Core>
 #include <chrono>
@@ -17,7 +20,7 @@ namespace talus::calibration {
 
 class Evaluator {
  public:
-  Evaluator(const Objective& objective, const OptimizerOptions& options, Summary& summary);
+  Evaluator(const Objective& objective, const OptimizerOptions& options, OptimizerSummary& summary);
 
   // The evaluation at u, from the history, the replay or a run of the objective. Throws what the
   // objective or on_evaluation throws, and std::runtime_error when the replay's next evaluation
@@ -45,7 +48,7 @@ class Evaluator {
  private:
   const Objective& objective_;
   const OptimizerOptions& options_;
-  Summary& summary_;
+  OptimizerSummary& summary_;
   std::chrono::steady_clock::time_point t0_;
   int start_ = 0;
   bool out_of_time_ = false;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <numeric>
 #include <random>
 #include <set>
@@ -127,6 +128,20 @@ HeldOutScores ScoreRuns(const Scene& scene, const RunSubset& subset, const Groun
     out.kinds.push_back(kind);
   }
   out.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return out;
+}
+
+std::string HeldOutScores::Report() const {
+  std::string out;
+  char line[256];
+  std::snprintf(line, sizeof line, "  %-24s %8s %14s %14s\n", "kind", "scored", "fitted",
+                "reference");
+  out += line;
+  for (const HeldOutKind& k : kinds) {
+    std::snprintf(line, sizeof line, "  %-24s %8d %11.4g %-2s %11.4g %-2s\n", k.kind.c_str(),
+                  k.scored, k.fitted, k.unit.c_str(), k.reference, k.unit.c_str());
+    out += line;
+  }
   return out;
 }
 

@@ -57,6 +57,7 @@ struct HeldOutScores {
   std::vector<fieldobs::ObservationScore> observations;
   long rocks = 0;
   double wall_time_s = 0;
+  std::string Report() const;  // per kind, fitted against reference, a few lines for people
 };
 
 // Runs `subset` on `scene` with the ground table `fitted`, and with `reference` when given, and

@@ -1,11 +1,13 @@
 #pragma once
-// Calibration on the objective (objective.hpp), in the unit cube, by NLopt's derivative-free
-// methods -- local BOBYQA and Sbplx, global CRS2-LM, DIRECT-L and ISRES -- or by Ceres Solver's
-// bounded nonlinear least squares on the residual vector ("ceres", least_squares.hpp), chosen by
-// name; optionally from several starts (the given start, then Sobol or Latin-hypercube points).
-// Every evaluation is kept, and a checkpoint's evaluations can be replayed so that an interrupted
-// calibration resumes to the identical result. The result is a Summary with a termination type, a
-// brief and a full report (Ceres style).
+// The vocabulary every optimiser of the calibration shares, at the bottom of the module: the
+// algorithms by name, the options, how a run ended (Termination), each start's record and the
+// OptimizerSummary with its brief and full report (Ceres style), and the start points. The
+// optimisers work on the objective (objective.hpp) in the unit cube: NLopt's derivative-free
+// methods (nlopt_optimizer.hpp) and Ceres Solver's bounded nonlinear least squares on the residual
+// vector (least_squares.hpp), two back-ends beside each other that keep their record through the
+// Evaluator (evaluator.hpp); Optimize (optimize.hpp) chooses one by name. Every evaluation is
+// kept, and a checkpoint's evaluations can be replayed so that an interrupted calibration resumes
+// to the identical result.
 //
 // Infeasible vectors (mu_min > mu_max where both are free; NLopt keeps to the box itself) run no
 // rock and get the finite penalty ObjectiveOptions::infeasible_value * (1 + violation), far above
@@ -51,7 +53,7 @@ struct OptimizerOptions {
   // is an error (the checkpoint belongs to another calibration).
   std::vector<Evaluation> replay;
   // Called after every evaluation (on the calling thread); may throw to stop (e.g. interrupted):
-  // the optimiser stops and the exception comes out of Calibrate.
+  // the optimiser stops and the exception comes out of Optimize (optimize.hpp).
   std::function<void(const Evaluation&, int evaluation)> on_evaluation;
 
   bool IsValid(std::string* why) const;
@@ -73,7 +75,7 @@ struct StartRecord {
   std::string result;  // NLopt's result (e.g. "FTOL_REACHED") or Ceres' termination message
 };
 
-struct Summary {
+struct OptimizerSummary {
   std::string algorithm;
   Termination termination = Termination::kFailure;
   std::string message;
@@ -102,9 +104,5 @@ struct Summary {
 // starts - 1 points of the design.
 std::vector<Eigen::VectorXd> StartPoints(const Objective& objective,
                                          const OptimizerOptions& options);
-
-// Minimises the objective. Throws what options.on_evaluation throws; std::invalid_argument for
-// invalid options (validate them first).
-Summary Calibrate(const Objective& objective, const OptimizerOptions& options);
 
 }  // namespace talus::calibration

@@ -9,37 +9,26 @@
 
 namespace talus::calibration {
 
-const char* ToString(GroundField field) {
-  switch (field) {
-    case GroundField::kMuMin:
-      return "mu_min";
-    case GroundField::kMuMax:
-      return "mu_max";
-    case GroundField::kBeta:
-      return "beta";
-    case GroundField::kKappa:
-      return "kappa";
-    case GroundField::kNu:
-      return "nu";
-  }
-  return "?";
+namespace {
+constexpr GroundField kAllFields[] = {GroundField::kMuMin,         GroundField::kMuMax,
+                                      GroundField::kBeta,          GroundField::kKappa,
+                                      GroundField::kNu,            GroundField::kSoilStrength,
+                                      GroundField::kCompactionDrag};
+}  // namespace
+
+// The enum's order is the table's: every calibrated row, in order, first.
+static_assert(std::size(kAllFields) <= std::tuple_size_v<decltype(kGroundFields)>);
+
+const GroundFieldInfo& InfoOf(GroundField field) {
+  return kGroundFields[static_cast<std::size_t>(field)];
 }
 
-const char* UnitOf(GroundField field) {
-  switch (field) {
-    case GroundField::kBeta:
-    case GroundField::kNu:
-      return "1/s";
-    case GroundField::kKappa:
-      return "1/m";
-    default:
-      return "1";
-  }
-}
+const char* ToString(GroundField field) { return InfoOf(field).key; }
+
+const char* UnitOf(GroundField field) { return InfoOf(field).unit; }
 
 bool ParseGroundField(const std::string& name, GroundField* field) {
-  for (GroundField f : {GroundField::kMuMin, GroundField::kMuMax, GroundField::kBeta,
-                        GroundField::kKappa, GroundField::kNu})
+  for (GroundField f : kAllFields)
     if (name == ToString(f)) {
       *field = f;
       return true;
@@ -47,29 +36,12 @@ bool ParseGroundField(const std::string& name, GroundField* field) {
   return false;
 }
 
-double& FieldOf(GroundParams& p, GroundField field) {
-  switch (field) {
-    case GroundField::kMuMin:
-      return p.mu_min;
-    case GroundField::kMuMax:
-      return p.mu_max;
-    case GroundField::kBeta:
-      return p.beta_1_s;
-    case GroundField::kKappa:
-      return p.kappa_1_m;
-    case GroundField::kNu:
-      break;
-  }
-  return p.nu_1_s;
-}
+double& FieldOf(GroundParams& p, GroundField field) { return p.*InfoOf(field).member; }
 
-double FieldOf(const GroundParams& p, GroundField field) {
-  return FieldOf(const_cast<GroundParams&>(p), field);
-}
+double FieldOf(const GroundParams& p, GroundField field) { return p.*InfoOf(field).member; }
 
 bool ParameterSpec::UsesLog() const {
-  return log.value_or(field == GroundField::kBeta || field == GroundField::kKappa ||
-                      field == GroundField::kNu);
+  return log.value_or(InfoOf(field).log_scale);
 }
 
 std::string ParameterSpec::Name() const { return category + "." + ToString(field); }
@@ -113,6 +85,10 @@ ParameterSet::ParameterSet(std::vector<ParameterSpec> specs, const GroundTable& 
     const int index = table.IndexOfName(s.category);
     if (index < 0) throw InputError(s.Name() + ": no ground category '" + s.category + "'");
     category_index_.push_back(index);
+    if (InfoOf(s.field).group == GroundFieldInfo::Group::kSoil && !table.params(index).IsSoil())
+      throw InputError(s.Name() + ": category '" + s.category +
+                       "' has no scarring soil (a soil parameter acts only with model = "
+                       "\"lu2019\")");
     for (std::size_t j = 0; j < k; ++j)
       if (specs_[j].category == s.category && specs_[j].field == s.field)
         throw InputError(s.Name() + ": freed twice");

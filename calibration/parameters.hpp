@@ -18,10 +18,21 @@
 
 namespace talus::calibration {
 
-// The five fields of a ground category that a calibration may free.
-enum class GroundField { kMuMin, kMuMax, kBeta, kKappa, kNu };
-const char* ToString(GroundField field);  // "mu_min", "mu_max", "beta", "kappa", "nu"
-const char* UnitOf(GroundField field);    // "1", "1", "1/s", "1/m", "1/s"
+// The fields of a ground category that a calibration may free: the seed's five and the scarring
+// soil's two (a category with model = "lu2019"). In the order of kGroundFields
+// (solver/ground.hpp), whose rows give their names, units and default transforms.
+enum class GroundField {
+  kMuMin,
+  kMuMax,
+  kBeta,
+  kKappa,
+  kNu,
+  kSoilStrength,
+  kCompactionDrag
+};
+const GroundFieldInfo& InfoOf(GroundField field);
+const char* ToString(GroundField field);  // "mu_min", ..., "soil_strength", "compaction_drag"
+const char* UnitOf(GroundField field);    // "1", "1", "1/s", "1/m", "1/s", "MN/m^2", "1"
 bool ParseGroundField(const std::string& name, GroundField* field);
 double& FieldOf(GroundParams& params, GroundField field);
 double FieldOf(const GroundParams& params, GroundField field);
@@ -32,7 +43,8 @@ struct ParameterSpec {
   GroundField field = GroundField::kMuMin;
   double lower = 0;  // in the field's unit; > 0
   double upper = 0;  // > lower; mu <= kMaxFriction
-  // Log transform of the coordinate; nullopt: on for beta, kappa and nu, off for mu_min, mu_max.
+  // Log transform of the coordinate; nullopt: on for beta, kappa, nu and soil_strength, off for
+  // mu_min, mu_max and compaction_drag (GroundFieldInfo::log_scale).
   std::optional<bool> log;
   std::string tie;  // parameters with the same non-empty tie share one coordinate
 

@@ -1,5 +1,5 @@
 #pragma once
-// Numbers in the calibration's text reports (Summary, Uncertainty).
+// Numbers in the calibration's text reports (OptimizerSummary, Uncertainty).
 
 #include <cmath>
 #include <cstdio>

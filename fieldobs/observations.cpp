@@ -22,6 +22,8 @@ const char* ToString(Quantity quantity) {
       return "impact_duration";
     case Quantity::kScarLength:
       return "scar_length";
+    case Quantity::kImpactScarDepth:
+      return "impact_scar_depth";
     case Quantity::kSegmentMaxSpeed:
       return "segment_max_speed";
     case Quantity::kSegmentMeanAngularSpeed:
@@ -44,6 +46,7 @@ const char* UnitOf(Quantity quantity) {
   switch (quantity) {
     case Quantity::kRunout:
     case Quantity::kScarLength:
+    case Quantity::kImpactScarDepth:
     case Quantity::kSegmentMaxJumpHeight:
     case Quantity::kZoneJumpHeight:
       return "m";

@@ -22,6 +22,7 @@ enum class Quantity {
   kImpactAngularSpeedOut,  // rad/s: angular speed leaving the first contact episode
   kImpactDuration,         // s: duration of the first contact episode
   kScarLength,             // m: longest scar of the run's first loaded contact episode
+  kImpactScarDepth,        // m: deepest penetration of the first contact episode (soil; 0 hard)
   // Over an observed trajectory segment: from the run's start for the segment's duration.
   kSegmentMaxSpeed,          // m/s: largest speed of the centre of mass
   kSegmentMeanAngularSpeed,  // rad/s: mean angular speed

@@ -175,6 +175,7 @@ void EnsembleSamples::OnRock(const ensemble::RockOutcome& outcome) {
     if (in2 > 0) rock.energy_ratio = e.velocity_out_m_s.squaredNorm() / in2;
     rock.angular_speed_out_rad_s = e.angular_velocity_out_rad_s.norm();
     rock.duration_s = e.duration_s();
+    rock.scar_depth_m = e.max_scar_depth_m;
     for (const ContactEpisode& loaded : outcome.episodes)
       if (loaded.loaded) {
         rock.scar_m = loaded.max_scar_m;
@@ -233,6 +234,9 @@ std::vector<double> EnsembleSamples::Values(Quantity quantity, const std::string
         break;
       case Quantity::kScarLength:
         v = r.scar_m;
+        break;
+      case Quantity::kImpactScarDepth:
+        v = r.scar_depth_m;
         break;
       case Quantity::kSegmentMaxSpeed:
         v = r.segment_max_speed_m_s;
@@ -323,7 +327,7 @@ std::string EnsembleSamples::Serialize() const {
     for (double v : {r.end_m.x(), r.end_m.y(), r.start_m.x(), r.start_m.y()}) Put(out, v);
     for (const auto* v :
          {&r.speed_out_m_s, &r.energy_ratio, &r.angular_speed_out_rad_s, &r.duration_s, &r.scar_m,
-          &r.segment_max_speed_m_s, &r.segment_mean_angular_speed_rad_s, &r.segment_max_jump_m})
+          &r.scar_depth_m, &r.segment_max_speed_m_s, &r.segment_mean_angular_speed_rad_s, &r.segment_max_jump_m})
       PutOptional(out, *v);
     Put<std::uint64_t>(out, r.zones.size());
     for (double v : r.zones) Put(out, v);
@@ -347,7 +351,7 @@ void EnsembleSamples::Append(const std::string& bytes) {
     r.start_m.y() = in.Get<double>();
     for (auto* v :
          {&r.speed_out_m_s, &r.energy_ratio, &r.angular_speed_out_rad_s, &r.duration_s, &r.scar_m,
-          &r.segment_max_speed_m_s, &r.segment_mean_angular_speed_rad_s, &r.segment_max_jump_m})
+          &r.scar_depth_m, &r.segment_max_speed_m_s, &r.segment_mean_angular_speed_rad_s, &r.segment_max_jump_m})
       *v = in.GetOptional();
     const auto zones = in.Get<std::uint64_t>();
     if (zones > (std::uint64_t{1} << 32))

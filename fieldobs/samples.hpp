@@ -70,7 +70,8 @@ class EnsembleSamples : public ensemble::RockSink {
     Eigen::Vector2d end_m = Eigen::Vector2d::Zero();
     Eigen::Vector2d start_m = Eigen::Vector2d::Zero();
     // From the first contact episode (and the first loaded one, for the scar).
-    std::optional<double> speed_out_m_s, energy_ratio, angular_speed_out_rad_s, duration_s, scar_m;
+    std::optional<double> speed_out_m_s, energy_ratio, angular_speed_out_rad_s, duration_s, scar_m,
+        scar_depth_m;
     // Over the run's observed segment (SegmentRecorders).
     std::optional<double> segment_max_speed_m_s, segment_mean_angular_speed_rad_s,
         segment_max_jump_m;

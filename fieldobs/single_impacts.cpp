@@ -112,8 +112,8 @@ ensemble::ReleaseRun SingleImpactRun(const IncomingImpact& impact, const Terrain
   return run;
 }
 
-void ReadSingleImpactOutcomes(const CsvTable& t, const SingleImpactColumns& c, ObservationSet& out,
-                              std::vector<std::string>* not_scored) {
+void ReadSingleImpactOutcomes(const CsvTable& t, const SingleImpactColumns& c,
+                              ObservationSet& out) {
   t.Require({c.id});
   if (!t.Has(c.energy_ratio) && !t.Has(c.speed_out))
     throw InputError(t.path() + ": no observed outcome: give the column " + c.energy_ratio +
@@ -130,13 +130,12 @@ void ReadSingleImpactOutcomes(const CsvTable& t, const SingleImpactColumns& c, O
       out.scalars.push_back(
           {Quantity::kImpactSpeedOut, run, t.NonNegativeNumber(row, c.speed_out), where});
   }
-  if (!not_scored || !t.Has(c.scar_depth)) return;
-  int depths = 0;
-  for (int row = 0; row < t.rows(); ++row) depths += t.Empty(row, c.scar_depth) ? 0 : 1;
-  if (depths > 0)
-    not_scored->push_back(t.path() + ": column '" + c.scar_depth + "': " + std::to_string(depths) +
-                          " scar depths not scored: the model's scar is a length along the path, "
-                          "it has no depth (that needs a soil layer, Lu et al. 2019)");
+  if (!t.Has(c.scar_depth)) return;
+  for (int row = 0; row < t.rows(); ++row)
+    if (!t.Empty(row, c.scar_depth))
+      out.scalars.push_back({Quantity::kImpactScarDepth, t.Text(row, c.id),
+                             t.NonNegativeNumber(row, c.scar_depth),
+                             t.path() + ":" + std::to_string(t.line(row))});
 }
 
 }  // namespace talus::fieldobs

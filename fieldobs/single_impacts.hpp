@@ -34,7 +34,8 @@ struct SingleImpactColumns {
   // speed after the impact (m/s). Empty cells are not observed.
   std::string energy_ratio = "energy_ratio";
   std::string speed_out = "outgoing_speed_mps";
-  // Observed scar depth (m): reported as not scored (the model's scar is a length, not a depth).
+  // Observed scar depth (m), against the first contact episode's deepest penetration (a soil
+  // category, GroundModel::kLu2019; on hard ground the simulated depth is 0).
   std::string scar_depth = "scar_depth_m";
 };
 
@@ -66,10 +67,9 @@ Eigen::Vector3d DownslopeDirection(const Eigen::Vector3d& normal);
 ensemble::ReleaseRun SingleImpactRun(const IncomingImpact& impact, const Terrain& terrain,
                                      const Eigen::Vector2d& xy_m, double clearance_m, int block);
 
-// The observations of every row (energy ratio, speed after; rows with empty cells give none), as
-// observations of the first contact episode of the row's run. When the table has a scar-depth
-// column, `not_scored` gets a line saying so and why (the model has no scar depth).
+// The observations of every row (energy ratio, speed after, scar depth; rows with empty cells give
+// none), as observations of the first contact episode of the row's run.
 void ReadSingleImpactOutcomes(const CsvTable& table, const SingleImpactColumns& columns,
-                              ObservationSet& out, std::vector<std::string>* not_scored);
+                              ObservationSet& out);
 
 }  // namespace talus::fieldobs

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "calibration/designs.hpp"
+#include "common/closest_name.hpp"
 #include "common/error.hpp"
 #include "io/toml_section.hpp"
 
@@ -15,7 +16,14 @@ namespace {
 
 using calibration::ParameterSpec;
 
-const std::vector<std::string> kFields = {"mu_min", "mu_max", "beta", "kappa", "nu"};
+// The fields a calibration may free (kGroundFields' calibrated rows).
+std::vector<std::string> CalibratedFields() {
+  std::vector<std::string> fields;
+  for (const GroundFieldInfo& f : kGroundFields)
+    if (f.calibrated) fields.emplace_back(f.key);
+  return fields;
+}
+const std::vector<std::string> kFields = CalibratedFields();
 
 std::string Hint(const std::string& word, const std::vector<std::string>& known) {
   const std::string hint = ClosestName(word, known);
@@ -63,11 +71,11 @@ void LoadParameters(const Context& context, const toml::table& root, Calibration
       s.Fail("category", "unknown ground category '" + spec.category + "'" +
                              Hint(spec.category, categories) + "; the scene has " +
                              Join(categories));
-    if (!s.Has("field")) s.Fail("field", "missing: one of mu_min, mu_max, beta, kappa, nu");
+    if (!s.Has("field")) s.Fail("field", "missing: one of " + Join(kFields));
     const std::string field = s.String("field", "");
     if (!calibration::ParseGroundField(field, &spec.field))
-      s.Fail("field", "unknown parameter '" + field + "'" + Hint(field, kFields) +
-                          "; known: mu_min, mu_max, beta, kappa, nu");
+      s.Fail("field",
+             "unknown parameter '" + field + "'" + Hint(field, kFields) + "; known: " + Join(kFields));
     for (const char* bound : {"lower", "upper"})
       if (!s.Has(bound))
         s.Fail(bound, std::string("missing: the ") + bound + " bound, in " +
@@ -157,7 +165,7 @@ void LoadOptimizer(const Context& context, const toml::table* table, Calibration
   const Section s(context, table, "optimizer",
                   {"algorithm", "max_evaluations", "max_time_s", "ftol_rel", "ftol_abs", "xtol_abs",
                    "initial_step", "population", "starts", "start_design", "seed", "fd_step"});
-  calibration::OptimizerOptions& o = out.optimizer;
+  calibration::OptimizerOptions& o = out.options.optimizer;
   o.algorithm = s.String("algorithm", o.algorithm);
   const auto& names = calibration::AlgorithmNames();
   if (std::find(names.begin(), names.end(), o.algorithm) == names.end())
@@ -205,26 +213,26 @@ void LoadOptimizer(const Context& context, const toml::table* table, Calibration
 
 void LoadRoughness(const Context& context, const toml::table* table, CalibrationFile& out) {
   const Section s(context, table, "roughness", {"enabled", "steps", "seeds", "profile_points"});
-  out.roughness = s.Bool("enabled", true);
+  out.options.roughness = s.Bool("enabled", true);
   if (const toml::node* node = s.Node("steps")) {
     const toml::array* array = node->as_array();
     if (!array || array->empty()) s.Fail("steps", "expected a list of steps, e.g. [1e-4, 1e-2]");
-    out.roughness_options.steps = s.Numbers("steps", array->size());
+    out.options.roughness_options.steps = s.Numbers("steps", array->size());
   }
-  const long seeds = s.Integer("seeds", out.roughness_options.seeds);
+  const long seeds = s.Integer("seeds", out.options.roughness_options.seeds);
   if (seeds < 0 || seeds > 100) s.Fail("seeds", std::to_string(seeds) + " must be in 0 .. 100");
-  out.roughness_options.seeds = static_cast<int>(seeds);
-  const long points = s.Integer("profile_points", out.profile_options.points);
+  out.options.roughness_options.seeds = static_cast<int>(seeds);
+  const long points = s.Integer("profile_points", out.options.profile_options.points);
   if (points < 2 || points > 1000)
     s.Fail("profile_points", std::to_string(points) + " must be in 2 .. 1000");
-  out.profile_options.points = static_cast<int>(points);
+  out.options.profile_options.points = static_cast<int>(points);
   std::string why;
-  if (!out.roughness_options.IsValid(&why)) s.Fail("steps", why);
+  if (!out.options.roughness_options.IsValid(&why)) s.Fail("steps", why);
 }
 
 // [uncertainty] bootstrap*: the bootstrap over runs (calibration/bootstrap.hpp).
 void LoadBootstrap(const Section& s, CalibrationFile& out) {
-  calibration::BootstrapOptions& b = out.bootstrap_options;
+  calibration::BootstrapOptions& b = out.options.bootstrap_options;
   constexpr long kMax = calibration::BootstrapOptions::kMaxResamples;
   const long resamples = s.Integer("bootstrap", b.resamples);
   if (resamples != 0 && (resamples < 10 || resamples > kMax))
@@ -237,13 +245,13 @@ void LoadBootstrap(const Section& s, CalibrationFile& out) {
            std::to_string(evaluations) + " must be in 0 .. 100000 (per refit; 0: 10 (n + 2))");
   b.refit_evaluations = static_cast<int>(evaluations);
   if (s.Has("bootstrap_resolution"))
-    out.bootstrap_resolution = s.Checked(
+    out.options.bootstrap_resolution = s.Checked(
         "bootstrap_resolution", 0.0, [](double v) { return v >= 0 && v <= 0.25; },
         "must be in [0, 0.25] (a fraction of each range; 0: the points BOBYQA asks for)");
   b.level = s.Checked(
       "bootstrap_level", b.level, [](double v) { return v > 0 && v < 1; }, "must be in (0, 1)");
-  b.seed = out.optimizer.seed;
-  if (b.resamples > 0 && !out.uncertainty)
+  b.seed = out.options.optimizer.seed;
+  if (b.resamples > 0 && !out.options.uncertainty)
     s.Fail("bootstrap", "needs enabled = true (it is estimated with the covariance)");
   std::string why;
   if (!b.IsValid(&why)) s.FailCheck(why);
@@ -253,12 +261,12 @@ void LoadBootstrap(const Section& s, CalibrationFile& out) {
 // (calibration/seeds.hpp).
 void LoadSeedRefits(const Section& s, CalibrationFile& out) {
   constexpr long kMax = calibration::SeedRefitOptions::kMaxSeeds;
-  const long seeds = s.Integer("seeds", out.seed_options.seeds);
+  const long seeds = s.Integer("seeds", out.options.seed_options.seeds);
   if (seeds != 0 && (seeds < 2 || seeds > kMax))
     s.Fail("seeds", std::to_string(seeds) + " must be 0 (off) or in 2 .. " + std::to_string(kMax) +
                         " (refits with other release seeds; an sd needs 2)");
-  out.seed_options.seeds = static_cast<int>(seeds);
-  if (seeds > 0 && out.bootstrap_options.resamples == 0)
+  out.options.seed_options.seeds = static_cast<int>(seeds);
+  if (seeds > 0 && out.options.bootstrap_options.resamples == 0)
     s.Fail("seeds", "needs bootstrap (its standard error is combined with the bootstrap's)");
 }
 
@@ -267,8 +275,8 @@ void LoadUncertainty(const Context& context, const toml::table* table, Calibrati
       context, table, "uncertainty",
       {"enabled", "fd_step", "min_reciprocal_condition_number", "weak_fraction", "bootstrap",
        "bootstrap_evaluations", "bootstrap_resolution", "bootstrap_level", "seeds"});
-  calibration::UncertaintyOptions& o = out.uncertainty_options;
-  out.uncertainty = s.Bool("enabled", true);
+  calibration::UncertaintyOptions& o = out.options.uncertainty_options;
+  out.options.uncertainty = s.Bool("enabled", true);
   o.fd_step = s.Checked(
       "fd_step", 0.0, [](double v) { return v >= 0 && v <= 0.25; },
       "must be in [0, 0.25] (a fraction of each range; 0: the optimiser's or the roughness')");
@@ -277,7 +285,7 @@ void LoadUncertainty(const Context& context, const toml::table* table, Calibrati
       [](double v) { return v > 0 && v < 1; }, "must be in (0, 1)");
   o.weak_fraction = s.Checked(
       "weak_fraction", o.weak_fraction, [](double v) { return v > 0; }, "must be > 0");
-  o.profile = out.profile_options;
+  o.profile = out.options.profile_options;
   LoadBootstrap(s, out);
   LoadSeedRefits(s, out);
 }
@@ -347,7 +355,7 @@ CalibrationFile LoadCalibration(const std::string& path) {
   for (const auto& [kind, weight] : ob.weights) path_text << ' ' << kind << ' ' << weight;
   path_text << ' ' << ob.normalise << ' ' << ob.prior_weight << ' ' << out.prior_reference << ' '
             << ob.tolerance_m_s;
-  const calibration::OptimizerOptions& o = out.optimizer;
+  const calibration::OptimizerOptions& o = out.options.optimizer;
   path_text << ' ' << o.algorithm << ' ' << o.ftol_rel << ' ' << o.ftol_abs << ' ' << o.xtol_abs
             << ' ' << o.initial_step << ' ' << o.population << ' ' << o.starts << ' '
             << o.start_design << ' ' << o.seed << ' ' << o.fd_step;

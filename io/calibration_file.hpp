@@ -5,17 +5,12 @@
 // its budget, and the roughness measurement.
 // Loading validates everything before any rock runs; errors are "<file>:<line>: <key>: <reason>".
 
-#include <optional>
 #include <string>
 #include <vector>
 
-#include "calibration/bootstrap.hpp"
-#include "calibration/seeds.hpp"
-#include "calibration/least_squares.hpp"
+#include "calibration/calibrate.hpp"
 #include "calibration/objective.hpp"
-#include "calibration/optimizer.hpp"
 #include "calibration/parameters.hpp"
-#include "calibration/roughness.hpp"
 #include "io/event_file.hpp"
 
 namespace talus::io {
@@ -30,20 +25,9 @@ struct CalibrationFile {
   // (the scene's own [solver] tolerance_m_s, tighter than the default) or "default"
   // (calibration::kCalibrationTolerance_m_s).
   std::string tolerance_source = "default";
-  calibration::OptimizerOptions optimizer;
-  bool roughness = true;  // measure roughness and profile every parameter at the optimum
-  calibration::RoughnessOptions roughness_options;
-  calibration::ProfileOptions profile_options;
-  // The covariance at the optimum (Ceres). fd_step 0 in uncertainty_options: the optimiser's
-  // step (Ceres), else the roughness measurement's recommendation, else 0.01.
-  bool uncertainty = true;
-  calibration::UncertaintyOptions uncertainty_options;
-  // The bootstrap over runs beside the covariance (resamples 0: off; seed: the optimiser's).
-  // Its resolution when the file does not give one: the covariance's finite-difference step.
-  calibration::BootstrapOptions bootstrap_options;
-  std::optional<double> bootstrap_resolution;
-  // Refits with other release seeds after the bootstrap, combined with it (seeds 0: off).
-  calibration::SeedRefitOptions seed_options;
+  // The optimiser and the measurements at the optimum (its callbacks left empty: the command
+  // sets them).
+  calibration::CalibrationOptions options;
   std::vector<std::string> inputs;  // the calibration file and the event's inputs
   std::string inputs_hash;
   // What decides an optimiser's path -- the event's inputs, rocks and seed, the parameters, the

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <set>
 
 namespace talus::io {
@@ -138,50 +139,9 @@ json HeldOut(const calibration::HeldOutScores& s) {
           {"wall_time_s", s.wall_time_s}};
 }
 
-}  // namespace
-
-std::string HeldOutReport(const calibration::HeldOutScores& scores) {
-  std::string out;
-  char line[256];
-  std::snprintf(line, sizeof line, "  %-24s %8s %14s %14s\n", "kind", "scored", "fitted",
-                "reference");
-  out += line;
-  for (const auto& k : scores.kinds) {
-    std::snprintf(line, sizeof line, "  %-24s %8d %11.4g %-2s %11.4g %-2s\n", k.kind.c_str(),
-                  k.scored, k.fitted, k.unit.c_str(), k.reference, k.unit.c_str());
-    out += line;
-  }
-  return out;
-}
-
-std::string GroundTableToml(const CalibrationFile& file, const Objective& objective,
-                            const GroundTable& fitted) {
-  std::string out = "# Ground table fitted by talus calibrate " + file.path +
-                    " (docs/calibration.md).\n# Paste into a scene file, or append to one.\n";
-  for (int k : Touched(objective, fitted)) {
-    const GroundCategory& c = fitted.category(k);
-    out += "\n[ground." + c.name + "]\ncode = " + std::to_string(c.code) +
-           "\nmu_min = " + G(c.params.mu_min) + "\nmu_max = " + G(c.params.mu_max) +
-           "\nbeta = " + G(c.params.beta_1_s) + "\nkappa = " + G(c.params.kappa_1_m) +
-           "\nnu = " + G(c.params.nu_1_s) + "\n";
-  }
-  return out;
-}
-
-std::string GroundTableCsv(const Objective& objective, const GroundTable& fitted) {
-  std::string out = "category,code,mu_min,mu_max,beta,kappa,nu\n";
-  for (int k : Touched(objective, fitted)) {
-    const GroundCategory& c = fitted.category(k);
-    out += c.name + "," + std::to_string(c.code) + "," + G(c.params.mu_min) + "," +
-           G(c.params.mu_max) + "," + G(c.params.beta_1_s) + "," + G(c.params.kappa_1_m) + "," +
-           G(c.params.nu_1_s) + "\n";
-  }
-  return out;
-}
-
-std::string CalibrationJson(const CalibrationFile& file, const Objective& objective,
-                            const CalibrationRun& run) {
-  const calibration::Summary& s = run.summary;
+// Per coordinate: its parameters, bounds, initial and fitted values, and its profile when measured.
+json ParametersJson(const Objective& objective, const calibration::CalibrationSummary& run) {
+  const calibration::OptimizerSummary& s = run.fit;
   json parameters = json::array();
   const auto& coordinates = objective.parameters().coordinates();
   for (std::size_t j = 0; j < coordinates.size(); ++j) {
@@ -213,6 +173,34 @@ std::string CalibrationJson(const CalibrationFile& file, const Objective& object
     }
     parameters.push_back(p);
   }
+  return parameters;
+}
+
+// Per parameter, the standard errors and intervals of the covariance, the seed refits and the
+// bootstrap, when there is an uncertainty.
+void AddStandardErrors(const calibration::CalibrationSummary& run, json& parameters) {
+  if (!run.uncertainty) return;
+  const auto& u = *run.uncertainty;
+  for (std::size_t k = 0; k < u.names.size() && k < parameters.size(); ++k)
+    parameters[k]["standard_error"] = Number(u.standard_error[static_cast<Eigen::Index>(k)]);
+  if (run.seeds)
+    for (std::size_t k = 0; k < run.seeds->names.size() && k < parameters.size(); ++k) {
+      const auto q = static_cast<Eigen::Index>(k);
+      parameters[k]["seed_sd"] = Number(run.seeds->sd[q]);
+      parameters[k]["combined_standard_error"] = Number(run.seeds->combined_standard_error[q]);
+      parameters[k]["combined_interval"] = {Number(run.seeds->lower[q]),
+                                            Number(run.seeds->upper[q])};
+    }
+  if (run.bootstrap)
+    for (std::size_t k = 0; k < run.bootstrap->names.size() && k < parameters.size(); ++k) {
+      const auto q = static_cast<Eigen::Index>(k);
+      parameters[k]["bootstrap_standard_error"] = Number(run.bootstrap->standard_error[q]);
+      parameters[k]["bootstrap_interval"] = {Number(run.bootstrap->lower[q]),
+                                             Number(run.bootstrap->upper[q])};
+    }
+}
+
+json StartsJson(const calibration::OptimizerSummary& s) {
   json starts = json::array();
   for (const auto& r : s.starts)
     starts.push_back({{"start", Vector(r.u0)},
@@ -220,8 +208,119 @@ std::string CalibrationJson(const CalibrationFile& file, const Objective& object
                       {"best_objective", Number(r.best_value)},
                       {"evaluations", r.evaluations},
                       {"result", r.result}});
+  return starts;
+}
+
+// The sandwich covariance, with the bootstrap and the seed refits beside it; null without one.
+json UncertaintyJson(const calibration::CalibrationSummary& run) {
+  if (!run.uncertainty) return nullptr;
+  const auto& u = *run.uncertainty;
+  json identified = json::array(), weak = json::array();
+  for (std::size_t k = 0; k < u.identified.size(); ++k) {
+    identified.push_back(bool(u.identified[k]));
+    weak.push_back(bool(u.weak[k]));
+  }
+  return {{"method",
+           "sandwich covariance H^-1 V H^-1 over runs, (J^T J)^-1 from "
+           "ceres::Covariance (dense SVD)"},
+          {"computed", u.computed},
+          {"rank_deficient", u.rank_deficient},
+          {"names", u.names},
+          {"values", Vector(u.values)},
+          {"standard_error", Vector(u.standard_error)},
+          {"standard_error_unit", Vector(u.standard_error_unit)},
+          {"correlation", Matrix(u.correlation)},
+          {"covariance", Matrix(u.covariance)},
+          {"identified", identified},
+          {"weak", weak},
+          {"runs", u.groups},
+          {"note", u.note},
+          {"evaluations", u.evaluations},
+          {"wall_time_s", u.wall_time_s},
+          {"bootstrap", run.bootstrap ? BootstrapJson(*run.bootstrap) : json(nullptr)},
+          {"seeds", run.seeds ? SeedRefitsJson(*run.seeds) : json(nullptr)}};
+}
+
+// Each fold's fit and scores, and the scores pooled over the folds; null without folds.
+json CrossValidationJson(const calibration::CalibrationSummary& run) {
+  if (run.folds.empty()) return nullptr;
+  json folds = json::array();
+  for (const calibration::FoldRun& f : run.folds) {
+    json fold = HeldOut(f.scores);
+    fold["fitted"] = Vector(f.summary.best.values);
+    fold["objective"] = Number(f.summary.best.value);
+    fold["evaluations"] = f.summary.evaluations();
+    fold["termination"] = calibration::ToString(f.summary.termination);
+    folds.push_back(fold);
+  }
+  return {{"folds", folds}, {"kinds", HeldOutKinds(run.cross_validated)}};
+}
+
+json RoughnessJson(const std::optional<calibration::RoughnessReport>& roughness) {
+  if (!roughness) return nullptr;
+  const auto& r = *roughness;
+  return {{"at_objective", Number(r.value)},
+          {"steps", r.steps},
+          {"change", r.change},
+          {"noise", Number(r.noise)},
+          {"seed_values", r.seed_values},
+          {"seed_sd", Number(r.seed_sd)},
+          {"level", Number(r.level())},
+          {"finite_difference_step", Number(r.fd_step)},
+          {"ftol_abs", Number(r.ftol_abs)},
+          {"evaluations", r.evaluations}};
+}
+
+}  // namespace
+
+// The fields written for a fitted category: every row of kGroundFields that applies to it, with
+// its model when that is not the default.
+std::string GroundTableToml(const CalibrationFile& file, const Objective& objective,
+                            const GroundTable& fitted) {
+  std::string out = "# Ground table fitted by talus calibrate " + file.path +
+                    " (docs/calibration.md).\n# Paste into a scene file, or append to one.\n";
+  for (int k : Touched(objective, fitted)) {
+    const GroundCategory& c = fitted.category(k);
+    out += "\n[ground." + c.name + "]\ncode = " + std::to_string(c.code) + "\n";
+    if (c.params.IsSoil()) out.append("model = \"").append(ToString(c.params.model)).append("\"\n");
+    for (const GroundFieldInfo& f : kGroundFields)
+      if (f.group != GroundFieldInfo::Group::kDragLayer && GroundFieldApplies(f, c.params))
+        out.append(f.key).append(" = ").append(G(c.params.*f.member)).append("\n");
+  }
+  return out;
+}
+
+// One row per fitted category; the soil's columns when some fitted category has the soil.
+std::string GroundTableCsv(const Objective& objective, const GroundTable& fitted) {
+  const std::vector<int> touched = Touched(objective, fitted);
+  bool soil = false;
+  for (int k : touched) soil = soil || fitted.params(k).IsSoil();
+  std::vector<const GroundFieldInfo*> columns;
+  for (const GroundFieldInfo& f : kGroundFields)
+    if (f.group == GroundFieldInfo::Group::kFriction ||
+        (soil && f.group == GroundFieldInfo::Group::kSoil))
+      columns.push_back(&f);
+  std::string out = soil ? "category,code,model" : "category,code";
+  for (const GroundFieldInfo* f : columns) out.append(",").append(f->key);
+  out += "\n";
+  for (int k : touched) {
+    const GroundCategory& c = fitted.category(k);
+    out += c.name + "," + std::to_string(c.code);
+    if (soil) out.append(",").append(ToString(c.params.model));
+    for (const GroundFieldInfo* f : columns) out.append(",").append(G(c.params.*f->member));
+    out += "\n";
+  }
+  return out;
+}
+
+std::string CalibrationJson(const CalibrationFile& file, const Objective& objective,
+                            const calibration::CalibrationSummary& run,
+                            const std::string& version) {
+  const calibration::OptimizerSummary& s = run.fit;
+  json parameters = ParametersJson(objective, run);
+  AddStandardErrors(run, parameters);
   const ensemble::ReleaseSpec& release = objective.release();
-  json j = {{"version", run.version},
+  json j = {{"version", version},
             {"calibration_file", file.path},
             {"event", file.event.path},
             {"inputs", file.inputs},
@@ -252,7 +351,7 @@ std::string CalibrationJson(const CalibrationFile& file, const Objective& object
             {"replayed_from_checkpoint", s.replayed},
             {"finite_difference_step", Number(s.fd_step)},
             {"finite_difference_shrink", Number(s.fd_shrink)},
-            {"starts", starts},
+            {"starts", StartsJson(s)},
             {"timings",
              {{"calibration_s", s.wall_time_s},
               // Over the evaluations this run made (not those replayed from a checkpoint).
@@ -262,91 +361,15 @@ std::string CalibrationJson(const CalibrationFile& file, const Objective& object
               {"roughness_and_profiles_s",
                run.roughness ? json(run.roughness->wall_time_s) : json(nullptr)},
               {"total_s", run.wall_time_s}}}};
-  if (run.uncertainty) {
-    const auto& u = *run.uncertainty;
-    json identified = json::array(), weak = json::array();
-    for (std::size_t k = 0; k < u.identified.size(); ++k) {
-      identified.push_back(bool(u.identified[k]));
-      weak.push_back(bool(u.weak[k]));
-    }
-    j["uncertainty"] = {{"method",
-                         "sandwich covariance H^-1 V H^-1 over runs, (J^T J)^-1 from "
-                         "ceres::Covariance (dense SVD)"},
-                        {"computed", u.computed},
-                        {"rank_deficient", u.rank_deficient},
-                        {"names", u.names},
-                        {"values", Vector(u.values)},
-                        {"standard_error", Vector(u.standard_error)},
-                        {"standard_error_unit", Vector(u.standard_error_unit)},
-                        {"correlation", Matrix(u.correlation)},
-                        {"covariance", Matrix(u.covariance)},
-                        {"identified", identified},
-                        {"weak", weak},
-                        {"runs", u.groups},
-                        {"note", u.note},
-                        {"evaluations", u.evaluations},
-                        {"wall_time_s", u.wall_time_s}};
-    for (std::size_t k = 0; k < u.names.size() && k < j["parameters"].size(); ++k)
-      j["parameters"][k]["standard_error"] = Number(u.standard_error[static_cast<Eigen::Index>(k)]);
-    j["uncertainty"]["bootstrap"] = run.bootstrap ? BootstrapJson(*run.bootstrap) : json(nullptr);
-    j["uncertainty"]["seeds"] = run.seeds ? SeedRefitsJson(*run.seeds) : json(nullptr);
-    if (run.seeds)
-      for (std::size_t k = 0; k < run.seeds->names.size() && k < j["parameters"].size(); ++k) {
-        const auto q = static_cast<Eigen::Index>(k);
-        j["parameters"][k]["seed_sd"] = Number(run.seeds->sd[q]);
-        j["parameters"][k]["combined_standard_error"] =
-            Number(run.seeds->combined_standard_error[q]);
-        j["parameters"][k]["combined_interval"] = {Number(run.seeds->lower[q]),
-                                                   Number(run.seeds->upper[q])};
-      }
-    if (run.bootstrap)
-      for (std::size_t k = 0; k < run.bootstrap->names.size() && k < j["parameters"].size(); ++k) {
-        const auto q = static_cast<Eigen::Index>(k);
-        j["parameters"][k]["bootstrap_standard_error"] = Number(run.bootstrap->standard_error[q]);
-        j["parameters"][k]["bootstrap_interval"] = {Number(run.bootstrap->lower[q]),
-                                                    Number(run.bootstrap->upper[q])};
-      }
-  } else {
-    j["uncertainty"] = nullptr;
-  }
-  j["not_scored"] = run.not_scored;  // observed values without a simulated counterpart
+  j["uncertainty"] = UncertaintyJson(run);
+  j["not_scored"] = file.event.not_scored;  // observed values without a simulated counterpart
   j["holdout"] = run.holdout ? HeldOut(*run.holdout) : json(nullptr);
-  if (!run.folds.empty()) {
-    json folds = json::array();
-    std::vector<calibration::HeldOutScores> sets;
-    for (const FoldRun& f : run.folds) {
-      json fold = HeldOut(f.scores);
-      fold["fitted"] = Vector(f.summary.best.values);
-      fold["objective"] = Number(f.summary.best.value);
-      fold["evaluations"] = f.summary.evaluations();
-      fold["termination"] = calibration::ToString(f.summary.termination);
-      folds.push_back(fold);
-      sets.push_back(f.scores);
-    }
-    j["cross_validation"] = {{"folds", folds},
-                             {"kinds", HeldOutKinds(calibration::PoolKinds(sets))}};
-  } else {
-    j["cross_validation"] = nullptr;
-  }
-  if (run.roughness) {
-    const auto& r = *run.roughness;
-    j["roughness"] = {{"at_objective", Number(r.value)},
-                      {"steps", r.steps},
-                      {"change", r.change},
-                      {"noise", Number(r.noise)},
-                      {"seed_values", r.seed_values},
-                      {"seed_sd", Number(r.seed_sd)},
-                      {"level", Number(r.level())},
-                      {"finite_difference_step", Number(r.fd_step)},
-                      {"ftol_abs", Number(r.ftol_abs)},
-                      {"evaluations", r.evaluations}};
-  } else {
-    j["roughness"] = nullptr;
-  }
+  j["cross_validation"] = CrossValidationJson(run);
+  j["roughness"] = RoughnessJson(run.roughness);
   return j.dump(2) + "\n";
 }
 
-std::string HistoryCsv(const Objective& objective, const calibration::Summary& summary) {
+std::string HistoryCsv(const Objective& objective, const calibration::OptimizerSummary& summary) {
   std::string out = "evaluation,start,feasible,objective,data,prior";
   // Cells appended one by one (GCC 12 warns wrongly about chains of std::string operator+).
   const auto cell = [&out](const std::string& text) {

@@ -20,8 +20,7 @@ using svg::kTop;
 using svg::kWidth;
 using svg::Pad;
 
-
-std::string ConvergenceSvg(const calibration::Summary& summary) {
+std::string ConvergenceSvg(const calibration::OptimizerSummary& summary) {
   double lo = INFINITY, hi = -INFINITY;
   for (const calibration::Evaluation& e : summary.history)
     if (e.feasible && std::isfinite(e.value)) {

@@ -12,7 +12,7 @@
 namespace talus::io {
 
 // Every feasible evaluation's objective (dots) and the best so far (line), against the evaluation.
-std::string ConvergenceSvg(const calibration::Summary& summary);
+std::string ConvergenceSvg(const calibration::OptimizerSummary& summary);
 
 // For the scored observations of `kind` (a scalar kind): observed (x) against the simulated
 // median (y), before (grey) and after (blue) the fit, with the 1:1 line. `before` and `after` are

@@ -7,7 +7,7 @@
 
 #include "common/csv_table.hpp"
 #include "common/error.hpp"
-#include "io/report_html.hpp"
+#include "common/statistics.hpp"
 #include "io/rocks_csv.hpp"
 
 namespace talus::io {

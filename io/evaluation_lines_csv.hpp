@@ -38,7 +38,7 @@ class EvaluationLinesCsvWriter {
   const ensemble::ReleaseSpec& release_;
 };
 
-// Mean, nearest-rank percentiles (io/report_html.hpp NearestRankPercentile) and largest value of
+// Mean, nearest-rank percentiles (common/statistics.hpp NearestRankPercentile) and largest value of
 // one quantity over the rocks that crossed a line; NaN when none did.
 struct CrossingStatistics {
   static constexpr std::array<const char*, 6> kNames = {"mean", "p50", "p90", "p95", "p99", "max"};

@@ -8,6 +8,7 @@
 #include <optional>
 #include <set>
 
+#include "common/closest_name.hpp"
 #include "common/csv_table.hpp"
 #include "common/error.hpp"
 #include "fieldobs/single_impacts.hpp"
@@ -43,9 +44,9 @@ GroundTable ReferenceGround(const GroundTable& scene_ground, bool* differs) {
     if (b < 0) continue;
     const GroundParams& want = builtin.params(b);
     GroundParams& have = out.mutable_params(k);
-    changed = changed || have.mu_min != want.mu_min || have.mu_max != want.mu_max ||
-              have.beta_1_s != want.beta_1_s || have.kappa_1_m != want.kappa_1_m ||
-              have.nu_1_s != want.nu_1_s;
+    changed = changed || have.model != want.model;
+    for (const GroundFieldInfo& f : kGroundFields)
+      changed = changed || have.*f.member != want.*f.member;
     have = want;
   }
   if (differs) *differs = changed;
@@ -170,8 +171,7 @@ EventFile LoadEvent(const std::string& path) {
         fieldobs::ReadTrajectories(table, columns, event.scene.scene.terrain, event.observations);
       if (kind == "zones") fieldobs::ReadZoneObservations(table, columns, event.observations);
       if (kind == "single_impacts")
-        fieldobs::ReadSingleImpactOutcomes(table, SingleImpactColumnsOf(o), event.observations,
-                                           &event.not_scored);
+        fieldobs::ReadSingleImpactOutcomes(table, SingleImpactColumnsOf(o), event.observations);
     }
     if (event.observations.size() == before) o.Fail("file", file + " holds no observation");
     event.needs_episodes =

@@ -12,6 +12,7 @@
 
 #include "common/csv_table.hpp"
 #include "common/error.hpp"
+#include "common/statistics.hpp"
 #include "io/quicklook.hpp"
 #include "io/svg_plot.hpp"
 
@@ -127,16 +128,6 @@ RockColumns ReadRockColumns(const std::string& rocks_csv) {
     out.travel_angle_deg.push_back(value(angle));
   }
   return out;
-}
-
-double NearestRankPercentile(std::vector<double> values, double p) {
-  values.erase(std::remove_if(values.begin(), values.end(), [](double v) { return !std::isfinite(v); }),
-               values.end());
-  if (values.empty()) return std::numeric_limits<double>::quiet_NaN();
-  const auto n = static_cast<double>(values.size());
-  const auto rank = static_cast<std::size_t>(std::max(1.0, std::ceil(p / 100 * n)));
-  std::nth_element(values.begin(), values.begin() + static_cast<long>(rank - 1), values.end());
-  return values[rank - 1];
 }
 
 std::string HistogramSvg(const std::string& title, const std::string& x_label,

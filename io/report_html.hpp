@@ -27,9 +27,6 @@ struct RockColumns {
 // per rock. Throws naming the file and line when it cannot be read or a value is not a number.
 RockColumns ReadRockColumns(const std::string& rocks_csv);
 
-// Nearest-rank percentile (0 < p <= 100) of `values`; NaN when empty.
-double NearestRankPercentile(std::vector<double> values, double p);
-
 // A histogram of `values` in `bins` equal bins from 0 (or the smallest value, when negative) to the
 // largest, as SVG, with n, median, 95th percentile and largest value in the corner.
 std::string HistogramSvg(const std::string& title, const std::string& x_label,

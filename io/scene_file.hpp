@@ -66,8 +66,4 @@ SceneFile LoadScene(const std::string& path);
 // scene's [solver] gives itself, which keep the scene's values.
 void UseSolverPreset(SceneFile& scene, SolverPreset preset);
 
-// Names close to `word` among `candidates` for "did you mean" hints (edit distance <= 2, or a third
-// of the word's length); empty when none is close.
-std::string ClosestName(const std::string& word, const std::vector<std::string>& candidates);
-
 }  // namespace talus::io

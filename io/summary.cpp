@@ -19,6 +19,7 @@ nlohmann::ordered_json SolverJson(const SolverOptions& o) {
           {"prox_alpha", o.prox_alpha},
           {"penetration_tolerance", o.penetration_tolerance},
           {"predicted_lever", ToString(o.predicted_lever)},
+          {"soil_drag", ToString(o.soil_drag)},
           {"rest_speed_m_s", o.rest_speed_m_s},
           {"rest_angular_speed_rad_s", o.rest_angular_speed_rad_s},
           {"rest_hold_s", o.rest_hold_s}};
@@ -31,13 +32,10 @@ nlohmann::ordered_json GroundJson(const GroundTable& table) {
   for (int i = 0; i < table.size(); ++i) {
     const GroundCategory& c = table.category(i);
     const GroundParams& p = c.params;
-    nlohmann::ordered_json g = {{"code", c.code},     {"mu_min", p.mu_min},   {"mu_max", p.mu_max},
-                                {"beta", p.beta_1_s}, {"kappa", p.kappa_1_m}, {"nu", p.nu_1_s}};
-    if (p.HasDragLayer()) {
-      g["drag_height_m"] = p.drag_height_m;
-      g["drag_translational"] = p.drag_translational_1_s;
-      g["drag_rotational"] = p.drag_rotational_1_s;
-    }
+    nlohmann::ordered_json g = {{"code", c.code}};
+    if (p.IsSoil()) g["model"] = ToString(p.model);
+    for (const GroundFieldInfo& f : kGroundFields)
+      if (GroundFieldApplies(f, p)) g[f.key] = p.*f.member;
     out[c.name] = g;
   }
   return out;

@@ -13,8 +13,8 @@
 #include <string>
 #include <vector>
 
+#include "common/closest_name.hpp"
 #include "common/error.hpp"
-#include "io/scene_file.hpp"
 
 namespace talus::io {
 

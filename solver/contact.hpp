@@ -4,6 +4,8 @@
 #include <Eigen/Core>
 #include <vector>
 
+#include "solver/soil.hpp"
+
 namespace talus {
 
 // One vertex contact of the step: closed at the midpoint configuration (gap_m = 0), or open there
@@ -32,9 +34,18 @@ struct Contact {
   Eigen::Vector3d percussion = Eigen::Vector3d::Zero();  // (P_N, P_T1, P_T2), N s
 };
 
+// The scarring soil as contact detection leaves it for the rest of the step.
+struct SoilContact {
+  int ground = -1;          // soil category of the episode; -1: no vertex in a soil layer
+  double depth_m = 0;       // rebound plane below the surface (eq. 11), m
+  bool submerged = false;   // a vertex over soil is below the surface at the midpoint
+};
+
 // Scratch space reused across steps; one per thread. Reset() before each new rock.
 struct StepWorkspace {
   std::vector<Contact> contacts;
+  SoilContact soil;
+  SubmergedPart submerged;  // the hull's part below the terrain (soil steps only)
   // Warm start: world percussion of each vertex in the previous step, and whether it was closed.
   std::vector<Eigen::Vector3d> last_percussion;
   std::vector<char> last_closed;

@@ -34,11 +34,33 @@ Eigen::Vector3d PredictedLeverArm(PredictedLever lever, const Eigen::Vector3d& b
 
 }  // namespace
 
+// Whether the terrain point (x, y) is over a soil category, and then in *depth_m the depth of the
+// rebound plane below the surface there for a vertex that is below the surface, or predicted to be
+// by the end of the horizon: the episode's depth, or, when this vertex is the rock's first to enter
+// a layer, eq. 11's from the vertical speed of the predicted velocity (Lu et al. 2019).
+bool SoilDepthAt(const Scene& scene, const RockShape& rock, double x_m, double y_m,
+                 double vertical_speed_m_s, SoilContact& soil, double* depth_m) {
+  const int ground = scene.terrain.GroundAt(x_m, y_m);
+  const GroundParams& params = scene.ground.params(ground);
+  if (!params.IsSoil()) return false;
+  if (soil.ground < 0) {
+    soil.ground = ground;
+    soil.depth_m = params.PenetrationDepth(rock.mass_kg, std::min(0.0, vertical_speed_m_s));
+  }
+  *depth_m = soil.depth_m;
+  return true;
+}
+
 DetectResult DetectContacts(const Scene& scene, const RockShape& rock, const RockState& mid,
                             const Eigen::Matrix3d& rotation, const Eigen::Vector3d& velocity_m_s,
                             const Eigen::Vector3d& omega_rad_s, double horizon_s,
                             double allowed_depth_m, StepWorkspace& workspace) {
   workspace.contacts.clear();
+  // Soil: the episode goes on while some vertex is in the layer (or about to enter it).
+  SoilContact& soil = workspace.soil;
+  soil = SoilContact{mid.soil_ground, mid.soil_depth_m, false};
+  bool in_soil = false;
+  const bool any_soil = scene.ground.AnySoil();
   const Terrain& terrain = scene.terrain;
   const Eigen::Vector3d& r = mid.position_m;
   const double radius = rock.bounding_radius_m;
@@ -55,8 +77,10 @@ DetectResult DetectContacts(const Scene& scene, const RockShape& rock, const Roc
   const double centre_rate = m.dot(velocity_m_s);
   const double lowest_rate = centre_rate - radius * m.norm() * omega_rad_s.norm();
   if (local && centre_height - radius * m.norm() + horizon_s * std::min(0.0, lowest_rate) >
-                   plane.deviation_m)
+                   plane.deviation_m) {
+    soil = SoilContact{};
     return DetectResult::kClear;
+  }
   const Eigen::Vector3d m_body = rotation.transpose() * m;
   const Eigen::Vector3d rate_lever = m_body.cross(omega_rad_s);
 
@@ -72,7 +96,14 @@ DetectResult DetectContacts(const Scene& scene, const RockShape& rock, const Roc
     // The gap (x_z - h) n_z has the sign of x_z - h: the normal is needed only for contacts.
     double height;
     if (!terrain.Height(x.x(), x.y(), &height)) return DetectResult::kOutsideDomain;
-    if (x.z() <= height) {
+    // Over soil, the contact is with the rebound plane below the surface.
+    double depth = 0;
+    if (any_soil && x.z() <= height &&
+        SoilDepthAt(scene, rock, x.x(), x.y(), velocity_m_s.z(), soil, &depth)) {
+      in_soil = true;
+      soil.submerged = true;
+    }
+    if (x.z() <= height - depth) {
       // Closed at the midpoint.
       TerrainSample sample;
       terrain.Sample(x.x(), x.y(), &sample);
@@ -93,7 +124,13 @@ DetectResult DetectContacts(const Scene& scene, const RockShape& rock, const Roc
     if (!terrain.Sample(x_end.x(), x_end.y(), &end)) continue;  // leaving: the next step says so
     const Eigen::Vector3d& n = end.normal;
     if ((x_end.z() - end.height_m) * n.z() >= -allowed_depth_m) continue;
-    const Eigen::Vector3d on_plane(x_end.x(), x_end.y(), end.height_m);
+    double depth_end = 0;
+    if (any_soil && SoilDepthAt(scene, rock, x_end.x(), x_end.y(), velocity_m_s.z(), soil,
+                                &depth_end)) {
+      in_soil = true;
+      if ((x_end.z() - end.height_m + depth_end) * n.z() >= -allowed_depth_m) continue;
+    }
+    const Eigen::Vector3d on_plane(x_end.x(), x_end.y(), end.height_m - depth_end);
     Contact& c = workspace.contacts.emplace_back();
     c.vertex = k;
     const double gap_mid = n.dot(x - on_plane);
@@ -102,6 +139,7 @@ DetectResult DetectContacts(const Scene& scene, const RockShape& rock, const Roc
                                   n.dot(x_end - on_plane));
     SetFrame(scene, mid, x_end, n, c);
   }
+  if (!in_soil) soil = SoilContact{};
   return DetectResult::kOk;
 }
 

@@ -14,7 +14,7 @@ void EpisodeRecorder::Begin(const RockState& start) {
 void EpisodeRecorder::OnStep(const RockState& state, const StepReport& step,
                              const TerrainSample& /*ground*/) {
   const double dt = state.time_s - previous_.time_s;
-  if (step.contacts > 0) {
+  if (step.contacts > 0 || step.in_soil) {
     if (!open_) {
       current_ = ContactEpisode{};
       current_.start_time_s = previous_.time_s;
@@ -24,12 +24,24 @@ void EpisodeRecorder::OnStep(const RockState& state, const StepReport& step,
       current_.ground = terrain_.GroundAt(state.position_m.x(), state.position_m.y());
       open_ = true;
       hop_path_m_ = 0;
+      scarred_ = false;
+    }
+    if (step.in_soil) {
+      const Eigen::Vector2d v = current_.velocity_in_m_s.head<2>();
+      const Eigen::Vector2d d = v.norm() > 0 ? Eigen::Vector2d(v.normalized()) : Eigen::Vector2d::UnitX();
+      const double rear = d.dot(step.soil_rear_m.head<2>());
+      const double front = d.dot(step.soil_front_m.head<2>());
+      scar_rear_m_ = scarred_ ? std::min(scar_rear_m_, rear) : rear;
+      scar_front_m_ = scarred_ ? std::max(scar_front_m_, front) : front;
+      scarred_ = true;
+      current_.scar_extent_m = scar_front_m_ - scar_rear_m_;
     }
     // A short hop belongs to the episode: its path counts once contact resumes.
     current_.path_length_m +=
         hop_path_m_ + (state.position_m - previous_.position_m).head<2>().norm();
     hop_path_m_ = 0;
     current_.max_scar_m = std::max(current_.max_scar_m, state.scar_m);
+    current_.max_scar_depth_m = std::max(current_.max_scar_depth_m, step.soil_penetration_m);
     ++current_.contact_steps;
     current_.loaded = current_.loaded || step.loaded;
     last_contact_ = state;

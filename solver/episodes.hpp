@@ -9,7 +9,7 @@
 
 namespace talus {
 
-// One stretch of ground contact. It begins with the first step that closes a contact after a
+// One stretch of ground contact (a closed contact, or part of the hull in a soil layer). It begins with the first step that closes a contact after a
 // flight (or at release, when the rock starts on the ground) and ends with the last contact step
 // before a flight of at least EpisodeOptions::min_flight_s (or at the rock's end). "In" is the
 // state just before the first contact step, "out" the state after the last one. World frame, SI.
@@ -22,6 +22,13 @@ struct ContactEpisode {
   Eigen::Vector3d angular_velocity_in_rad_s = Eigen::Vector3d::Zero();   // world frame
   Eigen::Vector3d angular_velocity_out_rad_s = Eigen::Vector3d::Zero();  // world frame
   double max_scar_m = 0;     // longest scar reached in the episode
+  // Scarring soil (Lu et al. 2019): the deepest the hull reached below the terrain's tangent plane
+  // (along its normal) in the episode, m; 0 on hard ground. The simulated scar depth.
+  double max_scar_depth_m = 0;
+  // Scarring soil: the scar's extent seen at the surface, along the horizontal direction of the
+  // incoming velocity: from the rearmost to the foremost point of the hull's part below the
+  // surface over the episode (Lu et al. 2019's scar length), m; 0 on hard ground.
+  double scar_extent_m = 0;
   double path_length_m = 0;  // horizontal path of the centre of mass during the episode
   int ground = -1;           // ground index under the centre of mass at the first contact step
   long contact_steps = 0;    // steps with a closed contact
@@ -58,6 +65,9 @@ class EpisodeRecorder : public StepObserver {
   double hop_path_m_ = 0;   // horizontal path since then
   RockState previous_;      // state before the current step
   RockState last_contact_;  // state after the open episode's last contact step
+  // Soil: the rear- and foremost projections of the submerged part on the episode's direction.
+  double scar_rear_m_ = 0, scar_front_m_ = 0;
+  bool scarred_ = false;
 };
 
 }  // namespace talus

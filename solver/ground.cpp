@@ -1,6 +1,7 @@
 #include "solver/ground.hpp"
 
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <sstream>
 
@@ -10,41 +11,120 @@ double GroundParams::Friction(double scar_m) const {
   return mu_min + (2.0 / std::numbers::pi) * (mu_max - mu_min) * std::atan(kappa_1_m * scar_m);
 }
 
-namespace {
-bool Check(bool ok, std::string* why, const char* field, double value, const char* bound) {
-  if (!ok && why) {
-    std::ostringstream msg;
-    msg << field << " = " << value << " violates " << bound;
-    *why = msg.str();
-  }
-  return ok;
+double GroundParams::PenetrationDepth(double mass_kg, double vertical_speed_m_s) const {
+  const double strength_kn_m2 = 1000.0 * soil_strength_mn_m2;
+  return 0.1 * std::cbrt(mass_kg) * std::pow(strength_kn_m2, -0.4) *
+         std::pow(std::abs(vertical_speed_m_s), 0.8);
 }
+
+const char* ToString(GroundModel model) {
+  return model == GroundModel::kLu2019 ? "lu2019" : "hard";
+}
+
+bool ParseGroundModel(std::string_view name, GroundModel* model) {
+  for (GroundModel m : {GroundModel::kHard, GroundModel::kLu2019})
+    if (name == ToString(m)) {
+      *model = m;
+      return true;
+    }
+  return false;
+}
+
+namespace {
+constexpr double kInf = std::numeric_limits<double>::infinity();
+using Group = GroundFieldInfo::Group;
 }  // namespace
 
+// The order of the calibrated fields is calibration::GroundField's.
+const std::array<GroundFieldInfo, 12> kGroundFields = {{
+    {"mu_min", &GroundParams::mu_min, "1", 0, 10, false, Group::kFriction, true, false,
+     "friction coefficient at the start of a scar"},
+    {"mu_max", &GroundParams::mu_max, "1", 0, 10, false, Group::kFriction, true, false,
+     "limit friction coefficient of a long scar (>= mu_min)"},
+    {"beta", &GroundParams::beta_1_s, "1/s", 0, 1e5, false, Group::kFriction, true, true,
+     "scar decay rate in flight"},
+    {"kappa", &GroundParams::kappa_1_m, "1/m", 0, 1e4, false, Group::kFriction, true, true,
+     "scar hardening rate"},
+    {"nu", &GroundParams::nu_1_s, "1/s", 0, 1e4, false, Group::kFriction, true, true,
+     "viscous ground term while in contact ([solver] viscous)"},
+    {"soil_strength", &GroundParams::soil_strength_mn_m2, "MN/m^2", 0.1, 1000, false,
+     Group::kSoil, true, true,
+     "M_E, soil strength of eq. 11 (Lu et al. 2019; the formula takes kN/m^2)"},
+    {"compaction_drag", &GroundParams::compaction_drag, "1", 0, 100, false, Group::kSoil, true,
+     false, "C_s, compaction part of the scar drag coefficient (eq. 12)"},
+    {"fluid_drag", &GroundParams::fluid_drag, "1", 0, 100, false, Group::kSoil, false, false,
+     "C_f, fluid part of the scar drag coefficient (eq. 12)"},
+    {"soil_density", &GroundParams::soil_density_kg_m3, "kg/m^3", 100, 3000, false, Group::kSoil,
+     false, false, "rho_Sigma, density of the scarring layer (eq. 9)"},
+    {"drag_height_m", &GroundParams::drag_height_m, "m", 0, 100, false, Group::kDragLayer, false,
+     false, "drag layer thickness above the terrain"},
+    {"drag_translational", &GroundParams::drag_translational_1_s, "1/s", 0, 1000, false,
+     Group::kDragLayer, false, false, "drag layer: v decays as exp(-c_t t)"},
+    {"drag_rotational", &GroundParams::drag_rotational_1_s, "1/s", 0, 1000, false,
+     Group::kDragLayer, false, false, "drag layer: Omega decays as exp(-c_r t)"},
+}};
+
+const GroundFieldInfo* FindGroundField(std::string_view key) {
+  for (const GroundFieldInfo& f : kGroundFields)
+    if (key == f.key) return &f;
+  return nullptr;
+}
+
+bool GroundFieldApplies(const GroundFieldInfo& field, const GroundParams& params) {
+  switch (field.group) {
+    case Group::kFriction:
+      return true;
+    case Group::kDragLayer:
+      return params.HasDragLayer();
+    case Group::kSoil:
+      return params.IsSoil();
+  }
+  return true;
+}
+
 bool GroundParams::IsValid(std::string* why) const {
-  return Check(std::isfinite(mu_min) && mu_min >= 0, why, "mu_min", mu_min, "0 <= mu_min") &&
-         Check(std::isfinite(mu_max) && mu_max >= mu_min, why, "mu_max", mu_max,
-               "mu_min <= mu_max < infinity") &&
-         Check(std::isfinite(beta_1_s) && beta_1_s >= 0, why, "beta", beta_1_s,
-               "beta >= 0 (1/s)") &&
-         Check(std::isfinite(kappa_1_m) && kappa_1_m >= 0, why, "kappa", kappa_1_m,
-               "kappa >= 0 (1/m)") &&
-         Check(std::isfinite(nu_1_s) && nu_1_s >= 0, why, "nu", nu_1_s, "nu >= 0 (1/s)") &&
-         Check(std::isfinite(drag_height_m) && drag_height_m >= 0 && drag_height_m <= 100, why,
-               "drag_height_m", drag_height_m, "0 <= drag_height_m <= 100 (m)") &&
-         Check(std::isfinite(drag_translational_1_s) && drag_translational_1_s >= 0 &&
-                   drag_translational_1_s <= 1000,
-               why, "drag_translational", drag_translational_1_s,
-               "0 <= drag_translational <= 1000 (1/s)") &&
-         Check(std::isfinite(drag_rotational_1_s) && drag_rotational_1_s >= 0 &&
-                   drag_rotational_1_s <= 1000,
-               why, "drag_rotational", drag_rotational_1_s, "0 <= drag_rotational <= 1000 (1/s)");
+  for (const GroundFieldInfo& f : kGroundFields) {
+    const double v = this->*f.member;
+    const bool ok =
+        std::isfinite(v) && (f.lower_open ? v > f.lower : v >= f.lower) && v <= f.upper;
+    if (ok) continue;
+    if (why) {
+      std::ostringstream msg;
+      msg << f.key << " = " << v << " violates " << f.lower << (f.lower_open ? " < " : " <= ")
+          << f.key;
+      if (f.upper < kInf) msg << " <= " << f.upper;
+      if (std::string_view(f.unit) != "1") msg << " (" << f.unit << ")";
+      *why = msg.str();
+    }
+    return false;
+  }
+  if (!(mu_max >= mu_min)) {
+    if (why) {
+      std::ostringstream msg;
+      msg << "mu_max = " << mu_max << " violates mu_min <= mu_max < infinity";
+      *why = msg.str();
+    }
+    return false;
+  }
+  return true;
 }
 
 bool GroundTable::AnyDragLayer() const {
   for (const GroundCategory& c : categories_)
     if (c.params.HasDragLayer()) return true;
   return false;
+}
+
+bool GroundTable::AnySoil() const {
+  for (const GroundCategory& c : categories_)
+    if (c.params.IsSoil()) return true;
+  return false;
+}
+
+const std::array<const char*, 8>& GroundTable::BuiltInNames() {
+  static const std::array<const char*, 8> names = {
+      "extra_soft", "soft", "medium_soft", "medium", "medium_hard", "hard", "extra_hard", "snow"};
+  return names;
 }
 
 GroundTable GroundTable::BuiltIn() {

@@ -65,6 +65,20 @@ bool ParsePredictedLever(std::string_view name, PredictedLever* lever) {
   return false;
 }
 
+const char* ToString(SoilDragPoint point) {
+  return point == SoilDragPoint::kSubmergedCentroid ? "submerged_centroid" : "centre_of_mass";
+}
+
+bool ParseSoilDragPoint(std::string_view name, SoilDragPoint* point) {
+  for (SoilDragPoint p : {SoilDragPoint::kCentreOfMass, SoilDragPoint::kSubmergedCentroid}) {
+    if (name == ToString(p)) {
+      *point = p;
+      return true;
+    }
+  }
+  return false;
+}
+
 const char* ToString(SolverPreset preset) {
   switch (preset) {
     case SolverPreset::kFast:
@@ -134,6 +148,9 @@ bool SolverOptions::IsValid(std::string* why) const {
         penetration_tolerance, "0 < penetration_tolerance <= 0.5");
   check(predicted_lever == PredictedLever::kMidpoint || predicted_lever == PredictedLever::kTouch,
         "predicted_lever", static_cast<double>(predicted_lever), "a PredictedLever value");
+  check(soil_drag == SoilDragPoint::kCentreOfMass ||
+            soil_drag == SoilDragPoint::kSubmergedCentroid,
+        "soil_drag", static_cast<double>(soil_drag), "a SoilDragPoint value");
   check(rest_speed_m_s >= 0 && std::isfinite(rest_speed_m_s), "rest_speed_m_s", rest_speed_m_s,
         "rest_speed_m_s >= 0");
   check(rest_angular_speed_rad_s >= 0 && std::isfinite(rest_angular_speed_rad_s),

@@ -50,6 +50,20 @@ enum class PredictedLever {
 const char* ToString(PredictedLever lever);  // "midpoint", "touch"
 bool ParsePredictedLever(std::string_view name, PredictedLever* lever);
 
+// Where the scar drag of the scarring soil (Lu et al. 2019, eq. 9) acts. Scene files name the
+// points "centre_of_mass" and "submerged_centroid".
+enum class SoilDragPoint {
+  // At the centre of mass, against its velocity, on the frontal area normal to it (the paper: the
+  // rock keeps its rotation, no drag torque).
+  kCentreOfMass,
+  // At the centroid of the hull's part below the surface, against that point's velocity, on the
+  // frontal area normal to it: the drag also exerts a torque (beyond the paper; its authors name
+  // the missing drag torque as why rotational energy is matched only roughly).
+  kSubmergedCentroid,
+};
+const char* ToString(SoilDragPoint point);  // "centre_of_mass", "submerged_centroid"
+bool ParseSoilDragPoint(std::string_view name, SoilDragPoint* point);
+
 struct SolverOptions {
   double dt_s = 0.002;                  // time step
   double max_time_s = 300;              // a rock still moving then ends as max_time
@@ -76,6 +90,8 @@ struct SolverOptions {
   double penetration_tolerance = 0.01;
   // Where a predicted contact's percussion acts.
   PredictedLever predicted_lever = PredictedLever::kMidpoint;
+  // Where the scar drag of a soil category (GroundModel::kLu2019) acts.
+  SoilDragPoint soil_drag = SoilDragPoint::kCentreOfMass;
   // Rest: speed and angular speed below these thresholds, in contact, for rest_hold_s.
   double rest_speed_m_s = 0.02;
   double rest_angular_speed_rad_s = 0.05;

@@ -62,11 +62,19 @@ RockShape MakeRockShape(const Polyhedron& hull, double density_kg_m3) {
   rock.principal_to_input = Eigen::Quaterniond(axes).normalized();
   rock.centroid_input_m = mp.centroid_m;
 
-  for (const Eigen::Vector3d& vertex : UsedVertices(hull)) {
-    const Eigen::Vector3d local = axes.transpose() * (vertex - mp.centroid_m);
+  // The used vertices in index order (as UsedVertices), and the faces renumbered to match.
+  std::vector<int> renumber(hull.vertices_m.size(), -1);
+  for (const auto& t : hull.triangles)
+    for (int k : t) renumber[k] = 0;
+  for (std::size_t i = 0; i < renumber.size(); ++i) {
+    if (renumber[i] < 0) continue;
+    renumber[i] = static_cast<int>(rock.vertices_m.size());
+    const Eigen::Vector3d local = axes.transpose() * (hull.vertices_m[i] - mp.centroid_m);
     rock.vertices_m.push_back(local);
     rock.bounding_radius_m = std::max(rock.bounding_radius_m, local.norm());
   }
+  for (const auto& t : hull.triangles)
+    rock.triangles.push_back({renumber[t[0]], renumber[t[1]], renumber[t[2]]});
   Eigen::Vector3d lo = Eigen::Vector3d::Zero(), hi = Eigen::Vector3d::Zero();
   for (const Eigen::Vector3d& b : rock.vertices_m) {
     lo = lo.cwiseMin(b);

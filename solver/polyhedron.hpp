@@ -31,6 +31,9 @@ MassProperties ComputeMassProperties(const Polyhedron& poly, double density_kg_m
 struct RockShape {
   std::vector<Eigen::Vector3d>
       vertices_m;  // hull vertices, principal frame, origin at the centroid
+  // Hull faces: indices into vertices_m, counter-clockwise seen from outside (the scarring soil
+  // clips them by the terrain, solver/soil.hpp). Empty for a shape not made by MakeRockShape.
+  std::vector<std::array<int, 3>> triangles;
   double mass_kg = 0;
   double volume_m3 = 0;
   Eigen::Vector3d inertia_kg_m2 = Eigen::Vector3d::Ones();  // principal moments, ascending

@@ -15,6 +15,11 @@ struct RockState {
   double time_s = 0;
   double rest_timer_s = 0;  // how long the rock has been below the rest thresholds
   int scar_ground = -1;     // ground index of the last loaded contact (its beta decays the scar)
+  // Scarring soil (Lu et al. 2019): while part of the hull is in a soil layer, the category where
+  // it entered (-1 outside) and the depth of the rebound plane below the surface, set by eq. 11
+  // from the vertical speed at entry and kept until the rock has left the layer entirely.
+  int soil_ground = -1;
+  double soil_depth_m = 0;
 };
 
 }  // namespace talus

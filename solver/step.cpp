@@ -1,10 +1,12 @@
 #include "solver/step.hpp"
 
+#include <Eigen/LU>
 #include <cmath>
 
 #include "solver/contact_detection.hpp"
 #include "solver/contact_solver.hpp"
 #include "solver/kinematics.hpp"
+#include "solver/soil.hpp"
 
 namespace talus {
 namespace {
@@ -75,6 +77,65 @@ void DragLayer(const Scene& scene, const Eigen::Vector3d& centre, const Eigen::V
   inertia.inertia_scale /= Phi(x_r);
 }
 
+// Scar drag of the scarring soil (Lu et al. 2019, eqs. 9 and 12; docs/model.md, "The scarring
+// soil"): F = (C_f + C_s) rho / 2 A zeta'^2 against the velocity v of the point where it acts, zeta'
+// the rate of penetration -- of its depth below the surface measured vertically, (v . n) / n_z
+// for the terrain's tangent plane with normal n under the centre of mass: zero for motion parallel
+// to the surface -- and A the frontal area of the hull's part below that plane, projected normal
+// to v. Implicit in v with zeta'^2 / |v| from the step's beginning: F = -k (zeta_B'^2 / |v_B|) v_E.
+// - centre of mass (the paper): m (1 + dt k zeta'^2 / (m |v|)) v_E = m v_free + sum P, folded into
+//   the contact solve as CentreOfMassDrag folds nu;
+// - submerged centroid: the percussion P = -h v_c,E (h = dt k zeta_c'^2 / |v_c|, kg) at the part's
+//   centroid c, v_c,E = v_c,free + K P with K the point's inverse mass matrix, solved before the
+//   contacts.
+// Both only take energy: P . v_c,E <= 0. Reports the penetration (m) along the plane's normal.
+void SoilDrag(const Scene& scene, const RockShape& rock, const RockState& mid,
+              const Eigen::Matrix3d& rotation, const RockState& begin, Eigen::Vector3d& velocity,
+              Eigen::Vector3d& omega, EffectiveInertia& inertia, StepWorkspace& workspace,
+              StepReport& report) {
+  TerrainSample under;
+  if (!scene.terrain.Sample(mid.position_m.x(), mid.position_m.y(), &under)) return;
+  const Eigen::Vector3d plane_point(0, 0, under.height_m - mid.position_m.z());
+  SubmergedPart& part = workspace.submerged;
+  const Eigen::Vector3d along(begin.velocity_m_s.x(), begin.velocity_m_s.y(), 0);
+  ClipBelowPlane(rock, rotation, plane_point, under.normal, &part, along);
+  report.soil_penetration_m = part.depth_m;
+  if (part.empty()) return;
+  report.soil_rear_m = mid.position_m + part.rear_m;
+  report.soil_front_m = mid.position_m + part.front_m;
+  const double dt = scene.options.dt_s;
+  const double k = scene.ground.params(workspace.soil.ground).DragFactor_kg_m3();
+  if (scene.options.soil_drag == SoilDragPoint::kCentreOfMass) {
+    const double speed = begin.velocity_m_s.norm();
+    if (speed == 0) return;
+    const double rate = begin.velocity_m_s.dot(under.normal) / under.normal.z();
+    const double h = dt * k * part.FrontalArea(begin.velocity_m_s / speed) * rate * rate / speed;
+    velocity *= inertia.mass_kg / (inertia.mass_kg + h);
+    inertia.mass_kg += h;
+    return;
+  }
+  const Eigen::Vector3d& a = part.centroid_m;
+  const Eigen::Vector3d point_begin =
+      begin.velocity_m_s + (begin.orientation * begin.angular_velocity_rad_s).cross(a);
+  const double speed = point_begin.norm();
+  if (speed == 0) return;
+  const double rate = point_begin.dot(under.normal) / under.normal.z();
+  const double h = dt * k * part.FrontalArea(point_begin / speed) * rate * rate / speed;
+  // K = I / m - [a]x R Theta^-1 R' [a]x, the velocity change of point c per unit percussion there.
+  const Eigen::Vector3d inv_inertia =
+      rock.inertia_kg_m2.cwiseInverse() / inertia.inertia_scale;
+  Eigen::Matrix3d cross_a;
+  cross_a << 0, -a.z(), a.y(), a.z(), 0, -a.x(), -a.y(), a.x(), 0;
+  const Eigen::Matrix3d rotated = rotation * inv_inertia.asDiagonal() * rotation.transpose();
+  const Eigen::Matrix3d mobility = Eigen::Matrix3d::Identity() / inertia.mass_kg -
+                                   cross_a * rotated * cross_a;
+  const Eigen::Vector3d point_free = velocity + (rotation * omega).cross(a);
+  const Eigen::Vector3d percussion =
+      -h * (Eigen::Matrix3d::Identity() + h * mobility).partialPivLu().solve(point_free);
+  velocity += percussion / inertia.mass_kg;
+  omega += inv_inertia.cwiseProduct(rotation.transpose() * a.cross(percussion));
+}
+
 }  // namespace
 
 StepReport Step(const Scene& scene, const RockShape& rock, RockState& state,
@@ -112,6 +173,11 @@ StepReport Step(const Scene& scene, const RockShape& rock, RockState& state,
     return report;
   }
   report.clear = detected == DetectResult::kClear;
+  state.soil_ground = workspace.soil.ground;
+  state.soil_depth_m = workspace.soil.depth_m;
+  report.in_soil = workspace.soil.submerged;
+  if (workspace.soil.submerged)
+    SoilDrag(scene, rock, state, rotation, begin, velocity, omega, inertia, workspace, report);
   clock.Lap(&StageTimes::contacts_s);
 
   // 5. Velocity update: the viscous term (centre-of-mass reading: implicit drag m (1 + nu dt) v_E
@@ -154,6 +220,8 @@ StepReport FlightStep(const Scene& scene, const RockShape& rock, RockState& stat
   state.velocity_m_s = FreeVelocity(scene.options, state.velocity_m_s);
   workspace.contacts.clear();
   workspace.ForgetPercussions();
+  state.soil_ground = -1;
+  state.soil_depth_m = 0;
   EndStep(scene, report, workspace, state);
   clock.Lap(&StageTimes::end_s);
   if (times) ++times->steps;

@@ -16,6 +16,12 @@ struct StepReport {
   bool loaded = false;          // a contact carried load: the scar grew
   bool outside_domain = false;  // a vertex near the ground is outside the DEM or over nodata
   bool clear = false;           // no vertex needed a test (bounding sphere clear, or FlightStep)
+  bool in_soil = false;         // part of the hull is in a soil layer at the midpoint (Lu 2019)
+  double soil_penetration_m = 0;  // deepest vertex below the surface's tangent plane, soil only
+  // Soil only: the rear and front (world, m) of the hull's part below the surface along the
+  // horizontal velocity, at the midpoint: the scar's extent in this step.
+  Eigen::Vector3d soil_rear_m = Eigen::Vector3d::Zero();
+  Eigen::Vector3d soil_front_m = Eigen::Vector3d::Zero();
 };
 
 // Wall-clock time spent in each stage, accumulated when a StageTimes is passed to Step.

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <sstream>
 
@@ -32,9 +33,55 @@ Terrain::Terrain()
       ground_(std::make_shared<const GroundGrid>()),
       grid_(heights_->grid) {}
 
+PlanePyramid PlanePyramid::Build(const Heightfield& heights) {
+  PlanePyramid pyramid;
+  const GridGeometry& g = heights.grid;
+  if (g.nx < 2 || g.ny < 2 || heights.z_m.size() != static_cast<std::size_t>(g.nx) * g.ny)
+    return pyramid;
+  auto z = [&](int i, int j) { return heights.z_m[static_cast<std::size_t>(j) * g.nx + i]; };
+  const int cells_x = g.nx - 1, cells_y = g.ny - 1;
+  for (int k = kFirstLevel; k <= kLastLevel; ++k) {
+    Level level;
+    level.cells = 1 << k;
+    // A level whose blocks are twice those of one that already held the whole grid adds nothing.
+    if (level.cells / 2 >= std::max(cells_x, cells_y) && k > kFirstLevel) break;
+    level.nbx = (cells_x + level.cells - 1) / level.cells;
+    level.nby = (cells_y + level.cells - 1) / level.cells;
+    level.blocks.resize(static_cast<std::size_t>(level.nbx) * level.nby);
+    for (int bj = 0; bj < level.nby; ++bj) {
+      const int j0 = bj * level.cells, j1 = std::min(j0 + level.cells, cells_y);
+      for (int bi = 0; bi < level.nbx; ++bi) {
+        const int i0 = bi * level.cells, i1 = std::min(i0 + level.cells, cells_x);
+        Block& b = level.blocks[static_cast<std::size_t>(bj) * level.nbx + bi];
+        // The plane through the mean of the corners with the mean slopes of the block's edges.
+        const double z00 = z(i0, j0), z10 = z(i1, j0), z01 = z(i0, j1), z11 = z(i1, j1);
+        b.slope_x = ((z10 - z00) + (z11 - z01)) / (2 * (i1 - i0) * g.dx_m);
+        b.slope_y = ((z01 - z00) + (z11 - z10)) / (2 * (j1 - j0) * g.dy_m);
+        b.z_m = 0.25 * (z00 + z10 + z01 + z11);
+        const double ic = 0.5 * (i0 + i1), jc = 0.5 * (j0 + j1);
+        double residual = 0;
+        for (int j = j0; j <= j1 && !std::isnan(residual); ++j)
+          for (int i = i0; i <= i1; ++i) {
+            const double d = z(i, j) - (b.z_m + b.slope_x * (i - ic) * g.dx_m +
+                                        b.slope_y * (j - jc) * g.dy_m);
+            if (std::isnan(d)) {
+              residual = std::numeric_limits<double>::quiet_NaN();
+              break;
+            }
+            residual = std::max(residual, std::abs(d));
+          }
+        b.residual_m = residual;
+      }
+    }
+    pyramid.levels.push_back(std::move(level));
+  }
+  return pyramid;
+}
+
 Terrain::Terrain(Heightfield heights, int default_ground)
     : heights_(std::make_shared<const Heightfield>(std::move(heights))),
       ground_(std::make_shared<const GroundGrid>()),
+      pyramid_(std::make_shared<const PlanePyramid>(PlanePyramid::Build(*heights_))),
       grid_(heights_->grid),
       z_(heights_->z_m.data()),
       inv_dx_(1.0 / grid_.dx_m),
@@ -106,6 +153,40 @@ bool Terrain::PlaneAround(double x_m, double y_m, double r_m, LocalPlane* out) c
   const Eigen::Vector3d& n = out->at.normal;
   out->slope_x = -n.x() / n.z();
   out->slope_y = -n.y() / n.z();
+  const double span_cells = std::max(fx_hi - fx_lo, fy_hi - fy_lo);
+  if (span_cells > kExactCells && pyramid_) {
+    for (const PlanePyramid::Level& level : pyramid_->levels) {
+      if (level.cells < span_cells) continue;
+      // The box lies in at most 2 x 2 blocks of this level.
+      const int bi_lo = static_cast<int>(fx_lo) / level.cells;
+      const int bj_lo = static_cast<int>(fy_lo) / level.cells;
+      const int bi_hi = std::min(static_cast<int>(fx_hi) / level.cells, level.nbx - 1);
+      const int bj_hi = std::min(static_cast<int>(fy_hi) / level.cells, level.nby - 1);
+      double deviation = 0;
+      for (int bj = bj_lo; bj <= bj_hi; ++bj) {
+        const double j0 = bj * level.cells, j1 = std::min(j0 + level.cells, g.ny - 1.0);
+        const double w_corners[2] = {std::max(fy_lo, j0), std::min(fy_hi, j1)};
+        for (int bi = bi_lo; bi <= bi_hi; ++bi) {
+          const PlanePyramid::Block& b = level.blocks[static_cast<std::size_t>(bj) * level.nbx + bi];
+          if (std::isnan(b.residual_m)) return false;  // a nodata node: no bound
+          const double i0 = bi * level.cells, i1 = std::min(i0 + level.cells, g.nx - 1.0);
+          const double u_corners[2] = {std::max(fx_lo, i0), std::min(fx_hi, i1)};
+          const double ic = 0.5 * (i0 + i1), jc = 0.5 * (j0 + j1);
+          for (double fy : w_corners)
+            for (double fx : u_corners) {
+              const double block = b.z_m + b.slope_x * (fx - ic) * g.dx_m +
+                                   b.slope_y * (fy - jc) * g.dy_m;
+              const double plane = out->at.height_m +
+                                   out->slope_x * (g.x0_m + fx * g.dx_m - x_m) +
+                                   out->slope_y * (g.y0_m + fy * g.dy_m - y_m);
+              deviation = std::max(deviation, b.residual_m + std::abs(block - plane));
+            }
+        }
+      }
+      out->deviation_m = deviation + kPlaneRounding_m;
+      return true;
+    }
+  }
   const int i_lo = std::min(static_cast<int>(fx_lo), g.nx - 2);
   const int i_hi = std::min(static_cast<int>(fx_hi), g.nx - 2);
   const int j_lo = std::min(static_cast<int>(fy_lo), g.ny - 2);

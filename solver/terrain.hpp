@@ -46,6 +46,29 @@ struct TerrainSample {
   Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  // unit, upward, normal of the bilinear patch
 };
 
+// A hierarchy of square blocks of the DEM's cells, 2^k x 2^k cells for k = kFirstLevel ..
+// kLastLevel (fewer at the grid's far edges), each with a plane and the largest vertical departure of
+// the block's nodes from it (NaN when one is nodata). The bilinear terrain less a plane is bilinear
+// in each cell, so it departs from the block's plane nowhere in the block by more than at a node:
+// Terrain::PlaneAround bounds a large box by the few blocks that cover it instead of every cell.
+struct PlanePyramid {
+  static constexpr int kFirstLevel = 2;  // blocks of 4 x 4 cells
+  static constexpr int kLastLevel = 8;   // blocks of 256 x 256 cells
+  struct Block {
+    double z_m = 0;        // the plane's height at the block's centre
+    double slope_x = 0;    // dz/dx
+    double slope_y = 0;    // dz/dy
+    double residual_m = 0; // largest |node height - plane| over the block's nodes; NaN: nodata
+  };
+  struct Level {
+    int cells = 0;      // block side, cells
+    int nbx = 0, nby = 0;  // blocks along x and y
+    std::vector<Block> blocks;  // row after row along y
+  };
+  std::vector<Level> levels;  // levels[k - kFirstLevel]; only those the grid can hold
+  static PlanePyramid Build(const Heightfield& heights);
+};
+
 // The heights and the ground grid are immutable once set and shared between copies (a copy of a
 // Terrain, and so of a Scene, costs two reference counts, not the DEM): calibration runs many
 // scenes that differ only in their ground table.
@@ -69,10 +92,14 @@ class Terrain {
 
   // The tangent plane of the terrain at (x, y) and how far the terrain departs from it, vertically,
   // anywhere in the box [x - r, x + r] x [y - r, y + r]: |h(p) - plane(p)| <= deviation_m there.
-  // In each cell that holds a point of the box, h - plane is bilinear, so its extremes over the
-  // part of the box in that cell are at that part's corners: deviation_m is the largest of those,
-  // the tightest such bound, plus 1e-6 m for rounding. False when the box reaches beyond the grid
-  // or a cell that holds a point of it has a nodata corner.
+  // A box over at most kExactCells cells per side: in each cell that holds a point of the box,
+  // h - plane is bilinear, so its extremes over the part of the box in that cell are at that part's
+  // corners: deviation_m is the largest of those, the tightest such bound. A larger box (a fine DEM):
+  // the at most 2 x 2 blocks of the smallest PlanePyramid level whose blocks are as wide as the box,
+  // each adding its residual to the largest departure of its plane from the tangent plane at the
+  // corners of the box's part in it; a bound whose cost does not grow with the DEM's resolution.
+  // Plus 1e-6 m for rounding. False when the box reaches beyond the grid or a cell that holds a
+  // point of it (a block, for the pyramid's bound) has a nodata corner.
   struct LocalPlane {
     TerrainSample at;    // height and normal at (x, y)
     double slope_x = 0;  // dh/dx
@@ -80,6 +107,7 @@ class Terrain {
     double deviation_m = 0;
   };
   bool PlaneAround(double x_m, double y_m, double r_m, LocalPlane* out) const;
+  static constexpr int kExactCells = 4;
 
   // A box of horizontal positions, m.
   struct Box {
@@ -119,6 +147,7 @@ class Terrain {
   // Shared, immutable. The hot path reads the cached grid and pointers below, not through these.
   std::shared_ptr<const Heightfield> heights_;
   std::shared_ptr<const GroundGrid> ground_;
+  std::shared_ptr<const PlanePyramid> pyramid_;
   GridGeometry grid_;                           // heights_->grid
   const double* z_ = nullptr;                   // heights_->z_m.data()
   GridGeometry ground_geometry_;                // ground_->grid

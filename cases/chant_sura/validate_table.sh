@@ -1,14 +1,16 @@
 #!/bin/sh
 # The validation tables of README.md: `talus validate` of an event of this case for each ground
 # category that could describe the slope and each reading of the viscous term, with 30 rocks per run.
-# Usage: cases/chant_sura/validate_table.sh [TALUS] [OUT] [ROCKS] [SEED] [EVENT]
-#   (defaults: build/app/talus, out/chant_sura, 30, 1, event.toml). Needs jq and awk.
+# Usage: [MODELS="hard lu2019"] [READINGS="..."] cases/chant_sura/validate_table.sh [TALUS] [OUT]
+#        [ROCKS] [SEED] [EVENT]
+#   (defaults: build/app/talus, out/chant_sura, 30, 1, event.toml; MODELS: hard, the seed's contact
+#   at the surface, and/or lu2019, the scarring soil under the category; READINGS: both readings of
+#   the viscous term). Needs jq and awk.
 #   EVENT: event.toml (the impacts), event_segments.toml (the flight segments) or
 #   event_impacts.toml (the six single impacts of impacts_esurf2019.csv).
-# Each variant is the event's scene with only `default_ground` and `[solver] viscous` changed,
-# written with absolute data paths into OUT/<category>-<reading>/ (segments:
-# OUT/segments-<category>-<reading>/, single impacts: OUT/single-<category>-<reading>/), and the
-# event naming it.
+# Each variant is the event's scene with only `default_ground`, `[solver] viscous` and (lu2019) the
+# category's `model` changed, written with absolute data paths into OUT/<category>-<reading>[-lu2019]/
+# (segments: OUT/segments-..., single impacts: OUT/single-...), and the event naming it.
 set -eu
 case_dir=$(cd "$(dirname "$0")" && pwd)
 talus=${1:-build/app/talus}
@@ -31,17 +33,19 @@ case $event in
   event_impacts.toml)
     prefix=single-
     scene=scene_impacts.toml
-    kinds="impact_energy_ratio"
-    printf '| ground | viscous | CRPS energy ratio | skill_c | in 90%% | median energy ratio sim / obs | scored |\n'
-    printf '|---|---|---|---|---|---|---|\n' ;;
+    kinds="impact_energy_ratio impact_scar_depth"
+    printf '| ground | viscous | CRPS energy ratio | skill_c | in 90%% | CRPS scar depth (m) | skill_c | in 90%% | median energy ratio sim / obs | scored |\n'
+    printf '|---|---|---|---|---|---|---|---|---|---|\n' ;;
   *) echo "validate_table.sh: EVENT must be event.toml, event_segments.toml or event_impacts.toml, not '$event'" >&2
      exit 2 ;;
 esac
 mkdir -p "$out"
 out=$(cd "$out" && pwd)
+for model in ${MODELS:-hard}; do
 for ground in hard medium_hard medium; do
-  for viscous in centre_of_mass contact_friction; do
-    dir="$out/$prefix$ground-$viscous"
+  for viscous in ${READINGS:-centre_of_mass contact_friction}; do
+    suffix=; [ "$model" = hard ] || suffix="-$model"
+    dir="$out/$prefix$ground-$viscous$suffix"
     mkdir -p "$dir"
     sed -e "s|^default_ground = \"[a-z_]*\"|default_ground = \"$ground\"|" \
         -e "s|^\[solver\]|[solver]\nviscous = \"$viscous\"|" \
@@ -49,6 +53,7 @@ for ground in hard medium_hard medium; do
         -e "s|\"release_points.csv\"|\"$case_dir/release_points.csv\"|" \
         -e "s|\"impacts_esurf2019.csv\"|\"$case_dir/impacts_esurf2019.csv\"|" \
         "$case_dir/$scene" > "$dir/$scene"
+    [ "$model" = hard ] || printf '\n[ground.%s]\nmodel = "%s"\n' "$ground" "$model" >> "$dir/$scene"
     sed -e "s|\"contact_events.csv\"|\"$case_dir/contact_events.csv\"|" \
         -e "s|\"observed_trajectories.csv\"|\"$case_dir/observed_trajectories.csv\"|" \
         -e "s|\"impacts_esurf2019.csv\"|\"$case_dir/impacts_esurf2019.csv\"|" \
@@ -78,6 +83,7 @@ for ground in hard medium_hard medium; do
           join(" / ")' "$dir/out/scores.json")
     fi
     scored=$(jq -r '.observations_scored' "$dir/out/scores.json")
-    printf '| %s | %s | %s%s | %s |\n' "$ground" "$viscous" "$columns" "$extra" "$scored"
+    printf '| %s | %s | %s%s | %s |\n' "$ground$suffix" "$viscous" "$columns" "$extra" "$scored"
   done
+done
 done

@@ -11,8 +11,8 @@
 #include <cmath>
 #include <cstdio>
 
-#include "calibration/least_squares.hpp"
-#include "calibration/optimizer.hpp"
+#include "calibration/covariance.hpp"
+#include "calibration/optimize.hpp"
 #include "calibration/seeds.hpp"
 #include "tests/calibration/fixtures.hpp"
 
@@ -110,7 +110,7 @@ TEST(Bootstrap, StatesTheDataErrorWhereTheSandwichUnderstatesIt) {
   fit.max_evaluations = 25;
   fit.start = Eigen::VectorXd::Constant(1, (0.2 - 0.1) / 0.8);
   fit.initial_step = 0.2;
-  const Summary summary = Calibrate(objective, fit);
+  const OptimizerSummary summary = Optimize(objective, fit);
   std::printf("%s", summary.BriefReport().c_str());
   ASSERT_TRUE(summary.IsSolutionUsable());
 

@@ -4,14 +4,14 @@
 // parameter the data cannot see has a flat profile and is reported unidentified; an interrupted
 // calibration resumed from its evaluations ends bit for bit where an uninterrupted one does.
 
-#include "calibration/optimizer.hpp"
-
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>
 
+#include "calibration/covariance.hpp"
 #include "calibration/least_squares.hpp"
+#include "calibration/optimize.hpp"
 #include "calibration/roughness.hpp"
 #include "tests/calibration/fixtures.hpp"
 
@@ -76,7 +76,7 @@ TEST(Calibrate, BobyqaRecoversMuMinFromADistantStart) {
   options.max_evaluations = 25;
   options.start = Eigen::VectorXd::Constant(1, (0.2 - 0.1) / 0.8);
   options.initial_step = 0.2;
-  const Summary summary = Calibrate(objective, options);
+  const OptimizerSummary summary = Optimize(objective, options);
   std::printf("%s", summary.FullReport().c_str());
   ASSERT_TRUE(summary.IsSolutionUsable());
 
@@ -189,7 +189,7 @@ TEST(Calibrate, CeresRecoversMuMinAndItsUncertaintyCoversTheTruth) {
   options.algorithm = "ceres";
   options.max_evaluations = 40;
   options.start = Eigen::VectorXd::Constant(1, (0.2 - 0.1) / 0.8);
-  const Summary summary = Calibrate(objective, options);
+  const OptimizerSummary summary = Optimize(objective, options);
   std::printf("%s", summary.FullReport().c_str());
   ASSERT_TRUE(summary.IsSolutionUsable());
   EXPECT_GT(summary.fd_step, 0);
@@ -231,7 +231,7 @@ TEST(Calibrate, AnInterruptedCalibrationResumesToTheIdenticalResult) {
     options.max_evaluations = 6;
     options.fd_step = 0.05;
     options.start = Eigen::VectorXd::Constant(1, 0.125);
-    const Summary whole = Calibrate(objective, options);
+    const OptimizerSummary whole = Optimize(objective, options);
 
     std::vector<Evaluation> kept;
     OptimizerOptions interrupted = options;
@@ -239,11 +239,11 @@ TEST(Calibrate, AnInterruptedCalibrationResumesToTheIdenticalResult) {
       kept.push_back(e);
       if (index == 2) throw Stop{};
     };
-    EXPECT_THROW(Calibrate(objective, interrupted), Stop);
+    EXPECT_THROW(Optimize(objective, interrupted), Stop);
     ASSERT_EQ(kept.size(), 3u);
     OptimizerOptions resumed = options;
     resumed.replay = kept;
-    const Summary rest = Calibrate(objective, resumed);
+    const OptimizerSummary rest = Optimize(objective, resumed);
 
     EXPECT_EQ(rest.replayed, 3);
     ASSERT_EQ(rest.evaluations(), whole.evaluations());
@@ -270,7 +270,7 @@ TEST(Calibrate, AReplayOfAnotherCalibrationIsRefused) {
   Evaluation other;
   other.u = Eigen::VectorXd::Constant(1, 0.9);
   options.replay = {other};
-  EXPECT_THROW(Calibrate(objective, options), std::runtime_error);
+  EXPECT_THROW(Optimize(objective, options), std::runtime_error);
 }
 
 }  // namespace

@@ -89,6 +89,45 @@ TEST(ParameterSet, BadSpecsAreClearErrors) {
             "snow: mu_min >= 0.5 and mu_max <= 0.35 within the bounds: no parameter vector has "
             "mu_min <= mu_max");
   EXPECT_EQ(ErrorOf({}), "no free parameter");
+  // A soil parameter of a category without the scarring soil would change nothing.
+  EXPECT_EQ(ErrorOf({Spec("medium", GroundField::kSoilStrength, 5, 50)}),
+            "medium.soil_strength: category 'medium' has no scarring soil (a soil parameter acts "
+            "only with model = \"lu2019\")");
+}
+
+// The calibrated fields are kGroundFields' rows in the enum's order, with their units and
+// default transforms: one list of names for the scene, the calibration file and the outputs.
+TEST(GroundField, IsTheGroundFieldTablesCalibratedRows) {
+  std::vector<std::string> calibrated;
+  for (const GroundFieldInfo& f : kGroundFields)
+    if (f.calibrated) calibrated.emplace_back(f.key);
+  const std::vector<std::string> expected = {"mu_min", "mu_max", "beta",           "kappa",
+                                             "nu",     "soil_strength", "compaction_drag"};
+  EXPECT_EQ(calibrated, expected);
+  for (std::size_t k = 0; k < expected.size(); ++k) {
+    GroundField field;
+    ASSERT_TRUE(ParseGroundField(expected[k], &field));
+    EXPECT_EQ(static_cast<std::size_t>(field), k);
+    EXPECT_EQ(ToString(field), expected[k]);
+  }
+  EXPECT_STREQ(UnitOf(GroundField::kSoilStrength), "MN/m^2");
+  ParameterSpec strength;
+  strength.field = GroundField::kSoilStrength;
+  EXPECT_TRUE(strength.UsesLog());
+  ParameterSpec drag;
+  drag.field = GroundField::kCompactionDrag;
+  EXPECT_FALSE(drag.UsesLog());
+
+  // Freed on a soil category, they reach the table.
+  GroundTable table = GroundTable::BuiltIn();
+  table.mutable_params(table.IndexOfName("medium")).model = GroundModel::kLu2019;
+  const ParameterSet set({Spec("medium", GroundField::kSoilStrength, 5, 50),
+                          Spec("medium", GroundField::kCompactionDrag, 0.1, 4)},
+                         table);
+  std::string why;
+  ASSERT_TRUE(set.Apply(Eigen::Vector2d(1, 0), table, &why)) << why;
+  EXPECT_EQ(table.params(table.IndexOfName("medium")).soil_strength_mn_m2, 50);
+  EXPECT_EQ(table.params(table.IndexOfName("medium")).compaction_drag, 0.1);
 }
 
 // Both friction bounds free: the corner mu_min = 1.5 > mu_max = 1 is infeasible, says why and

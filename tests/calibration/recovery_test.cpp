@@ -18,7 +18,7 @@
 
 #include "calibration/bootstrap.hpp"
 #include "calibration/least_squares.hpp"
-#include "calibration/optimizer.hpp"
+#include "calibration/optimize.hpp"
 #include "calibration/roughness.hpp"
 #include "calibration/seeds.hpp"
 #include "io/scene_file.hpp"
@@ -88,7 +88,7 @@ void ExpectRecovered(const Objective& objective, const Problem& p, const std::st
   // Jacobian's measured noise and curvature (ChooseFiniteDifferenceStep).
   options.start = objective.StartPoint();
   (*options.start)[0] = UnitMu(p.start);
-  const Summary summary = Calibrate(objective, options);
+  const OptimizerSummary summary = Optimize(objective, options);
   std::printf("%s", summary.FullReport().c_str());
   ASSERT_TRUE(summary.IsSolutionUsable());
 

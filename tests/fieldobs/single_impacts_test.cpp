@@ -87,26 +87,27 @@ TEST(SingleImpacts, BadTablesAreErrorsNamingFileLineAndColumn) {
   EXPECT_NE(ErrorOf(header + "a,3,20\n", spin).find("omega_radps"), std::string::npos);
 }
 
-TEST(SingleImpacts, OutcomesAreObservationsOfTheRunAndScarDepthsAreReportedNotScored) {
+TEST(SingleImpacts, OutcomesAndScarDepthsAreObservationsOfTheRun) {
   const CsvTable t =
       Table("impact_id,energy_ratio,outgoing_speed_mps,scar_depth_m\na,0.4,3,0.1\nb,,2,0.2\n");
   ObservationSet set;
-  std::vector<std::string> not_scored;
-  ReadSingleImpactOutcomes(t, {}, set, &not_scored);
-  ASSERT_EQ(set.scalars.size(), 3u);  // b has no energy ratio
+  ReadSingleImpactOutcomes(t, {}, set);
+  ASSERT_EQ(set.scalars.size(), 5u);  // b has no energy ratio
   EXPECT_EQ(set.scalars[0].quantity, Quantity::kImpactEnergyRatio);
   EXPECT_EQ(set.scalars[0].run, "a");
   EXPECT_EQ(set.scalars[0].value, 0.4);
   EXPECT_EQ(set.scalars[2].quantity, Quantity::kImpactSpeedOut);
   EXPECT_EQ(set.scalars[2].where, "impacts.csv:3");
-  ASSERT_EQ(not_scored.size(), 1u);
-  EXPECT_NE(not_scored[0].find("column 'scar_depth_m': 2 scar depths not scored"),
-            std::string::npos);
+  EXPECT_EQ(set.scalars[3].quantity, Quantity::kImpactScarDepth);
+  EXPECT_EQ(set.scalars[3].run, "a");
+  EXPECT_EQ(set.scalars[3].value, 0.1);
+  EXPECT_EQ(set.scalars[4].run, "b");
+  EXPECT_EQ(set.scalars[4].value, 0.2);
   ObservationSet none;
-  EXPECT_THROW(ReadSingleImpactOutcomes(Table("impact_id,mass_kg\na,780\n"), {}, none, nullptr),
+  EXPECT_THROW(ReadSingleImpactOutcomes(Table("impact_id,mass_kg\na,780\n"), {}, none),
                InputError);
   EXPECT_THROW(
-      ReadSingleImpactOutcomes(Table("impact_id,energy_ratio\na,-0.1\n"), {}, none, nullptr),
+      ReadSingleImpactOutcomes(Table("impact_id,energy_ratio\na,-0.1\n"), {}, none),
       InputError);
 }
 

@@ -320,11 +320,12 @@ TEST(LoadEvent, SingleImpactsAreRunsOnThePlaneAndObservationsOfTheirFirstEpisode
       rock.start.orientation * rock.shape->principal_to_input.conjugate();
   EXPECT_NEAR(std::abs(shape.dot(Eigen::Quaterniond(0, 1, 0, 0))), 1.0, 1e-12);
   EXPECT_TRUE(event.needs_episodes);
-  ASSERT_EQ(event.observations.scalars.size(), 2u);
+  ASSERT_EQ(event.observations.scalars.size(), 4u);  // energy ratios and scar depths
   EXPECT_EQ(event.observations.scalars[1].run, "i2");
   EXPECT_EQ(event.observations.scalars[1].value, 0.6);
-  ASSERT_EQ(event.not_scored.size(), 1u);
-  EXPECT_HAS(event.not_scored[0], "column 'depth_m': 2 scar depths not scored");
+  EXPECT_EQ(event.observations.scalars[3].quantity, fieldobs::Quantity::kImpactScarDepth);
+  EXPECT_EQ(event.observations.scalars[3].value, 0.05);
+  EXPECT_TRUE(event.not_scored.empty());
 }
 
 TEST(LoadEvent, SingleImpactErrorsNameFileLineAndKey) {

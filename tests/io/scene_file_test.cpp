@@ -208,6 +208,42 @@ TEST(LoadScene, DragLayerPerCategoryWithBounds) {
              "did you mean 'drag_height_m'?");
 }
 
+TEST(LoadScene, ScarringSoilPerCategoryWithItsParametersAndBounds) {
+  const auto dir = testing::FreshDir("soil");
+  testing::WriteText(dir / "scene.toml",
+                     std::string(kPlaneScene) +
+                         "[ground.medium]\nmodel = \"lu2019\"\nsoil_strength = 25\n"
+                         "compaction_drag = 4\n");
+  const SceneFile s = LoadScene((dir / "scene.toml").string());
+  const GroundParams& p = s.scene.ground.params(s.scene.ground.IndexOfName("medium"));
+  EXPECT_EQ(p.model, GroundModel::kLu2019);
+  EXPECT_EQ(p.soil_strength_mn_m2, 25);
+  EXPECT_EQ(p.compaction_drag, 4);
+  EXPECT_EQ(p.fluid_drag, 1.0);            // the paper's C_f
+  EXPECT_EQ(p.soil_density_kg_m3, 1700);  // and rho
+  EXPECT_TRUE(s.scene.ground.AnySoil());
+  EXPECT_EQ(s.scene.options.soil_drag, SoilDragPoint::kCentreOfMass);
+  testing::WriteText(dir / "scene.toml", kPlaneScene);
+  EXPECT_FALSE(LoadScene((dir / "scene.toml").string()).scene.ground.AnySoil());  // off
+  EXPECT_HAS(ErrorOf(std::string(kPlaneScene) + "[ground.medium]\nmodel = \"lu2018\"\n", dir),
+             "ground.medium.model: unknown ground model 'lu2018'; known: hard, lu2019");
+  EXPECT_HAS(ErrorOf(std::string(kPlaneScene) + "[ground.medium]\nsoil_strength = 25\n", dir),
+             "ground.medium.soil_strength: soil_strength acts only in a category with model = "
+             "\"lu2019\"");
+  EXPECT_HAS(ErrorOf(std::string(kPlaneScene) +
+                         "[ground.medium]\nmodel = \"lu2019\"\nsoil_strength = 0\n",
+                     dir),
+             "soil_strength = 0 violates 0.1 <= soil_strength <= 1000 (MN/m^2)");
+  EXPECT_HAS(ErrorOf(std::string(kPlaneScene) +
+                         "[ground.medium]\nmodel = \"lu2019\"\ncompaction_drag = nan\n",
+                     dir),
+             "compaction_drag = nan violates");
+  EXPECT_HAS(ErrorOf(std::string(kPlaneScene) + "[ground.medium]\nnu = 1e160\n", dir),
+             "nu = 1e+160 violates 0 <= nu <= 10000 (1/s)");
+  EXPECT_HAS(ErrorOf(Replace(kPlaneScene, "[solver]", "[solver]\nsoil_drag = \"centroid\""), dir),
+             "solver.soil_drag: unknown drag point 'centroid'");
+}
+
 TEST(LoadScene, ContactSolveMethodIsChosenByNameWithDidYouMean) {
   const auto dir = testing::FreshDir("contact_solve");
   testing::WriteText(dir / "scene.toml", kPlaneScene);
@@ -490,12 +526,6 @@ TEST(LoadScene, OutOfRangeIntegersAreErrors) {
                            {1000.0, 20.0, 0.0, 2050.0, 0.0, -20.0}, 31287, 255.0);
   EXPECT_HAS(ErrorOf(Replace(kDemScene, "\"data/ground.tif\"", "\"data/ground_huge.tif\""), dir),
              "has the value 1e+20");
-}
-
-TEST(ClosestName, OnlySuggestsCloseNames) {
-  EXPECT_EQ(ClosestName("sead", {"seed", "rocks"}), "seed");
-  EXPECT_EQ(ClosestName("trajectory", {"trajectories", "rasters"}), "trajectories");
-  EXPECT_EQ(ClosestName("xyz", {"seed", "rocks"}), "");
 }
 
 // The built-in rock: { rock = [a, b, c] } with its knobs; given dimensions and a mass, the

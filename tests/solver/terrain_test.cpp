@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 
 namespace talus {
@@ -83,6 +84,22 @@ Heightfield RoughHeights() {
   return hf;
 }
 
+// The largest |h - plane| on a lattice of (points + 1)^2 points over the box (x0, y0) +- r.
+double LatticeDeparture(const Terrain& t, const Terrain::LocalPlane& plane, double x0, double y0,
+                        double r, int points) {
+  double sampled = 0;
+  for (int a = 0; a <= points; ++a)
+    for (int b = 0; b <= points; ++b) {
+      const double x = x0 - r + 2 * r * a / points, y = y0 - r + 2 * r * b / points;
+      double h = 0;
+      EXPECT_TRUE(t.Height(x, y, &h));
+      const double on_plane =
+          plane.at.height_m + plane.slope_x * (x - x0) + plane.slope_y * (y - y0);
+      sampled = std::max(sampled, std::abs(h - on_plane));
+    }
+  return sampled;
+}
+
 TEST(Terrain, LocalPlaneBoundIsTheLargestDepartureOverTheBox) {
   // A rough grid (41 x 31 nodes, 1.5 m spacing) and boxes inside a cell, across cell edges and
   // over many cells: the bound is at least |h - plane| at every point of a fine lattice over the
@@ -91,26 +108,72 @@ TEST(Terrain, LocalPlaneBoundIsTheLargestDepartureOverTheBox) {
   // h - plane, below 10 here, times the lattice's spacing).
   const Heightfield hf = RoughHeights();
   const Terrain t(hf, 0);
+  // Boxes of at most Terrain::kExactCells cells a side (1.5 m cells: r <= 3 m).
   const double boxes[][3] = {{120.4, -5.3, 0.3}, {121.4, -4.6, 0.8}, {130.0, 0.0, 0.7},
-                             {140.2, 10.9, 4.0}, {103.0, -17.0, 2.9}};
+                             {140.2, 10.9, 2.9}, {103.0, -17.0, 2.9}};
   for (const auto& [x0, y0, r] : boxes) {
     Terrain::LocalPlane plane;
     ASSERT_TRUE(t.PlaneAround(x0, y0, r, &plane));
-    double sampled = 0;
     constexpr int kPoints = 200;
-    for (int a = 0; a <= kPoints; ++a)
-      for (int b = 0; b <= kPoints; ++b) {
-        const double x = x0 - r + 2 * r * a / kPoints, y = y0 - r + 2 * r * b / kPoints;
-        double h = 0;
-        ASSERT_TRUE(t.Height(x, y, &h));
-        const double on_plane =
-            plane.at.height_m + plane.slope_x * (x - x0) + plane.slope_y * (y - y0);
-        sampled = std::max(sampled, std::abs(h - on_plane));
-      }
+    const double sampled = LatticeDeparture(t, plane, x0, y0, r, kPoints);
     EXPECT_GE(plane.deviation_m, sampled) << "box at " << x0 << ", " << y0 << " +- " << r;
     EXPECT_LE(plane.deviation_m, sampled + 1e-6 + 10 * 2 * r / kPoints)
         << "box at " << x0 << ", " << y0 << " +- " << r;
   }
+}
+
+TEST(Terrain, LocalPlaneBoundOfALargeBoxHoldsFromThePyramidsBlocks) {
+  // Boxes wider than Terrain::kExactCells cells are bounded by the plane pyramid's blocks: the bound
+  // must still hold at every point of a fine lattice over the box. It is looser than the
+  // cell-by-cell bound (a block reaches beyond the box, and its plane is not the tangent plane):
+  // against the largest departure of the nodes of the cells the box touches, measured at most
+  // 2.70 times; asserted within 4 times, so that a pyramid that bounds by far too much (and makes
+  // detection test every vertex) fails. On the rough grid (1.5 m cells) and a fine one (0.05 m)
+  // with boxes of 5 to 60 cells.
+  double worst_ratio = 0;
+  for (const double cell : {1.5, 0.05}) {
+    Heightfield hf = RoughHeights();
+    hf.grid.dx_m = hf.grid.dy_m = cell;
+    hf.grid.x0_m = 100.0;
+    hf.grid.y0_m = -20.0;
+    if (cell < 1) {  // a larger, finer grid: 401 x 301 nodes of 0.05 m
+      hf.grid.nx = 401;
+      hf.grid.ny = 301;
+      hf.z_m.clear();
+      for (int j = 0; j < 301; ++j)
+        for (int i = 0; i < 401; ++i)
+          hf.z_m.push_back(0.02 * i + 0.3 * std::sin(0.13 * i) * std::cos(0.07 * j) +
+                           0.01 * ((i * 7 + j * 13) % 5));
+    }
+    const Terrain t(hf, 0);
+    for (const double span_cells : {5.0, 9.0, 20.0, 60.0}) {
+      const double r = 0.5 * span_cells * cell;
+      if (span_cells >= hf.grid.ny - 1) continue;  // wider than the rough grid
+      for (const double fx : {0.21, 0.5, 0.77}) {
+        const double x0 = hf.grid.x0_m + r + fx * (hf.grid.x_max_m() - hf.grid.x0_m - 2 * r);
+        const double y0 = hf.grid.y0_m + r + (1 - fx) * (hf.grid.y_max_m() - hf.grid.y0_m - 2 * r);
+        Terrain::LocalPlane plane;
+        ASSERT_TRUE(t.PlaneAround(x0, y0, r, &plane));
+        const double sampled = LatticeDeparture(t, plane, x0, y0, r, 120);
+        EXPECT_GE(plane.deviation_m, sampled)
+            << "cell " << cell << ", box at " << x0 << ", " << y0 << " +- " << r;
+        // The exact bound over the nodes of the cells the box touches, and the residuals.
+        double nodes = 0;
+        for (int j = 0; j < hf.grid.ny; ++j)
+          for (int i = 0; i < hf.grid.nx; ++i) {
+            const double x = hf.grid.x0_m + i * cell, y = hf.grid.y0_m + j * cell;
+            if (std::abs(x - x0) > r + cell || std::abs(y - y0) > r + cell) continue;
+            const double on_plane =
+                plane.at.height_m + plane.slope_x * (x - x0) + plane.slope_y * (y - y0);
+            nodes = std::max(nodes, std::abs(hf.z_m[j * hf.grid.nx + i] - on_plane));
+          }
+        EXPECT_LE(plane.deviation_m, 4 * nodes + 1e-6)
+            << "cell " << cell << ", box at " << x0 << ", " << y0 << " +- " << r;
+        worst_ratio = std::max(worst_ratio, plane.deviation_m / nodes);
+      }
+    }
+  }
+  std::printf("largest pyramid bound / departure at the box's nodes: %.2f\n", worst_ratio);
 }
 
 TEST(Terrain, MaxAbovePlaneBoundsTheTerrainOverTheBox) {

@@ -1,0 +1,249 @@
+#include "calibration/calibrate.hpp"
+
+#include <chrono>
+#include <cstdio>
+#include <stdexcept>
+#include <utility>
+
+namespace talus::calibration {
+namespace {
+
+// printf into a string (the stages' lines for people).
+template <class... Args>
+std::string Format(const char* format, Args... args) {
+  char line[512];
+  std::snprintf(line, sizeof line, format, args...);
+  return line;
+}
+
+std::string ProfilesReport(const std::vector<ParameterProfile>& profiles) {
+  std::string out;
+  for (const ParameterProfile& p : profiles)
+    out +=
+        Format("  %-28s profile range %-10.3g threshold %-10.3g %s\n", p.name.c_str(), p.range,
+               p.threshold,
+               p.identified ? "identified" : "UNIDENTIFIED: the observations do not constrain it");
+  return out;
+}
+
+std::string CrossValidatedReport(std::size_t folds, const std::vector<HeldOutKind>& kinds) {
+  HeldOutScores pooled;
+  pooled.kinds = kinds;
+  return Format("Cross-validated (%zu folds), every run scored by the fit without it:\n", folds) +
+         pooled.Report();
+}
+
+bool BudgetEnded(const OptimizerSummary& s) {
+  return s.termination == Termination::kMaxEvaluations || s.termination == Termination::kMaxTime;
+}
+
+// The stages of one calibration, sharing the problem, the options and the summary they fill.
+class Pipeline {
+ public:
+  Pipeline(const CalibrationProblem& problem, const CalibrationOptions& options,
+           CalibrationSummary& run)
+      : problem_(problem), objective_(problem.objective()), options_(options), run_(run) {}
+
+  void Fit();
+  void Roughness();
+  void Uncertainty();
+  void ScoreBeforeAndAfter();
+  void HoldOut();
+  void CrossValidate();
+
+ private:
+  void Say(const std::string& text) const {
+    if (options_.on_progress) options_.on_progress(text);
+  }
+  OptimizerSummary Optimise(const Objective& objective, const std::string& stage) const;
+  HeldOutScores Score(const RunSubset& runs, const GroundTable& table,
+                      const GroundTable* reference) const {
+    // Every scoring runs the scene as the objective does (its contact-solve tolerance).
+    return ScoreRuns(objective_.scene(), runs, table, reference, objective_.options().threads,
+                     objective_.needs_episodes(), objective_.options().run_ensemble);
+  }
+  const GroundTable* reference() const {
+    return problem_.reference() ? &*problem_.reference() : nullptr;
+  }
+
+  const CalibrationProblem& problem_;
+  const Objective& objective_;
+  const CalibrationOptions& options_;
+  CalibrationSummary& run_;
+};
+
+// One optimisation, its evaluations replayed from and reported to the caller by stage.
+OptimizerSummary Pipeline::Optimise(const Objective& objective, const std::string& stage) const {
+  OptimizerOptions optimizer = options_.optimizer;
+  if (const auto replay = options_.replay.find(stage); replay != options_.replay.end())
+    optimizer.replay = replay->second;
+  if (options_.on_evaluation)
+    optimizer.on_evaluation = [this, stage](const Evaluation& e, int index) {
+      options_.on_evaluation(stage, e, index);
+    };
+  if (options_.on_optimization_begins) options_.on_optimization_begins(stage);
+  OptimizerSummary summary = Optimize(objective, optimizer);
+  if (options_.on_optimization_ends) options_.on_optimization_ends(stage);
+  return summary;
+}
+
+void Pipeline::Fit() {
+  run_.fit = Optimise(objective_, "fit");
+  Say(run_.fit.FullReport());
+  if (!run_.fit.IsSolutionUsable()) throw std::runtime_error(run_.fit.message);
+  run_.fitted = objective_.GroundOf(run_.fit.best.u);
+}
+
+void Pipeline::Roughness() {
+  if (!options_.roughness) return;
+  const Evaluation& best = run_.fit.best;
+  Say("Measuring the roughness and the profiles at the optimum...\n");
+  run_.roughness = MeasureRoughness(objective_, best.u, options_.roughness_options);
+  const auto t1 = std::chrono::steady_clock::now();
+  run_.profiles = ProfileParameters(objective_, best.u, best.value, run_.roughness->level(),
+                                    options_.profile_options);
+  run_.roughness->wall_time_s +=
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
+  Say(run_.roughness->Report() + ProfilesReport(run_.profiles));
+}
+
+void Pipeline::Uncertainty() {
+  if (!options_.uncertainty) return;
+  const Evaluation& best = run_.fit.best;
+  UncertaintyOptions uncertainty = options_.uncertainty_options;
+  if (!(uncertainty.fd_step > 0))
+    uncertainty.fd_step = run_.fit.fd_step > 0 ? run_.fit.fd_step
+                          : run_.roughness     ? run_.roughness->fd_step
+                                               : 0.01;
+  uncertainty.noise = run_.roughness ? run_.roughness->level() : 0;
+  uncertainty.profiles = run_.profiles;
+  Say("Estimating the covariance at the optimum...\n");
+  run_.uncertainty = EstimateUncertainty(objective_, best.u, uncertainty, run_.fit.history);
+  Say(run_.uncertainty->Report());
+  if (options_.bootstrap_options.resamples <= 0) return;
+  BootstrapOptions bootstrap = options_.bootstrap_options;
+  bootstrap.resolution = options_.bootstrap_resolution.value_or(uncertainty.fd_step);
+  bootstrap.profiles = run_.profiles;
+  Say(Format("Bootstrap over runs: %d resamples, each refitted...\n", bootstrap.resamples));
+  run_.bootstrap = BootstrapOverRuns(objective_, best.u, bootstrap, run_.fit.history);
+  Say(run_.bootstrap->Report());
+  if (options_.seed_options.seeds <= 0) return;
+  Say(Format("Refits with %d other release seeds...\n", options_.seed_options.seeds));
+  run_.seeds = RefitWithOtherSeeds(objective_, *run_.bootstrap, bootstrap, options_.seed_options);
+  Say(run_.seeds->Report());
+}
+
+void Pipeline::ScoreBeforeAndAfter() {
+  Say("Scoring the observations before and after for the plots...\n");
+  run_.before = Score(problem_.fitted_runs(), objective_.GroundOf(run_.fit.initial.u), nullptr);
+  run_.after = Score(problem_.fitted_runs(), run_.fitted, nullptr);
+}
+
+void Pipeline::HoldOut() {
+  if (problem_.holdout().empty()) return;
+  Say(Format("Scoring the %zu held-out runs...\n", problem_.holdout().size()));
+  run_.holdout = Score(problem_.HeldOutRuns(), run_.fitted, reference());
+  Say(run_.holdout->Report());
+}
+
+void Pipeline::CrossValidate() {
+  const auto& folds = problem_.folds();
+  for (std::size_t f = 0; f < folds.size(); ++f) {
+    Say(Format("Cross-validation: fold %zu of %zu (%zu runs held out)\n", f + 1, folds.size(),
+               folds[f].size()));
+    const Objective objective = problem_.ObjectiveOn(problem_.FoldTraining(static_cast<int>(f)));
+    FoldRun fold;
+    fold.summary = Optimise(objective, "fold" + std::to_string(f + 1));
+    Say(fold.summary.BriefReport() + "\n");
+    if (!fold.summary.IsSolutionUsable())
+      throw std::runtime_error("fold " + std::to_string(f + 1) + ": " + fold.summary.message);
+    fold.scores = Score(problem_.FoldRuns(static_cast<int>(f)),
+                        objective.GroundOf(fold.summary.best.u), reference());
+    run_.folds.push_back(std::move(fold));
+  }
+  if (run_.folds.empty()) return;
+  std::vector<HeldOutScores> sets;
+  for (const FoldRun& f : run_.folds) sets.push_back(f.scores);
+  run_.cross_validated = PoolKinds(sets);
+  Say(CrossValidatedReport(run_.folds.size(), run_.cross_validated));
+}
+
+}  // namespace
+
+CalibrationProblem::CalibrationProblem(const Scene& scene, const ensemble::ReleaseSpec& release,
+                                       const fieldobs::ObservationSet& observations,
+                                       std::vector<ParameterSpec> parameters,
+                                       const ObjectiveOptions& options, HeldOutChecks checks)
+    : scene_(scene),
+      release_(release),
+      observations_(observations),
+      parameters_(std::move(parameters)),
+      options_(options),
+      checks_(std::move(checks)),
+      fit_([&] {
+        SelectRuns(release, observations, checks_.holdout, false);  // refuses an unknown id
+        return SelectRuns(release, observations, OtherRuns(release, checks_.holdout), true);
+      }()),
+      folds_(checks_.folds > 0 ? Folds(fit_.release, checks_.folds, checks_.seed)
+                               : std::vector<std::vector<std::string>>{}),
+      objective_(scene, fit_.release, fit_.observations, parameters_, options) {}
+
+RunSubset CalibrationProblem::HeldOutRuns() const {
+  return SelectRuns(release_, observations_, checks_.holdout, false);
+}
+
+RunSubset CalibrationProblem::FoldTraining(int f) const {
+  return SelectRuns(fit_.release, fit_.observations,
+                    OtherRuns(fit_.release, folds_[static_cast<std::size_t>(f)]), true);
+}
+
+RunSubset CalibrationProblem::FoldRuns(int f) const {
+  return SelectRuns(fit_.release, fit_.observations, folds_[static_cast<std::size_t>(f)], false);
+}
+
+Objective CalibrationProblem::ObjectiveOn(const RunSubset& runs) const {
+  return Objective(scene_, runs.release, runs.observations, parameters_, options_);
+}
+
+bool CalibrationSummary::BudgetEndedAFit() const {
+  bool budget = BudgetEnded(fit);
+  for (const FoldRun& f : folds) budget = budget || BudgetEnded(f.summary);
+  return budget;
+}
+
+std::string CalibrationSummary::BriefReport() const {
+  std::string out = fit.BriefReport();
+  if (holdout) out += Format("; %zu runs held out", holdout->runs.size());
+  if (!folds.empty()) out += Format("; %zu folds cross-validated", folds.size());
+  return out;
+}
+
+std::string CalibrationSummary::FullReport() const {
+  std::string out = fit.FullReport();
+  if (roughness) out += roughness->Report() + ProfilesReport(profiles);
+  if (uncertainty) out += uncertainty->Report();
+  if (bootstrap) out += bootstrap->Report();
+  if (seeds) out += seeds->Report();
+  if (holdout) out += "Held-out runs:\n" + holdout->Report();
+  for (std::size_t f = 0; f < folds.size(); ++f)
+    out += Format("Fold %zu: ", f + 1) + folds[f].summary.BriefReport() + "\n";
+  if (!folds.empty()) out += CrossValidatedReport(folds.size(), cross_validated);
+  return out;
+}
+
+CalibrationSummary Calibrate(const CalibrationProblem& problem, const CalibrationOptions& options) {
+  const auto t0 = std::chrono::steady_clock::now();
+  CalibrationSummary run;
+  run.threads = problem.objective().options().threads;
+  Pipeline stages(problem, options, run);
+  stages.Fit();
+  stages.Roughness();
+  stages.Uncertainty();
+  stages.ScoreBeforeAndAfter();
+  stages.HoldOut();
+  stages.CrossValidate();
+  run.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return run;
+}
+
+}  // namespace talus::calibration
