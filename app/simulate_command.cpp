@@ -82,7 +82,7 @@ int LoadForSimulate(const SimulateArgs& args, io::SceneFile* scene, std::pair<lo
       SolverPreset preset = SolverPreset::kDefault;
       if (!ParseSolverPreset(args.preset, &preset))
         throw InputError("--preset: unknown preset '" + args.preset +
-                         "'; known: fast, default, accurate");
+                         "'; known: " + kSolverPresetNames.List());
       io::UseSolverPreset(*scene, preset);
     }
     // The scene was valid; only --rocks can break it now (too many rocks in all).

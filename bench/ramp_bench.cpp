@@ -26,6 +26,11 @@
 
 namespace {
 
+// The names of an enum's values, for CLI11's IsMember.
+std::vector<std::string> Names(const talus::EnumNames& names) {
+  return {names.names.begin(), names.names.end()};
+}
+
 std::string CpuModel() {
   std::ifstream in("/proc/cpuinfo");
   for (std::string line; std::getline(in, line);)
@@ -197,10 +202,10 @@ int RunBenchmark(int argc, char** argv) {
   app.add_option("--seed", seed, "Seed of the release orientations");
   app.add_option("--viscous,--drag", viscous,
                  "Reading of the viscous ground term: centre_of_mass or contact_friction")
-      ->check(CLI::IsMember({"centre_of_mass", "contact_friction"}));
+      ->check(CLI::IsMember(Names(talus::kViscousReadingNames)));
   app.add_option("--contact-solve", contact_solve,
                  "Two-contact steps: gauss_seidel sweeps or one block solve")
-      ->check(CLI::IsMember({"gauss_seidel", "block"}));
+      ->check(CLI::IsMember(Names(talus::kContactSolveMethodNames)));
   bool no_profile = false, no_cells = false;
   app.add_flag("--no-profile", no_profile,
                "Skip the stage profile and the per-cell statistics runs (for instruction counts "
@@ -211,11 +216,11 @@ int RunBenchmark(int argc, char** argv) {
   std::string ground_model = "hard", soil_drag = "centre_of_mass";
   double soil_strength = 15, compaction_drag = 1.5;
   app.add_option("--ground-model", ground_model, "hard (the seed's) or lu2019 (scarring soil)")
-      ->check(CLI::IsMember({"hard", "lu2019"}));
+      ->check(CLI::IsMember(Names(talus::kGroundModelNames)));
   app.add_option("--soil-strength", soil_strength, "lu2019: M_E, MN/m^2");
   app.add_option("--compaction-drag", compaction_drag, "lu2019: C_s");
   app.add_option("--soil-drag", soil_drag, "lu2019: where the drag acts")
-      ->check(CLI::IsMember({"centre_of_mass", "submerged_centroid"}));
+      ->check(CLI::IsMember(Names(talus::kSoilDragPointNames)));
   bool detect_every_step = false;
   app.add_flag("--detect-every-step", detect_every_step,
                "Contact detection in every step, no flight windows (same results, bit for bit)");

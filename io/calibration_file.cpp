@@ -74,8 +74,8 @@ void LoadParameters(const Context& context, const toml::table& root, Calibration
     if (!s.Has("field")) s.Fail("field", "missing: one of " + Join(kFields));
     const std::string field = s.String("field", "");
     if (!calibration::ParseGroundField(field, &spec.field))
-      s.Fail("field",
-             "unknown parameter '" + field + "'" + Hint(field, kFields) + "; known: " + Join(kFields));
+      s.Fail("field", "unknown parameter '" + field + "'" + Hint(field, kFields) +
+                          "; known: " + Join(kFields));
     for (const char* bound : {"lower", "upper"})
       if (!s.Has(bound))
         s.Fail(bound, std::string("missing: the ") + bound + " bound, in " +
@@ -154,9 +154,12 @@ void LoadSolver(const Context& context, const toml::table* table, CalibrationFil
     out.tolerance_source = "scene";
   }
   if (s.Has("tolerance_m_s")) {
+    // The bounds of [solver] tolerance_m_s in scene files.
+    const SolverOptionInfo& f = *FindSolverOption("tolerance_m_s");
     tolerance = s.Checked(
-        "tolerance_m_s", tolerance, [](double v) { return v > 0 && v < 1; },
-        "must be in (0, 1) m/s (the contact solve's tolerance of every evaluation)");
+        "tolerance_m_s", tolerance, [&](double v) { return f.valid.Contains(v); },
+        "must be in " + f.valid.Interval() + " " + f.unit +
+            " (the contact solve's tolerance of every evaluation)");
     out.tolerance_source = "calibration file";
   }
 }

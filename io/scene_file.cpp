@@ -16,8 +16,7 @@
 namespace talus::io {
 namespace {
 
-using scene_tables::kMaxGravity_m_s2;
-using scene_tables::kMinGravity_m_s2;
+using scene_tables::Fmt;
 using scene_tables::kPositive;
 using scene_tables::RequireWithin;
 
@@ -50,10 +49,11 @@ void LoadGround(const Context& context, const toml::table* ground, GroundTable& 
       const std::string hint = ClosestName(name, builtin);
       for (const char* required : {"code", "mu_min", "mu_max", "beta", "kappa", "nu"})
         if (!s.Has(required))
-          s.Fail(required,
-                 std::string(
-                     "missing: a new ground category needs code, mu_min, mu_max, beta, kappa and nu") +
-                     (hint.empty() ? "" : " (or did you mean the built-in '" + hint + "'?)"));
+          s.Fail(
+              required,
+              std::string(
+                  "missing: a new ground category needs code, mu_min, mu_max, beta, kappa and nu") +
+                  (hint.empty() ? "" : " (or did you mean the built-in '" + hint + "'?)"));
     }
     const long code = s.Integer("code", category.code);
     if (code < 0 || code > 254) s.Fail("code", std::to_string(code) + " must be in 0..254");
@@ -62,7 +62,7 @@ void LoadGround(const Context& context, const toml::table* ground, GroundTable& 
     if (s.Has("model")) {
       const std::string model = s.String("model", "");
       if (!ParseGroundModel(model, &p.model))
-        s.Fail("model", "unknown ground model '" + model + "'; known: hard, lu2019");
+        s.Fail("model", "unknown ground model '" + model + "'; known: " + kGroundModelNames.List());
     }
     for (const GroundFieldInfo& f : kGroundFields) {
       p.*f.member = s.Number(f.key, p.*f.member);
@@ -102,60 +102,59 @@ std::string HashFiles(const std::vector<std::string>& files) {
   return Hex(h);
 }
 
-// A key naming one value of an enum: parsed by `parse` into *out when given; else an error naming
-// the known names and the closest one.
-template <class Enum>
-void Choice(const Section& s, const std::string& key, const std::string& what,
-            const std::vector<std::string>& known, bool (*parse)(std::string_view, Enum*),
-            Enum* out) {
-  if (!s.Has(key)) return;
+// A key naming one value of an enum: its number, or an error naming the known names and the
+// closest one.
+int Choice(const Section& s, const std::string& key, const EnumNames& names) {
   const std::string name = s.String(key, "");
-  if (parse(name, out)) return;
+  const int value = names.Find(name);
+  if (value >= 0) return value;
+  const std::vector<std::string> known(names.names.begin(), names.names.end());
   const std::string hint = ClosestName(name, known);
-  std::string list;
-  for (const std::string& k : known) list += (list.empty() ? "" : ", ") + k;
-  s.Fail(key, "unknown " + what + " '" + name + "'" +
-                  (hint.empty() ? "" : " (did you mean '" + hint + "'?)") + "; known: " + list);
+  s.Fail(key, "unknown " + std::string(names.what) + " '" + name + "'" +
+                  (hint.empty() ? "" : " (did you mean '" + hint + "'?)") +
+                  "; known: " + names.List());
+}
+
+// The value [solver] gives for option `f` (the key is there), as SolverOptionInfo::Member sets it.
+double SolverValue(const Section& s, const SolverOptionInfo& f) {
+  switch (f.type) {
+    case SolverOptionInfo::Type::kNumber: {
+      const double v = s.Number(f.key, 0);
+      if (f.HasPlausibleRange())
+        RequireWithin(s, f.key, v, f.plausible_lower, f.plausible_upper, f.unit);
+      return v;
+    }
+    case SolverOptionInfo::Type::kInteger: {
+      const long v = s.Integer(f.key, 0);
+      if (v != static_cast<int>(v))
+        s.Fail(f.key, std::to_string(v) + " is out of range (" + Fmt(f.valid.lower) + " .. " +
+                          Fmt(f.valid.upper) + ")");
+      return static_cast<double>(v);
+    }
+    case SolverOptionInfo::Type::kChoice:
+      return Choice(s, f.key, *f.choices);
+  }
+  return 0;
+}
+
+// The keys of [solver]: preset and every scene key of kSolverOptions.
+std::vector<std::string> SolverKeys() {
+  std::vector<std::string> keys = {"preset"};
+  for (const SolverOptionInfo& f : kSolverOptions)
+    if (f.scene_key) keys.emplace_back(f.key);
+  return keys;
 }
 
 void LoadSolver(const Section& s, SolverOptions& o, SolverPreset& preset,
                 std::vector<std::string>& given) {
   // The preset sets the accuracy knobs' defaults; keys given here override them.
-  if (s.Has("preset")) {
-    const std::string name = s.String("preset", "");
-    if (!ParseSolverPreset(name, &preset)) {
-      const std::string hint = ClosestName(name, {"fast", "default", "accurate"});
-      s.Fail("preset", "unknown preset '" + name + "'" +
-                           (hint.empty() ? "" : " (did you mean '" + hint + "'?)") +
-                           "; known: fast, default, accurate");
-    }
-  }
+  if (s.Has("preset")) preset = static_cast<SolverPreset>(Choice(s, "preset", kSolverPresetNames));
   ApplyPreset(preset, &o);
-  for (const char* key : {"dt_s", "tolerance_m_s", "max_iterations"})
-    if (s.Has(key)) given.push_back(key);
-  o.dt_s = s.Number("dt_s", o.dt_s);
-  o.max_time_s = s.Number("max_time_s", o.max_time_s);
-  o.gravity_m_s2 = s.Number("gravity_m_s2", o.gravity_m_s2);
-  RequireWithin(s, "gravity_m_s2", o.gravity_m_s2, kMinGravity_m_s2, kMaxGravity_m_s2, "m/s2");
-  o.normal_restitution = s.Number("normal_restitution", o.normal_restitution);
-  o.tangential_restitution = s.Number("tangential_restitution", o.tangential_restitution);
-  Choice(s, "viscous", "reading", {"centre_of_mass", "contact_friction"}, ParseViscousReading,
-         &o.viscous);
-  Choice(s, "contact_solve", "method", {"gauss_seidel", "block"}, ParseContactSolveMethod,
-         &o.contact_solve);
-  Choice(s, "predicted_lever", "lever", {"midpoint", "touch"}, ParsePredictedLever,
-         &o.predicted_lever);
-  Choice(s, "soil_drag", "drag point", {"centre_of_mass", "submerged_centroid"},
-         ParseSoilDragPoint, &o.soil_drag);
-  o.tolerance_m_s = s.Number("tolerance_m_s", o.tolerance_m_s);
-  const long max_iterations = s.Integer("max_iterations", o.max_iterations);
-  if (max_iterations != static_cast<int>(max_iterations))
-    s.Fail("max_iterations", std::to_string(max_iterations) + " is out of range (1 .. 100000)");
-  o.max_iterations = static_cast<int>(max_iterations);
-  o.prox_alpha = s.Number("prox_alpha", o.prox_alpha);
-  o.rest_speed_m_s = s.Number("rest_speed_m_s", o.rest_speed_m_s);
-  o.rest_angular_speed_rad_s = s.Number("rest_angular_speed_rad_s", o.rest_angular_speed_rad_s);
-  o.rest_hold_s = s.Number("rest_hold_s", o.rest_hold_s);
+  for (const SolverOptionInfo& f : kSolverOptions) {
+    if (!f.scene_key || !s.Has(f.key)) continue;
+    if (f.preset_knob) given.emplace_back(f.key);
+    f.member.set(o, SolverValue(s, f));
+  }
   std::string why;
   if (!o.IsValid(&why)) s.FailCheck(why);
 }
@@ -220,11 +219,9 @@ void LoadOutput(const Section& s, OutputSpec& o) {
 void UseSolverPreset(SceneFile& scene, SolverPreset preset) {
   SolverOptions o = scene.scene.options;
   ApplyPreset(preset, &o);
-  const SolverOptions& given = scene.scene.options;
   for (const std::string& key : scene.solver_keys_given) {
-    if (key == "dt_s") o.dt_s = given.dt_s;
-    if (key == "tolerance_m_s") o.tolerance_m_s = given.tolerance_m_s;
-    if (key == "max_iterations") o.max_iterations = given.max_iterations;
+    const SolverOptionInfo* f = FindSolverOption(key);
+    f->member.set(o, f->member.get(scene.scene.options));
   }
   scene.scene.options = o;
   scene.solver_preset = preset;
@@ -292,11 +289,7 @@ SceneFile LoadScene(const std::string& path) {
       Section(context, SubTable(context, root, "evaluation_lines"), "evaluation_lines",
               {"lines", "names", "file", "name_field"}),
       out);
-  LoadSolver(Section(context, SubTable(context, root, "solver"), "solver",
-                     {"preset", "dt_s", "max_time_s", "gravity_m_s2", "normal_restitution",
-                      "tangential_restitution", "viscous", "contact_solve", "predicted_lever",
-                      "soil_drag", "tolerance_m_s", "max_iterations", "prox_alpha",
-                      "rest_speed_m_s", "rest_angular_speed_rad_s", "rest_hold_s"}),
+  LoadSolver(Section(context, SubTable(context, root, "solver"), "solver", SolverKeys()),
              out.scene.options, out.solver_preset, out.solver_keys_given);
   LoadOutput(Section(context, SubTable(context, root, "output"), "output",
                      {"trajectories", "trajectory_interval_s", "rasters", "percentiles",

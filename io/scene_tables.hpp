@@ -32,7 +32,6 @@ inline constexpr double kMinDensity_kg_m3 = 100, kMaxDensity_kg_m3 = 30000;
 inline constexpr double kMinVolume_m3 = 1e-9, kMaxVolume_m3 = 1e6;
 inline constexpr double kMaxSpeed_m_s = 200, kMaxAngularSpeed_rad_s = 1000;
 inline constexpr double kMaxReleaseHeight_m = 10000;
-inline constexpr double kMinGravity_m_s2 = 0.1, kMaxGravity_m_s2 = 100;
 
 // "<v> is outside <lo> .. <hi> <unit>", or "" when lo <= v <= hi.
 inline std::string OutsideBounds(double v, double lo, double hi, const std::string& unit) {

@@ -5,24 +5,24 @@
 namespace talus::io {
 namespace {
 
-// Every solver option, by the names of the scene's [solver] table.
+// Every solver option (kSolverOptions), by the names of the scene's [solver] table.
 nlohmann::ordered_json SolverJson(const SolverOptions& o) {
-  return {{"dt_s", o.dt_s},
-          {"max_time_s", o.max_time_s},
-          {"gravity_m_s2", o.gravity_m_s2},
-          {"normal_restitution", o.normal_restitution},
-          {"tangential_restitution", o.tangential_restitution},
-          {"viscous", ToString(o.viscous)},
-          {"contact_solve", ToString(o.contact_solve)},
-          {"tolerance_m_s", o.tolerance_m_s},
-          {"max_iterations", o.max_iterations},
-          {"prox_alpha", o.prox_alpha},
-          {"penetration_tolerance", o.penetration_tolerance},
-          {"predicted_lever", ToString(o.predicted_lever)},
-          {"soil_drag", ToString(o.soil_drag)},
-          {"rest_speed_m_s", o.rest_speed_m_s},
-          {"rest_angular_speed_rad_s", o.rest_angular_speed_rad_s},
-          {"rest_hold_s", o.rest_hold_s}};
+  nlohmann::ordered_json j = nlohmann::ordered_json::object();
+  for (const SolverOptionInfo& f : kSolverOptions) {
+    const double v = f.member.get(o);
+    switch (f.type) {
+      case SolverOptionInfo::Type::kNumber:
+        j[f.key] = v;
+        break;
+      case SolverOptionInfo::Type::kInteger:
+        j[f.key] = static_cast<int>(v);
+        break;
+      case SolverOptionInfo::Type::kChoice:
+        j[f.key] = f.choices->Name(static_cast<int>(v));
+        break;
+    }
+  }
+  return j;
 }
 
 // The ground table the run used, by the keys of the scene's [ground.<name>] tables; the drag

@@ -1,7 +1,6 @@
 #include "solver/ground.hpp"
 
 #include <cmath>
-#include <limits>
 #include <numbers>
 #include <sstream>
 
@@ -17,50 +16,45 @@ double GroundParams::PenetrationDepth(double mass_kg, double vertical_speed_m_s)
          std::pow(std::abs(vertical_speed_m_s), 0.8);
 }
 
-const char* ToString(GroundModel model) {
-  return model == GroundModel::kLu2019 ? "lu2019" : "hard";
-}
-
-bool ParseGroundModel(std::string_view name, GroundModel* model) {
-  for (GroundModel m : {GroundModel::kHard, GroundModel::kLu2019})
-    if (name == ToString(m)) {
-      *model = m;
-      return true;
-    }
-  return false;
-}
-
 namespace {
-constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr std::array<const char*, 2> kGroundModels = {"hard", "lu2019"};
 using Group = GroundFieldInfo::Group;
 }  // namespace
 
+constinit const EnumNames kGroundModelNames{"ground model", kGroundModels};
+
+const char* ToString(GroundModel model) { return kGroundModelNames.NameOf(model); }
+
+bool ParseGroundModel(std::string_view name, GroundModel* model) {
+  return kGroundModelNames.Parse(name, model);
+}
+
 // The order of the calibrated fields is calibration::GroundField's.
 const std::array<GroundFieldInfo, 12> kGroundFields = {{
-    {"mu_min", &GroundParams::mu_min, "1", 0, 10, false, Group::kFriction, true, false,
+    {"mu_min", &GroundParams::mu_min, "1", Bounds::Between(0, 10), Group::kFriction, true, false,
      "friction coefficient at the start of a scar"},
-    {"mu_max", &GroundParams::mu_max, "1", 0, 10, false, Group::kFriction, true, false,
+    {"mu_max", &GroundParams::mu_max, "1", Bounds::Between(0, 10), Group::kFriction, true, false,
      "limit friction coefficient of a long scar (>= mu_min)"},
-    {"beta", &GroundParams::beta_1_s, "1/s", 0, 1e5, false, Group::kFriction, true, true,
+    {"beta", &GroundParams::beta_1_s, "1/s", Bounds::Between(0, 1e5), Group::kFriction, true, true,
      "scar decay rate in flight"},
-    {"kappa", &GroundParams::kappa_1_m, "1/m", 0, 1e4, false, Group::kFriction, true, true,
-     "scar hardening rate"},
-    {"nu", &GroundParams::nu_1_s, "1/s", 0, 1e4, false, Group::kFriction, true, true,
+    {"kappa", &GroundParams::kappa_1_m, "1/m", Bounds::Between(0, 1e4), Group::kFriction, true,
+     true, "scar hardening rate"},
+    {"nu", &GroundParams::nu_1_s, "1/s", Bounds::Between(0, 1e4), Group::kFriction, true, true,
      "viscous ground term while in contact ([solver] viscous)"},
-    {"soil_strength", &GroundParams::soil_strength_mn_m2, "MN/m^2", 0.1, 1000, false,
+    {"soil_strength", &GroundParams::soil_strength_mn_m2, "MN/m^2", Bounds::Between(0.1, 1000),
      Group::kSoil, true, true,
      "M_E, soil strength of eq. 11 (Lu et al. 2019; the formula takes kN/m^2)"},
-    {"compaction_drag", &GroundParams::compaction_drag, "1", 0, 100, false, Group::kSoil, true,
-     false, "C_s, compaction part of the scar drag coefficient (eq. 12)"},
-    {"fluid_drag", &GroundParams::fluid_drag, "1", 0, 100, false, Group::kSoil, false, false,
-     "C_f, fluid part of the scar drag coefficient (eq. 12)"},
-    {"soil_density", &GroundParams::soil_density_kg_m3, "kg/m^3", 100, 3000, false, Group::kSoil,
-     false, false, "rho_Sigma, density of the scarring layer (eq. 9)"},
-    {"drag_height_m", &GroundParams::drag_height_m, "m", 0, 100, false, Group::kDragLayer, false,
-     false, "drag layer thickness above the terrain"},
-    {"drag_translational", &GroundParams::drag_translational_1_s, "1/s", 0, 1000, false,
+    {"compaction_drag", &GroundParams::compaction_drag, "1", Bounds::Between(0, 100), Group::kSoil,
+     true, false, "C_s, compaction part of the scar drag coefficient (eq. 12)"},
+    {"fluid_drag", &GroundParams::fluid_drag, "1", Bounds::Between(0, 100), Group::kSoil, false,
+     false, "C_f, fluid part of the scar drag coefficient (eq. 12)"},
+    {"soil_density", &GroundParams::soil_density_kg_m3, "kg/m^3", Bounds::Between(100, 3000),
+     Group::kSoil, false, false, "rho_Sigma, density of the scarring layer (eq. 9)"},
+    {"drag_height_m", &GroundParams::drag_height_m, "m", Bounds::Between(0, 100), Group::kDragLayer,
+     false, false, "drag layer thickness above the terrain"},
+    {"drag_translational", &GroundParams::drag_translational_1_s, "1/s", Bounds::Between(0, 1000),
      Group::kDragLayer, false, false, "drag layer: v decays as exp(-c_t t)"},
-    {"drag_rotational", &GroundParams::drag_rotational_1_s, "1/s", 0, 1000, false,
+    {"drag_rotational", &GroundParams::drag_rotational_1_s, "1/s", Bounds::Between(0, 1000),
      Group::kDragLayer, false, false, "drag layer: Omega decays as exp(-c_r t)"},
 }};
 
@@ -85,14 +79,10 @@ bool GroundFieldApplies(const GroundFieldInfo& field, const GroundParams& params
 bool GroundParams::IsValid(std::string* why) const {
   for (const GroundFieldInfo& f : kGroundFields) {
     const double v = this->*f.member;
-    const bool ok =
-        std::isfinite(v) && (f.lower_open ? v > f.lower : v >= f.lower) && v <= f.upper;
-    if (ok) continue;
+    if (f.valid.Contains(v)) continue;
     if (why) {
       std::ostringstream msg;
-      msg << f.key << " = " << v << " violates " << f.lower << (f.lower_open ? " < " : " <= ")
-          << f.key;
-      if (f.upper < kInf) msg << " <= " << f.upper;
+      msg << f.key << " = " << v << " violates " << f.valid.Describe(f.key);
       if (std::string_view(f.unit) != "1") msg << " (" << f.unit << ")";
       *why = msg.str();
     }
@@ -122,8 +112,8 @@ bool GroundTable::AnySoil() const {
 }
 
 const std::array<const char*, 8>& GroundTable::BuiltInNames() {
-  static const std::array<const char*, 8> names = {
-      "extra_soft", "soft", "medium_soft", "medium", "medium_hard", "hard", "extra_hard", "snow"};
+  static const std::array<const char*, 8> names = {"extra_soft",  "soft", "medium_soft", "medium",
+                                                   "medium_hard", "hard", "extra_hard",  "snow"};
   return names;
 }
 

@@ -7,6 +7,8 @@
 #include <string_view>
 #include <vector>
 
+#include "solver/option_table.hpp"
+
 namespace talus {
 
 // What lies under the DEM surface of a category (docs/model.md, "The scarring soil").
@@ -19,7 +21,8 @@ enum class GroundModel {
   // contact with mu(s) (eqs. 13, 14).
   kLu2019,
 };
-const char* ToString(GroundModel model);  // "hard", "lu2019"
+extern const EnumNames kGroundModelNames;  // "hard", "lu2019"
+const char* ToString(GroundModel model);
 bool ParseGroundModel(std::string_view name, GroundModel* model);
 
 // Parameters of one ground category (seed paper, Eqs. 1-3 and Table 1).
@@ -72,15 +75,14 @@ struct GroundParams {
 // list of ground fields reads kGroundFields, so that a new field is one row here.
 struct GroundFieldInfo {
   enum class Group {
-    kFriction,    // the seed's five parameters; always written
-    kDragLayer,   // written for a category with a drag layer
-    kSoil,        // written for a category with model = "lu2019"
+    kFriction,   // the seed's five parameters; always written
+    kDragLayer,  // written for a category with a drag layer
+    kSoil,       // written for a category with model = "lu2019"
   };
   const char* key;  // scene key in [ground.<name>], e.g. "mu_min"
   double GroundParams::*member;
-  const char* unit;    // "1" for dimensionless
-  double lower, upper;  // valid values: lower <= value <= upper (finite); see lower_open
-  bool lower_open;      // lower < value instead of lower <= value
+  const char* unit;  // "1" for dimensionless
+  Bounds valid;      // GroundParams::IsValid
   Group group;
   bool calibrated;  // calibration may free it (calibration::GroundField has the same order)
   bool log_scale;   // calibration's default transform

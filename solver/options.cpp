@@ -1,111 +1,198 @@
 #include "solver/options.hpp"
 
-#include <cmath>
 #include <sstream>
+#include <type_traits>
 
 namespace talus {
 
-const char* ToString(ViscousReading reading) {
-  switch (reading) {
-    case ViscousReading::kCentreOfMass:
-      return "centre_of_mass";
-    case ViscousReading::kContactFriction:
-      return "contact_friction";
-  }
-  return "unknown";
-}
+namespace {
 
+constexpr std::array<const char*, 2> kViscousReadings = {"centre_of_mass", "contact_friction"};
+constexpr std::array<const char*, 2> kContactSolveMethods = {"gauss_seidel", "block"};
+constexpr std::array<const char*, 2> kPredictedLevers = {"midpoint", "touch"};
+constexpr std::array<const char*, 2> kSoilDragPoints = {"centre_of_mass", "submerged_centroid"};
+constexpr std::array<const char*, 3> kSolverPresets = {"fast", "default", "accurate"};
+
+}  // namespace
+
+constinit const EnumNames kViscousReadingNames{"reading", kViscousReadings};
+constinit const EnumNames kContactSolveMethodNames{"method", kContactSolveMethods};
+constinit const EnumNames kPredictedLeverNames{"lever", kPredictedLevers};
+constinit const EnumNames kSoilDragPointNames{"drag point", kSoilDragPoints};
+constinit const EnumNames kSolverPresetNames{"preset", kSolverPresets};
+
+const char* ToString(ViscousReading reading) { return kViscousReadingNames.NameOf(reading); }
 bool ParseViscousReading(std::string_view name, ViscousReading* reading) {
-  for (ViscousReading r : {ViscousReading::kCentreOfMass, ViscousReading::kContactFriction}) {
-    if (name == ToString(r)) {
-      *reading = r;
-      return true;
-    }
-  }
-  return false;
+  return kViscousReadingNames.Parse(name, reading);
 }
 
-const char* ToString(ContactSolveMethod method) {
-  switch (method) {
-    case ContactSolveMethod::kGaussSeidel:
-      return "gauss_seidel";
-    case ContactSolveMethod::kBlock:
-      return "block";
-  }
-  return "unknown";
-}
-
+const char* ToString(ContactSolveMethod method) { return kContactSolveMethodNames.NameOf(method); }
 bool ParseContactSolveMethod(std::string_view name, ContactSolveMethod* method) {
-  for (ContactSolveMethod m : {ContactSolveMethod::kGaussSeidel, ContactSolveMethod::kBlock}) {
-    if (name == ToString(m)) {
-      *method = m;
-      return true;
-    }
-  }
-  return false;
+  return kContactSolveMethodNames.Parse(name, method);
 }
 
-const char* ToString(PredictedLever lever) {
-  switch (lever) {
-    case PredictedLever::kMidpoint:
-      return "midpoint";
-    case PredictedLever::kTouch:
-      return "touch";
-  }
-  return "unknown";
-}
-
+const char* ToString(PredictedLever lever) { return kPredictedLeverNames.NameOf(lever); }
 bool ParsePredictedLever(std::string_view name, PredictedLever* lever) {
-  for (PredictedLever l : {PredictedLever::kMidpoint, PredictedLever::kTouch}) {
-    if (name == ToString(l)) {
-      *lever = l;
-      return true;
-    }
-  }
-  return false;
+  return kPredictedLeverNames.Parse(name, lever);
 }
 
-const char* ToString(SoilDragPoint point) {
-  return point == SoilDragPoint::kSubmergedCentroid ? "submerged_centroid" : "centre_of_mass";
-}
-
+const char* ToString(SoilDragPoint point) { return kSoilDragPointNames.NameOf(point); }
 bool ParseSoilDragPoint(std::string_view name, SoilDragPoint* point) {
-  for (SoilDragPoint p : {SoilDragPoint::kCentreOfMass, SoilDragPoint::kSubmergedCentroid}) {
-    if (name == ToString(p)) {
-      *point = p;
-      return true;
-    }
-  }
-  return false;
+  return kSoilDragPointNames.Parse(name, point);
 }
 
-const char* ToString(SolverPreset preset) {
-  switch (preset) {
-    case SolverPreset::kFast:
-      return "fast";
-    case SolverPreset::kDefault:
-      return "default";
-    case SolverPreset::kAccurate:
-      return "accurate";
-  }
-  return "unknown";
-}
-
+const char* ToString(SolverPreset preset) { return kSolverPresetNames.NameOf(preset); }
 bool ParseSolverPreset(std::string_view name, SolverPreset* preset) {
-  for (SolverPreset p : {SolverPreset::kFast, SolverPreset::kDefault, SolverPreset::kAccurate}) {
-    if (name == ToString(p)) {
-      *preset = p;
-      return true;
-    }
-  }
-  return false;
+  return kSolverPresetNames.Parse(name, preset);
+}
+
+namespace {
+
+using O = SolverOptions;
+using Type = SolverOptionInfo::Type;
+
+template <auto kMember>
+constexpr SolverOptionInfo::Member MemberOf() {
+  return {[](const SolverOptions& o) { return static_cast<double>(o.*kMember); },
+          [](SolverOptions& o, double v) {
+            using T = std::remove_cvref_t<decltype(o.*kMember)>;
+            if constexpr (std::is_enum_v<T>) {
+              o.*kMember = static_cast<T>(static_cast<int>(v));
+            } else {
+              o.*kMember = static_cast<T>(v);
+            }
+          }};
+}
+
+// A choice's valid values: the numbers of its enumerators.
+template <std::size_t N>
+constexpr Bounds Choices(const std::array<const char*, N>& /*names*/) {
+  return Bounds::Between(0, static_cast<double>(N) - 1);
+}
+
+}  // namespace
+
+// In the order of summary.json's "solver".
+constinit const std::array<SolverOptionInfo, 16> kSolverOptions = {{
+    {.key = "dt_s",
+     .type = Type::kNumber,
+     .member = MemberOf<&O::dt_s>(),
+     .unit = "s",
+     .valid = Bounds::AboveAtMost(0, 0.1),
+     .preset_knob = true,
+     .doc = "time step"},
+    {.key = "max_time_s",
+     .type = Type::kNumber,
+     .member = MemberOf<&O::max_time_s>(),
+     .unit = "s",
+     .valid = Bounds::Above(0),
+     .doc = "a rock still moving then ends as max_time"},
+    {.key = "gravity_m_s2",
+     .type = Type::kNumber,
+     .member = MemberOf<&O::gravity_m_s2>(),
+     .unit = "m/s2",
+     .valid = Bounds::AtLeast(0),
+     .plausible_lower = 0.1,
+     .plausible_upper = 100,
+     .doc = "along -z"},
+    {.key = "normal_restitution",
+     .type = Type::kNumber,
+     .member = MemberOf<&O::normal_restitution>(),
+     .unit = "1",
+     .valid = Bounds::Between(0, 1),
+     .doc = "epsilon_N; the model is fully plastic (0)"},
+    {.key = "tangential_restitution",
+     .type = Type::kNumber,
+     .member = MemberOf<&O::tangential_restitution>(),
+     .unit = "1",
+     .valid = Bounds::Between(-1, 1),
+     .doc = "epsilon_T; 0: no tangential rebound"},
+    {.key = "viscous",
+     .type = Type::kChoice,
+     .member = MemberOf<&O::viscous>(),
+     .unit = "1",
+     .valid = Choices(kViscousReadings),
+     .choices = &kViscousReadingNames,
+     .doc = "how the ground's nu acts (below)"},
+    {.key = "contact_solve",
+     .type = Type::kChoice,
+     .member = MemberOf<&O::contact_solve>(),
+     .unit = "1",
+     .valid = Choices(kContactSolveMethods),
+     .choices = &kContactSolveMethodNames,
+     .doc = "how a step with two contacts is solved (below)"},
+    {.key = "tolerance_m_s",
+     .type = Type::kNumber,
+     .member = MemberOf<&O::tolerance_m_s>(),
+     .unit = "m/s",
+     .valid = Bounds::Inside(0, 1),
+     .preset_knob = true,
+     .doc = "the contact solve stops when no sweep changes a contact velocity by more"},
+    {.key = "max_iterations",
+     .type = Type::kInteger,
+     .member = MemberOf<&O::max_iterations>(),
+     .unit = "1",
+     .valid = Bounds::Between(1, 100000),
+     .preset_knob = true,
+     .doc = "contact solve sweeps at most"},
+    {.key = "prox_alpha",
+     .type = Type::kNumber,
+     .member = MemberOf<&O::prox_alpha>(),
+     .unit = "1",
+     .valid = Bounds::Inside(0, 2),
+     .doc = "step length of the contact solve's prox iteration"},
+    // Not a scene key (yet): summary.json records it so that a run's options are all stated.
+    {.key = "penetration_tolerance",
+     .type = Type::kNumber,
+     .member = MemberOf<&O::penetration_tolerance>(),
+     .unit = "1",
+     .valid = Bounds::AboveAtMost(0, 0.5),
+     .scene_key = false,
+     .doc = "a predicted contact is stopped at this fraction of the rock's thickness"},
+    {.key = "predicted_lever",
+     .type = Type::kChoice,
+     .member = MemberOf<&O::predicted_lever>(),
+     .unit = "1",
+     .valid = Choices(kPredictedLevers),
+     .choices = &kPredictedLeverNames,
+     .doc = "where a predicted contact's percussion acts (below)"},
+    {.key = "soil_drag",
+     .type = Type::kChoice,
+     .member = MemberOf<&O::soil_drag>(),
+     .unit = "1",
+     .valid = Choices(kSoilDragPoints),
+     .choices = &kSoilDragPointNames,
+     .doc = "where the scar drag of a soil category acts (below)"},
+    {.key = "rest_speed_m_s",
+     .type = Type::kNumber,
+     .member = MemberOf<&O::rest_speed_m_s>(),
+     .unit = "m/s",
+     .valid = Bounds::AtLeast(0),
+     .doc = "at rest: slower than this, in contact, for rest_hold_s"},
+    {.key = "rest_angular_speed_rad_s",
+     .type = Type::kNumber,
+     .member = MemberOf<&O::rest_angular_speed_rad_s>(),
+     .unit = "rad/s",
+     .valid = Bounds::AtLeast(0),
+     .doc = "at rest: turning slower than this, in contact, for rest_hold_s"},
+    {.key = "rest_hold_s",
+     .type = Type::kNumber,
+     .member = MemberOf<&O::rest_hold_s>(),
+     .unit = "s",
+     .valid = Bounds::AtLeast(0),
+     .doc = "how long a rock must be slow to be at rest"},
+}};
+
+const SolverOptionInfo* FindSolverOption(std::string_view key) {
+  for (const SolverOptionInfo& f : kSolverOptions)
+    if (key == f.key) return &f;
+  return nullptr;
 }
 
 void ApplyPreset(SolverPreset preset, SolverOptions* options) {
   const SolverOptions defaults;
-  options->dt_s = defaults.dt_s;
-  options->tolerance_m_s = defaults.tolerance_m_s;
-  options->max_iterations = defaults.max_iterations;
+  for (const SolverOptionInfo& f : kSolverOptions)
+    if (f.preset_knob) f.member.set(*options, f.member.get(defaults));
   switch (preset) {
     case SolverPreset::kFast:
       options->tolerance_m_s = 1e-2;
@@ -121,45 +208,23 @@ void ApplyPreset(SolverPreset preset, SolverOptions* options) {
 }
 
 bool SolverOptions::IsValid(std::string* why) const {
-  std::ostringstream msg;
-  auto check = [&](bool ok, const char* field, double value, const char* bound) {
-    if (!ok && msg.str().empty()) msg << field << " = " << value << " violates " << bound;
-  };
-  check(dt_s > 0 && dt_s <= 0.1, "dt_s", dt_s, "0 < dt_s <= 0.1 s");
-  check(max_time_s > 0 && std::isfinite(max_time_s), "max_time_s", max_time_s,
-        "0 < max_time_s < inf");
-  check(gravity_m_s2 >= 0 && std::isfinite(gravity_m_s2), "gravity_m_s2", gravity_m_s2,
-        "gravity >= 0");
-  check(normal_restitution >= 0 && normal_restitution <= 1, "normal_restitution",
-        normal_restitution, "0 <= normal_restitution <= 1");
-  check(tangential_restitution >= -1 && tangential_restitution <= 1, "tangential_restitution",
-        tangential_restitution, "-1 <= tangential_restitution <= 1");
-  check(viscous == ViscousReading::kCentreOfMass || viscous == ViscousReading::kContactFriction,
-        "viscous", static_cast<double>(viscous), "a ViscousReading value");
-  check(tolerance_m_s > 0 && tolerance_m_s < 1, "tolerance_m_s", tolerance_m_s,
-        "0 < tolerance_m_s < 1 m/s");
-  check(max_iterations >= 1 && max_iterations <= 100000, "max_iterations", max_iterations,
-        "1 <= max_iterations <= 100000");
-  check(contact_solve == ContactSolveMethod::kGaussSeidel ||
-            contact_solve == ContactSolveMethod::kBlock,
-        "contact_solve", static_cast<double>(contact_solve), "a ContactSolveMethod value");
-  check(prox_alpha > 0 && prox_alpha < 2, "prox_alpha", prox_alpha, "0 < prox_alpha < 2");
-  check(penetration_tolerance > 0 && penetration_tolerance <= 0.5, "penetration_tolerance",
-        penetration_tolerance, "0 < penetration_tolerance <= 0.5");
-  check(predicted_lever == PredictedLever::kMidpoint || predicted_lever == PredictedLever::kTouch,
-        "predicted_lever", static_cast<double>(predicted_lever), "a PredictedLever value");
-  check(soil_drag == SoilDragPoint::kCentreOfMass ||
-            soil_drag == SoilDragPoint::kSubmergedCentroid,
-        "soil_drag", static_cast<double>(soil_drag), "a SoilDragPoint value");
-  check(rest_speed_m_s >= 0 && std::isfinite(rest_speed_m_s), "rest_speed_m_s", rest_speed_m_s,
-        "rest_speed_m_s >= 0");
-  check(rest_angular_speed_rad_s >= 0 && std::isfinite(rest_angular_speed_rad_s),
-        "rest_angular_speed_rad_s", rest_angular_speed_rad_s, "rest_angular_speed_rad_s >= 0");
-  check(rest_hold_s >= 0 && std::isfinite(rest_hold_s), "rest_hold_s", rest_hold_s,
-        "rest_hold_s >= 0");
-  if (msg.str().empty()) return true;
-  if (why) *why = msg.str();
-  return false;
+  for (const SolverOptionInfo& f : kSolverOptions) {
+    const double v = f.member.get(*this);
+    if (f.valid.Contains(v)) continue;
+    if (why) {
+      std::ostringstream msg;
+      msg << f.key << " = " << v;
+      if (f.choices) {
+        msg << " is not one of " << f.choices->List();
+      } else {
+        msg << " violates " << f.valid.Describe(f.key);
+        if (std::string_view(f.unit) != "1") msg << " " << f.unit;
+      }
+      *why = msg.str();
+    }
+    return false;
+  }
+  return true;
 }
 
 }  // namespace talus

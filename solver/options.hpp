@@ -1,8 +1,11 @@
 #pragma once
 // Solver options: every knob a user trades against accuracy, with defaults, units and a check.
 
+#include <array>
 #include <string>
 #include <string_view>
+
+#include "solver/option_table.hpp"
 
 namespace talus {
 
@@ -18,8 +21,9 @@ enum class ViscousReading {
   // feels -m nu v (the seed's S_v); a rolling contact that does not slip feels nothing.
   kContactFriction,
 };
-const char* ToString(ViscousReading reading);  // "centre_of_mass", "contact_friction"
-// False when `name` is not one of the names ToString gives.
+extern const EnumNames kViscousReadingNames;   // "centre_of_mass", "contact_friction"
+const char* ToString(ViscousReading reading);  // its name in kViscousReadingNames
+// False, leaving *reading as it is, when `name` is not one of the names ToString gives.
 bool ParseViscousReading(std::string_view name, ViscousReading* reading);
 
 // How the contact solve treats a step with two contacts (a rock on an edge). Scene files name the
@@ -34,7 +38,8 @@ enum class ContactSolveMethod {
   // at the solver tolerance. Other contact counts are solved as with kGaussSeidel.
   kBlock,
 };
-const char* ToString(ContactSolveMethod method);  // "gauss_seidel", "block"
+extern const EnumNames kContactSolveMethodNames;  // "gauss_seidel", "block"
+const char* ToString(ContactSolveMethod method);
 bool ParseContactSolveMethod(std::string_view name, ContactSolveMethod* method);
 
 // Where the percussion of a predicted contact (a vertex open at the midpoint that the step's free
@@ -47,7 +52,8 @@ enum class PredictedLever {
   // contact acts").
   kTouch,
 };
-const char* ToString(PredictedLever lever);  // "midpoint", "touch"
+extern const EnumNames kPredictedLeverNames;  // "midpoint", "touch"
+const char* ToString(PredictedLever lever);
 bool ParsePredictedLever(std::string_view name, PredictedLever* lever);
 
 // Where the scar drag of the scarring soil (Lu et al. 2019, eq. 9) acts. Scene files name the
@@ -61,9 +67,12 @@ enum class SoilDragPoint {
   // the missing drag torque as why rotational energy is matched only roughly).
   kSubmergedCentroid,
 };
-const char* ToString(SoilDragPoint point);  // "centre_of_mass", "submerged_centroid"
+extern const EnumNames kSoilDragPointNames;  // "centre_of_mass", "submerged_centroid"
+const char* ToString(SoilDragPoint point);
 bool ParseSoilDragPoint(std::string_view name, SoilDragPoint* point);
 
+// Every option below is a row of kSolverOptions (after the struct): its key, unit, bounds and doc
+// line, from which [solver] in scene files, summary.json, IsValid and the docs' table are read.
 struct SolverOptions {
   double dt_s = 0.002;                  // time step
   double max_time_s = 300;              // a rock still moving then ends as max_time
@@ -97,9 +106,46 @@ struct SolverOptions {
   double rest_angular_speed_rad_s = 0.05;
   double rest_hold_s = 1.0;
 
-  // False, with the field, value and violated bound in *why, when an option is out of range.
+  // False, with the field, value and violated bound in *why, when an option is out of range
+  // (kSolverOptions' bounds).
   bool IsValid(std::string* why) const;
 };
+
+// One option of SolverOptions as scene files ([solver]), summary.json and docs/scenes.md name it:
+// every list of solver options reads kSolverOptions, so that a new option is one row there (and
+// the code that uses it).
+struct SolverOptionInfo {
+  enum class Type {
+    kNumber,   // a double
+    kInteger,  // an int
+    kChoice,   // an enum, by the names of `choices`
+  };
+  // Reads and writes the option's member as a double (an enum: its enumerator's number).
+  struct Member {
+    double (*get)(const SolverOptions&);
+    void (*set)(SolverOptions&, double);
+  };
+  const char* key;  // in [solver] and summary.json, e.g. "dt_s"
+  Type type;
+  Member member;
+  const char* unit;  // "1" for dimensionless numbers and for choices
+  // Valid values (IsValid); a choice: 0 .. the number of names - 1.
+  Bounds valid;
+  // Scene files also reject finite values outside plausible_lower .. plausible_upper (a typo or a
+  // wrong unit that would otherwise run), where that is narrower than `valid`.
+  double plausible_lower = -Bounds::kInf, plausible_upper = Bounds::kInf;
+  const EnumNames* choices = nullptr;  // kChoice: the names of the values
+  bool scene_key = true;               // read from [solver] (else only written to summary.json)
+  bool preset_knob = false;            // set by a SolverPreset (ApplyPreset)
+  const char* doc = "";                // one line for the docs' table
+
+  bool HasPlausibleRange() const {
+    return plausible_lower > -Bounds::kInf || plausible_upper < Bounds::kInf;
+  }
+};
+extern const std::array<SolverOptionInfo, 16> kSolverOptions;
+// nullptr when `key` is no option's key.
+const SolverOptionInfo* FindSolverOption(std::string_view key);
 
 // Named settings of the accuracy knobs (dt_s, tolerance_m_s, max_iterations), chosen from the
 // work-precision study on the ramp and cases/tirol (bench/README.md, "The work-precision map of
@@ -114,9 +160,11 @@ struct SolverOptions {
 //   default; it is the step whose statistics agree with dt 0.5 ms on both scenes, where dt 2 ms
 //   shortens tirol's runout median by 81 +- 18 m: the setting to check a result against).
 enum class SolverPreset { kFast, kDefault, kAccurate };
-const char* ToString(SolverPreset preset);  // "fast", "default", "accurate"
+extern const EnumNames kSolverPresetNames;  // "fast", "default", "accurate"
+const char* ToString(SolverPreset preset);
 bool ParseSolverPreset(std::string_view name, SolverPreset* preset);
-// Sets the preset's knobs in *options, leaving every other option as it is.
+// Sets the preset's knobs (kSolverOptions' rows with preset_knob) in *options, leaving every other
+// option as it is.
 void ApplyPreset(SolverPreset preset, SolverOptions* options);
 
 }  // namespace talus

@@ -219,7 +219,7 @@ TEST(LoadScene, ScarringSoilPerCategoryWithItsParametersAndBounds) {
   EXPECT_EQ(p.model, GroundModel::kLu2019);
   EXPECT_EQ(p.soil_strength_mn_m2, 25);
   EXPECT_EQ(p.compaction_drag, 4);
-  EXPECT_EQ(p.fluid_drag, 1.0);            // the paper's C_f
+  EXPECT_EQ(p.fluid_drag, 1.0);           // the paper's C_f
   EXPECT_EQ(p.soil_density_kg_m3, 1700);  // and rho
   EXPECT_TRUE(s.scene.ground.AnySoil());
   EXPECT_EQ(s.scene.options.soil_drag, SoilDragPoint::kCentreOfMass);
@@ -230,10 +230,10 @@ TEST(LoadScene, ScarringSoilPerCategoryWithItsParametersAndBounds) {
   EXPECT_HAS(ErrorOf(std::string(kPlaneScene) + "[ground.medium]\nsoil_strength = 25\n", dir),
              "ground.medium.soil_strength: soil_strength acts only in a category with model = "
              "\"lu2019\"");
-  EXPECT_HAS(ErrorOf(std::string(kPlaneScene) +
-                         "[ground.medium]\nmodel = \"lu2019\"\nsoil_strength = 0\n",
-                     dir),
-             "soil_strength = 0 violates 0.1 <= soil_strength <= 1000 (MN/m^2)");
+  EXPECT_HAS(
+      ErrorOf(std::string(kPlaneScene) + "[ground.medium]\nmodel = \"lu2019\"\nsoil_strength = 0\n",
+              dir),
+      "soil_strength = 0 violates 0.1 <= soil_strength <= 1000 (MN/m^2)");
   EXPECT_HAS(ErrorOf(std::string(kPlaneScene) +
                          "[ground.medium]\nmodel = \"lu2019\"\ncompaction_drag = nan\n",
                      dir),
@@ -309,6 +309,57 @@ TEST(LoadScene, SolverPresetSetsTheKnobsTheSceneDoesNotGive) {
     std::string why;
     EXPECT_TRUE(o.IsValid(&why)) << ToString(p) << ": " << why;
   }
+}
+
+// Every [solver] key of the options table (kSolverOptions) sets its option, and summary.json
+// writes the value back under the same key: a valid value other than the default, per row.
+TEST(LoadScene, EverySolverOptionOfTheTableIsReadAndWrittenBack) {
+  const auto dir = testing::FreshDir("solver_table");
+  const SolverOptions defaults;
+  int read = 0;
+  for (const SolverOptionInfo& f : kSolverOptions) {
+    if (!f.scene_key) continue;
+    const double fallback = f.member.get(defaults);
+    double value = 0;
+    std::string text;
+    if (f.type == SolverOptionInfo::Type::kChoice) {
+      value = std::fmod(fallback + 1, f.choices->size());
+      text = std::string("\"") + f.choices->Name(static_cast<int>(value)) + "\"";
+    } else {
+      const double upper = f.HasPlausibleRange() ? f.plausible_upper : f.valid.upper;
+      value = f.type == SolverOptionInfo::Type::kInteger || std::isinf(upper)
+                  ? fallback + 1
+                  : (fallback + upper) / 2;
+      char buffer[64];
+      std::snprintf(buffer, sizeof buffer, "%.17g", value);
+      text = buffer;
+      if (f.type == SolverOptionInfo::Type::kNumber &&
+          text.find_first_of(".e") == std::string::npos)
+        text += ".0";  // a TOML float
+    }
+    testing::WriteText(dir / "scene.toml", Replace(kPlaneScene, "dt_s = 0.004\nmax_time_s = 20",
+                                                   std::string(f.key) + " = " + text));
+    SceneFile scene;
+    try {
+      scene = LoadScene((dir / "scene.toml").string());
+    } catch (const InputError& e) {
+      ADD_FAILURE() << f.key << " = " << text << ": " << e.what();
+      continue;
+    }
+    ++read;
+    EXPECT_EQ(f.member.get(scene.scene.options), value) << f.key;
+    const auto j = nlohmann::json::parse(SummaryJson(scene, ensemble::EnsembleReport{}, "0", {}));
+    const nlohmann::json& written = j["solver"][f.key];
+    if (f.choices) {
+      EXPECT_EQ(written, f.choices->Name(static_cast<int>(value))) << f.key;
+    } else if (f.type == SolverOptionInfo::Type::kInteger) {
+      EXPECT_TRUE(written.is_number_integer()) << f.key;
+      EXPECT_EQ(written.get<double>(), value) << f.key;
+    } else {
+      EXPECT_EQ(written.get<double>(), value) << f.key;
+    }
+  }
+  EXPECT_GE(read, 15);
 }
 
 // [output] percentiles: integers 1 .. 99, sorted and without repeats; the default is the p95

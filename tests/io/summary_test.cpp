@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
 
 #include "test_files.hpp"
 
@@ -44,6 +46,24 @@ TEST(SummaryJson, CarriesHashVersionCountsAndRate) {
   EXPECT_FALSE(j["ground"]["medium"].contains("drag_height_m"));  // no layer
   EXPECT_DOUBLE_EQ(j["trajectories_per_s"].get<double>(), 5.0);
   EXPECT_DOUBLE_EQ(j["wall_time_s"].get<double>(), 2.0);
+}
+
+// "solver": every option of kSolverOptions in the table's order, then the preset.
+TEST(SummaryJson, SolverIsTheOptionsTableInItsOrderThenThePreset) {
+  const auto dir = testing::FreshDir("summary_solver");
+  testing::WriteText(dir / "scene.toml",
+                     "[terrain]\nplane = {}\n[rock]\nshape = { box = [1, 1, 1] "
+                     "}\n[release]\npoints = [[10, 0]]\n");
+  const SceneFile scene = LoadScene((dir / "scene.toml").string());
+  const auto j = nlohmann::ordered_json::parse(
+      SummaryJson(scene, ensemble::EnsembleReport{}, "9.9.9", {"rocks.csv"}));
+  std::vector<std::string> keys, expected;
+  for (const auto& [key, value] : j["solver"].items()) keys.push_back(key);
+  for (const SolverOptionInfo& f : kSolverOptions) expected.emplace_back(f.key);
+  expected.emplace_back("preset");
+  EXPECT_EQ(keys, expected);
+  EXPECT_TRUE(j["solver"]["max_iterations"].is_number_integer());
+  EXPECT_EQ(j["solver"]["penetration_tolerance"], 0.01);
 }
 
 TEST(SummaryJson, HashFollowsTheInputs) {

@@ -136,55 +136,6 @@ TEST(Simulate, CentreOfMassReadingIsBitIdenticalToWave1) {
   }
 }
 
-TEST(Options, DefaultsAreValidAndBadValuesAreNamed) {
-  std::string why;
-  EXPECT_TRUE(SolverOptions{}.IsValid(&why)) << why;
-  SolverOptions o;
-  o.dt_s = 0;
-  EXPECT_FALSE(o.IsValid(&why));
-  EXPECT_NE(why.find("dt_s"), std::string::npos) << why;
-  o = SolverOptions{};
-  o.prox_alpha = 2.5;
-  EXPECT_FALSE(o.IsValid(&why));
-  EXPECT_NE(why.find("prox_alpha"), std::string::npos) << why;
-  o = SolverOptions{};
-  o.penetration_tolerance = 0;
-  EXPECT_FALSE(o.IsValid(&why));
-  EXPECT_NE(why.find("penetration_tolerance"), std::string::npos) << why;
-  o = SolverOptions{};
-  o.predicted_lever = static_cast<PredictedLever>(7);
-  EXPECT_FALSE(o.IsValid(&why));
-  EXPECT_NE(why.find("predicted_lever"), std::string::npos) << why;
-  o = SolverOptions{};
-  o.normal_restitution = std::nan("");
-  EXPECT_FALSE(o.IsValid(&why));
-  EXPECT_NE(why.find("normal_restitution"), std::string::npos) << why;
-}
-
-TEST(Options, ViscousReadingNamesRoundTrip) {
-  EXPECT_EQ(SolverOptions{}.viscous, ViscousReading::kContactFriction);  // docs/model.md
-  for (ViscousReading r : {ViscousReading::kCentreOfMass, ViscousReading::kContactFriction}) {
-    ViscousReading parsed = r == ViscousReading::kCentreOfMass ? ViscousReading::kContactFriction
-                                                               : ViscousReading::kCentreOfMass;
-    EXPECT_TRUE(ParseViscousReading(ToString(r), &parsed));
-    EXPECT_EQ(parsed, r);
-  }
-  ViscousReading parsed = ViscousReading::kCentreOfMass;
-  EXPECT_FALSE(ParseViscousReading("drag", &parsed));
-}
-
-TEST(Options, PredictedLeverNamesRoundTrip) {
-  EXPECT_EQ(SolverOptions{}.predicted_lever, PredictedLever::kMidpoint);
-  for (PredictedLever l : {PredictedLever::kMidpoint, PredictedLever::kTouch}) {
-    PredictedLever parsed = PredictedLever::kMidpoint;
-    EXPECT_TRUE(ParsePredictedLever(ToString(l), &parsed));
-    EXPECT_EQ(parsed, l);
-  }
-  PredictedLever parsed = PredictedLever::kTouch;
-  EXPECT_FALSE(ParsePredictedLever("contact", &parsed));
-  EXPECT_EQ(parsed, PredictedLever::kTouch);
-}
-
 TEST(Random, StreamsDependOnSeedAndRockOnlyAndOrientationsAreUniform) {
   RockRandom a(5, 9), b(5, 9), c(5, 10);
   EXPECT_EQ(a.Uniform(), b.Uniform());
