@@ -26,6 +26,7 @@
 #include "app/commands.hpp"
 #include "app/interrupt.hpp"
 #include "app/mpi_session.hpp"
+#include "app/run_verb.hpp"
 #include "app/simulate.hpp"
 #include "calibration/calibrate.hpp"
 #include "common/atomic_file.hpp"
@@ -331,26 +332,25 @@ int RunCalibrate(const CalibrateArgs& args, const Processes& processes) {
 
   CheckpointKeeper keeper(loaded, root);
   std::optional<StagingDirectory> staging;
-  try {
-    const calibration::CalibrationSummary run =
-        calibration::Calibrate(*loaded.problem, RunOptions(loaded, processes, keeper));
-    // Rank 0 writes; the other ranks only agree on how it went (below).
-    if (root) WriteOutputs(args, loaded, run, staging);
-  } catch (const Interrupted& e) {
-    staging.reset();
+  VerbHooks hooks;
+  hooks.on_failure = [&](bool interrupted) {
     keeper.SaveBeforeLeaving();
-    code = ExitCodeForSignal(e.signal());
-    message = std::string(e.what()) + "; no output written, " + args.out +
-              " is as it was before the run but for " + kCheckpoint + " (resume with --resume)";
-    if (root) std::printf("\n");
-  } catch (const std::exception& e) {
-    code = kExitRunFailed;
-    message =
-        (staging ? staging->Describe(e.what()) : std::string(e.what())) + " (no output written)";
-    staging.reset();
-    keeper.SaveBeforeLeaving();
-  }
-  return processes.Step(code, message);
+    if (interrupted && root) std::printf("\n");
+  };
+  hooks.interrupted_message = [&](const Interrupted& e) {
+    return std::string(e.what()) + "; no output written, " + args.out +
+           " is as it was before the run but for " + kCheckpoint + " (resume with --resume)";
+  };
+  const VerbOutcome outcome = RunStaged(
+      args.out, staging,
+      [&] {
+        const calibration::CalibrationSummary run =
+            calibration::Calibrate(*loaded.problem, RunOptions(loaded, processes, keeper));
+        // Rank 0 writes; the other ranks only agree on how it went (below).
+        if (root) WriteOutputs(args, loaded, run, staging);
+      },
+      hooks);
+  return processes.Step(outcome.code, outcome.message);
 }
 
 #if TALUS_HAVE_MPI

@@ -13,6 +13,7 @@
 #include "app/commands.hpp"
 #include "app/interrupt.hpp"
 #include "app/run_outputs.hpp"
+#include "app/run_verb.hpp"
 #include "common/error.hpp"
 
 namespace talus::app {
@@ -44,15 +45,7 @@ int RunMerge(const MergeArgs& args) {
     std::cerr << "talus merge: " << e.what() << "\n";
     return kExitRunFailed;
   }
-  if (const std::string why = PrepareOutputDirectory(args.out); !why.empty()) {
-    std::cerr << "talus merge: " << why << "\n";
-    return kExitBadInput;
-  }
-  const InterruptScope interrupts;
-  std::signal(SIGXFSZ, SIG_IGN);  // a file-size limit is a write error ("File too large")
-  RemoveStaleTemporaries(args.out);
-  std::optional<StagingDirectory> staging;
-  try {
+  return RunVerb({.name = "merge", .out = args.out}, [&](std::optional<StagingDirectory>& staging) {
     staging.emplace(args.out);
     // The threads and wall time of the parts, for the summary: the most threads any part used and
     // the sum of the parts' wall times.
@@ -69,17 +62,7 @@ int RunMerge(const MergeArgs& args) {
     std::printf("Merged %zu parts of %s: %s\n", parts.size(), scene.path.c_str(),
                 report.BriefReport().c_str());
     std::printf("Wrote %zu files to %s\n", files.size(), args.out.c_str());
-    return kExitOk;
-  } catch (const Interrupted& e) {
-    staging.reset();
-    std::cerr << "talus merge: " << InterruptedMessage(e, args.out) << "\n";
-    return ExitCodeForSignal(e.signal());
-  } catch (const std::exception& e) {
-    const std::string message = staging ? staging->Describe(e.what()) : e.what();
-    staging.reset();
-    std::cerr << "talus merge: " << message << " (no output written)\n";
-    return kExitRunFailed;
-  }
+  });
 }
 
 }  // namespace

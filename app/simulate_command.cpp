@@ -18,6 +18,7 @@
 #include "app/commands.hpp"
 #include "app/interrupt.hpp"
 #include "app/run_outputs.hpp"
+#include "app/run_verb.hpp"
 #include "app/simulate.hpp"
 #include "common/atomic_file.hpp"
 #include "common/error.hpp"
@@ -115,38 +116,30 @@ int RunSimulate(const SimulateArgs& args) {
     std::cerr << "talus simulate: " << message << "\n";
     return code;
   }
-  if (const std::string why = PrepareOutputDirectory(args.out); !why.empty()) {
-    std::cerr << "talus simulate: " << why << "\n";
-    return kExitBadInput;
-  }
+  Verb verb{.name = "simulate", .out = args.out};
   // A run too large for this machine fails now, with the estimate and the knob to turn.
   const io::ResourceEstimate needs = io::EstimateResources(
       scene, ensemble::WorkerThreads(args.threads, scene.release.total_rocks()));
-  const io::MachineCapacity capacity = io::MeasureCapacity(args.out);
-  if (const std::string why = io::CheckResources(needs, capacity); !why.empty()) {
-    std::cerr << "talus simulate: " << why << "\n";
-    return kExitBadInput;
-  }
-  // From here on SIGINT / SIGTERM unwind the run: no temporary file is left behind.
-  const InterruptScope interrupts;
-  std::signal(SIGXFSZ, SIG_IGN);  // a file-size limit is a write error ("File too large")
-  if (const auto stale = RemoveStaleTemporaries(args.out); !stale.empty())
-    std::printf("Removed %zu temporary files of interrupted runs from %s\n", stale.size(),
-                args.out.c_str());
-
-  std::printf("Scene %s: %s; %s\n", args.scene.c_str(), scene.terrain_description.c_str(),
-              DescribeRocks(scene).c_str());
-  PrintSceneWarnings(scene);
-  std::printf(
-      "Needs about %s of memory (%s available) and %s of disk (%s free)\n",
-      io::FormatBytes(needs.memory_bytes()).c_str(), io::FormatBytes(capacity.memory_bytes).c_str(),
-      io::FormatBytes(needs.disk_bytes()).c_str(), io::FormatBytes(capacity.disk_bytes).c_str());
-  std::fflush(stdout);
-  // Every output is written into a staging directory and moved into --out only when all are
-  // complete: a failed or interrupted run leaves --out as it was.
-  std::optional<StagingDirectory> staging;
+  io::MachineCapacity capacity;
+  verb.checks = [&] {
+    capacity = io::MeasureCapacity(args.out);
+    return io::CheckResources(needs, capacity);
+  };
+  verb.say_removed_temporaries = true;
   ProgressBar progress;
-  try {
+  verb.hooks.on_failure = [&progress](bool) { progress.Break(); };
+  return RunVerb(verb, [&](std::optional<StagingDirectory>& staging) {
+    std::printf("Scene %s: %s; %s\n", args.scene.c_str(), scene.terrain_description.c_str(),
+                DescribeRocks(scene).c_str());
+    PrintSceneWarnings(scene);
+    std::printf("Needs about %s of memory (%s available) and %s of disk (%s free)\n",
+                io::FormatBytes(needs.memory_bytes()).c_str(),
+                io::FormatBytes(capacity.memory_bytes).c_str(),
+                io::FormatBytes(needs.disk_bytes()).c_str(),
+                io::FormatBytes(capacity.disk_bytes).c_str());
+    std::fflush(stdout);
+    // Every output is written into a staging directory and moved into --out only when all are
+    // complete: a failed or interrupted run leaves --out as it was.
     staging.emplace(args.out);
     // Thrown on the calling thread, Interrupted stops the workers and comes out of RunEnsemble.
     auto show_progress = [&progress](long done, long total) {
@@ -167,19 +160,7 @@ int RunSimulate(const SimulateArgs& args) {
       std::fprintf(stderr,
                    "talus simulate: %ld rocks failed numerically (end = failed in rocks.csv)\n",
                    report.count(EndReason::kFailed));
-    return kExitOk;
-  } catch (const Interrupted& e) {
-    staging.reset();
-    progress.Break();
-    std::cerr << "talus simulate: " << InterruptedMessage(e, args.out) << "\n";
-    return ExitCodeForSignal(e.signal());
-  } catch (const std::exception& e) {
-    const std::string message = staging ? staging->Describe(e.what()) : e.what();
-    staging.reset();
-    progress.Break();
-    std::cerr << "talus simulate: " << message << " (no output written)\n";
-    return kExitRunFailed;
-  }
+  });
 }
 
 }  // namespace

@@ -19,6 +19,7 @@
 #include "app/interrupt.hpp"
 #include "app/mpi_session.hpp"
 #include "app/run_outputs.hpp"
+#include "app/run_verb.hpp"
 #include "app/simulate.hpp"
 #include "common/error.hpp"
 
@@ -176,39 +177,34 @@ int SimulateOnRanks(const MpiSession& mpi, const SimulateArgs& args) {
   const long end = total * (mpi.rank() + 1) / mpi.size();
   std::optional<StagingDirectory> staging, part;
   ensemble::EnsembleReport report;
-  try {
-    // Ranks other than 0 stage in $TMPDIR/talus-ranks, where they also remove what ranks that
-    // died (SIGKILL, a lost node) left there, as rank 0 does in --out.
-    const fs::path dir = root ? fs::path(args.out) : fs::temp_directory_path() / "talus-ranks";
-    if (!root) {
-      fs::create_directories(dir);
-      RemoveStaleTemporaries(dir.string());
-    }
-    staging.emplace(dir.string());
-    part.emplace(staging->staging_path());
-    auto show_progress = [&progress, root](long done, long rocks) {
-      ThrowIfInterrupted();
-      if (root) progress(done, rocks);
-    };
-    RunIntoStaging(scene, args.threads, first, end, true, *part, show_progress, &report);
-  } catch (const Interrupted& e) {
-    code = ExitCodeForSignal(e.signal());
-    message = InterruptedMessage(e, args.out);
-  } catch (const std::exception& e) {
-    code = kExitRunFailed;
-    message =
-        (staging ? staging->Describe(e.what()) : std::string(e.what())) + " (no output written)";
-  }
+  VerbHooks hooks;
+  // A failed rank removes its temporary files before waiting for the other ranks.
+  hooks.on_failure = [&part](bool) { part.reset(); };
+  VerbOutcome outcome = RunStaged(
+      args.out, staging,
+      [&] {
+        // Ranks other than 0 stage in $TMPDIR/talus-ranks, where they also remove what ranks that
+        // died (SIGKILL, a lost node) left there, as rank 0 does in --out.
+        const fs::path dir = root ? fs::path(args.out) : fs::temp_directory_path() / "talus-ranks";
+        if (!root) {
+          fs::create_directories(dir);
+          RemoveStaleTemporaries(dir.string());
+        }
+        staging.emplace(dir.string());
+        part.emplace(staging->staging_path());
+        auto show_progress = [&progress, root](long done, long rocks) {
+          ThrowIfInterrupted();
+          if (root) progress(done, rocks);
+        };
+        RunIntoStaging(scene, args.threads, first, end, true, *part, show_progress, &report);
+      },
+      hooks);
   progress.Break();
-  if (code != kExitOk) {  // remove the temporary files before waiting for the other ranks
-    part.reset();
-    staging.reset();
-  }
-  if (const int failed = Agree(mpi, code, message, "talus simulate")) return failed;
+  if (const int failed = Agree(mpi, outcome.code, outcome.message, "talus simulate")) return failed;
 
   // Sending the parts to rank 0, rank by rank; then rank 0 merges them into --out.
   std::vector<fs::path> dirs = {part->staging_path()};
-  try {
+  outcome = RunStaged(args.out, staging, [&] {
     for (int r = 1; r < mpi.size(); ++r) {
       if (root) {
         dirs.push_back(fs::path(staging->staging_path()) / ("rank-" + std::to_string(r)));
@@ -235,17 +231,10 @@ int SimulateOnRanks(const MpiSession& mpi, const SimulateArgs& args) {
                      "talus simulate: %ld rocks failed numerically (end = failed in rocks.csv)\n",
                      merged.count(EndReason::kFailed));
     }
-    code = kExitOk;
-  } catch (const Interrupted& e) {
-    code = ExitCodeForSignal(e.signal());
-    message = InterruptedMessage(e, args.out);
-  } catch (const std::exception& e) {
-    code = kExitRunFailed;
-    message = staging->Describe(e.what()) + " (no output written)";
-  }
+  });
   part.reset();
   staging.reset();
-  return Agree(mpi, code, message, "talus simulate");
+  return Agree(mpi, outcome.code, outcome.message, "talus simulate");
 }
 
 }  // namespace

@@ -14,6 +14,7 @@
 
 #include "app/commands.hpp"
 #include "app/interrupt.hpp"
+#include "app/run_verb.hpp"
 #include "app/simulate.hpp"
 #include "common/atomic_file.hpp"
 #include "common/error.hpp"
@@ -51,23 +52,17 @@ int RunValidate(const ValidateArgs& args) {
     std::cerr << "talus validate: cannot load " << args.event << ": " << e.what() << "\n";
     return kExitRunFailed;
   }
-  if (const std::string why = PrepareOutputDirectory(args.out); !why.empty()) {
-    std::cerr << "talus validate: " << why << "\n";
-    return kExitBadInput;
-  }
-  PrintSceneWarnings(event.scene, "validate");
-  // From here on SIGINT / SIGTERM unwind the run: no temporary file is left behind.
-  const InterruptScope interrupts;
-  RemoveStaleTemporaries(args.out);
-  const ensemble::ReleaseSpec& release = event.scene.release;
-  std::printf("Event %s: %zu observations (%zu scalar, %zu deposits) of %ld runs x %ld rocks\n",
-              args.event.c_str(), event.observations.size(), event.observations.scalars.size(),
-              event.observations.deposits.size(), release.release_count(),
-              release.rocks_per_release);
-  PrintNotScored(event.not_scored);
-  // Every output is staged and moved into --out only when all are complete.
-  std::optional<StagingDirectory> staging;
-  try {
+  Verb verb{.name = "validate", .out = args.out};
+  verb.hooks.late_input_errors = true;  // a shape per rock that cannot be built, found late
+  return RunVerb(verb, [&](std::optional<StagingDirectory>& staging) {
+    PrintSceneWarnings(event.scene, "validate");
+    const ensemble::ReleaseSpec& release = event.scene.release;
+    std::printf("Event %s: %zu observations (%zu scalar, %zu deposits) of %ld runs x %ld rocks\n",
+                args.event.c_str(), event.observations.size(), event.observations.scalars.size(),
+                event.observations.deposits.size(), release.release_count(),
+                release.rocks_per_release);
+    PrintNotScored(event.not_scored);
+    // Every output is staged and moved into --out only when all are complete.
     staging.emplace(args.out);
     const auto out = [&](const std::string& name) { return staging->path(name); };
     ensemble::EnsembleOptions options;
@@ -123,21 +118,7 @@ int RunValidate(const ValidateArgs& args) {
     staging->Commit(outputs);
     std::printf("%s", report.FullReport().c_str());
     std::printf("Wrote %zu files to %s\n", outputs.size(), args.out.c_str());
-    return kExitOk;
-  } catch (const Interrupted& e) {
-    staging.reset();
-    std::cerr << "talus validate: " << InterruptedMessage(e, args.out) << "\n";
-    return ExitCodeForSignal(e.signal());
-  } catch (const InputError& e) {  // a shape per rock that cannot be built, found late
-    staging.reset();
-    std::cerr << "talus validate: " << e.what() << " (no output written)\n";
-    return kExitBadInput;
-  } catch (const std::exception& e) {
-    const std::string message = staging ? staging->Describe(e.what()) : e.what();
-    staging.reset();
-    std::cerr << "talus validate: " << message << " (no output written)\n";
-    return kExitRunFailed;
-  }
+  });
 }
 
 }  // namespace
