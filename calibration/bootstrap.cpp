@@ -14,6 +14,7 @@
 #include <stdexcept>
 
 #include "calibration/report_text.hpp"
+#include "common/statistics.hpp"
 
 namespace talus::calibration {
 namespace {
@@ -104,14 +105,6 @@ double RefitObjective(unsigned /*n*/, const double* x, double* /*grad*/, void* d
   }
 }
 
-// The p-quantile of sorted values, interpolated between order statistics (Hyndman & Fan type 7).
-double Quantile(const std::vector<double>& sorted, double p) {
-  const double h = (double(sorted.size()) - 1) * p;
-  const auto lo = static_cast<std::size_t>(std::floor(h));
-  if (lo + 1 >= sorted.size()) return sorted.back();
-  return sorted[lo] + (h - double(lo)) * (sorted[lo + 1] - sorted[lo]);
-}
-
 // Standard errors, intervals and correlations from the refits.
 void Summarise(Bootstrap& out) {
   const int n = static_cast<int>(out.names.size());
@@ -127,8 +120,8 @@ void Summarise(Bootstrap& out) {
     std::vector<double> sorted(out.refits.col(j).data(),
                                out.refits.col(j).data() + out.refits.rows());
     std::sort(sorted.begin(), sorted.end());
-    out.lower[j] = Quantile(sorted, (1 - out.level) / 2);
-    out.upper[j] = Quantile(sorted, (1 + out.level) / 2);
+    out.lower[j] = SortedQuantile(sorted, (1 - out.level) / 2);
+    out.upper[j] = SortedQuantile(sorted, (1 + out.level) / 2);
   }
   for (int j = 0; j < n; ++j)
     for (int k = 0; k < n; ++k) {
@@ -305,11 +298,16 @@ std::string Bootstrap::Report() const {
   out += line;
   for (std::size_t j = 0; j < names.size(); ++j) {
     const auto k = static_cast<Eigen::Index>(j);
-    std::snprintf(
-        line, sizeof line, "  %-28s %14s %10s  %s\n", names[j].c_str(),
-        Num(standard_error[k], "%.4g").c_str(), Num(standard_error_unit[k], "%.3f").c_str(),
-        identified[j] ? ("[" + Num(lower[k], "%.6g") + ", " + Num(upper[k], "%.6g") + "]").c_str()
-                      : "UNIDENTIFIED");
+    // Appended piecewise: GCC 12 warns falsely (-Wrestrict) on "[" + std::string.
+    std::string range = "[";
+    range += Num(lower[k], "%.6g");
+    range += ", ";
+    range += Num(upper[k], "%.6g");
+    range += "]";
+    std::snprintf(line, sizeof line, "  %-28s %14s %10s  %s\n", names[j].c_str(),
+                  Num(standard_error[k], "%.4g").c_str(),
+                  Num(standard_error_unit[k], "%.3f").c_str(),
+                  identified[j] ? range.c_str() : "UNIDENTIFIED");
     out += line;
   }
   if (names.size() > 1) {

@@ -6,22 +6,17 @@
 #include <sstream>
 
 #include "common/error.hpp"
+#include "common/statistics.hpp"
 #include "ensemble/runner.hpp"
 #include "fieldobs/samples.hpp"
 #include "fieldobs/scores.hpp"
+#include "fieldobs/validation.hpp"
 
 namespace talus::calibration {
 namespace {
 
 // Mirrors fieldobs::Validate: scalars score against ensembles of at least 2 members.
 constexpr int kMinMembers = 2;
-
-double Mean(const std::vector<double>& v) {
-  if (v.empty()) return kNaN;
-  double sum = 0;
-  for (double x : v) sum += x;
-  return sum / double(v.size());
-}
 
 }  // namespace
 
@@ -95,10 +90,7 @@ Objective::Objective(const Scene& scene, const ensemble::ReleaseSpec& release,
         for (std::size_t i = 0; i < observations_.scalars.size(); ++i) {
           const auto& o = observations_.scalars[i];
           if (kinds_[k] != fieldobs::ToString(o.quantity)) continue;
-          std::vector<double> others;
-          for (std::size_t q = 0; q < observations_.scalars.size(); ++q)
-            if (q != i && observations_.scalars[q].quantity == o.quantity)
-              others.push_back(observations_.scalars[q].value);
+          const std::vector<double> others = fieldobs::ScalarClimatology(observations_.scalars, i);
           if (static_cast<int>(others.size()) >= kMinMembers)
             scores.push_back(fieldobs::CrpsEnsemble(others, o.value));
         }
@@ -116,10 +108,8 @@ Objective::Objective(const Scene& scene, const ensemble::ReleaseSpec& release,
           starts.push_back(o.run.empty() ? std::nullopt : start_of(o.run));
         for (std::size_t i = 0; i < observations_.deposits.size(); ++i) {
           if (!starts[i]) continue;
-          std::vector<Eigen::Vector2d> others;
-          for (std::size_t q = 0; q < observations_.deposits.size(); ++q)
-            if (q != i && starts[q])
-              others.push_back(*starts[i] + observations_.deposits[q].xy_m - *starts[q]);
+          const std::vector<Eigen::Vector2d> others =
+              fieldobs::DepositClimatology(observations_.deposits, starts, i);
           if (static_cast<int>(others.size()) >= kMinMembers)
             scores.push_back(fieldobs::EnergyScore(others, observations_.deposits[i].xy_m));
         }

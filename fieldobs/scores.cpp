@@ -2,23 +2,21 @@
 
 #include <algorithm>
 #include <boost/math/distributions/chi_squared.hpp>
-#include <charconv>
 #include <cmath>
 #include <limits>
 #include <numbers>
 #include <stdexcept>
 #include <string>
 
+#include "common/format.hpp"
+#include "common/statistics.hpp"
+
 namespace talus::fieldobs {
 
 namespace {
 
 // Shortest text that reads back as the same double ("0.1", "nan", "-inf").
-std::string Text(double value) {
-  char buffer[32];
-  const auto result = std::to_chars(buffer, buffer + sizeof buffer, value);
-  return std::string(buffer, result.ptr);
-}
+std::string Text(double value) { return RoundTrip(value); }
 std::string Text(const Eigen::Vector2d& value) {
   // Appended piecewise: GCC 12 warns falsely (-Wrestrict) on "(" + std::string.
   std::string text = "(";
@@ -76,13 +74,6 @@ double CrpsSorted(const std::vector<double>& x, double y) {
 }
 
 // Type-7 quantile of a sorted, non-empty ensemble.
-double QuantileSorted(const std::vector<double>& x, double p) {
-  const double h = static_cast<double>(x.size() - 1) * p;
-  const size_t lo = static_cast<size_t>(std::floor(h));
-  if (lo + 1 >= x.size()) return x.back();
-  return x[lo] + (h - static_cast<double>(lo)) * (x[lo + 1] - x[lo]);
-}
-
 double PitSorted(const std::vector<double>& x, double y, double u) {
   const auto below = std::lower_bound(x.begin(), x.end(), y);
   const auto above = std::upper_bound(below, x.end(), y);
@@ -140,7 +131,7 @@ double Pit(std::span<const double> ensemble, double observed, double u) {
 double Quantile(std::span<const double> ensemble, double p) {
   RequireEnsemble("Quantile", ensemble);
   if (!(p >= 0 && p <= 1)) Fail("Quantile", "p", Text(p), "is not in [0, 1]");
-  return QuantileSorted(Sorted(ensemble), p);
+  return SortedQuantile(Sorted(ensemble), p);
 }
 
 ScalarScore ScoreScalar(std::span<const double> ensemble, double observed, double u) {
@@ -164,9 +155,9 @@ ScalarScore ScoreScalar(std::span<const double> ensemble, double observed, doubl
   for (double xi : x) sum_sq += (xi - s.mean) * (xi - s.mean);
   s.sd = x.size() > 1 ? std::sqrt(sum_sq / (n - 1)) : 0.0;
 
-  s.median = QuantileSorted(x, 0.5);
-  s.q05 = QuantileSorted(x, 0.05);
-  s.q95 = QuantileSorted(x, 0.95);
+  s.median = SortedQuantile(x, 0.5);
+  s.q05 = SortedQuantile(x, 0.05);
+  s.q95 = SortedQuantile(x, 0.95);
   s.inside_90 = s.q05 <= observed && observed <= s.q95;
   s.bias = s.mean - observed;
   return s;

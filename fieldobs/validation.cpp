@@ -6,6 +6,8 @@
 #include <map>
 #include <numeric>
 
+#include "common/format.hpp"
+#include "common/statistics.hpp"
 #include "solver/random.hpp"
 
 namespace talus::fieldobs {
@@ -13,10 +15,6 @@ namespace {
 
 // The stream of the PITs' uniforms, apart from the rocks' streams of the same seed.
 constexpr std::uint64_t kPitStream = 0x5049545049545049ULL;
-
-double Mean(const std::vector<double>& v) {
-  return v.empty() ? kNaN : std::accumulate(v.begin(), v.end(), 0.0) / double(v.size());
-}
 
 void ScoreScalarObservation(const ScalarObservation& o, const EnsembleSamples& sim,
                             const EnsembleSamples* reference,
@@ -90,14 +88,31 @@ void ScoreDeposit(const DepositObservation& o, const EnsembleSamples& sim,
     s.climatology_score = EnergyScore(climatology, o.xy_m);
 }
 
+// The report's numbers: "-" for one that does not exist.
 std::string Number(double v, const char* format = "%.3g") {
-  if (std::isnan(v)) return "-";
-  char b[64];
-  std::snprintf(b, sizeof b, format, v);
-  return b;
+  return FormatOrMissing(v, format, "-");
 }
 
 }  // namespace
+
+std::vector<double> ScalarClimatology(const std::vector<ScalarObservation>& scalars,
+                                      std::size_t k) {
+  std::vector<double> climatology;
+  for (std::size_t q = 0; q < scalars.size(); ++q)
+    if (q != k && scalars[q].quantity == scalars[k].quantity)
+      climatology.push_back(scalars[q].value);
+  return climatology;
+}
+
+std::vector<Eigen::Vector2d> DepositClimatology(
+    const std::vector<DepositObservation>& deposits,
+    const std::vector<std::optional<Eigen::Vector2d>>& starts, std::size_t k) {
+  std::vector<Eigen::Vector2d> climatology;
+  if (!starts[k]) return climatology;
+  for (std::size_t q = 0; q < deposits.size(); ++q)
+    if (q != k && starts[q]) climatology.push_back(*starts[k] + deposits[q].xy_m - *starts[q]);
+  return climatology;
+}
 
 ValidationReport Validate(const ObservationSet& observations, const EnsembleSamples& simulated,
                           const EnsembleSamples* reference, const ValidationOptions& options) {
@@ -107,10 +122,7 @@ ValidationReport Validate(const ObservationSet& observations, const EnsembleSamp
   // Scalars. Climatology: the other observations of the same quantity (leave-one-out).
   for (std::size_t k = 0; k < observations.scalars.size(); ++k) {
     const ScalarObservation& o = observations.scalars[k];
-    std::vector<double> climatology;
-    for (std::size_t q = 0; q < observations.scalars.size(); ++q)
-      if (q != k && observations.scalars[q].quantity == o.quantity)
-        climatology.push_back(observations.scalars[q].value);
+    const std::vector<double> climatology = ScalarClimatology(observations.scalars, k);
     ObservationScore s;
     s.kind = ToString(o.quantity);
     s.unit = UnitOf(o.quantity);
@@ -123,15 +135,13 @@ ValidationReport Validate(const ObservationSet& observations, const EnsembleSamp
   }
   // Deposits. Climatology: the other runs' observed displacements from their release, applied to
   // this run's release (leave-one-out); none for observations of the whole scene.
+  std::vector<std::optional<Eigen::Vector2d>> starts;
+  for (const DepositObservation& o : observations.deposits)
+    starts.push_back(simulated.StartOf(o.run));
   for (std::size_t k = 0; k < observations.deposits.size(); ++k) {
     const DepositObservation& o = observations.deposits[k];
-    std::vector<Eigen::Vector2d> climatology;
-    const auto start = simulated.StartOf(o.run);
-    if (start)
-      for (std::size_t q = 0; q < observations.deposits.size(); ++q) {
-        const auto other = simulated.StartOf(observations.deposits[q].run);
-        if (q != k && other) climatology.push_back(*start + observations.deposits[q].xy_m - *other);
-      }
+    const std::vector<Eigen::Vector2d> climatology =
+        DepositClimatology(observations.deposits, starts, k);
     ObservationScore s;
     s.kind = "deposit";
     s.unit = "m";

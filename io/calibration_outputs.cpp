@@ -1,11 +1,12 @@
 #include "io/calibration_outputs.hpp"
 
-#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <set>
+
+#include "common/format.hpp"
 
 namespace talus::io {
 namespace {
@@ -16,12 +17,7 @@ using nlohmann::json;
 
 // The shortest text that reads back as exactly v: a fitted table written and read again is the
 // table that was fitted (the ensemble resolves differences far below 10 significant digits).
-std::string G(double v) {
-  if (std::isnan(v)) return "";
-  char b[64];
-  const auto end = std::to_chars(b, b + sizeof b, v).ptr;
-  return std::string(b, end);
-}
+std::string G(double v) { return std::isnan(v) ? "" : RoundTrip(v); }
 
 // NaN and infinities as null.
 json Number(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }

@@ -7,6 +7,7 @@
 
 #include "common/csv_table.hpp"
 #include "common/error.hpp"
+#include "common/format.hpp"
 #include "common/statistics.hpp"
 #include "io/rocks_csv.hpp"
 
@@ -16,12 +17,7 @@ namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 // "%.10g", or an empty field for NaN (no rock crossed).
-std::string Field(double v) {
-  if (std::isnan(v)) return "";
-  char buffer[64];
-  std::snprintf(buffer, sizeof buffer, "%.10g", v);
-  return buffer;
-}
+std::string Field(double v) { return FormatOrMissing(v, "%.10g", ""); }
 
 }  // namespace
 

@@ -12,6 +12,7 @@
 #include <stdexcept>
 
 #include "common/atomic_file.hpp"
+#include "common/format.hpp"
 
 namespace talus::io {
 namespace {
@@ -46,11 +47,7 @@ std::vector<ColourClass> Classes(const std::vector<double>& lower,
   return classes;
 }
 
-std::string Number(double value) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.3g", value);
-  return text;
-}
+std::string Number(double value) { return FormatDouble(value, "%.3g"); }
 
 bool StartsWith(const std::string& s, const char* prefix) { return s.rfind(prefix, 0) == 0; }
 

@@ -12,6 +12,7 @@
 
 #include "common/csv_table.hpp"
 #include "common/error.hpp"
+#include "common/format.hpp"
 #include "common/statistics.hpp"
 #include "io/quicklook.hpp"
 #include "io/svg_plot.hpp"
@@ -26,9 +27,7 @@ using svg::Escape;
 // A value for a table cell: numbers with up to 6 significant digits, text escaped.
 std::string Cell(const Json& value) {
   if (value.is_number_float()) {
-    char text[32];
-    std::snprintf(text, sizeof text, "%.6g", value.get<double>());
-    return text;
+    return FormatDouble(value.get<double>(), "%.6g");
   }
   if (value.is_string()) return Escape(value.get<std::string>());
   if (value.is_array()) {
@@ -40,10 +39,7 @@ std::string Cell(const Json& value) {
 }
 
 std::string Number(double v, const char* format = "%.4g") {
-  if (!std::isfinite(v)) return "&ndash;";
-  char text[32];
-  std::snprintf(text, sizeof text, format, v);
-  return text;
+  return std::isfinite(v) ? FormatDouble(v, format) : "&ndash;";
 }
 
 // A two-column table of the scalar members of `object` (nested objects left out).
@@ -80,13 +76,6 @@ std::string Base64(const std::string& bytes) {
   std::string out = encoded ? encoded : "";
   CPLFree(encoded);
   return out;
-}
-
-double Mean(const std::vector<double>& values) {
-  if (values.empty()) return std::numeric_limits<double>::quiet_NaN();
-  double sum = 0;
-  for (double v : values) sum += v;
-  return sum / static_cast<double>(values.size());
 }
 
 constexpr const char* kStyle = R"(body{font-family:sans-serif;max-width:1100px;margin:2em auto;color:#222}

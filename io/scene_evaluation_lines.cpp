@@ -84,8 +84,9 @@ void LoadEvaluationLines(const Context& context, const Section& s, SceneFile& ou
     if (!on_dem)
       throw InputError(origin[k] + ": the line '" + line.name +
                        "' lies entirely outside the DEM or on nodata (the DEM covers x " +
-                       Fmt(g.x0_m) + " .. " + Fmt(g.x_max_m()) + ", y " + Fmt(g.y0_m) + " .. " +
-                       Fmt(g.y_max_m()) + "), so no rock can cross it");
+                       TenDigits(g.x0_m) + " .. " + TenDigits(g.x_max_m()) + ", y " +
+                       TenDigits(g.y0_m) + " .. " + TenDigits(g.y_max_m()) +
+                       "), so no rock can cross it");
     for (std::size_t j = 0; j < k; ++j)
       if (lines[j].name == line.name)
         throw InputError(origin[k] + ": the name '" + line.name + "' is also that of " + origin[j] +

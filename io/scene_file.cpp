@@ -16,7 +16,6 @@
 namespace talus::io {
 namespace {
 
-using scene_tables::Fmt;
 using scene_tables::kPositive;
 using scene_tables::RequireWithin;
 
@@ -127,8 +126,8 @@ double SolverValue(const Section& s, const SolverOptionInfo& f) {
     case SolverOptionInfo::Type::kInteger: {
       const long v = s.Integer(f.key, 0);
       if (v != static_cast<int>(v))
-        s.Fail(f.key, std::to_string(v) + " is out of range (" + Fmt(f.valid.lower) + " .. " +
-                          Fmt(f.valid.upper) + ")");
+        s.Fail(f.key, std::to_string(v) + " is out of range (" + TenDigits(f.valid.lower) + " .. " +
+                          TenDigits(f.valid.upper) + ")");
       return static_cast<double>(v);
     }
     case SolverOptionInfo::Type::kChoice:

@@ -76,8 +76,8 @@ void LoadRuns(const Context& context, const Section& s, SceneFile& out) {
     if (run.height_m && *run.height_m < 0)
       throw InputError(rows.Where(k, "height_m") + ": must be >= 0");
     if (run.height_m && *run.height_m > kMaxReleaseHeight_m)
-      throw InputError(rows.Where(k, "height_m") + ": " + Fmt(*run.height_m) + " is more than " +
-                       Fmt(kMaxReleaseHeight_m) + " m");
+      throw InputError(rows.Where(k, "height_m") + ": " + TenDigits(*run.height_m) +
+                       " is more than " + TenDigits(kMaxReleaseHeight_m) + " m");
     const auto vector = [&](const char* x, const char* y, const char* z) {
       return Eigen::Vector3d(rows.OptionalNumber(k, x).value_or(0),
                              rows.OptionalNumber(k, y).value_or(0),
@@ -105,20 +105,21 @@ void LoadRuns(const Context& context, const Section& s, SceneFile& out) {
                                  rows.Number(k, "qz"));
       if (std::abs(q.norm() - 1) > 1e-3)
         throw InputError(rows.Where(k, "qw") + ": quaternion [qw, qx, qy, qz] has norm " +
-                         Fmt(q.norm()) + ", expected 1");
+                         TenDigits(q.norm()) + ", expected 1");
       run.orientation = q.normalized();
     }
     run.block = BlockOfRow(rows, k, block_column, out);
     double ground_m;
     if (!out.scene.terrain.Height(run.xy_m.x(), run.xy_m.y(), &ground_m))
-      throw InputError(rows.Where(k, "x_m") + ": (" + Fmt(run.xy_m.x()) + ", " + Fmt(run.xy_m.y()) +
-                       ") is outside the DEM or on nodata (the DEM covers x " + Fmt(g.x0_m) +
-                       " .. " + Fmt(g.x_max_m()) + ", y " + Fmt(g.y0_m) + " .. " +
-                       Fmt(g.y_max_m()) + ")");
+      throw InputError(rows.Where(k, "x_m") + ": (" + TenDigits(run.xy_m.x()) + ", " +
+                       TenDigits(run.xy_m.y()) +
+                       ") is outside the DEM or on nodata (the DEM covers x " + TenDigits(g.x0_m) +
+                       " .. " + TenDigits(g.x_max_m()) + ", y " + TenDigits(g.y0_m) + " .. " +
+                       TenDigits(g.y_max_m()) + ")");
     if (run.z_m && *run.z_m - ground_m > kMaxReleaseHeight_m)
-      throw InputError(rows.Where(k, "z_m") + ": " + Fmt(*run.z_m) + " m is " +
-                       Fmt(*run.z_m - ground_m) + " m above the ground, more than " +
-                       Fmt(kMaxReleaseHeight_m) + " m");
+      throw InputError(rows.Where(k, "z_m") + ": " + TenDigits(*run.z_m) + " m is " +
+                       TenDigits(*run.z_m - ground_m) + " m above the ground, more than " +
+                       TenDigits(kMaxReleaseHeight_m) + " m");
     r.runs.push_back(run);
   }
 }
@@ -161,7 +162,8 @@ void LoadSingleImpacts(const Context& context, const Section& release, SceneFile
     s.Fail("at", "missing: give the point [x, y] of the DEM where the impacts happen");
   }
   if (!ensemble::OnTerrain(out.scene.terrain, at))
-    s.Fail("at", "(" + Fmt(at.x()) + ", " + Fmt(at.y()) + ") is outside the DEM or on nodata");
+    s.Fail("at", "(" + TenDigits(at.x()) + ", " + TenDigits(at.y()) +
+                     ") is outside the DEM or on nodata");
   const std::string block_column = release.String("block_column", "block_id");
   out.inputs.push_back(path);
   const CsvTable rows = CsvTable::Read(path);
@@ -178,11 +180,11 @@ void LoadSingleImpacts(const Context& context, const Section& release, SceneFile
     const fieldobs::IncomingImpact& impact = impacts[static_cast<std::size_t>(k)];
     const double speed = std::hypot(impact.normal_speed_m_s, impact.tangent_speed_m_s);
     if (speed > kMaxSpeed_m_s)
-      throw InputError(impact.where + ": incoming speed " + Fmt(speed) + " m/s is more than " +
-                       Fmt(kMaxSpeed_m_s) + " m/s");
+      throw InputError(impact.where + ": incoming speed " + TenDigits(speed) +
+                       " m/s is more than " + TenDigits(kMaxSpeed_m_s) + " m/s");
     if (std::abs(impact.angular_speed_rad_s) > kMaxAngularSpeed_rad_s)
       throw InputError(rows.Where(k, columns.angular_speed) + ": more than " +
-                       Fmt(kMaxAngularSpeed_rad_s) + " rad/s");
+                       TenDigits(kMaxAngularSpeed_rad_s) + " rad/s");
     out.release.runs.push_back(fieldobs::SingleImpactRun(impact, out.scene.terrain, at, clearance_m,
                                                          BlockOfRow(rows, k, block_column, out)));
   }
@@ -246,7 +248,8 @@ void LoadReleaseStart(const Section& s, ensemble::ReleaseSpec& r) {
   r.height_m = s.Checked(
       "height_m", 1.0, [](double v) { return v >= 0; }, "must be >= 0");
   if (r.height_m > kMaxReleaseHeight_m)
-    s.Fail("height_m", Fmt(r.height_m) + " is more than " + Fmt(kMaxReleaseHeight_m) + " m");
+    s.Fail("height_m",
+           TenDigits(r.height_m) + " is more than " + TenDigits(kMaxReleaseHeight_m) + " m");
   if (s.Has("height_reference")) {
     const std::string name = s.String("height_reference", "");
     if (name == "lowest_point") {
@@ -268,7 +271,7 @@ void LoadReleaseStart(const Section& s, ensemble::ReleaseSpec& r) {
       const Eigen::Quaterniond quat(q[0], q[1], q[2], q[3]);
       if (std::abs(quat.norm() - 1) > 1e-3)
         s.Fail("orientation",
-               "quaternion [w, x, y, z] has norm " + Fmt(quat.norm()) + ", expected 1");
+               "quaternion [w, x, y, z] has norm " + TenDigits(quat.norm()) + ", expected 1");
       r.orientation = quat.normalized();
     }
   }
@@ -307,10 +310,11 @@ std::vector<double> CheckReleasesOnTerrain(const std::vector<std::string>& origi
     const ReleaseGeometry& release = r.releases[k];
     const auto v = ensemble::PointOffTerrain(out.scene.terrain, release);
     if (!v) continue;
-    const std::string dem = " (the DEM covers x " + Fmt(g.x0_m) + " .. " + Fmt(g.x_max_m()) +
-                            ", y " + Fmt(g.y0_m) + " .. " + Fmt(g.y_max_m()) + ")";
+    const std::string dem = " (the DEM covers x " + TenDigits(g.x0_m) + " .. " +
+                            TenDigits(g.x_max_m()) + ", y " + TenDigits(g.y0_m) + " .. " +
+                            TenDigits(g.y_max_m()) + ")";
     if (!r.clip_to_dem || release.kind == ReleaseGeometry::Kind::kPoint)
-      throw InputError(origin[k] + ": (" + Fmt(v->x()) + ", " + Fmt(v->y()) +
+      throw InputError(origin[k] + ": (" + TenDigits(v->x()) + ", " + TenDigits(v->y()) +
                        ") is outside the DEM or on nodata" + dem +
                        (r.clip_to_dem ? "" : "; clip_to_dem = true starts rocks on the rest"));
     on_terrain[k] = ensemble::FractionOnTerrain(out.scene.terrain, release);
@@ -328,10 +332,10 @@ std::vector<double> CheckReleasesOnTerrain(const std::vector<std::string>& origi
       fill *= ensemble::ReleaseArea(release) / (hi - lo).prod();
     }
     if (fill < ensemble::kMinPolygonFill)
-      throw InputError(origin[k] + ": the part on valid DEM cells is " + Fmt(100 * fill) +
+      throw InputError(origin[k] + ": the part on valid DEM cells is " + TenDigits(100 * fill) +
                        " % of its " +
                        (release.kind == ReleaseGeometry::Kind::kLine ? "length" : "bounding box") +
-                       ", less than " + Fmt(100 * ensemble::kMinPolygonFill) +
+                       ", less than " + TenDigits(100 * ensemble::kMinPolygonFill) +
                        " %: too little to draw start points from" + dem);
   }
   return on_terrain;
@@ -359,7 +363,7 @@ void SetRocksByArea(const Section& s, const std::string& count_key,
                  ": give rocks instead");
     const double n = std::round(per_m2 * ensemble::ReleaseArea(r.releases[k]) * on_terrain[k]);
     if (!(n <= double(ensemble::ReleaseSpec::kMaxTotalRocks)))
-      s.Fail(count_key, Fmt(n) + " rocks for " + origin[k] + ", more than " +
+      s.Fail(count_key, TenDigits(n) + " rocks for " + origin[k] + ", more than " +
                             std::to_string(ensemble::ReleaseSpec::kMaxTotalRocks));
     counts.push_back(std::max(1L, static_cast<long>(n)));
   }

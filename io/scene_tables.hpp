@@ -7,21 +7,14 @@
 // (it brings in toml++).
 
 #include <Eigen/Core>
-#include <cstdio>
 #include <string>
 #include <vector>
 
+#include "common/format.hpp"
 #include "io/scene_file.hpp"
 #include "io/toml_section.hpp"
 
 namespace talus::io::scene_tables {
-
-// A number for messages: 10 significant digits.
-inline std::string Fmt(double v) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof buffer, "%.10g", v);
-  return buffer;
-}
 
 inline constexpr auto kPositive = [](double v) { return v > 0; };
 
@@ -36,7 +29,7 @@ inline constexpr double kMaxReleaseHeight_m = 10000;
 // "<v> is outside <lo> .. <hi> <unit>", or "" when lo <= v <= hi.
 inline std::string OutsideBounds(double v, double lo, double hi, const std::string& unit) {
   if (v >= lo && v <= hi) return "";
-  return Fmt(v) + " is outside " + Fmt(lo) + " .. " + Fmt(hi) + " " + unit;
+  return TenDigits(v) + " is outside " + TenDigits(lo) + " .. " + TenDigits(hi) + " " + unit;
 }
 
 // Fails on `key` unless lo <= v <= hi.
@@ -48,7 +41,8 @@ inline void RequireWithin(const Section& s, const std::string& key, double v, do
 // "" when |v| <= max, else "|v| = <|v|> <unit> is more than <max> <unit>".
 inline std::string TooFast(const Eigen::Vector3d& v, double max, const std::string& unit) {
   if (v.norm() <= max) return "";
-  return "|v| = " + Fmt(v.norm()) + " " + unit + " is more than " + Fmt(max) + " " + unit;
+  return "|v| = " + TenDigits(v.norm()) + " " + unit + " is more than " + TenDigits(max) + " " +
+         unit;
 }
 
 // The list of [x, y] points at `node`; errors name `key`.

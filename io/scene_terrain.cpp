@@ -76,8 +76,9 @@ void LoadGroundPolygons(const Context& context, const Section& terrain, SceneFil
     }
   }
   if (!any)
-    throw InputError(what + ": " + path + " covers no cell centre of the DEM (x " + Fmt(d.x0_m) +
-                     " .. " + Fmt(d.x_max_m()) + ", y " + Fmt(d.y0_m) + " .. " + Fmt(d.y_max_m()) +
+    throw InputError(what + ": " + path + " covers no cell centre of the DEM (x " +
+                     TenDigits(d.x0_m) + " .. " + TenDigits(d.x_max_m()) + ", y " +
+                     TenDigits(d.y0_m) + " .. " + TenDigits(d.y_max_m()) +
                      "): every contact would get the default ground");
   scene.terrain.SetGroundGrid(std::move(grid));
   std::string why;
@@ -101,10 +102,11 @@ void LoadGroundRaster(const Context& context, const Section& s, SceneFile& out) 
   const double cx0 = c.x0_m - 0.5 * c.dx_m, cx1 = c.x_max_m() + 0.5 * c.dx_m;
   const double cy0 = c.y0_m - 0.5 * c.dy_m, cy1 = c.y_max_m() + 0.5 * c.dy_m;
   if (!(cx0 < d.x_max_m() && cx1 > d.x0_m && cy0 < d.y_max_m() && cy1 > d.y0_m))
-    s.Fail("ground", path + " covers x " + Fmt(cx0) + " .. " + Fmt(cx1) + ", y " + Fmt(cy0) +
-                         " .. " + Fmt(cy1) + ", which does not overlap the DEM (x " + Fmt(d.x0_m) +
-                         " .. " + Fmt(d.x_max_m()) + ", y " + Fmt(d.y0_m) + " .. " +
-                         Fmt(d.y_max_m()) + "): every contact would get the default ground");
+    s.Fail("ground", path + " covers x " + TenDigits(cx0) + " .. " + TenDigits(cx1) + ", y " +
+                         TenDigits(cy0) + " .. " + TenDigits(cy1) +
+                         ", which does not overlap the DEM (x " + TenDigits(d.x0_m) + " .. " +
+                         TenDigits(d.x_max_m()) + ", y " + TenDigits(d.y0_m) + " .. " +
+                         TenDigits(d.y_max_m()) + "): every contact would get the default ground");
   GroundGrid grid;
   grid.grid = codes.grid;
   grid.index.resize(codes.values.size());
@@ -117,7 +119,7 @@ void LoadGroundRaster(const Context& context, const Section& s, SceneFile& out) 
     const bool code = v == std::round(v) && v >= 0 && v <= 254;  // and so fits an int
     const int index = code ? scene.ground.IndexOfCode(static_cast<int>(v)) : -1;
     if (index < 0)
-      throw InputError(what + ": " + path + " has the value " + Fmt(v) + " (cell " +
+      throw InputError(what + ": " + path + " has the value " + TenDigits(v) + " (cell " +
                        std::to_string(k % static_cast<std::size_t>(codes.grid.nx)) + ", " +
                        std::to_string(k / static_cast<std::size_t>(codes.grid.nx)) +
                        " from the south-west), which is not the code of any ground category");
@@ -151,8 +153,8 @@ void LoadTerrain(const Context& context, const Section& s, SceneFile& out) {
     heights = MakePlaneHeightfield(spec);
     out.plane = spec;
     out.terrain_description =
-        "plane " + Fmt(spec.slope_deg) + " deg, " + std::to_string(heights.grid.nx) + " x " +
-        std::to_string(heights.grid.ny) + " cells of " + Fmt(spec.cell_m) + " m";
+        "plane " + TenDigits(spec.slope_deg) + " deg, " + std::to_string(heights.grid.nx) + " x " +
+        std::to_string(heights.grid.ny) + " cells of " + TenDigits(spec.cell_m) + " m";
   } else {
     const std::string path = context.Resolve(s.String("dem", ""));
     Raster dem = ReadRaster(path, context.Where(s.Node("dem")) + ": " + s.Key("dem"));
@@ -168,10 +170,10 @@ void LoadTerrain(const Context& context, const Section& s, SceneFile& out) {
     }
     for (std::size_t k = 0; k < dem.values.size(); ++k)
       if (std::abs(dem.values[k]) > kMaxAbsHeight_m)  // false for nodata (NaN)
-        s.Fail("dem", path + " has the height " + Fmt(dem.values[k]) + " m (cell " +
+        s.Fail("dem", path + " has the height " + TenDigits(dem.values[k]) + " m (cell " +
                           std::to_string(k % static_cast<std::size_t>(dem.grid.nx)) + ", " +
                           std::to_string(k / static_cast<std::size_t>(dem.grid.nx)) +
-                          " from the south-west), beyond +-" + Fmt(kMaxAbsHeight_m) +
+                          " from the south-west), beyond +-" + TenDigits(kMaxAbsHeight_m) +
                           " m: a nodata value the file does not declare, or not metres?");
     out.inputs.push_back(path);
     out.crs_wkt = dem.crs_wkt;
@@ -179,7 +181,7 @@ void LoadTerrain(const Context& context, const Section& s, SceneFile& out) {
     heights.z_m = std::move(dem.values);
     out.terrain_description =
         fs::path(path).filename().string() + " (" + std::to_string(heights.grid.nx) + " x " +
-        std::to_string(heights.grid.ny) + " cells of " + Fmt(heights.grid.dx_m) + " m)";
+        std::to_string(heights.grid.ny) + " cells of " + TenDigits(heights.grid.dx_m) + " m)";
   }
   const std::string default_name = s.String("default_ground", "medium");
   const int default_index = scene.ground.IndexOfName(default_name);

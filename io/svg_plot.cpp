@@ -4,19 +4,13 @@
 #include <cmath>
 #include <cstdio>
 
+#include "common/format.hpp"
+
 namespace talus::io::svg {
 
-std::string F(double v) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.2f", v);
-  return b;
-}
+std::string F(double v) { return FormatDouble(v, "%.2f"); }
 
-std::string Label(double v) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.4g", v);
-  return b;
-}
+std::string Label(double v) { return FormatDouble(v, "%.4g"); }
 
 void Pad(double& lo, double& hi) {
   if (!(hi > lo)) {

@@ -8,22 +8,15 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <cstdio>
 #include <filesystem>
 #include <string>
 #include <vector>
 
 #include "common/closest_name.hpp"
 #include "common/error.hpp"
+#include "common/format.hpp"
 
 namespace talus::io {
-
-// "%.10g".
-inline std::string FormatNumber(double v) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof buffer, "%.10g", v);
-  return buffer;
-}
 
 // Reads a TOML file (a scene, event or calibration file: `what`), with errors "<path>: <what> not
 // found", "<path>: is a directory, not the <what>" and "<path>:<line>: TOML syntax error: ...".
@@ -110,7 +103,7 @@ class Section {
   template <class Pred>
   double Checked(const std::string& key, double fallback, Pred ok, const std::string& bound) const {
     const double v = Number(key, fallback);
-    if (!std::isfinite(v) || !ok(v)) Fail(key, FormatNumber(v) + " " + bound);
+    if (!std::isfinite(v) || !ok(v)) Fail(key, TenDigits(v) + " " + bound);
     return v;
   }
   long Integer(const std::string& key, long fallback) const {

@@ -8,7 +8,9 @@
 #include <stdexcept>
 
 #include "common/atomic_file.hpp"
+#include "common/format.hpp"
 #include "io/quicklook.hpp"
+#include "io/rocks_csv.hpp"
 
 namespace talus::io {
 namespace {
@@ -18,19 +20,8 @@ nlohmann::ordered_json Num(double v) {
   return std::isfinite(v) ? nlohmann::ordered_json(v) : nlohmann::ordered_json(nullptr);
 }
 
-std::string Csv(double v) {
-  if (std::isnan(v)) return "";
-  char b[32];
-  std::snprintf(b, sizeof b, "%.10g", v);
-  return b;
-}
-
-std::string CsvText(const std::string& text) {
-  if (text.find_first_of(",\"\n\r") == std::string::npos) return text;
-  std::string out = "\"";
-  for (char c : text) out += c == '"' ? std::string("\"\"") : std::string(1, c);
-  return out + "\"";
-}
+// "%.10g", or an empty field for NaN (a value that does not exist).
+std::string Csv(double v) { return FormatOrMissing(v, "%.10g", ""); }
 
 std::string Xml(const std::string& text) {
   std::string out;
@@ -47,11 +38,7 @@ std::string Xml(const std::string& text) {
   return out;
 }
 
-std::string Fmt(double v, const char* format = "%.3g") {
-  char b[64];
-  std::snprintf(b, sizeof b, format, v);
-  return b;
-}
+std::string Fmt(double v, const char* format = "%.3g") { return FormatDouble(v, format); }
 
 }  // namespace
 
@@ -113,13 +100,13 @@ std::string ObservationsCsv(const fieldobs::ValidationReport& report) {
       "kind,run,unit,observed,observed_x_m,observed_y_m,scored,members,score,pit,mean,median,sd,"
       "q05,q95,inside_90,bias,reference_score,climatology_score,source,note\n";
   for (const fieldobs::ObservationScore& s : report.observations) {
-    out += CsvText(s.kind) + "," + CsvText(s.run) + "," + s.unit + "," + Csv(s.observed) + "," +
+    out += CsvField(s.kind) + "," + CsvField(s.run) + "," + s.unit + "," + Csv(s.observed) + "," +
            Csv(s.observed_xy_m.x()) + "," + Csv(s.observed_xy_m.y()) + "," +
            (s.scored ? "1" : "0") + "," + std::to_string(s.members) + "," + Csv(s.score) + "," +
            Csv(s.pit) + "," + Csv(s.mean) + "," + Csv(s.median) + "," + Csv(s.sd) + "," +
            Csv(s.q05) + "," + Csv(s.q95) + "," + (s.scored ? (s.inside_90 ? "1" : "0") : "") + "," +
            Csv(s.bias) + "," + Csv(s.reference_score) + "," + Csv(s.climatology_score) + "," +
-           CsvText(s.where) + "," + CsvText(s.not_scored) + "\n";
+           CsvField(s.where) + "," + CsvField(s.not_scored) + "\n";
   }
   return out;
 }

@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "common/error.hpp"
+#include "common/format.hpp"
 #include "pointclouds/builtin_shapes.hpp"
 #include "pointclouds/convex_hull.hpp"
 
@@ -78,11 +79,7 @@ std::vector<double> Array(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z(
 
 std::string Vec(const Eigen::Vector3d& v, const char* format = "%.6g") {
   std::string out = "(";
-  char number[64];
-  for (int k = 0; k < 3; ++k) {
-    std::snprintf(number, sizeof number, format, v[k]);
-    out += (k ? ", " : "") + std::string(number);
-  }
+  for (int k = 0; k < 3; ++k) out += (k ? ", " : "") + FormatDouble(v[k], format);
   return out + ")";
 }
 

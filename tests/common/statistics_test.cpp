@@ -19,5 +19,21 @@ TEST(Statistics, NearestRankPercentiles) {
   EXPECT_EQ(NearestRankPercentile({NAN, 2}, 100), 2);  // NaN (no value) is left out
 }
 
+TEST(Statistics, MeanIsNanWithoutValues) {
+  EXPECT_EQ(Mean({1, 2, 3, 6}), 3);
+  EXPECT_EQ(Mean({0.1, 0.2, 0.3}), (0.1 + 0.2 + 0.3) / 3);  // summed in order
+  EXPECT_TRUE(std::isnan(Mean({})));
+}
+
+TEST(Statistics, SortedQuantilesInterpolateBetweenOrderStatistics) {
+  // Definition 7: h = (n - 1) p, between the floor(h)-th and the next (0-based).
+  const std::vector<double> sorted = {1, 2, 4, 8, 16};
+  EXPECT_EQ(SortedQuantile(sorted, 0), 1);
+  EXPECT_EQ(SortedQuantile(sorted, 0.5), 4);
+  EXPECT_EQ(SortedQuantile(sorted, 0.625), 6);  // h = 2.5
+  EXPECT_EQ(SortedQuantile(sorted, 1), 16);
+  EXPECT_EQ(SortedQuantile({7}, 0.9), 7);
+}
+
 }  // namespace
 }  // namespace talus
