@@ -155,8 +155,10 @@ std::string HistogramSvg(const std::string& title, const std::string& x_label,
   return out + "</svg>\n";
 }
 
-std::string RunReportHtml(const RunReportInput& input) {
-  const Json summary = Json::parse(input.summary_json);
+namespace {
+
+// The page's head and "What ran": scene, version, inputs hash, the summary's settings, the rock.
+std::string WhatRanSection(const Json& summary) {
   const auto get = [&](const char* key) { return summary.contains(key) ? summary[key] : Json(); };
   std::string html = "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n";
   Add(html, "<title>Talus run: ", Cell(get("scene")), "</title>\n<style>\n", kStyle,
@@ -175,8 +177,13 @@ std::string RunReportHtml(const RunReportInput& input) {
     html += "<h3>Rock</h3>\n";
     html += KeyValueTable(summary["rock"]);
   }
+  return html;
+}
 
-  html += "<h2>How the rocks ended</h2>\n<table>\n";
+// "How the rocks ended": each ending's count and share, and the steps.
+std::string EndingsSection(const Json& summary) {
+  const auto get = [&](const char* key) { return summary.contains(key) ? summary[key] : Json(); };
+  std::string html = "<h2>How the rocks ended</h2>\n<table>\n";
   const long rocks = get("rocks").is_number() ? get("rocks").get<long>() : 0;
   const auto count_row = [&](const std::string& label, const Json& value) {
     const double n = value.is_number() ? value.get<double>() : 0;
@@ -190,8 +197,11 @@ std::string RunReportHtml(const RunReportInput& input) {
   html += "</table>\n";
   Add(html, "<p class=\"note\">", Cell(get("steps")), " steps, ", Cell(get("unconverged_steps")),
       " of them with a contact solve that did not converge.</p>\n");
+  return html;
+}
 
-  // Maps with their legends.
+// "Maps": the run's main rasters on the hillshade, with their legends ("" without rasters).
+std::string MapsSection(const RunReportInput& input) {
   std::vector<const ensemble::RasterLayer*> maps;
   if (input.layers && input.dem) {
     for (const char* name : {"reach_probability", "energy_max", "speed_max", "jump_height_max"})
@@ -200,21 +210,22 @@ std::string RunReportHtml(const RunReportInput& input) {
     if (maps.empty())
       if (const ensemble::RasterLayer* layer = QuickLookLayer(*input.layers)) maps.push_back(layer);
   }
-  if (!maps.empty()) {
-    html += "<h2>Maps</h2>\n";
-    for (const ensemble::RasterLayer* layer : maps) {
-      const std::string png = QuickLookPng(*input.dem, layer, input.paths, {}, input.lines);
-      Add(html, "<figure><img alt=\"", Escape(layer->name), "\" src=\"data:image/png;base64,",
-          Base64(png), "\"><figcaption>", Escape(LegendOf(*layer).title), " (",
-          Escape(layer->name), ".tif)</figcaption></figure>\n");
-    }
+  if (maps.empty()) return "";
+  std::string html = "<h2>Maps</h2>\n";
+  for (const ensemble::RasterLayer* layer : maps) {
+    const std::string png = QuickLookPng(*input.dem, layer, input.paths, {}, input.lines);
+    Add(html, "<figure><img alt=\"", Escape(layer->name), "\" src=\"data:image/png;base64,",
+        Base64(png), "\"><figcaption>", Escape(LegendOf(*layer).title), " (", Escape(layer->name),
+        ".tif)</figcaption></figure>\n");
   }
+  return html;
+}
 
-  // Distributions over the rocks.
-  const RockColumns& r = input.rocks;
+// "Distributions over the rocks": histograms and a table of statistics.
+std::string DistributionsSection(const RockColumns& r) {
   std::vector<double> energy_kj;
   for (double e : r.max_kinetic_energy_j) energy_kj.push_back(e / 1000);
-  html += "<h2>Distributions over the rocks</h2>\n<div class=\"plots\">\n";
+  std::string html = "<h2>Distributions over the rocks</h2>\n<div class=\"plots\">\n";
   html += HistogramSvg("Runout", "runout (m)", r.runout_m);
   html += HistogramSvg("Largest kinetic energy", "energy (kJ)", energy_kj);
   html += HistogramSvg("Largest jump height", "jump height of the centre of mass (m)",
@@ -234,51 +245,58 @@ std::string RunReportHtml(const RunReportInput& input) {
   stats_row("travel angle (&deg;)", r.travel_angle_deg);
   html += "</table>\n<p class=\"note\">Percentiles are nearest-rank, over the rocks (one value per "
           "rock).</p>\n";
+  return html;
+}
 
-  // Evaluation lines: who crossed, and the design numbers at the crossing.
-  if (summary.contains("evaluation_lines") && summary["evaluation_lines"].is_array()) {
-    const Json& lines = summary["evaluation_lines"];
-    html +=
-        "<h2>Evaluation lines</h2>\n<table>\n<tr><th>line</th><th>length (m)</th>"
-        "<th>rocks</th><th>crossed</th><th>passing probability</th></tr>\n";
-    for (const Json& line : lines) {
-      const double p = line["passing_probability"].is_number()
-                           ? line["passing_probability"].get<double>()
-                           : std::numeric_limits<double>::quiet_NaN();
-      Add(html, "<tr><th>", Cell(line["name"]), "</th><td>", Cell(line["length_m"]), "</td><td>",
-          Cell(line["rocks"]), "</td><td>", Cell(line["crossed"]), "</td><td>",
-          Number(100 * p, "%.1f"), " %</td></tr>\n");
+// "Evaluation lines": who crossed, and the design numbers at the crossing ("" without lines).
+std::string EvaluationLinesSection(const Json& summary) {
+  if (!summary.contains("evaluation_lines") || !summary["evaluation_lines"].is_array()) return "";
+  const Json& lines = summary["evaluation_lines"];
+  std::string html =
+      "<h2>Evaluation lines</h2>\n<table>\n<tr><th>line</th><th>length (m)</th>"
+      "<th>rocks</th><th>crossed</th><th>passing probability</th></tr>\n";
+  for (const Json& line : lines) {
+    const double p = line["passing_probability"].is_number()
+                         ? line["passing_probability"].get<double>()
+                         : std::numeric_limits<double>::quiet_NaN();
+    Add(html, "<tr><th>", Cell(line["name"]), "</th><td>", Cell(line["length_m"]), "</td><td>",
+        Cell(line["rocks"]), "</td><td>", Cell(line["crossed"]), "</td><td>",
+        Number(100 * p, "%.1f"), " %</td></tr>\n");
+  }
+  html += "</table>\n";
+  const std::pair<const char*, const char*> quantities[] = {
+      {"speed_m_s", "speed (m/s)"},
+      {"energy_J", "kinetic energy (kJ)"},
+      {"com_height_m", "height of the centre of mass (m)"},
+      {"bounce_height_m", "bounce height (m)"}};
+  for (const Json& line : lines) {
+    Add(html, "<h3>", Cell(line["name"]),
+        "</h3>\n<table>\n<tr><th></th><th>mean</th>"
+        "<th>median</th><th>90 %</th><th>95 %</th><th>99 %</th><th>largest</th></tr>\n");
+    for (const auto& [key, label] : quantities) {
+      Add(html, "<tr><th>", label, "</th>");
+      for (const char* statistic : {"mean", "p50", "p90", "p95", "p99", "max"}) {
+        const Json& v = line[key][statistic];
+        const double scale = std::string(key) == "energy_J" ? 1e-3 : 1.0;
+        Add(html, "<td>",
+            Number(v.is_number() ? scale * v.get<double>()
+                                 : std::numeric_limits<double>::quiet_NaN()),
+            "</td>");
+      }
+      html += "</tr>\n";
     }
     html += "</table>\n";
-    const std::pair<const char*, const char*> quantities[] = {
-        {"speed_m_s", "speed (m/s)"},
-        {"energy_J", "kinetic energy (kJ)"},
-        {"com_height_m", "height of the centre of mass (m)"},
-        {"bounce_height_m", "bounce height (m)"}};
-    for (const Json& line : lines) {
-      Add(html, "<h3>", Cell(line["name"]),
-          "</h3>\n<table>\n<tr><th></th><th>mean</th>"
-          "<th>median</th><th>90 %</th><th>95 %</th><th>99 %</th><th>largest</th></tr>\n");
-      for (const auto& [key, label] : quantities) {
-        Add(html, "<tr><th>", label, "</th>");
-        for (const char* statistic : {"mean", "p50", "p90", "p95", "p99", "max"}) {
-          const Json& v = line[key][statistic];
-          const double scale = std::string(key) == "energy_J" ? 1e-3 : 1.0;
-          Add(html, "<td>",
-              Number(v.is_number() ? scale * v.get<double>()
-                                   : std::numeric_limits<double>::quiet_NaN()),
-              "</td>");
-        }
-        html += "</tr>\n";
-      }
-      html += "</table>\n";
-    }
-    html +=
-        "<p class=\"note\">Over the rocks that crossed each line, at the first crossing of the "
-        "centre of mass (evaluation_lines.csv); heights are vertical, above the terrain; the "
-        "bounce height is that of the rock's lowest point. Percentiles are nearest-rank.</p>\n";
   }
+  html +=
+      "<p class=\"note\">Over the rocks that crossed each line, at the first crossing of the "
+      "centre of mass (evaluation_lines.csv); heights are vertical, above the terrain; the "
+      "bounce height is that of the rock's lowest point. Percentiles are nearest-rank.</p>\n";
+  return html;
+}
 
+// The ground table, the solver options and the files, as summary.json has them; the page's end.
+std::string SettingsSection(const Json& summary) {
+  std::string html;
   if (summary.contains("ground")) {
     html += "<h2>Ground table</h2>\n";
     html += RowsTable(summary["ground"], "category");
@@ -294,6 +312,15 @@ std::string RunReportHtml(const RunReportInput& input) {
   }
   html += "</body>\n</html>\n";
   return html;
+}
+
+}  // namespace
+
+std::string RunReportHtml(const RunReportInput& input) {
+  const Json summary = Json::parse(input.summary_json);
+  return WhatRanSection(summary) + EndingsSection(summary) + MapsSection(input) +
+         DistributionsSection(input.rocks) + EvaluationLinesSection(summary) +
+         SettingsSection(summary);
 }
 
 }  // namespace talus::io
