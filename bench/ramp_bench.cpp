@@ -183,68 +183,74 @@ CellValues RunCellStatistics(const talus::Scene& scene, int rocks, std::uint64_t
 
 }  // namespace
 
-int RunBenchmark(int argc, char** argv) {
-  CLI::App app{"Ramp benchmark: EOTA221 block trajectories down a 40 degree plane, one core"};
+// The command line.
+struct BenchArgs {
   int rocks = 200, repeats = 5;
   double dt_s = 0.002, tolerance = -1;
   int max_iterations = -1;
   std::uint64_t seed = 1;
   std::string viscous = talus::ToString(talus::SolverOptions{}.viscous);
   std::string contact_solve = talus::ToString(talus::SolverOptions{}.contact_solve);
-  app.add_option("--rocks", rocks, "Trajectories per repeat")->check(CLI::PositiveNumber);
-  app.add_option("--repeats", repeats, "Repeats (the median is reported)")
-      ->check(CLI::PositiveNumber);
-  app.add_option("--dt", dt_s, "Time step, s")->check(CLI::PositiveNumber);
-  app.add_option("--tolerance", tolerance,
-                 "Contact solver tolerance, m/s (default: solver default)");
-  app.add_option("--max-iterations", max_iterations,
-                 "Contact solver sweeps at most (default: solver default)");
-  app.add_option("--seed", seed, "Seed of the release orientations");
-  app.add_option("--viscous,--drag", viscous,
-                 "Reading of the viscous ground term: centre_of_mass or contact_friction")
-      ->check(CLI::IsMember(Names(talus::kViscousReadingNames)));
-  app.add_option("--contact-solve", contact_solve,
-                 "Two-contact steps: gauss_seidel sweeps or one block solve")
-      ->check(CLI::IsMember(Names(talus::kContactSolveMethodNames)));
   bool no_profile = false, no_cells = false;
-  app.add_flag("--no-profile", no_profile,
-               "Skip the stage profile and the per-cell statistics runs (for instruction counts "
-               "of exactly --rocks trajectories)");
-  app.add_flag("--no-cells", no_cells, "Skip the per-cell statistics run");
   // The scarring soil (Lu et al. 2019) under the ramp's medium_hard ground: its model, M_E and C_s
   // (the paper's whole-trajectory soil by default), and where its drag acts.
   std::string ground_model = "hard", soil_drag = "centre_of_mass";
   double soil_strength = 15, compaction_drag = 1.5;
-  app.add_option("--ground-model", ground_model, "hard (the seed's) or lu2019 (scarring soil)")
-      ->check(CLI::IsMember(Names(talus::kGroundModelNames)));
-  app.add_option("--soil-strength", soil_strength, "lu2019: M_E, MN/m^2");
-  app.add_option("--compaction-drag", compaction_drag, "lu2019: C_s");
-  app.add_option("--soil-drag", soil_drag, "lu2019: where the drag acts")
-      ->check(CLI::IsMember(Names(talus::kSoilDragPointNames)));
   bool detect_every_step = false;
-  app.add_flag("--detect-every-step", detect_every_step,
-               "Contact detection in every step, no flight windows (same results, bit for bit)");
-  CLI11_PARSE(app, argc, argv);
+};
 
+// The options of `app`, read into *args.
+void AddOptions(CLI::App& app, BenchArgs* args) {
+  app.add_option("--rocks", args->rocks, "Trajectories per repeat")->check(CLI::PositiveNumber);
+  app.add_option("--repeats", args->repeats, "Repeats (the median is reported)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--dt", args->dt_s, "Time step, s")->check(CLI::PositiveNumber);
+  app.add_option("--tolerance", args->tolerance,
+                 "Contact solver tolerance, m/s (default: solver default)");
+  app.add_option("--max-iterations", args->max_iterations,
+                 "Contact solver sweeps at most (default: solver default)");
+  app.add_option("--seed", args->seed, "Seed of the release orientations");
+  app.add_option("--viscous,--drag", args->viscous,
+                 "Reading of the viscous ground term: centre_of_mass or contact_friction")
+      ->check(CLI::IsMember(Names(talus::kViscousReadingNames)));
+  app.add_option("--contact-solve", args->contact_solve,
+                 "Two-contact steps: gauss_seidel sweeps or one block solve")
+      ->check(CLI::IsMember(Names(talus::kContactSolveMethodNames)));
+  app.add_flag("--no-profile", args->no_profile,
+               "Skip the stage profile and the per-cell statistics runs (for instruction counts "
+               "of exactly --rocks trajectories)");
+  app.add_flag("--no-cells", args->no_cells, "Skip the per-cell statistics run");
+  app.add_option("--ground-model", args->ground_model,
+                 "hard (the seed's) or lu2019 (scarring soil)")
+      ->check(CLI::IsMember(Names(talus::kGroundModelNames)));
+  app.add_option("--soil-strength", args->soil_strength, "lu2019: M_E, MN/m^2");
+  app.add_option("--compaction-drag", args->compaction_drag, "lu2019: C_s");
+  app.add_option("--soil-drag", args->soil_drag, "lu2019: where the drag acts")
+      ->check(CLI::IsMember(Names(talus::kSoilDragPointNames)));
+  app.add_flag("--detect-every-step", args->detect_every_step,
+               "Contact detection in every step, no flight windows (same results, bit for bit)");
+}
+
+// The ramp with the options and the ground model asked for.
+talus::Scene MakeScene(const BenchArgs& args) {
   talus::Scene scene = talus::scenes::Ramp40();
-  scene.options.dt_s = dt_s;
-  if (tolerance > 0) scene.options.tolerance_m_s = tolerance;
-  if (max_iterations > 0) scene.options.max_iterations = max_iterations;
-  talus::ParseViscousReading(viscous, &scene.options.viscous);
-  talus::ParseContactSolveMethod(contact_solve, &scene.options.contact_solve);
-  talus::ParseSoilDragPoint(soil_drag, &scene.options.soil_drag);
+  scene.options.dt_s = args.dt_s;
+  if (args.tolerance > 0) scene.options.tolerance_m_s = args.tolerance;
+  if (args.max_iterations > 0) scene.options.max_iterations = args.max_iterations;
+  talus::ParseViscousReading(args.viscous, &scene.options.viscous);
+  talus::ParseContactSolveMethod(args.contact_solve, &scene.options.contact_solve);
+  talus::ParseSoilDragPoint(args.soil_drag, &scene.options.soil_drag);
   for (int i = 0; i < scene.ground.size(); ++i) {
     talus::GroundParams& p = scene.ground.mutable_params(i);
-    talus::ParseGroundModel(ground_model, &p.model);
-    p.soil_strength_mn_m2 = soil_strength;
-    p.compaction_drag = compaction_drag;
+    talus::ParseGroundModel(args.ground_model, &p.model);
+    p.soil_strength_mn_m2 = args.soil_strength;
+    p.compaction_drag = args.compaction_drag;
   }
-  std::string why;
-  if (!scene.IsValid(&why)) {
-    std::fprintf(stderr, "ramp_bench: %s\n", why.c_str());
-    return 1;
-  }
+  return scene;
+}
 
+// The machine, the build and the scene: the heading of every result.
+void PrintSetting(const talus::Scene& scene, const BenchArgs& args) {
   utsname host{};
   uname(&host);
   std::printf("machine: %s, %u hardware threads, %s %s\n", CpuModel().c_str(),
@@ -263,23 +269,33 @@ int RunBenchmark(int argc, char** argv) {
       scene.rock.mass_kg, scene.rock.vertices_m.size(), scene.options.dt_s,
       scene.options.tolerance_m_s, scene.options.max_iterations,
       talus::ToString(scene.options.viscous), talus::ToString(scene.options.contact_solve),
-      ground_model.c_str());
-  if (ground_model == "lu2019")
-    std::printf(" (M_E %g MN/m^2, C_s %g, drag at %s)", soil_strength, compaction_drag,
-                soil_drag.c_str());
+      args.ground_model.c_str());
+  if (args.ground_model == "lu2019")
+    std::printf(" (M_E %g MN/m^2, C_s %g, drag at %s)", args.soil_strength, args.compaction_drag,
+                args.soil_drag.c_str());
   std::printf("\n");
+}
 
+// The timed repeats: each one's rate, then the median; returns the last repeat.
+Batch RunRepeats(const talus::Scene& scene, const BenchArgs& args) {
   std::vector<double> rates, step_rates;
   Batch last;
-  for (int r = 0; r < repeats; ++r) {
-    last = RunBatch(scene, rocks, seed, !detect_every_step, nullptr);
-    rates.push_back(rocks / last.wall_s);
+  for (int r = 0; r < args.repeats; ++r) {
+    last = RunBatch(scene, args.rocks, args.seed, !args.detect_every_step, nullptr);
+    rates.push_back(args.rocks / last.wall_s);
     step_rates.push_back(last.steps / last.wall_s);
-    std::printf("repeat %d: %d trajectories in %.3f s = %.1f trajectories/s\n", r + 1, rocks,
+    std::printf("repeat %d: %d trajectories in %.3f s = %.1f trajectories/s\n", r + 1, args.rocks,
                 last.wall_s, rates.back());
   }
-  std::printf("\ntrajectories per second (one core, median of %d): %.1f\n", repeats, Median(rates));
+  std::printf("\ntrajectories per second (one core, median of %d): %.1f\n", args.repeats,
+              Median(rates));
   std::printf("steps per second (median): %.3g\n", Median(step_rates));
+  return last;
+}
+
+// What a batch's rocks did: accuracy figures, the contact solve's work, the ramp statistics of
+// Leine et al. 2021 and the endings.
+void PrintBatchStatistics(const Batch& last, int rocks) {
   const auto [runout, runout_error] = MeanAndError(last.runouts_m);
   const auto [speed, speed_error] = MeanAndError(last.max_speeds_m_s);
   std::printf("mean simulated time per trajectory: %.2f s\n", last.time_sum_s / rocks);
@@ -323,28 +339,30 @@ int RunBenchmark(int argc, char** argv) {
   std::printf(
       "\nreference: RAMMS::ROCKFALL 1000 trajectories in 161.5 s = 6.2 trajectories/s "
       "(Leine et al. 2021, Table 1)\n");
+}
 
-  if (no_profile) return 0;
-  if (!no_cells) {
-    // The same rocks again, with the per-cell recorder (a separate run: it is not timed).
-    const CellValues cells = RunCellStatistics(scene, rocks, seed);
-    std::printf(
-        "\nramp statistics pooled per cell (RAMMS's statistic mode: each rock's maximum in each "
-        "%.0f m cell its centre of mass passed, %zu values of %d rocks; mean +- sd (median)):\n",
-        scene.terrain.heights().grid.dx_m, cells.speeds_m_s.size(), rocks);
-    const std::pair<const char*, const std::vector<double>*> pooled[] = {
-        {"speed, m/s", &cells.speeds_m_s},
-        {"rotation rate, rot/s", &cells.rotation_rates_1_s},
-        {"jump height, m", &cells.jump_heights_m},
-        {"kinetic energy, kJ", &cells.kinetic_energies_kj}};
-    for (const auto& [name, values] : pooled) {
-      const auto [mean, sd] = MeanAndSd(*values);
-      std::printf("  %-22s %8.2f +- %7.2f (%.2f)\n", name, mean, sd, Median(*values));
-    }
+// The same rocks again, with the per-cell recorder (a separate run: it is not timed).
+void PrintCellStatistics(const talus::Scene& scene, const BenchArgs& args) {
+  const CellValues cells = RunCellStatistics(scene, args.rocks, args.seed);
+  std::printf(
+      "\nramp statistics pooled per cell (RAMMS's statistic mode: each rock's maximum in each "
+      "%.0f m cell its centre of mass passed, %zu values of %d rocks; mean +- sd (median)):\n",
+      scene.terrain.heights().grid.dx_m, cells.speeds_m_s.size(), args.rocks);
+  const std::pair<const char*, const std::vector<double>*> pooled[] = {
+      {"speed, m/s", &cells.speeds_m_s},
+      {"rotation rate, rot/s", &cells.rotation_rates_1_s},
+      {"jump height, m", &cells.jump_heights_m},
+      {"kinetic energy, kJ", &cells.kinetic_energies_kj}};
+  for (const auto& [name, values] : pooled) {
+    const auto [mean, sd] = MeanAndSd(*values);
+    std::printf("  %-22s %8.2f +- %7.2f (%.2f)\n", name, mean, sd, Median(*values));
   }
-  // Stage profile in a separate run (the clock calls cost time of their own).
+}
+
+// The stages' share of a step, in a separate run (the clock calls cost time of their own).
+void PrintStageProfile(const talus::Scene& scene, const BenchArgs& args) {
   talus::StageTimes times;
-  const Batch profiled = RunBatch(scene, std::max(1, rocks / 4), seed, !detect_every_step, &times);
+  RunBatch(scene, std::max(1, args.rocks / 4), args.seed, !args.detect_every_step, &times);
   const double total =
       times.midpoint_s + times.free_rotation_s + times.contacts_s + times.solve_s + times.end_s;
   std::printf("\nstage profile (%ld steps, %.0f ns/step timed):\n", times.steps,
@@ -357,7 +375,24 @@ int RunBenchmark(int argc, char** argv) {
   for (const auto& [name, seconds] : stages)
     std::printf("  %-18s %6.1f %%  %6.0f ns/step\n", name, 100 * seconds / total,
                 1e9 * seconds / times.steps);
-  (void)profiled;
+}
+
+int RunBenchmark(int argc, char** argv) {
+  CLI::App app{"Ramp benchmark: EOTA221 block trajectories down a 40 degree plane, one core"};
+  BenchArgs args;
+  AddOptions(app, &args);
+  CLI11_PARSE(app, argc, argv);
+  const talus::Scene scene = MakeScene(args);
+  std::string why;
+  if (!scene.IsValid(&why)) {
+    std::fprintf(stderr, "ramp_bench: %s\n", why.c_str());
+    return 1;
+  }
+  PrintSetting(scene, args);
+  PrintBatchStatistics(RunRepeats(scene, args), args.rocks);
+  if (args.no_profile) return 0;
+  if (!args.no_cells) PrintCellStatistics(scene, args);
+  PrintStageProfile(scene, args);
   return 0;
 }
 
