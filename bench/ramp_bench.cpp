@@ -20,6 +20,7 @@
 #include <thread>
 #include <vector>
 
+#include "bench/bench_main.hpp"
 #include "ensemble/rasters.hpp"
 #include "scenes/scenes.hpp"
 #include "solver/simulate.hpp"
@@ -180,8 +181,6 @@ CellValues RunCellStatistics(const talus::Scene& scene, int rocks, std::uint64_t
   }
   return values;
 }
-
-}  // namespace
 
 // The command line.
 struct BenchArgs {
@@ -377,6 +376,8 @@ void PrintStageProfile(const talus::Scene& scene, const BenchArgs& args) {
                 1e9 * seconds / times.steps);
 }
 
+}  // namespace
+
 int RunBenchmark(int argc, char** argv) {
   CLI::App app{"Ramp benchmark: EOTA221 block trajectories down a 40 degree plane, one core"};
   BenchArgs args;
@@ -394,14 +395,4 @@ int RunBenchmark(int argc, char** argv) {
   if (!args.no_cells) PrintCellStatistics(scene, args);
   PrintStageProfile(scene, args);
   return 0;
-}
-
-// What the benchmark throws (a bad scene file, a full disk) ends it with one line on stderr.
-int main(int argc, char** argv) {
-  try {
-    return RunBenchmark(argc, argv);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "%s: %s\n", argv[0], e.what());
-    return 1;
-  }
 }

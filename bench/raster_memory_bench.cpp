@@ -13,6 +13,7 @@
 #include <exception>
 #include <string>
 
+#include "bench/bench_main.hpp"
 #include "ensemble/runner.hpp"
 #include "io/scene_file.hpp"
 
@@ -79,14 +80,4 @@ int RunBenchmark(int argc, char** argv) {
       "(*) computed for the layout the summaries replaced (every passing rock's value per "
       "cell), without std::vector's spare capacity\n");
   return 0;
-}
-
-// What the benchmark throws (a bad scene file, a full disk) ends it with one line on stderr.
-int main(int argc, char** argv) {
-  try {
-    return RunBenchmark(argc, argv);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "%s: %s\n", argv[0], e.what());
-    return 1;
-  }
 }

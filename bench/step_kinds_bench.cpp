@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/bench_main.hpp"
 #include "io/scene_file.hpp"
 #include "solver/simulate.hpp"
 
@@ -198,14 +199,4 @@ int RunBenchmark(int argc, char** argv) {
   RunRocks(file, rocks, true, &times);
   PrintStageProfile(times);
   return 0;
-}
-
-// What the benchmark throws (a bad scene file, a full disk) ends it with one line on stderr.
-int main(int argc, char** argv) {
-  try {
-    return RunBenchmark(argc, argv);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "%s: %s\n", argv[0], e.what());
-    return 1;
-  }
 }

@@ -26,6 +26,7 @@
 #include <thread>
 #include <vector>
 
+#include "bench/bench_main.hpp"
 #include "common/error.hpp"
 #include "common/statistics.hpp"
 #include "ensemble/rasters.hpp"
@@ -790,14 +791,4 @@ int RunBenchmark(int argc, char** argv) {
     return 1;
   }
   return 0;
-}
-
-// What the benchmark throws (a bad scene file, a full disk) ends it with one line on stderr.
-int main(int argc, char** argv) {
-  try {
-    return RunBenchmark(argc, argv);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "%s: %s\n", argv[0], e.what());
-    return 1;
-  }
 }
