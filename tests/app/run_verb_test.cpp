@@ -21,7 +21,7 @@ namespace {
 namespace fs = std::filesystem;
 
 fs::path FreshDir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("talus_run_verb_test_" + name);
+  fs::path dir = fs::temp_directory_path() / ("talus_run_verb_test_" + name);
   fs::remove_all(dir);
   fs::create_directories(dir);
   return dir;
