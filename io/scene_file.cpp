@@ -138,7 +138,8 @@ void LoadSolver(const Section& s, SolverOptions& o, SolverPreset& preset,
   o.gravity_m_s2 = s.Number("gravity_m_s2", o.gravity_m_s2);
   RequireWithin(s, "gravity_m_s2", o.gravity_m_s2, kMinGravity_m_s2, kMaxGravity_m_s2, "m/s2");
   o.normal_restitution = s.Number("normal_restitution", o.normal_restitution);
-  o.tangential_restitution = s.Number("tangential_restitution", o.tangential_restitution);
+  // One coefficient (SolverOptions): the tangential one follows the normal one unless given.
+  o.tangential_restitution = s.Number("tangential_restitution", o.normal_restitution);
   Choice(s, "viscous", "reading", {"centre_of_mass", "contact_friction"}, ParseViscousReading,
          &o.viscous);
   Choice(s, "contact_solve", "method", {"gauss_seidel", "block"}, ParseContactSolveMethod,

@@ -28,8 +28,9 @@ struct Contact {
   // Contact-friction reading of the viscous term: nu dt m (kg), the tangential damping this
   // contact gets when it carries the whole normal load; 0 otherwise (SolveContacts).
   double viscous_kg = 0;
-  // Added to the end contact velocity in the laws: xi = gamma_E + eps (.) gamma_B + (gap_m/dt, 0,
-  // 0).
+  // Added to the end contact velocity in the laws: xi = gamma_E + eps gamma_B (Newton's law: a
+  // closed contact, or a predicted one reached within the step), else xi = gamma_E + (gap_m/dt,
+  // 0, 0).
   Eigen::Vector3d velocity_bias = Eigen::Vector3d::Zero();
   Eigen::Vector3d percussion = Eigen::Vector3d::Zero();  // (P_N, P_T1, P_T2), N s
 };

@@ -132,8 +132,10 @@ bool SolverOptions::IsValid(std::string* why) const {
         "gravity >= 0");
   check(normal_restitution >= 0 && normal_restitution <= 1, "normal_restitution",
         normal_restitution, "0 <= normal_restitution <= 1");
-  check(tangential_restitution >= -1 && tangential_restitution <= 1, "tangential_restitution",
-        tangential_restitution, "-1 <= tangential_restitution <= 1");
+  check(tangential_restitution == normal_restitution, "tangential_restitution",
+        tangential_restitution,
+        "tangential_restitution == normal_restitution (Newton's impact law adds energy for unequal "
+        "coefficients: Glocker 2013, Part I)");
   check(viscous == ViscousReading::kCentreOfMass || viscous == ViscousReading::kContactFriction,
         "viscous", static_cast<double>(viscous), "a ViscousReading value");
   check(tolerance_m_s > 0 && tolerance_m_s < 1, "tolerance_m_s", tolerance_m_s,

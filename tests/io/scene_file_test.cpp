@@ -244,6 +244,27 @@ TEST(LoadScene, ScarringSoilPerCategoryWithItsParametersAndBounds) {
              "solver.soil_drag: unknown drag point 'centroid'");
 }
 
+// Newton's impact law takes one coefficient (SolverOptions): tangential_restitution follows
+// normal_restitution unless given, and a different one is refused with the reason.
+TEST(LoadScene, RestitutionIsOneCoefficient) {
+  const auto dir = testing::FreshDir("restitution");
+  const auto with = [](const std::string& keys) {
+    return Replace(kPlaneScene, "max_time_s = 20", "max_time_s = 20\n" + keys);
+  };
+  testing::WriteText(dir / "scene.toml", with("normal_restitution = 0.4"));
+  const SolverOptions o = LoadScene((dir / "scene.toml").string()).scene.options;
+  EXPECT_EQ(o.normal_restitution, 0.4);
+  EXPECT_EQ(o.tangential_restitution, 0.4);
+  testing::WriteText(dir / "scene.toml",
+                     with("normal_restitution = 0.4\ntangential_restitution = 0.4"));
+  EXPECT_EQ(LoadScene((dir / "scene.toml").string()).scene.options.tangential_restitution, 0.4);
+  EXPECT_HAS(ErrorOf(with("normal_restitution = 1\ntangential_restitution = -1"), dir),
+             "tangential_restitution = -1 violates tangential_restitution == normal_restitution "
+             "(Newton's impact law adds energy for unequal coefficients");
+  EXPECT_HAS(ErrorOf(with("tangential_restitution = 0.5"), dir),
+             "tangential_restitution = 0.5 violates");
+}
+
 TEST(LoadScene, ContactSolveMethodIsChosenByNameWithDidYouMean) {
   const auto dir = testing::FreshDir("contact_solve");
   testing::WriteText(dir / "scene.toml", kPlaneScene);
