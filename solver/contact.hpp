@@ -13,6 +13,9 @@ namespace talus {
 struct Contact {
   int vertex = 0;    // hull vertex index
   double gap_m = 0;  // open contact's gap along n at the midpoint; 0 for a closed one
+  // The second contact of a closed vertex heading across a concave change of the terrain: the
+  // face ahead, as a predicted contact (DetectContacts). Not warm-started.
+  bool corner = false;
   int ground = 0;    // ground index at the contact point
   // Body frame: where the percussion acts; the vertex itself, or for a predicted contact with
   // SolverOptions::predicted_lever = kTouch the vertex turned to where it touches.

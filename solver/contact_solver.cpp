@@ -279,7 +279,7 @@ ContactSolveReport SolveContacts(const Scene& scene, const RockShape& rock,
     c.viscous_kg =
         viscous_friction ? scene.ground.params(c.ground).nu_1_s * opt.dt_s * rock.mass_kg : 0.0;
     c.percussion.setZero();
-    if (workspace.last_closed[c.vertex]) {
+    if (workspace.last_closed[c.vertex] && !c.corner) {
       // Previous step's percussion, re-expressed in this frame and made admissible.
       Eigen::Vector3d p = c.directions.transpose() * workspace.last_percussion[c.vertex];
       p.x() = std::max(0.0, p.x());
@@ -359,6 +359,10 @@ ContactSolveReport SolveContacts(const Scene& scene, const RockShape& rock,
 
   workspace.ForgetPercussions();
   for (const Contact& c : workspace.contacts) {
+    if (c.corner) {  // its vertex's closed contact comes first
+      workspace.last_percussion[c.vertex] += c.directions * c.percussion;
+      continue;
+    }
     workspace.last_closed[c.vertex] = 1;
     workspace.last_closed_list.push_back(c.vertex);
     workspace.last_percussion[c.vertex] = c.directions * c.percussion;

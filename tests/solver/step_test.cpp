@@ -239,6 +239,39 @@ TEST(Impact, NewtonRestitutionStopsAFastSmallBlockTunnelling) {
   EXPECT_NEAR(v_out, -eps * v_in, 1e-6 * std::abs(v_in));
 }
 
+TEST(Impact, ASmallCubeSlidingPastASlopeFootStaysOnTheGround) {
+  // A 1 cm cube slides face down at 8 m/s (1.6 cm, more than its size, per 2 ms step) down a 40
+  // deg plane onto the flat runout. Its closed contacts' law stops motion into the slope, not
+  // along it: without the second contact with the face ahead (AddCornerContact) it ran on below
+  // the runout and slid to rest with its centre 1.5 mm under the ground (repro W6). A resting or
+  // sliding cube on the flat has its centre at a/2, less the penetration tolerance (1 % of a);
+  // tolerance 1e-12 m beyond that.
+  const double a = 0.01;
+  PlaneSpec plane;
+  plane.slope_deg = 40;
+  plane.slope_length_m = 20;
+  plane.runout_m = 20;
+  plane.width_m = 10;
+  plane.cell_m = 1;
+  Scene scene;
+  const int test = scene.ground.Set({"test", 100, ConstantFriction(0.3)});
+  scene.terrain = Terrain(MakePlaneHeightfield(plane), test);
+  scene.rock = MakeRockShape(MakeBox(a, a, a), 2700);
+  const double slope = 40 * kDeg;
+  RockState s = Touching(scene, AboutY(slope), 19.5, 0.3);
+  s.velocity_m_s = 8 * Eigen::Vector3d(std::cos(slope), 0, -std::sin(slope));
+  StepWorkspace ws;
+  ws.Reset(scene.rock.vertices_m.size());
+  const double lowest_allowed = a / 2 - scene.options.penetration_tolerance * a - 1e-12;
+  double lowest_on_flat = 1;
+  for (int k = 0; k < 2000 && s.velocity_m_s.norm() > 1e-3; ++k) {
+    Step(scene, s, ws);
+    if (s.position_m.x() > 20 + a) lowest_on_flat = std::min(lowest_on_flat, s.position_m.z());
+  }
+  EXPECT_GT(s.position_m.x(), 20.5);  // it reached the runout and slid along it
+  EXPECT_GE(lowest_on_flat, lowest_allowed);
+}
+
 TEST(Rest, BlockOnFlatGroundStaysAndIsReportedAtRest) {
   Scene scene =
       scenes::Incline(0, MakeRockShape(MakeBox(1, 0.8, 0.5), 2700), ConstantFriction(0.5));
