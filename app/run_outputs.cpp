@@ -312,7 +312,7 @@ io::SceneFile LoadSceneOfPart(const io::PartialInfo& part) {
   SolverPreset preset = SolverPreset::kDefault;
   if (!ParseSolverPreset(part.solver_preset, &preset))
     throw InputError(part.dir + ": unknown solver preset '" + part.solver_preset + "'");
-  io::UseSolverPreset(scene, preset);
+  if (part.solver_preset_from_command_line) io::UseSolverPreset(scene, preset);
   if (scene.release.total_rocks() != part.total_rocks)
     throw InputError(part.dir + ": the scene gives " + std::to_string(scene.release.total_rocks()) +
                      " rocks, the part " + std::to_string(part.total_rocks));

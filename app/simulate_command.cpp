@@ -84,6 +84,8 @@ int LoadForSimulate(const SimulateArgs& args, io::SceneFile* scene, std::pair<lo
         throw InputError("--preset: unknown preset '" + args.preset +
                          "'; known: fast, default, accurate");
       io::UseSolverPreset(*scene, preset);
+      for (const std::string& key : scene->solver_keys_overridden)
+        std::printf("--preset %s overrides the scene's %s\n", args.preset.c_str(), key.c_str());
     }
     // The scene was valid; only --rocks can break it now (too many rocks in all).
     if (std::string why; !scene->release.IsValid(&why))
@@ -200,8 +202,9 @@ Runner AddSimulateCommand(CLI::App& app) {
          "Random seed (overrides the scene)")
       ->check(IntegerRange(0, std::numeric_limits<std::int64_t>::max()));
   cmd->add_option("--preset", args->preset,
-                  "Solver accuracy: fast, default or accurate (overrides the scene's [solver] "
-                  "preset; keys the scene sets itself are kept)");
+                  "Solver accuracy: fast, default or accurate (wins over the scene's [solver] "
+                  "preset and its dt_s, tolerance_m_s and max_iterations; each value it changes "
+                  "is printed and listed in summary.json)");
   cmd->add_option("--rock-range", args->rock_range,
                   "Run only rocks A .. B-1 (A:B) and write a partial result for talus merge");
   return [cmd, args]() { return *cmd ? RunSimulate(*args) : -1; };

@@ -46,6 +46,7 @@ std::string PartialJson(const SceneFile& scene, const std::string& version, long
   j["rocks_per_release"] =
       scene.release.release_first_rock.empty() ? scene.release.rocks_per_release : 0;
   j["solver_preset"] = ToString(scene.solver_preset);
+  j["solver_preset_from_command_line"] = scene.solver_preset_from_command_line;
   j["total_rocks"] = scene.release.total_rocks();
   j["first_rock"] = first_rock;
   j["end_rock"] = end_rock;
@@ -97,6 +98,7 @@ PartialInfo ReadPartialInfo(const std::string& dir) {
     p.seed = j.at("seed");
     p.rocks_per_release = j.at("rocks_per_release");
     p.solver_preset = j.at("solver_preset");
+    p.solver_preset_from_command_line = j.value("solver_preset_from_command_line", false);
     p.total_rocks = j.at("total_rocks");
     p.first_rock = j.at("first_rock");
     p.end_rock = j.at("end_rock");
@@ -133,6 +135,9 @@ std::vector<PartialInfo> CheckPartials(std::vector<PartialInfo> parts) {
     if (b.seed != a.seed) differ("seeds", std::to_string(a.seed), std::to_string(b.seed));
     if (b.solver_preset != a.solver_preset)
       differ("solver presets", a.solver_preset, b.solver_preset);
+    if (b.solver_preset_from_command_line != a.solver_preset_from_command_line)
+      differ("solver presets", a.solver_preset_from_command_line ? "--preset" : "the scene's",
+             b.solver_preset_from_command_line ? "--preset" : "the scene's");
     if (b.rocks_per_release != a.rocks_per_release || b.total_rocks != a.total_rocks)
       differ("rocks", std::to_string(a.total_rocks), std::to_string(b.total_rocks));
   }

@@ -33,6 +33,7 @@ struct PartialInfo {
   std::uint64_t seed = 0;
   long rocks_per_release = 0;
   std::string solver_preset;  // "fast", "default", "accurate" (the scene's or --preset)
+  bool solver_preset_from_command_line = false;  // --preset: it won over the scene's keys
   long total_rocks = 0;
   long first_rock = 0, end_rock = 0;  // rocks [first_rock, end_rock)
   bool trajectories = false;

@@ -222,13 +222,21 @@ void UseSolverPreset(SceneFile& scene, SolverPreset preset) {
   SolverOptions o = scene.scene.options;
   ApplyPreset(preset, &o);
   const SolverOptions& given = scene.scene.options;
-  for (const std::string& key : scene.solver_keys_given) {
-    if (key == "dt_s") o.dt_s = given.dt_s;
-    if (key == "tolerance_m_s") o.tolerance_m_s = given.tolerance_m_s;
-    if (key == "max_iterations") o.max_iterations = given.max_iterations;
-  }
+  scene.solver_keys_overridden.clear();
+  const auto note = [&](const std::string& key, double was, double now) {
+    const bool scene_gives = std::find(scene.solver_keys_given.begin(),
+                                       scene.solver_keys_given.end(),
+                                       key) != scene.solver_keys_given.end();
+    if (scene_gives && was != now)
+      scene.solver_keys_overridden.push_back(key + " = " + scene_tables::Fmt(was) + " -> " +
+                                             scene_tables::Fmt(now));
+  };
+  note("dt_s", given.dt_s, o.dt_s);
+  note("tolerance_m_s", given.tolerance_m_s, o.tolerance_m_s);
+  note("max_iterations", given.max_iterations, o.max_iterations);
   scene.scene.options = o;
   scene.solver_preset = preset;
+  scene.solver_preset_from_command_line = true;
 }
 
 ensemble::RasterRequest OutputSpec::Request(const GridGeometry& grid) const {

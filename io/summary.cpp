@@ -113,6 +113,8 @@ std::string SummaryJson(const SceneFile& scene, const ensemble::EnsembleReport& 
   // summary.json alone (with the inputs of the same hash).
   j["solver"] = SolverJson(scene.scene.options);
   j["solver"]["preset"] = ToString(scene.solver_preset);
+  j["solver"]["preset_from"] = scene.solver_preset_from_command_line ? "command line" : "scene";
+  j["solver"]["preset_overrode"] = scene.solver_keys_overridden;
   j["ground"] = GroundJson(scene.scene.ground);
   // How the rasters were asked for (the statistics rasters' percentiles and the file layout).
   j["raster_output"] = {

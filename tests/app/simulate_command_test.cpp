@@ -280,7 +280,25 @@ TEST(SimulateCommand, OverridesRocksAndSeed) {
       << log;
   const auto fast = nlohmann::json::parse(Slurp(dir / "fast" / "summary.json"));
   EXPECT_EQ(fast["solver"]["preset"], "fast");
+  EXPECT_EQ(fast["solver"]["preset_from"], "command line");
   EXPECT_EQ(fast["solver"]["tolerance_m_s"], 1e-2);
+  EXPECT_EQ(summary["solver"]["preset_from"], "scene");
+  // --preset accurate wins over the scene's own dt_s and says so.
+  std::string pinned = kScene;
+  pinned.replace(pinned.find("[solver]\n"), 9, "[solver]\ndt_s = 0.002\n");
+  std::ofstream(dir / "pinned.toml") << pinned;
+  ASSERT_EQ(RunCommand(std::string(TALUS_BINARY) + " simulate " + (dir / "pinned.toml").string() +
+                           " --out " + (dir / "accurate").string() + " --rocks 1 --preset accurate",
+                       &log),
+            0)
+      << log;
+  EXPECT_NE(log.find("--preset accurate overrides the scene's dt_s = 0.002 -> 0.001"),
+            std::string::npos)
+      << log;
+  const auto accurate = nlohmann::json::parse(Slurp(dir / "accurate" / "summary.json"));
+  EXPECT_EQ(accurate["solver"]["dt_s"], 0.001);
+  EXPECT_EQ(accurate["solver"]["tolerance_m_s"], 1e-7);
+  EXPECT_EQ(accurate["solver"]["preset_overrode"][0], "dt_s = 0.002 -> 0.001");
   EXPECT_EQ(RunCommand(std::string(TALUS_BINARY) + " simulate " + (dir / "scene.toml").string() +
                            " --out " + (dir / "bad").string() + " --preset quick",
                        &log),

@@ -295,8 +295,8 @@ TEST(LoadScene, PredictedLeverIsChosenByNameWithDidYouMean) {
              "scene.toml:23: solver.predicted_lever: unknown lever 'tuch' (did you mean 'touch'?)");
 }
 
-// [solver] preset sets the accuracy knobs (solver/options.hpp); keys the scene gives win, also
-// when talus simulate --preset (UseSolverPreset) changes the preset afterwards.
+// [solver] preset sets the accuracy knobs (solver/options.hpp) and keys the scene gives win over
+// it; talus simulate --preset (UseSolverPreset) wins over both and names the values it changed.
 TEST(LoadScene, SolverPresetSetsTheKnobsTheSceneDoesNotGive) {
   const auto dir = testing::FreshDir("preset");
   const auto load = [&](const std::string& extra) {
@@ -316,11 +316,19 @@ TEST(LoadScene, SolverPresetSetsTheKnobsTheSceneDoesNotGive) {
   EXPECT_EQ(scene.scene.options.dt_s, 0.001);
   EXPECT_EQ(scene.scene.options.max_iterations, 1000);
   EXPECT_EQ(scene.scene.options.tolerance_m_s, 1e-6);  // given: kept
+  EXPECT_FALSE(scene.solver_preset_from_command_line);
   UseSolverPreset(scene, SolverPreset::kFast);
   EXPECT_EQ(scene.solver_preset, SolverPreset::kFast);
+  EXPECT_TRUE(scene.solver_preset_from_command_line);
   EXPECT_EQ(scene.scene.options.dt_s, defaults.dt_s);
   EXPECT_EQ(scene.scene.options.max_iterations, defaults.max_iterations);
-  EXPECT_EQ(scene.scene.options.tolerance_m_s, 1e-6);  // still the scene's own
+  EXPECT_EQ(scene.scene.options.tolerance_m_s, 1e-2);  // the scene's own 1e-6 overridden
+  EXPECT_EQ(scene.solver_keys_overridden, std::vector<std::string>{"tolerance_m_s = 1e-06 -> 0.01"});
+  // The shipped scenes' case: dt_s = 0.002 given, --preset accurate halves it.
+  scene = load("dt_s = 0.002");
+  UseSolverPreset(scene, SolverPreset::kAccurate);
+  EXPECT_EQ(scene.scene.options.dt_s, 0.001);
+  EXPECT_EQ(scene.solver_keys_overridden, std::vector<std::string>{"dt_s = 0.002 -> 0.001"});
   EXPECT_HAS(
       ErrorOf(Replace(kPlaneScene, "max_time_s = 20", "max_time_s = 20\npreset = \"fats\""), dir),
       "scene.toml:23: solver.preset: unknown preset 'fats' (did you mean 'fast'?)");
