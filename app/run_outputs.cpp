@@ -70,7 +70,8 @@ std::vector<std::string> WriteSummaryOutputs(const io::SceneFile& scene,
                                              const std::vector<ensemble::RasterLayer>& layers,
                                              const std::vector<io::SamplePath>& paths,
                                              const StagingDirectory& staging,
-                                             std::vector<std::string> outputs) {
+                                             std::vector<std::string> outputs,
+                                             const ensemble::SelfCheckReport* self_check) {
   const GridGeometry& dem = scene.scene.terrain.heights().grid;
   // GDAL would print every failed write of a full disk; the writers throw with its last message.
   const QuietGdal quiet_gdal;
@@ -120,7 +121,8 @@ std::vector<std::string> WriteSummaryOutputs(const io::SceneFile& scene,
     outputs.push_back("rocks.gpkg");
   }
   if (scene.output.report) outputs.push_back("report.html");
-  const std::string summary = io::SummaryJson(scene, report, kVersion, outputs, lines);
+  const std::string summary =
+      io::SummaryJson(scene, report, kVersion, outputs, lines, self_check);
   if (scene.output.report) {
     ThrowIfInterrupted();
     io::RunReportInput page;
@@ -182,7 +184,8 @@ std::vector<std::string> TalusOutputNames() {
 std::vector<std::string> RunIntoStaging(const io::SceneFile& scene, int threads, long first_rock,
                                         long end_rock, bool part, const StagingDirectory& staging,
                                         std::function<void(long, long)> progress,
-                                        ensemble::EnsembleReport* report) {
+                                        ensemble::EnsembleReport* report,
+                                        const ensemble::SelfCheckReport* self_check) {
   ensemble::EnsembleOptions options;
   options.threads = threads;
   options.first_rock = first_rock;
@@ -221,7 +224,8 @@ std::vector<std::string> RunIntoStaging(const io::SceneFile& scene, int threads,
   if (trajectories) trajectories->Commit();
   if (lines) lines->Commit();
   if (!part)
-    return WriteSummaryOutputs(scene, *report, report->rasters, sink.paths, staging, outputs);
+    return WriteSummaryOutputs(scene, *report, report->rasters, sink.paths, staging, outputs,
+                               self_check);
   WriteFileAtomically(staging.path("partial.bin"), io::PartialState(*report, sink.paths));
   WriteFileAtomically(staging.path("partial.json"),
                       io::PartialJson(scene, kVersion, first_rock, end_rock, *report));
@@ -282,7 +286,7 @@ std::vector<std::string> MergeIntoStaging(const io::SceneFile& scene,
   const std::vector<ensemble::RasterLayer> layers =
       rasters ? rasters->Finish(scene.scene.terrain.heights())
               : std::vector<ensemble::RasterLayer>{};
-  return WriteSummaryOutputs(scene, *report, layers, paths, staging, outputs);
+  return WriteSummaryOutputs(scene, *report, layers, paths, staging, outputs, nullptr);
 }
 
 void CommitOutputs(StagingDirectory& staging, const std::vector<std::string>& files,

@@ -10,6 +10,7 @@
 
 #include "common/atomic_file.hpp"
 #include "ensemble/runner.hpp"
+#include "ensemble/self_check.hpp"
 #include "io/partial.hpp"
 #include "io/scene_file.hpp"
 
@@ -25,11 +26,13 @@ std::vector<std::string> TalusOutputNames();
 // Runs rocks [first_rock, end_rock) of the scene and writes them into `staging`: rocks.csv and
 // trajectories.h5 (when asked); then, as a `part`, partial.bin and partial.json, else (the whole
 // ensemble) the rasters, quick-look and summary.json. Returns the files written, in commit order.
-// `progress` is called on the calling thread (and may throw to stop the run).
+// `progress` is called on the calling thread (and may throw to stop the run). A self-check's
+// report, when given, goes into summary.json.
 std::vector<std::string> RunIntoStaging(const io::SceneFile& scene, int threads, long first_rock,
                                         long end_rock, bool part, const StagingDirectory& staging,
                                         std::function<void(long, long)> progress,
-                                        ensemble::EnsembleReport* report);
+                                        ensemble::EnsembleReport* report,
+                                        const ensemble::SelfCheckReport* self_check = nullptr);
 
 // Merges parts that CheckPartials accepted into `staging`: rocks.csv, trajectories.h5, rasters,
 // quick-look and summary.json, the same bytes as one run of all rocks (summary.json's threads and

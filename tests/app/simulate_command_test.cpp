@@ -307,6 +307,38 @@ TEST(SimulateCommand, OverridesRocksAndSeed) {
   EXPECT_NE(log.find("--preset: unknown preset 'quick'"), std::string::npos) << log;
 }
 
+// --self-check N: the subsample's statistics at dt and dt/2 with their verdict, printed and in
+// summary.json; refused for a part and for more rocks than the run has.
+TEST(SimulateCommand, SelfCheckIsPrintedAndWrittenToTheSummary) {
+  const fs::path dir = FreshDir("self_check");
+  std::ofstream(dir / "scene.toml") << kScene;
+  std::string log;
+  ASSERT_EQ(RunCommand(std::string(TALUS_BINARY) + " simulate " + (dir / "scene.toml").string() +
+                           " --out " + (dir / "out").string() + " --rocks 2 --self-check 4",
+                       &log),
+            0)
+      << log;
+  EXPECT_NE(log.find("Self-check: "), std::string::npos) << log;
+  const auto summary = nlohmann::json::parse(Slurp(dir / "out" / "summary.json"));
+  const auto& check = summary["self_check"];
+  EXPECT_EQ(check["rocks"], 4);
+  EXPECT_EQ(check["refined_dt_s"], 0.001);
+  EXPECT_EQ(check["statistics"][0]["name"], "run-out median");
+  EXPECT_TRUE(check["verdict"].is_string());
+  EXPECT_EQ(RunCommand(std::string(TALUS_BINARY) + " simulate " + (dir / "scene.toml").string() +
+                           " --out " + (dir / "part").string() + " --self-check 4 --rock-range 0:2",
+                       &log),
+            2)
+      << log;
+  EXPECT_NE(log.find("--self-check: not with --rock-range"), std::string::npos) << log;
+  EXPECT_EQ(RunCommand(std::string(TALUS_BINARY) + " simulate " + (dir / "scene.toml").string() +
+                           " --out " + (dir / "many").string() + " --rocks 1 --self-check 9",
+                       &log),
+            2)
+      << log;
+  EXPECT_NE(log.find("--self-check 9: the run has"), std::string::npos) << log;
+}
+
 // --rocks is checked like the scene's rocks: 2 releases x 2^63 - 1 rocks used to overflow to a
 // "successful" run of no rock.
 TEST(SimulateCommand, TooManyRocksOnTheCommandLineIsAnError) {
