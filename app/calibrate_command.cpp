@@ -19,6 +19,7 @@
 #include <functional>
 #include <iostream>
 #include <limits>
+#include <map>
 #include <memory>
 #include <optional>
 #include <sstream>
@@ -112,6 +113,19 @@ struct Loaded {
   std::string checkpoint_path;
 };
 
+// The shape of every evaluation of each optimisation of the calibration: the fit's, each fold's.
+std::map<std::string, io::EvaluationShape> EvaluationShapes(
+    const calibration::CalibrationProblem& problem, int folds) {
+  const auto shape = [](const calibration::Objective& o) {
+    return io::EvaluationShape{o.dimension(), static_cast<int>(o.kinds().size()),
+                               o.residual_count()};
+  };
+  std::map<std::string, io::EvaluationShape> shapes = {{"fit", shape(problem.objective())}};
+  for (int f = 0; f < folds; ++f)
+    shapes["fold" + std::to_string(f + 1)] = shape(problem.ObjectiveOn(problem.FoldTraining(f)));
+  return shapes;
+}
+
 // Loads the calibration file, its event, scene and observations, splits the runs (--holdout,
 // --folds) and checks the checkpoint in --out against --resume. kExitOk, or the exit code with the
 // reason in *message.
@@ -154,6 +168,7 @@ int Load(const CalibrateArgs& args, const Processes& processes, Loaded* loaded,
         throw InputError(path +
                          ": the checkpoint belongs to another calibration (other inputs, "
                          "parameters, optimiser options, --holdout or --folds)");
+      io::CheckEvaluations(saved, path, EvaluationShapes(*loaded->problem, args.folds));
       checkpoint.stages = saved.stages;
     } else if (exists) {
       throw InputError(path +

@@ -42,7 +42,7 @@ Evaluation Recorded(double u, double value, bool feasible = true) {
 
 TEST(Evaluator, RunsTheObjectiveAndAnswersAPointAskedAgainFromTheHistory) {
   OptimizerOptions options;
-  Summary summary;
+  OptimizerSummary summary;
   Evaluator evaluate(MuMinObjective(), options, summary);
   const Evaluation a = evaluate(U(0.3));
   EXPECT_EQ(a.value, MuMinObjective().Evaluate(U(0.3)).value);  // what the objective says
@@ -62,7 +62,7 @@ TEST(Evaluator, ServesACheckpointInOrderWithoutRunningRocksAndKeepsTheBestFeasib
   options.replay = {Recorded(0.5, 3.0), Recorded(0.7, 1.0, false), Recorded(0.2, 2.0)};
   std::vector<int> seen;
   options.on_evaluation = [&](const Evaluation&, int index) { seen.push_back(index); };
-  Summary summary;
+  OptimizerSummary summary;
   Evaluator evaluate(MuMinObjective(), options, summary);
   EXPECT_EQ(evaluate(U(0.5)).value, 3.0);  // the recorded value, not a run's
   EXPECT_EQ(summary.best.value, 3.0);
@@ -81,7 +81,7 @@ TEST(Evaluator, ServesACheckpointInOrderWithoutRunningRocksAndKeepsTheBestFeasib
 TEST(Evaluator, ACheckpointOfAnotherCalibrationIsRefused) {
   OptimizerOptions options;
   options.replay = {Recorded(0.5, 3.0), Recorded(0.7, 1.0)};
-  Summary summary;
+  OptimizerSummary summary;
   Evaluator evaluate(MuMinObjective(), options, summary);
   evaluate(U(0.5));
   try {
@@ -94,11 +94,27 @@ TEST(Evaluator, ACheckpointOfAnotherCalibrationIsRefused) {
   EXPECT_EQ(summary.evaluations(), 1);
 }
 
+// A replayed evaluation whose u has another number of coordinates (a damaged checkpoint) is the
+// same refusal, not a comparison of vectors of different sizes (which crashed).
+TEST(Evaluator, ACheckpointEvaluationOfAnotherDimensionIsRefused) {
+  for (const Eigen::VectorXd& u :
+       {Eigen::VectorXd(), Eigen::VectorXd(Eigen::VectorXd::Constant(3, 0.5))}) {
+    OptimizerOptions options;
+    Evaluation recorded = Recorded(0.5, 3.0);
+    recorded.u = u;
+    options.replay = {recorded};
+    OptimizerSummary summary;
+    Evaluator evaluate(MuMinObjective(), options, summary);
+    EXPECT_THROW(evaluate(U(0.5)), std::runtime_error) << u.size();
+    EXPECT_EQ(summary.evaluations(), 0);
+  }
+}
+
 TEST(Evaluator, StopsAtTheEvaluationBudgetButStillAnswersKnownPoints) {
   OptimizerOptions options;
   options.max_evaluations = 2;
   options.replay = {Recorded(0.1, 5.0), Recorded(0.2, 4.0)};
-  Summary summary;
+  OptimizerSummary summary;
   Evaluator evaluate(MuMinObjective(), options, summary);
   EXPECT_TRUE(evaluate.TryEvaluate(U(0.1)));
   EXPECT_FALSE(evaluate.out_of_evaluations());
@@ -122,7 +138,7 @@ TEST(Evaluator, StopsAtTheTimeBudgetWhichOutranksTheOtherEndings) {
   options.on_evaluation = [](const Evaluation&, int) {
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   };
-  Summary summary;
+  OptimizerSummary summary;
   Evaluator evaluate(MuMinObjective(), options, summary);
   EXPECT_TRUE(evaluate.TryEvaluate(U(0.1)));
   EXPECT_TRUE(evaluate.out_of_time());
@@ -139,7 +155,7 @@ TEST(Evaluator, AnExceptionFromACallbackIsKeptForRethrowAndStopsTheRun) {
   options.on_evaluation = [](const Evaluation&, int index) {
     if (index == 1) throw std::runtime_error("interrupted");
   };
-  Summary summary;
+  OptimizerSummary summary;
   Evaluator evaluate(MuMinObjective(), options, summary);
   EXPECT_TRUE(evaluate.TryEvaluate(U(0.1)));
   EXPECT_FALSE(evaluate.TryEvaluate(U(0.2)));
@@ -151,7 +167,7 @@ TEST(Evaluator, AnExceptionFromACallbackIsKeptForRethrowAndStopsTheRun) {
 TEST(Evaluator, FinishStatesConvergenceOrFailureAndAMissingFeasibleEvaluation) {
   OptimizerOptions options;
   options.replay = {Recorded(0.1, 5.0)};
-  Summary summary;
+  OptimizerSummary summary;
   Evaluator evaluate(MuMinObjective(), options, summary);
   evaluate(U(0.1));
   evaluate.Finish(false, true, "ftol_rel", "roundoff");
@@ -163,7 +179,7 @@ TEST(Evaluator, FinishStatesConvergenceOrFailureAndAMissingFeasibleEvaluation) {
 
   OptimizerOptions infeasible;
   infeasible.replay = {Recorded(0.1, 5.0, false)};
-  Summary none;
+  OptimizerSummary none;
   Evaluator only_infeasible(MuMinObjective(), infeasible, none);
   only_infeasible(U(0.1));
   only_infeasible.Finish(false, true, "xtol_abs", "");
