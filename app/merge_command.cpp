@@ -36,6 +36,7 @@ int RunMerge(const MergeArgs& args) {
       parts.push_back(io::ReadPartialInfo(dir));
     }
     parts = io::CheckPartials(std::move(parts));
+    for (const io::PartialInfo& part : parts) io::CheckPartFiles(part);
     scene = LoadSceneOfPart(parts.front());
   } catch (const InputError& e) {
     std::cerr << "talus merge: " << e.what() << "\n";

@@ -223,9 +223,11 @@ std::vector<std::string> RunIntoStaging(const io::SceneFile& scene, int threads,
   if (!part)
     return WriteSummaryOutputs(scene, *report, report->rasters, sink.paths, staging, outputs);
   WriteFileAtomically(staging.path("partial.bin"), io::PartialState(*report, sink.paths));
-  WriteFileAtomically(staging.path("partial.json"),
-                      io::PartialJson(scene, kVersion, first_rock, end_rock, *report));
   outputs.push_back("partial.bin");
+  std::vector<std::string> files;  // sizes and checksums in partial.json
+  for (const std::string& name : outputs) files.push_back(staging.path(name));
+  WriteFileAtomically(staging.path("partial.json"),
+                      io::PartialJson(scene, kVersion, first_rock, end_rock, *report, files));
   outputs.push_back("partial.json");  // last: a complete part is one with a partial.json
   return outputs;
 }

@@ -221,6 +221,7 @@ int SimulateOnRanks(const MpiSession& mpi, const SimulateArgs& args) {
       std::vector<io::PartialInfo> parts;
       for (const fs::path& dir : dirs) parts.push_back(io::ReadPartialInfo(dir.string()));
       parts = io::CheckPartials(std::move(parts));
+      for (const io::PartialInfo& p : parts) io::CheckPartFiles(p);  // as they were sent
       const double wall_time_s =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       ensemble::EnsembleReport merged;
