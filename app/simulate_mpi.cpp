@@ -4,6 +4,8 @@
 // code of `talus merge`. The ranks agree on success at every step (loading, running, sending), so
 // that a failure on any rank ends every rank with one message from rank 0 and no output.
 
+#include <unistd.h>
+
 #include <chrono>
 #include <csignal>
 #include <cstdlib>
@@ -177,11 +179,14 @@ int SimulateOnRanks(const MpiSession& mpi, const SimulateArgs& args) {
   std::optional<StagingDirectory> staging, part;
   ensemble::EnsembleReport report;
   try {
-    // Ranks other than 0 stage in $TMPDIR/talus-ranks, where they also remove what ranks that
+    // Ranks other than 0 stage in $TMPDIR/talus-ranks-<uid>, a directory of this user's alone
+    // (never one through a link someone else planted), where they also remove what ranks that
     // died (SIGKILL, a lost node) left there, as rank 0 does in --out.
-    const fs::path dir = root ? fs::path(args.out) : fs::temp_directory_path() / "talus-ranks";
+    const fs::path dir =
+        root ? fs::path(args.out)
+             : fs::temp_directory_path() / ("talus-ranks-" + std::to_string(::geteuid()));
     if (!root) {
-      fs::create_directories(dir);
+      MakePrivateDirectory(dir.string());
       RemoveStaleTemporaries(dir.string());
     }
     staging.emplace(dir.string());

@@ -1,6 +1,8 @@
 #include "common/atomic_file.hpp"
 
+#include <fcntl.h>
 #include <signal.h>  // NOLINT(modernize-deprecated-headers): POSIX sigaction is declared here
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -148,6 +150,31 @@ std::vector<std::string> RemoveStaleTemporaries(const std::string& dir) {
     if (fs::remove_all(fs::path(dir) / name, ignored) > 0 && !ignored) removed.push_back(name);
   }
   return removed;
+}
+
+void MakePrivateDirectory(const std::string& path) {
+  const auto fail = [&](const std::string& why) {
+    throw std::runtime_error(path + ": " + why +
+                             "; remove it, or point TMPDIR at a directory of your own");
+  };
+  if (::mkdir(path.c_str(), 0700) != 0 && errno != EEXIST)
+    fail(std::string("cannot create the directory: ") + std::strerror(errno));
+  // Opened without following a link, then checked and fixed through the descriptor (in a sticky
+  // $TMPDIR nobody else can rename or remove it afterwards).
+  const int fd = ::open(path.c_str(), O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC);
+  if (fd < 0) {
+    struct stat link {};
+    if (::lstat(path.c_str(), &link) == 0 && S_ISLNK(link.st_mode)) fail("is a symbolic link");
+    fail(std::string("not a directory of its own (") + std::strerror(errno) + ")");
+  }
+  struct stat st {};
+  const bool ok = ::fstat(fd, &st) == 0;
+  const bool mine = ok && st.st_uid == ::geteuid();
+  const bool fixed = mine && ((st.st_mode & 077) == 0 || ::fchmod(fd, 0700) == 0);
+  ::close(fd);
+  if (!ok) fail("cannot be examined");
+  if (!mine) fail("belongs to another user (uid " + std::to_string(st.st_uid) + ")");
+  if (!fixed) fail("its mode cannot be set to 0700");
 }
 
 }  // namespace talus

@@ -81,4 +81,11 @@ class StagingDirectory {
 // Returns the names removed. Errors (an unreadable directory) are ignored: this is housekeeping.
 std::vector<std::string> RemoveStaleTemporaries(const std::string& dir);
 
+// Makes `path` a directory of this user's alone, for files of its own (a rank's staging area in a
+// shared $TMPDIR): creates it with mode 0700, or accepts an existing one only when it is a
+// directory, not a symbolic link, and owned by this user (its mode is then set to 0700). Throws
+// std::runtime_error naming the path and why it is refused (a link someone else planted would
+// lead files, and their removal, elsewhere).
+void MakePrivateDirectory(const std::string& path);
+
 }  // namespace talus
