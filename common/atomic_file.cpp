@@ -18,9 +18,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr const char* kTempMarker = ".tmp-";
+constexpr const char* kTempMarker = ".talus-tmp-";
 
-// ".<name>.tmp-<pid>" in the directory of `path`.
+// ".<name>.talus-tmp-<pid>" in the directory of `path`.
 std::string TemporaryName(const fs::path& path) {
   std::string name = ".";  // appended piece by piece: GCC 12 warns (-Wrestrict) on a + b + c
   name += path.filename().string();
@@ -29,7 +29,7 @@ std::string TemporaryName(const fs::path& path) {
   return (path.parent_path() / name).string();
 }
 
-// The process id a temporary name ".<name>.tmp-<pid>" carries; 0 for any other name.
+// The process id a temporary name ".<name>.talus-tmp-<pid>" carries; 0 for any other name.
 pid_t OwnerOf(const std::string& name) {
   const std::size_t at = name.rfind(kTempMarker);
   if (name.size() < 2 || name[0] != '.' || at == std::string::npos || at < 2) return 0;

@@ -10,6 +10,7 @@
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
+
 #include "tests/test_tmp.hpp"
 
 namespace talus {
@@ -121,25 +122,30 @@ TEST(StagingDirectory, TargetUntouchedUntilCommit) {
   EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator()), 3);
 }
 
+// Only talus's own temporary names (".<name>.talus-tmp-<pid>"): a user's ".notes.tmp-<pid>"
+// of a dead pid stays.
 TEST(RemoveStaleTemporaries, RemovesThoseOfDeadProcessesOnly) {
   const auto dir = FreshDir("stale");
   const std::string dead = std::to_string(DeadPid());
   const std::string alive = std::to_string(::getpid());
-  std::ofstream(dir / (".rocks.csv.tmp-" + dead)) << "x";
-  fs::create_directories(dir / (".talus-run.tmp-" + dead));
-  std::ofstream(dir / (".talus-run.tmp-" + dead) / "rocks.csv") << "x";
-  std::ofstream(dir / (".rocks.csv.tmp-" + alive)) << "x";
-  std::ofstream(dir / (".rocks.csv.tmp-1")) << "x";   // init, always alive
-  std::ofstream(dir / ("notes.tmp-" + dead)) << "x";  // not a temporary name
-  std::ofstream(dir / (".notes.tmp-" + dead + "x")) << "x";
+  std::ofstream(dir / (".rocks.csv.talus-tmp-" + dead)) << "x";
+  fs::create_directories(dir / (".talus-run.talus-tmp-" + dead));
+  std::ofstream(dir / (".talus-run.talus-tmp-" + dead) / "rocks.csv") << "x";
+  std::ofstream(dir / (".rocks.csv.talus-tmp-" + alive)) << "x";
+  std::ofstream(dir / (".rocks.csv.talus-tmp-1")) << "x";   // init, always alive
+  std::ofstream(dir / ("notes.talus-tmp-" + dead)) << "x";  // not a temporary name
+  std::ofstream(dir / (".notes.talus-tmp-" + dead + "x")) << "x";
+  std::ofstream(dir / (".notes.tmp-" + dead)) << "x";  // the user's
+  fs::create_directories(dir / (".precious.tmp-" + dead));
   std::ofstream(dir / "rocks.csv") << "x";
   const std::vector<std::string> removed = RemoveStaleTemporaries(dir.string());
   EXPECT_EQ(removed.size(), 2u);
-  EXPECT_FALSE(fs::exists(dir / (".rocks.csv.tmp-" + dead)));
-  EXPECT_FALSE(fs::exists(dir / (".talus-run.tmp-" + dead)));
+  EXPECT_FALSE(fs::exists(dir / (".rocks.csv.talus-tmp-" + dead)));
+  EXPECT_FALSE(fs::exists(dir / (".talus-run.talus-tmp-" + dead)));
   for (const std::string& kept :
-       {".rocks.csv.tmp-" + alive, std::string(".rocks.csv.tmp-1"), "notes.tmp-" + dead,
-        ".notes.tmp-" + dead + "x", std::string("rocks.csv")})
+       {".rocks.csv.talus-tmp-" + alive, std::string(".rocks.csv.talus-tmp-1"),
+        "notes.talus-tmp-" + dead, ".notes.talus-tmp-" + dead + "x", ".notes.tmp-" + dead,
+        ".precious.tmp-" + dead, std::string("rocks.csv")})
     EXPECT_TRUE(fs::exists(dir / kept)) << kept;
 }
 

@@ -208,7 +208,7 @@ std::string WriteUntilFailure(const std::string& path, int rocks, int samples) {
   return "";
 }
 
-// A full disk: the writer's temporary file (".trajectories.h5.tmp-<pid>", common/atomic_file.hpp)
+// A full disk: the writer's temporary file (".trajectories.h5.talus-tmp-<pid>", common/atomic_file.hpp)
 // is made /dev/full, on which every write fails with ENOSPC. One exception naming the file and
 // the reason, nothing left behind, and no crash in HDF5's shutdown at exit (ctest runs each test
 // in a process of its own; HDF5's C++ API used to print "H5Dclose failed" for every dataset and
@@ -217,7 +217,7 @@ TEST(TrajectoryWriter, FullDiskIsOneErrorNamingTheFileAndLeavesNothing) {
   const auto dir = testing::FreshDir("full");
   const auto path = (dir / "trajectories.h5").string();
   std::filesystem::create_symlink("/dev/full",
-                                  dir / (".trajectories.h5.tmp-" + std::to_string(::getpid())));
+                                  dir / (".trajectories.h5.talus-tmp-" + std::to_string(::getpid())));
   const std::string message = WriteUntilFailure(path, 20, 200);
   EXPECT_NE(message.find(path + ": No space left on device"), std::string::npos) << message;
   EXPECT_TRUE(std::filesystem::is_empty(dir));
