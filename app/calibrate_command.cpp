@@ -11,7 +11,6 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
-#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -340,7 +339,6 @@ int RunCalibrate(const CalibrateArgs& args, const Processes& processes) {
   }
   if (const int failed = processes.Step(code, message)) return failed;
   const InterruptScope interrupts;
-  std::signal(SIGXFSZ, SIG_IGN);
   if (root) RemoveStaleTemporaries(args.out);
   PrintHeader(args, loaded, processes);
 

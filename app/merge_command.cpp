@@ -2,7 +2,6 @@
 // one run of all rocks (io/partial.hpp, docs/cluster.md).
 
 #include <algorithm>
-#include <csignal>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -50,7 +49,6 @@ int RunMerge(const MergeArgs& args) {
     return kExitBadInput;
   }
   const InterruptScope interrupts;
-  std::signal(SIGXFSZ, SIG_IGN);  // a file-size limit is a write error ("File too large")
   RemoveStaleTemporaries(args.out);
   std::optional<StagingDirectory> staging;
   try {

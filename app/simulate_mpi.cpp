@@ -7,7 +7,6 @@
 #include <unistd.h>
 
 #include <chrono>
-#include <csignal>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -159,7 +158,6 @@ int SimulateOnRanks(const MpiSession& mpi, const SimulateArgs& args) {
   if (const int failed = Agree(mpi, code, message, "talus simulate")) return failed;
 
   const InterruptScope interrupts;
-  std::signal(SIGXFSZ, SIG_IGN);  // a file-size limit is a write error ("File too large")
   ProgressBar progress;
   if (root) {
     if (const auto stale = RemoveStaleTemporaries(args.out); !stale.empty())

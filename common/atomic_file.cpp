@@ -67,10 +67,17 @@ AtomicTextFile::~AtomicTextFile() {
 }
 
 void AtomicTextFile::Commit() {
-  const bool ok = std::fflush(out_) == 0 && !std::ferror(out_);
+  // A failed write sets the stream's error; flushing what is buffered then fails the same way and
+  // says why (a full disk, "File too large" under a file-size limit).
+  errno = 0;
+  const bool flushed = std::fflush(out_) == 0;
+  const int error = errno;
+  const bool ok = flushed && !std::ferror(out_);
   std::fclose(out_);
   out_ = nullptr;
-  if (!ok) throw std::runtime_error("cannot write " + file_.temp_path());
+  if (!ok)
+    throw std::runtime_error("cannot write " + file_.final_path() +
+                             (error != 0 ? std::string(": ") + std::strerror(error) : ""));
   file_.Commit();
 }
 

@@ -502,6 +502,24 @@ TEST(SimulateCommand, AFullDiskIsOneErrorAndLeavesTheEarlierRunAsItWas) {
   EXPECT_TRUE(Snapshot(out) == earlier) << "the earlier run's outputs changed";
 }
 
+// A file-size limit (`ulimit -f` sets the soft and the hard one) hit while trajectories.h5 is
+// written: one error and exit 1, no output and no temporary file. The process crashed in HDF5's
+// exit handler (SIGSEGV, exit 139) after the error; talus merge did the same.
+TEST(SimulateCommand, AHardFileSizeLimitIsOneErrorNotACrash) {
+  const fs::path dir = FreshDir("hard_file_size_limit");
+  std::ofstream(dir / "scene.toml") << kScene;
+  const fs::path out = dir / "out";
+  std::string log;
+  EXPECT_EQ(RunCommand("ulimit -f 40; exec " + Talus("simulate " + (dir / "scene.toml").string() +
+                                                     " --rocks 40 --out " + out.string()),
+                       &log),
+            1)
+      << log;
+  EXPECT_NE(log.find("trajectories.h5: File too large (no output written)"), std::string::npos)
+      << log;
+  EXPECT_TRUE(!fs::exists(out) || fs::is_empty(out)) << log;
+}
+
 TEST(SimulateCommand, RemovesTheTemporariesOfDeadRunsOnly) {
   const fs::path dir = FreshDir("stale_temporaries");
   std::ofstream(dir / "lean.toml") << LeanScene();
