@@ -76,6 +76,16 @@ struct Hdf5Failure {
 // setting is per thread in thread-safe builds, so each entry point makes it.)
 void SilenceHdf5() { H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr); }
 
+// HDF5's exit handler (H5_term_library) closes the files still open at exit. A file whose close
+// failed is one HDF5 can neither close nor drop, and that handler then crashes on it (SIGSEGV in
+// H5F__close_cb). Abandon below avoids such failures where it can; where it cannot (a hard
+// file-size limit hit while HDF5 flushes), the process must still end normally. Every file is
+// closed explicitly here, so the handler has nothing else to do at exit but free memory: it is
+// turned off. This runs at static initialisation, before the first HDF5 call of a program that
+// links this file (afterwards the handler is registered already; HDF5's C++ library, which
+// talus does not use, registers one of its own when it is loaded).
+[[maybe_unused]] const bool kNoHdf5ExitHandler = H5dont_atexit() >= 0;
+
 hid_t Check(hid_t id, const char* what) {
   if (id < 0) Fail(what);
   return id;
