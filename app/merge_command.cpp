@@ -2,7 +2,6 @@
 // one run of all rocks (io/partial.hpp, docs/cluster.md).
 
 #include <algorithm>
-#include <csignal>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -36,6 +35,7 @@ int RunMerge(const MergeArgs& args) {
       parts.push_back(io::ReadPartialInfo(dir));
     }
     parts = io::CheckPartials(std::move(parts));
+    for (const io::PartialInfo& part : parts) io::CheckPartFiles(part);
     scene = LoadSceneOfPart(parts.front());
   } catch (const InputError& e) {
     std::cerr << "talus merge: " << e.what() << "\n";
@@ -49,7 +49,6 @@ int RunMerge(const MergeArgs& args) {
     return kExitBadInput;
   }
   const InterruptScope interrupts;
-  std::signal(SIGXFSZ, SIG_IGN);  // a file-size limit is a write error ("File too large")
   RemoveStaleTemporaries(args.out);
   std::optional<StagingDirectory> staging;
   try {

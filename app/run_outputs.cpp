@@ -227,9 +227,11 @@ std::vector<std::string> RunIntoStaging(const io::SceneFile& scene, int threads,
     return WriteSummaryOutputs(scene, *report, report->rasters, sink.paths, staging, outputs,
                                self_check);
   WriteFileAtomically(staging.path("partial.bin"), io::PartialState(*report, sink.paths));
-  WriteFileAtomically(staging.path("partial.json"),
-                      io::PartialJson(scene, kVersion, first_rock, end_rock, *report));
   outputs.push_back("partial.bin");
+  std::vector<std::string> files;  // sizes and checksums in partial.json
+  for (const std::string& name : outputs) files.push_back(staging.path(name));
+  WriteFileAtomically(staging.path("partial.json"),
+                      io::PartialJson(scene, kVersion, first_rock, end_rock, *report, files));
   outputs.push_back("partial.json");  // last: a complete part is one with a partial.json
   return outputs;
 }
@@ -289,16 +291,49 @@ std::vector<std::string> MergeIntoStaging(const io::SceneFile& scene,
   return WriteSummaryOutputs(scene, *report, layers, paths, staging, outputs, nullptr);
 }
 
+namespace {
+
+// The names a manifest lists that talus may have written there: a file it finds that is neither
+// gives it no licence to remove anything.
+std::vector<std::string> ReadManifest(const fs::path& path) {
+  const std::vector<std::string> known = TalusOutputNames();
+  std::vector<std::string> names;
+  std::ifstream in(path);
+  for (std::string name; std::getline(in, name);)
+    if (std::find(known.begin(), known.end(), name) != known.end() &&
+        std::find(names.begin(), names.end(), name) == names.end())
+      names.push_back(name);
+  return names;
+}
+
+std::string ManifestText(const std::vector<std::string>& names) {
+  std::string text;
+  for (const std::string& name : names) text += name + "\n";
+  return text;
+}
+
+}  // namespace
+
 void CommitOutputs(StagingDirectory& staging, const std::vector<std::string>& files,
                    const std::string& dir) {
+  const fs::path manifest = fs::path(dir) / kOutputManifest;
+  const std::vector<std::string> earlier = ReadManifest(manifest);
+  // Until the files are in, the manifest lists the earlier run's and this one's: an interruption
+  // in between leaves no file of either unlisted.
+  std::vector<std::string> both = earlier;
+  for (const std::string& name : files)
+    if (std::find(both.begin(), both.end(), name) == both.end()) both.push_back(name);
+  WriteFileAtomically(manifest.string(), ManifestText(both));
   staging.Commit(files);
-  // An earlier run's outputs that this run did not replace must not pass for this run's.
+  // An earlier run's outputs that this run did not replace must not pass for this run's; only
+  // what that run's manifest lists is removed, never a file of the same name the user made.
   int stale = 0;
-  for (const std::string& name : TalusOutputNames()) {
+  for (const std::string& name : earlier) {
     if (std::find(files.begin(), files.end(), name) != files.end()) continue;
     std::error_code error;
     stale += fs::remove(fs::path(dir) / name, error) ? 1 : 0;
   }
+  WriteFileAtomically(manifest.string(), ManifestText(files));
   if (stale > 0) std::printf("Removed %d outputs of an earlier run from %s\n", stale, dir.c_str());
 }
 

@@ -43,8 +43,13 @@ std::vector<std::string> MergeIntoStaging(const io::SceneFile& scene,
                                           double wall_time_s, const StagingDirectory& staging,
                                           ensemble::EnsembleReport* report);
 
-// Commits the staged files into `dir` and removes the outputs of an earlier run there that this one
-// did not replace (printing how many).
+// The list of the files a run wrote into its output directory, one name per line: what the next
+// run into the same directory may remove.
+inline constexpr const char* kOutputManifest = ".talus-outputs";
+
+// Commits the staged files into `dir`, removes the outputs of the earlier run there that this one
+// did not replace (those its kOutputManifest lists, and only talus's output names: never a file
+// the user made; printing how many) and writes this run's manifest.
 void CommitOutputs(StagingDirectory& staging, const std::vector<std::string>& files,
                    const std::string& dir);
 

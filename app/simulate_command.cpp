@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <cerrno>
 #include <chrono>
-#include <csignal>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -136,7 +135,6 @@ int RunSimulate(const SimulateArgs& args) {
   }
   // From here on SIGINT / SIGTERM unwind the run: no temporary file is left behind.
   const InterruptScope interrupts;
-  std::signal(SIGXFSZ, SIG_IGN);  // a file-size limit is a write error ("File too large")
   if (const auto stale = RemoveStaleTemporaries(args.out); !stale.empty())
     std::printf("Removed %zu temporary files of interrupted runs from %s\n", stale.size(),
                 args.out.c_str());

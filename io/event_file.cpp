@@ -5,12 +5,15 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <optional>
 #include <set>
+#include <tuple>
 
 #include "common/closest_name.hpp"
 #include "common/csv_table.hpp"
 #include "common/error.hpp"
+#include "ensemble/release.hpp"
 #include "fieldobs/single_impacts.hpp"
 #include "io/toml_section.hpp"
 #include "io/vector.hpp"
@@ -31,6 +34,27 @@ fieldobs::SingleImpactColumns SingleImpactColumnsOf(const Section& o) {
   c.speed_out = o.String("speed_out_column", c.speed_out);
   c.scar_depth = o.String("scar_depth_column", c.scar_depth);
   return c;
+}
+
+// A number for messages: 10 significant digits.
+std::string Fmt(double v) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, "%.10g", v);
+  return buffer;
+}
+
+// "(the DEM covers x .. y ..)" of a scene, for messages about places off it.
+std::string DemCover(const SceneFile& scene) {
+  const GridGeometry& g = scene.scene.terrain.heights().grid;
+  return "(the DEM covers x " + Fmt(g.x0_m) + " .. " + Fmt(g.x_max_m()) + ", y " + Fmt(g.y0_m) +
+         " .. " + Fmt(g.y_max_m()) + ")";
+}
+
+// The header of a table, for messages: "a, b, c".
+std::string ColumnsOf(const CsvTable& table) {
+  std::string out;
+  for (const std::string& c : table.columns()) out += (out.empty() ? "" : ", ") + c;
+  return out;
 }
 
 }  // namespace
@@ -100,6 +124,15 @@ EventFile LoadEvent(const std::string& path) {
       if (zone.points.size() < (zone.polygon ? 3u : 2u))
         z.Fail(key, zone.polygon ? "a polygon needs at least 3 points"
                                  : "a line needs at least 2 points");
+      // A zone no rock can reach would score its observations against no rock ('passed' = 0 as
+      // perfect): an error (another CRS, swapped coordinates), as for evaluation lines.
+      ensemble::ReleaseGeometry geometry;
+      geometry.kind = zone.polygon ? ensemble::ReleaseGeometry::Kind::kPolygon
+                                   : ensemble::ReleaseGeometry::Kind::kLine;
+      geometry.rings = {zone.points};
+      if (!(ensemble::FractionOnTerrain(event.scene.scene.terrain, geometry) > 0))
+        z.Fail(key, "the zone '" + zone.id + "' lies entirely outside the DEM or on nodata " +
+                        DemCover(event.scene) + ", so no rock can reach it");
       event.observations.zones.push_back(zone);
     }
   }
@@ -157,10 +190,19 @@ EventFile LoadEvent(const std::string& path) {
       // Rest positions as points of a vector file, placed in the DEM's CRS.
       const auto points = ReadDepositPoints(file, event.scene.crs_wkt, columns.run,
                                             context.Where(o.Node("file")) + ": " + o.Key("file"));
+      // A point without a run has no field run_column (a present field's empty value is an error).
+      if (o.Has("run_column"))
+        for (const fieldobs::DepositObservation& d : points)
+          if (d.run.empty()) o.Fail("run_column", d.where + " has no field '" + columns.run + "'");
       event.observations.deposits.insert(event.observations.deposits.end(), points.begin(),
                                          points.end());
     } else {
       const CsvTable table = CsvTable::Read(file);
+      // Without its run column every row would be an observation of the whole scene: a run column
+      // named on purpose must be there.
+      if (o.Has("run_column") && !table.Has(columns.run))
+        o.Fail("run_column", file + " has no column '" + columns.run +
+                                 "' (the header has: " + ColumnsOf(table) + ")");
       if (kind == "runout") fieldobs::ReadRunouts(table, columns, event.observations);
       if (kind == "deposits") fieldobs::ReadDeposits(table, columns, event.observations);
       if (kind == "impacts")
@@ -195,6 +237,37 @@ EventFile LoadEvent(const std::string& path) {
   };
   for (const auto& o : event.observations.scalars) check(o.run, o.where);
   for (const auto& o : event.observations.deposits) check(o.run, o.where);
+
+  // A run is one release of one block: each quantity of it (at each zone) was observed once. A
+  // second row would count twice, or contradict the first; observations of the whole scene (no
+  // run) may repeat.
+  std::map<std::tuple<fieldobs::Quantity, std::string, int>, std::string> first_scalar;
+  for (const auto& o : event.observations.scalars) {
+    if (o.run.empty()) continue;
+    if (const auto [at, added] =
+            first_scalar.emplace(std::tuple(o.quantity, o.run, o.zone), o.where);
+        !added)
+      throw InputError(
+          o.where + ": run '" + o.run + "' has a second " + fieldobs::ToString(o.quantity) +
+          " observation" +
+          (o.zone >= 0
+               ? " at zone '" + event.observations.zones[static_cast<std::size_t>(o.zone)].id + "'"
+               : std::string()) +
+          " (the first: " + at->second + "); a run's quantity is observed once");
+  }
+  std::map<std::string, std::string> first_deposit;
+  for (const auto& o : event.observations.deposits) {
+    if (o.run.empty()) continue;
+    if (const auto [at, added] = first_deposit.emplace(o.run, o.where); !added)
+      throw InputError(o.where + ": run '" + o.run + "' has a second rest position (the first: " +
+                       at->second + "); a run's block rests at one place");
+  }
+  // A rest position off the terrain is one no rock can reach: another CRS or swapped coordinates.
+  for (const auto& o : event.observations.deposits)
+    if (!ensemble::OnTerrain(event.scene.scene.terrain, o.xy_m))
+      throw InputError(o.where + ": the rest position (" + Fmt(o.xy_m.x()) + ", " +
+                       Fmt(o.xy_m.y()) + ") is outside the DEM or on nodata " +
+                       DemCover(event.scene) + ", so no rock can rest there");
 
   for (const std::string& input : event.scene.inputs) event.inputs.push_back(input);
   // The hash covers the event file, the observation tables and the scene's own hash.

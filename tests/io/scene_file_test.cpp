@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <ogr_spatialref.h>
 
+#include <chrono>
 #include <cmath>
 #include <fstream>
 #include <limits>
@@ -910,6 +911,25 @@ TEST(LoadScene, RunTableWithBlocksLoadsAsGiven) {
   EXPECT_NEAR(plate.volume_m3, 0.46 * 0.30 * 0.20, 1e-12);
   EXPECT_EQ(s.release.ReleaseName(2), "v3");
   EXPECT_EQ(s.inputs.size(), 3u);  // scene, blocks, runs
+}
+
+// A run table of 100 000 rows took 72 s to load (each run's id compared with every earlier
+// one's); 200 000 rows now take about a second, the quadratic check would take minutes.
+TEST(LoadScene, ALargeRunTableLoadsInTimeInProportion) {
+  const auto dir = testing::FreshDir("runs_large");
+  std::string runs = "trajectory_id,x_m,y_m\n";
+  for (int k = 0; k < 200000; ++k) runs.append("r").append(std::to_string(k)).append(",5,0\n");
+  testing::WriteText(dir / "runs.csv", runs);
+  testing::WriteText(dir / "scene.toml",
+                     "[terrain]\nplane = { slope_deg = 35, slope_length_m = 40, runout_m = 20, "
+                     "width_m = 30, cell_m = 1 }\n[rock]\nshape = { box = [0.5, 0.4, 0.3] }\n"
+                     "[release]\nruns = \"runs.csv\"\nrocks = 1\n");
+  const auto t0 = std::chrono::steady_clock::now();
+  const SceneFile s = LoadScene((dir / "scene.toml").string());
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  EXPECT_EQ(s.release.runs.size(), 200000u);
+  EXPECT_LT(seconds, 60.0);  // a wide margin for sanitizer builds and loaded machines
 }
 
 TEST(LoadScene, RunTableErrorsNameFileLineAndColumn) {
