@@ -46,10 +46,7 @@ std::string KindOf(const std::filesystem::file_status& status) {
 void CheckLineLengths(const std::string& text, const std::string& path) {
   int line = 1;
   for (std::size_t start = 0; start < text.size(); ++line) {
-    const void* found = std::memchr(text.data() + start, '\n', text.size() - start);
-    const std::size_t end =
-        found ? static_cast<std::size_t>(static_cast<const char*>(found) - text.data())
-              : text.size();
+    const std::size_t end = std::min(text.find('\n', start), text.size());
     if (end - start > kMaxCsvLineBytes)
       throw InputError(path + ":" + std::to_string(line) + ": a line longer than " +
                        std::to_string(kMaxCsvLineBytes >> 20) +

@@ -196,8 +196,7 @@ bool ReleaseSpec::IsValid(std::string* why) const {
   }
   std::unordered_set<std::string_view> ids;  // a set: comparing each id with all before it was
                                              // quadratic (a 10^5-run table took a minute)
-  for (std::size_t r = 0; r < runs.size(); ++r) {
-    const ReleaseRun& run = runs[r];
+  for (const ReleaseRun& run : runs) {
     const auto bad = [&](const std::string& what) {
       s << "run " << run.id << ": " << what;
       return Fail(why, s.str());
