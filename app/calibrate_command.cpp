@@ -11,7 +11,6 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
-#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -19,6 +18,7 @@
 #include <functional>
 #include <iostream>
 #include <limits>
+#include <map>
 #include <memory>
 #include <optional>
 #include <sstream>
@@ -113,6 +113,19 @@ struct Loaded {
   std::string checkpoint_path;
 };
 
+// The shape of every evaluation of each optimisation of the calibration: the fit's, each fold's.
+std::map<std::string, io::EvaluationShape> EvaluationShapes(
+    const calibration::CalibrationProblem& problem, int folds) {
+  const auto shape = [](const calibration::Objective& o) {
+    return io::EvaluationShape{o.dimension(), static_cast<int>(o.kinds().size()),
+                               o.residual_count()};
+  };
+  std::map<std::string, io::EvaluationShape> shapes = {{"fit", shape(problem.objective())}};
+  for (int f = 0; f < folds; ++f)
+    shapes["fold" + std::to_string(f + 1)] = shape(problem.ObjectiveOn(problem.FoldTraining(f)));
+  return shapes;
+}
+
 // Loads the calibration file, its event, scene and observations, splits the runs (--holdout,
 // --folds) and checks the checkpoint in --out against --resume. kExitOk, or the exit code with the
 // reason in *message.
@@ -155,6 +168,7 @@ int Load(const CalibrateArgs& args, const Processes& processes, Loaded* loaded,
         throw InputError(path +
                          ": the checkpoint belongs to another calibration (other inputs, "
                          "parameters, optimiser options, --holdout or --folds)");
+      io::CheckEvaluations(saved, path, EvaluationShapes(*loaded->problem, args.folds));
       checkpoint.stages = saved.stages;
     } else if (exists) {
       throw InputError(path +
@@ -326,7 +340,6 @@ int RunCalibrate(const CalibrateArgs& args, const Processes& processes) {
   }
   if (const int failed = processes.Step(code, message)) return failed;
   const InterruptScope interrupts;
-  std::signal(SIGXFSZ, SIG_IGN);
   if (root) RemoveStaleTemporaries(args.out);
   PrintHeader(args, loaded, processes);
 

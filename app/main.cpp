@@ -2,6 +2,7 @@
 // share the exit codes there: 0 done, 1 the run failed, 2 bad input or usage, 128 + signal.
 
 #include <CLI/CLI.hpp>
+#include <csignal>
 #include <cstdio>
 #include <exception>
 #include <vector>
@@ -45,6 +46,9 @@ int Run(int argc, char** argv) {
 // The verbs report their own failures; anything that still escapes (out of memory outside a run)
 // is a failed run, reported on one line.
 int main(int argc, char** argv) {
+  // A file-size limit (ulimit -f) is a write error ("File too large", EFBIG) that the verbs report
+  // like a full disk, removing their temporary files; its signal would kill the process instead.
+  std::signal(SIGXFSZ, SIG_IGN);
   try {
     return Run(argc, argv);
   } catch (const std::exception& e) {

@@ -2,7 +2,6 @@
 // one run of all rocks (io/partial.hpp, docs/cluster.md).
 
 #include <algorithm>
-#include <csignal>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -37,6 +36,7 @@ int RunMerge(const MergeArgs& args) {
       parts.push_back(io::ReadPartialInfo(dir));
     }
     parts = io::CheckPartials(std::move(parts));
+    for (const io::PartialInfo& part : parts) io::CheckPartFiles(part);
     scene = LoadSceneOfPart(parts.front());
   } catch (const InputError& e) {
     std::cerr << "talus merge: " << e.what() << "\n";

@@ -70,7 +70,8 @@ std::vector<std::string> WriteSummaryOutputs(const io::SceneFile& scene,
                                              const std::vector<ensemble::RasterLayer>& layers,
                                              const std::vector<io::SamplePath>& paths,
                                              const StagingDirectory& staging,
-                                             std::vector<std::string> outputs) {
+                                             std::vector<std::string> outputs,
+                                             const ensemble::SelfCheckReport* self_check) {
   const GridGeometry& dem = scene.scene.terrain.heights().grid;
   // GDAL would print every failed write of a full disk; the writers throw with its last message.
   const QuietGdal quiet_gdal;
@@ -120,7 +121,8 @@ std::vector<std::string> WriteSummaryOutputs(const io::SceneFile& scene,
     outputs.push_back("rocks.gpkg");
   }
   if (scene.output.report) outputs.push_back("report.html");
-  const std::string summary = io::SummaryJson(scene, report, kVersion, outputs, lines);
+  const std::string summary =
+      io::SummaryJson(scene, report, kVersion, outputs, lines, self_check);
   if (scene.output.report) {
     ThrowIfInterrupted();
     io::RunReportInput page;
@@ -182,7 +184,8 @@ std::vector<std::string> TalusOutputNames() {
 std::vector<std::string> RunIntoStaging(const io::SceneFile& scene, int threads, long first_rock,
                                         long end_rock, bool part, const StagingDirectory& staging,
                                         std::function<void(long, long)> progress,
-                                        ensemble::EnsembleReport* report) {
+                                        ensemble::EnsembleReport* report,
+                                        const ensemble::SelfCheckReport* self_check) {
   ensemble::EnsembleOptions options;
   options.threads = threads;
   options.first_rock = first_rock;
@@ -221,11 +224,14 @@ std::vector<std::string> RunIntoStaging(const io::SceneFile& scene, int threads,
   if (trajectories) trajectories->Commit();
   if (lines) lines->Commit();
   if (!part)
-    return WriteSummaryOutputs(scene, *report, report->rasters, sink.paths, staging, outputs);
+    return WriteSummaryOutputs(scene, *report, report->rasters, sink.paths, staging, outputs,
+                               self_check);
   WriteFileAtomically(staging.path("partial.bin"), io::PartialState(*report, sink.paths));
-  WriteFileAtomically(staging.path("partial.json"),
-                      io::PartialJson(scene, kVersion, first_rock, end_rock, *report));
   outputs.push_back("partial.bin");
+  std::vector<std::string> files;  // sizes and checksums in partial.json
+  for (const std::string& name : outputs) files.push_back(staging.path(name));
+  WriteFileAtomically(staging.path("partial.json"),
+                      io::PartialJson(scene, kVersion, first_rock, end_rock, *report, files));
   outputs.push_back("partial.json");  // last: a complete part is one with a partial.json
   return outputs;
 }
@@ -282,19 +288,52 @@ std::vector<std::string> MergeIntoStaging(const io::SceneFile& scene,
   const std::vector<ensemble::RasterLayer> layers =
       rasters ? rasters->Finish(scene.scene.terrain.heights())
               : std::vector<ensemble::RasterLayer>{};
-  return WriteSummaryOutputs(scene, *report, layers, paths, staging, outputs);
+  return WriteSummaryOutputs(scene, *report, layers, paths, staging, outputs, nullptr);
 }
+
+namespace {
+
+// The names a manifest lists that talus may have written there: a file it finds that is neither
+// gives it no licence to remove anything.
+std::vector<std::string> ReadManifest(const fs::path& path) {
+  const std::vector<std::string> known = TalusOutputNames();
+  std::vector<std::string> names;
+  std::ifstream in(path);
+  for (std::string name; std::getline(in, name);)
+    if (std::find(known.begin(), known.end(), name) != known.end() &&
+        std::find(names.begin(), names.end(), name) == names.end())
+      names.push_back(name);
+  return names;
+}
+
+std::string ManifestText(const std::vector<std::string>& names) {
+  std::string text;
+  for (const std::string& name : names) text += name + "\n";
+  return text;
+}
+
+}  // namespace
 
 void CommitOutputs(StagingDirectory& staging, const std::vector<std::string>& files,
                    const std::string& dir) {
+  const fs::path manifest = fs::path(dir) / kOutputManifest;
+  const std::vector<std::string> earlier = ReadManifest(manifest);
+  // Until the files are in, the manifest lists the earlier run's and this one's: an interruption
+  // in between leaves no file of either unlisted.
+  std::vector<std::string> both = earlier;
+  for (const std::string& name : files)
+    if (std::find(both.begin(), both.end(), name) == both.end()) both.push_back(name);
+  WriteFileAtomically(manifest.string(), ManifestText(both));
   staging.Commit(files);
-  // An earlier run's outputs that this run did not replace must not pass for this run's.
+  // An earlier run's outputs that this run did not replace must not pass for this run's; only
+  // what that run's manifest lists is removed, never a file of the same name the user made.
   int stale = 0;
-  for (const std::string& name : TalusOutputNames()) {
+  for (const std::string& name : earlier) {
     if (std::find(files.begin(), files.end(), name) != files.end()) continue;
     std::error_code error;
     stale += fs::remove(fs::path(dir) / name, error) ? 1 : 0;
   }
+  WriteFileAtomically(manifest.string(), ManifestText(files));
   if (stale > 0) std::printf("Removed %d outputs of an earlier run from %s\n", stale, dir.c_str());
 }
 
@@ -312,7 +351,7 @@ io::SceneFile LoadSceneOfPart(const io::PartialInfo& part) {
   SolverPreset preset = SolverPreset::kDefault;
   if (!ParseSolverPreset(part.solver_preset, &preset))
     throw InputError(part.dir + ": unknown solver preset '" + part.solver_preset + "'");
-  io::UseSolverPreset(scene, preset);
+  if (part.solver_preset_from_command_line) io::UseSolverPreset(scene, preset);
   if (scene.release.total_rocks() != part.total_rocks)
     throw InputError(part.dir + ": the scene gives " + std::to_string(scene.release.total_rocks()) +
                      " rocks, the part " + std::to_string(part.total_rocks));

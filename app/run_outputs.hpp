@@ -10,6 +10,7 @@
 
 #include "common/atomic_file.hpp"
 #include "ensemble/runner.hpp"
+#include "ensemble/self_check.hpp"
 #include "io/partial.hpp"
 #include "io/scene_file.hpp"
 
@@ -25,11 +26,13 @@ std::vector<std::string> TalusOutputNames();
 // Runs rocks [first_rock, end_rock) of the scene and writes them into `staging`: rocks.csv and
 // trajectories.h5 (when asked); then, as a `part`, partial.bin and partial.json, else (the whole
 // ensemble) the rasters, quick-look and summary.json. Returns the files written, in commit order.
-// `progress` is called on the calling thread (and may throw to stop the run).
+// `progress` is called on the calling thread (and may throw to stop the run). A self-check's
+// report, when given, goes into summary.json.
 std::vector<std::string> RunIntoStaging(const io::SceneFile& scene, int threads, long first_rock,
                                         long end_rock, bool part, const StagingDirectory& staging,
                                         std::function<void(long, long)> progress,
-                                        ensemble::EnsembleReport* report);
+                                        ensemble::EnsembleReport* report,
+                                        const ensemble::SelfCheckReport* self_check = nullptr);
 
 // Merges parts that CheckPartials accepted into `staging`: rocks.csv, trajectories.h5, rasters,
 // quick-look and summary.json, the same bytes as one run of all rocks (summary.json's threads and
@@ -40,8 +43,13 @@ std::vector<std::string> MergeIntoStaging(const io::SceneFile& scene,
                                           double wall_time_s, const StagingDirectory& staging,
                                           ensemble::EnsembleReport* report);
 
-// Commits the staged files into `dir` and removes the outputs of an earlier run there that this one
-// did not replace (printing how many).
+// The list of the files a run wrote into its output directory, one name per line: what the next
+// run into the same directory may remove.
+inline constexpr const char* kOutputManifest = ".talus-outputs";
+
+// Commits the staged files into `dir`, removes the outputs of the earlier run there that this one
+// did not replace (those its kOutputManifest lists, and only talus's output names: never a file
+// the user made; printing how many) and writes this run's manifest.
 void CommitOutputs(StagingDirectory& staging, const std::vector<std::string>& files,
                    const std::string& dir);
 

@@ -24,6 +24,7 @@ struct SimulateArgs {
   std::optional<std::uint64_t> seed;
   std::string rock_range;  // "A:B": write a partial result of rocks A .. B - 1
   std::string preset;      // --preset: fast, default, accurate; empty: the scene's
+  long self_check = 0;     // --self-check N: rerun N rocks at dt/2 and compare; 0: none
 };
 
 // Loads the scene with the overrides of `args` and the rocks to run ([0, total), or --rock-range).

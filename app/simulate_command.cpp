@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <cerrno>
 #include <chrono>
-#include <csignal>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -85,10 +84,17 @@ int LoadForSimulate(const SimulateArgs& args, io::SceneFile* scene, std::pair<lo
         throw InputError("--preset: unknown preset '" + args.preset +
                          "'; known: " + kSolverPresetNames.List());
       io::UseSolverPreset(*scene, preset);
+      for (const std::string& key : scene->solver_keys_overridden)
+        std::printf("--preset %s overrides the scene's %s\n", args.preset.c_str(), key.c_str());
     }
     // The scene was valid; only --rocks can break it now (too many rocks in all).
     if (std::string why; !scene->release.IsValid(&why))
       throw InputError("--rocks " + std::to_string(args.rocks) + ": " + why);
+    if (args.self_check > 0 && !args.rock_range.empty())
+      throw InputError("--self-check: not with --rock-range (check the whole run, not a part)");
+    if (args.self_check > scene->release.total_rocks())
+      throw InputError("--self-check " + std::to_string(args.self_check) + ": the run has " +
+                       std::to_string(scene->release.total_rocks()) + " rocks");
     *range = {0, scene->release.total_rocks()};
     if (!args.rock_range.empty()) {
       *range = ParseRockRange(args.rock_range);
@@ -146,12 +152,32 @@ int RunSimulate(const SimulateArgs& args) {
       ThrowIfInterrupted();
       progress(done, total);
     };
+    // The self-check runs first: its subsample is small, and its report goes into summary.json.
+    std::optional<ensemble::SelfCheckReport> self_check;
+    if (args.self_check > 0) {
+      ensemble::SelfCheckOptions check;
+      check.rocks = args.self_check;
+      check.threads = args.threads;
+      if (!scene.evaluation_lines.empty())
+        check.evaluation_lines =
+            std::make_shared<const std::vector<ensemble::EvaluationLine>>(scene.evaluation_lines);
+      std::printf("Self-check: %ld rocks at dt %g s and %g s ...\n", check.rocks,
+                  scene.scene.options.dt_s, scene.scene.options.dt_s / check.dt_divisor);
+      std::fflush(stdout);
+      self_check = ensemble::RunSelfCheck(scene.scene, scene.release, check);
+      ThrowIfInterrupted();
+    }
     ensemble::EnsembleReport report;
     const std::vector<std::string> files =
         RunIntoStaging(scene, args.threads, range.first, range.second, !args.rock_range.empty(),
-                       *staging, show_progress, &report);
+                       *staging, show_progress, &report, self_check ? &*self_check : nullptr);
     CommitOutputs(*staging, files, args.out);
     std::printf("%s\n", report.BriefReport().c_str());
+    if (self_check)
+      std::printf("%s(%.1f s; statistics as run, refined, difference +- standard error; * beyond "
+                  "%.2f standard errors, a 5 %% chance of a false alarm over all)\n",
+                  self_check->BriefReport().c_str(), self_check->wall_time_s,
+                  self_check->threshold);
     if (!args.rock_range.empty())
       std::printf("Wrote rocks %ld:%ld of %ld as a partial result (merge with talus merge)\n",
                   range.first, range.second, scene.release.total_rocks());
@@ -181,8 +207,14 @@ Runner AddSimulateCommand(CLI::App& app) {
          "Random seed (overrides the scene)")
       ->check(IntegerRange(0, std::numeric_limits<std::int64_t>::max()));
   cmd->add_option("--preset", args->preset,
-                  "Solver accuracy: fast, default or accurate (overrides the scene's [solver] "
-                  "preset; keys the scene sets itself are kept)");
+                  "Solver accuracy: fast, default or accurate (wins over the scene's [solver] "
+                  "preset and its dt_s, tolerance_m_s and max_iterations; each value it changes "
+                  "is printed and listed in summary.json)");
+  cmd->add_option("--self-check", args->self_check,
+                  "Rerun N rocks (every total/N-th) at half the time step and a 1e-7 m/s contact "
+                  "solve, and report each headline statistic's difference with its standard error "
+                  "(console and summary.json)")
+      ->check(IntegerRange(2, std::numeric_limits<long>::max()));
   cmd->add_option("--rock-range", args->rock_range,
                   "Run only rocks A .. B-1 (A:B) and write a partial result for talus merge");
   return [cmd, args]() { return *cmd ? RunSimulate(*args) : -1; };

@@ -4,8 +4,9 @@
 // code of `talus merge`. The ranks agree on success at every step (loading, running, sending), so
 // that a failure on any rank ends every rank with one message from rank 0 and no output.
 
+#include <unistd.h>
+
 #include <chrono>
-#include <csignal>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -158,7 +159,6 @@ int SimulateOnRanks(const MpiSession& mpi, const SimulateArgs& args) {
   if (const int failed = Agree(mpi, code, message, "talus simulate")) return failed;
 
   const InterruptScope interrupts;
-  std::signal(SIGXFSZ, SIG_IGN);  // a file-size limit is a write error ("File too large")
   ProgressBar progress;
   if (root) {
     if (const auto stale = RemoveStaleTemporaries(args.out); !stale.empty())
@@ -183,11 +183,14 @@ int SimulateOnRanks(const MpiSession& mpi, const SimulateArgs& args) {
   VerbOutcome outcome = RunStaged(
       args.out, staging,
       [&] {
-        // Ranks other than 0 stage in $TMPDIR/talus-ranks, where they also remove what ranks that
+        // Ranks other than 0 stage in $TMPDIR/talus-ranks-<uid>, a directory of this user's alone
+        // (never one through a link someone else planted), where they also remove what ranks that
         // died (SIGKILL, a lost node) left there, as rank 0 does in --out.
-        const fs::path dir = root ? fs::path(args.out) : fs::temp_directory_path() / "talus-ranks";
+        const fs::path dir =
+            root ? fs::path(args.out)
+                 : fs::temp_directory_path() / ("talus-ranks-" + std::to_string(::geteuid()));
         if (!root) {
-          fs::create_directories(dir);
+          MakePrivateDirectory(dir.string());
           RemoveStaleTemporaries(dir.string());
         }
         staging.emplace(dir.string());
@@ -217,6 +220,7 @@ int SimulateOnRanks(const MpiSession& mpi, const SimulateArgs& args) {
       std::vector<io::PartialInfo> parts;
       for (const fs::path& dir : dirs) parts.push_back(io::ReadPartialInfo(dir.string()));
       parts = io::CheckPartials(std::move(parts));
+      for (const io::PartialInfo& p : parts) io::CheckPartFiles(p);  // as they were sent
       const double wall_time_s =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       ensemble::EnsembleReport merged;

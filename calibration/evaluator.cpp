@@ -22,7 +22,7 @@ bool Evaluator::out_of_evaluations() const {
 
 Evaluation Evaluator::operator()(const Eigen::VectorXd& u) {
   for (const Evaluation& e : summary_.history)
-    if (e.u == u) {
+    if (e.u.size() == u.size() && e.u == u) {
       ++summary_.cache_hits;
       return e;
     }
@@ -30,7 +30,7 @@ Evaluation Evaluator::operator()(const Eigen::VectorXd& u) {
   Evaluation e;
   if (index < options_.replay.size()) {
     e = options_.replay[index];
-    if (e.u != u) {
+    if (e.u.size() != u.size() || e.u != u) {
       std::ostringstream msg;
       msg << "checkpoint: evaluation " << index << " was at other parameters than this "
           << "calibration asks for: the checkpoint belongs to another calibration";
@@ -53,7 +53,7 @@ Evaluation Evaluator::operator()(const Eigen::VectorXd& u) {
 std::optional<Evaluation> Evaluator::TryEvaluate(const Eigen::VectorXd& u) {
   // Points already known are answered even when stopped: they cost nothing.
   for (const Evaluation& e : summary_.history)
-    if (e.u == u) {
+    if (e.u.size() == u.size() && e.u == u) {
       ++summary_.cache_hits;
       return e;
     }

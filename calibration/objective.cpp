@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <map>
 #include <sstream>
 
 #include "common/error.hpp"
@@ -87,32 +88,28 @@ Objective::Objective(const Scene& scene, const ensemble::ReleaseSpec& release,
     for (std::size_t k = 0; k < kinds_.size(); ++k) {
       std::vector<double> scores;
       if (kinds_[k] != "deposit") {
-        for (std::size_t i = 0; i < observations_.scalars.size(); ++i) {
-          const auto& o = observations_.scalars[i];
-          if (kinds_[k] != fieldobs::ToString(o.quantity)) continue;
-          const std::vector<double> others = fieldobs::ScalarClimatology(observations_.scalars, i);
-          if (static_cast<int>(others.size()) >= kMinMembers)
-            scores.push_back(fieldobs::CrpsEnsemble(others, o.value));
-        }
+        std::vector<double> values;
+        for (const auto& o : observations_.scalars)
+          if (kinds_[k] == fieldobs::ToString(o.quantity)) values.push_back(o.value);
+        if (static_cast<int>(values.size()) - 1 >= kMinMembers)
+          scores = fieldobs::LeaveOneOutCrps(values);
       } else {
-        // The other runs' observed displacements from their own release, from this run's start.
-        const auto start_of = [&](const std::string& run) -> std::optional<Eigen::Vector2d> {
-          for (long r = 0; r < release_.release_count(); ++r)
-            if (release_.ReleaseName(static_cast<int>(r)) == run)
-              return ensemble::Release(scene_, release_, release_.FirstRockOf(static_cast<int>(r)))
+        // The other runs' observed displacements from their own release, from this run's start:
+        // the energy score of this run's displacement against the others'.
+        std::map<std::string, int> run_index;
+        for (long r = 0; r < release_.release_count(); ++r)
+          run_index.emplace(release_.ReleaseName(static_cast<int>(r)), static_cast<int>(r));
+        std::vector<Eigen::Vector2d> displacements;
+        for (const auto& o : observations_.deposits) {
+          const auto r = o.run.empty() ? run_index.end() : run_index.find(o.run);
+          if (r == run_index.end()) continue;
+          const Eigen::Vector2d start =
+              ensemble::Release(scene_, release_, release_.FirstRockOf(r->second))
                   .start.position_m.head<2>();
-          return std::nullopt;
-        };
-        std::vector<std::optional<Eigen::Vector2d>> starts;
-        for (const auto& o : observations_.deposits)
-          starts.push_back(o.run.empty() ? std::nullopt : start_of(o.run));
-        for (std::size_t i = 0; i < observations_.deposits.size(); ++i) {
-          if (!starts[i]) continue;
-          const std::vector<Eigen::Vector2d> others =
-              fieldobs::DepositClimatology(observations_.deposits, starts, i);
-          if (static_cast<int>(others.size()) >= kMinMembers)
-            scores.push_back(fieldobs::EnergyScore(others, observations_.deposits[i].xy_m));
+          displacements.push_back(o.xy_m - start);
         }
+        if (static_cast<int>(displacements.size()) - 1 >= kMinMembers)
+          scores = fieldobs::LeaveOneOutEnergyScores(displacements);
       }
       const double scale = Mean(scores);
       if (weights_[k] > 0 && !(scale > 0))

@@ -92,6 +92,17 @@ ParameterSet::ParameterSet(std::vector<ParameterSpec> specs, const GroundTable& 
     for (std::size_t j = 0; j < k; ++j)
       if (specs_[j].category == s.category && specs_[j].field == s.field)
         throw InputError(s.Name() + ": freed twice");
+    // A tie named as another free parameter that is not in the tie would label this parameter's
+    // values with that one's name (tie = "medium.mu_max" on mu_min swapped the labels).
+    if (!s.tie.empty())
+      for (const ParameterSpec& other : specs_)
+        if (&other != &s && other.Name() == s.tie && other.tie != s.tie)
+          throw InputError(
+              s.Name() + ": tie '" + s.tie + "' is the name of the free parameter " + other.Name() +
+              ", which is not in the tie" +
+              (other.tie.empty() ? std::string() : " (its tie is '" + other.tie + "')") +
+              ": name the tie otherwise (e.g. '" + ToString(s.field) + "'), or give " +
+              other.Name() + " the same tie");
     // A tie joins the coordinate of its name; else the parameter has a coordinate of its own.
     Coordinate* joined = nullptr;
     if (!s.tie.empty())

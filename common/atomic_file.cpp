@@ -1,6 +1,8 @@
 #include "common/atomic_file.hpp"
 
+#include <fcntl.h>
 #include <signal.h>  // NOLINT(modernize-deprecated-headers): POSIX sigaction is declared here
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -16,9 +18,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr const char* kTempMarker = ".tmp-";
+constexpr const char* kTempMarker = ".talus-tmp-";
 
-// ".<name>.tmp-<pid>" in the directory of `path`.
+// ".<name>.talus-tmp-<pid>" in the directory of `path`.
 std::string TemporaryName(const fs::path& path) {
   std::string name = ".";  // appended piece by piece: GCC 12 warns (-Wrestrict) on a + b + c
   name += path.filename().string();
@@ -27,7 +29,7 @@ std::string TemporaryName(const fs::path& path) {
   return (path.parent_path() / name).string();
 }
 
-// The process id a temporary name ".<name>.tmp-<pid>" carries; 0 for any other name.
+// The process id a temporary name ".<name>.talus-tmp-<pid>" carries; 0 for any other name.
 pid_t OwnerOf(const std::string& name) {
   const std::size_t at = name.rfind(kTempMarker);
   if (name.size() < 2 || name[0] != '.' || at == std::string::npos || at < 2) return 0;
@@ -65,10 +67,17 @@ AtomicTextFile::~AtomicTextFile() {
 }
 
 void AtomicTextFile::Commit() {
-  const bool ok = std::fflush(out_) == 0 && !std::ferror(out_);
+  // A failed write sets the stream's error; flushing what is buffered then fails the same way and
+  // says why (a full disk, "File too large" under a file-size limit).
+  errno = 0;
+  const bool flushed = std::fflush(out_) == 0;
+  const int error = errno;
+  const bool ok = flushed && !std::ferror(out_);
   std::fclose(out_);
   out_ = nullptr;
-  if (!ok) throw std::runtime_error("cannot write " + file_.temp_path());
+  if (!ok)
+    throw std::runtime_error("cannot write " + file_.final_path() +
+                             (error != 0 ? std::string(": ") + std::strerror(error) : ""));
   file_.Commit();
 }
 
@@ -148,6 +157,31 @@ std::vector<std::string> RemoveStaleTemporaries(const std::string& dir) {
     if (fs::remove_all(fs::path(dir) / name, ignored) > 0 && !ignored) removed.push_back(name);
   }
   return removed;
+}
+
+void MakePrivateDirectory(const std::string& path) {
+  const auto fail = [&](const std::string& why) {
+    throw std::runtime_error(path + ": " + why +
+                             "; remove it, or point TMPDIR at a directory of your own");
+  };
+  if (::mkdir(path.c_str(), 0700) != 0 && errno != EEXIST)
+    fail(std::string("cannot create the directory: ") + std::strerror(errno));
+  // Opened without following a link, then checked and fixed through the descriptor (in a sticky
+  // $TMPDIR nobody else can rename or remove it afterwards).
+  const int fd = ::open(path.c_str(), O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC);
+  if (fd < 0) {
+    struct stat link {};
+    if (::lstat(path.c_str(), &link) == 0 && S_ISLNK(link.st_mode)) fail("is a symbolic link");
+    fail(std::string("not a directory of its own (") + std::strerror(errno) + ")");
+  }
+  struct stat st {};
+  const bool ok = ::fstat(fd, &st) == 0;
+  const bool mine = ok && st.st_uid == ::geteuid();
+  const bool fixed = mine && ((st.st_mode & 077) == 0 || ::fchmod(fd, 0700) == 0);
+  ::close(fd);
+  if (!ok) fail("cannot be examined");
+  if (!mine) fail("belongs to another user (uid " + std::to_string(st.st_uid) + ")");
+  if (!fixed) fail("its mode cannot be set to 0700");
 }
 
 }  // namespace talus

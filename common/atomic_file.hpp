@@ -1,7 +1,8 @@
 #pragma once
 // Files that are complete or absent: written under a temporary name in the target directory and
-// renamed into place only when complete. Temporary names are ".<name>.tmp-<pid>", so that a later
-// run can tell the leftovers of a process that died (RemoveStaleTemporaries).
+// renamed into place only when complete. Temporary names are ".<name>.talus-tmp-<pid>", so that a
+// later run can tell the leftovers of a talus process that died (RemoveStaleTemporaries) from
+// anything else, a user's own ".<name>.tmp-<pid>" files included.
 
 #include <cstdio>
 #include <string>
@@ -50,7 +51,7 @@ class AtomicTextFile {
 void WriteFileAtomically(const std::string& path, const std::string& contents);
 
 // Files written together: each is written under its final name in a hidden staging directory
-// `<dir>/.talus-run.tmp-<pid>`, and Commit() moves them into `dir` only when all are complete.
+// `<dir>/.talus-run.talus-tmp-<pid>`, and Commit() moves them into `dir` only when all are complete.
 // Until then `dir` is untouched (an earlier run's files in it stay as they were); the staging
 // directory and whatever is in it are removed unless committed.
 class StagingDirectory {
@@ -76,9 +77,16 @@ class StagingDirectory {
   std::string staging_;
 };
 
-// Removes from `dir` the temporary files and staging directories (".<name>.tmp-<pid>") of
+// Removes from `dir` the temporary files and staging directories (".<name>.talus-tmp-<pid>") of
 // processes that no longer exist; those of live processes, and every other file, are left alone.
 // Returns the names removed. Errors (an unreadable directory) are ignored: this is housekeeping.
 std::vector<std::string> RemoveStaleTemporaries(const std::string& dir);
+
+// Makes `path` a directory of this user's alone, for files of its own (a rank's staging area in a
+// shared $TMPDIR): creates it with mode 0700, or accepts an existing one only when it is a
+// directory, not a symbolic link, and owned by this user (its mode is then set to 0700). Throws
+// std::runtime_error naming the path and why it is refused (a link someone else planted would
+// lead files, and their removal, elsewhere).
+void MakePrivateDirectory(const std::string& path);
 
 }  // namespace talus

@@ -5,6 +5,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -20,18 +21,70 @@ std::string Trim(const std::string& s) {
   return s.substr(begin, end - begin + 1);
 }
 
+// What a file that is not a regular file is, for messages.
+std::string KindOf(const std::filesystem::file_status& status) {
+  namespace fs = std::filesystem;
+  switch (status.type()) {
+    case fs::file_type::directory:
+      return "a directory";
+    case fs::file_type::character:
+      return "a character device";
+    case fs::file_type::block:
+      return "a block device";
+    case fs::file_type::fifo:
+      return "a pipe";
+    case fs::file_type::socket:
+      return "a socket";
+    case fs::file_type::not_found:
+      return "no such file";
+    default:
+      return "not a file";
+  }
+}
+
+// Throws naming the line when a line of `text` is longer than kMaxCsvLineBytes.
+void CheckLineLengths(const std::string& text, const std::string& path) {
+  int line = 1;
+  for (std::size_t start = 0; start < text.size(); ++line) {
+    const std::size_t end = std::min(text.find('\n', start), text.size());
+    if (end - start > kMaxCsvLineBytes)
+      throw InputError(path + ":" + std::to_string(line) + ": a line longer than " +
+                       std::to_string(kMaxCsvLineBytes >> 20) +
+                       " MiB: not a CSV table (a binary file?)");
+    start = end + 1;
+  }
+}
+
 }  // namespace
 
 CsvTable CsvTable::Read(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::error_code error;
+  const fs::file_status status = fs::status(path, error);  // follows symbolic links
+  if (error) throw InputError(path + ": cannot open (" + error.message() + ")");
+  if (!fs::is_regular_file(status))
+    throw InputError(path + ": not a regular file (" + KindOf(status) +
+                     "); a table must be a CSV file");
+  if (const std::uintmax_t size = fs::file_size(path, error); !error && size > kMaxCsvBytes)
+    throw InputError(path + ": " + std::to_string(size) + " bytes, more than a table may have (" +
+                     std::to_string(kMaxCsvBytes >> 20) + " MiB)");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path + ": cannot open (" + std::strerror(errno) + ")");
-  std::ostringstream text;
-  text << in.rdbuf();
+  // Read in chunks up to the bound: a file that grew since its size was asked is refused too.
+  std::string text;
+  char chunk[1 << 16];
+  while (in.read(chunk, sizeof chunk) || in.gcount() > 0) {
+    text.append(chunk, static_cast<std::size_t>(in.gcount()));
+    if (text.size() > kMaxCsvBytes)
+      throw InputError(path + ": more bytes than a table may have (" +
+                       std::to_string(kMaxCsvBytes >> 20) + " MiB)");
+  }
   if (in.bad()) throw InputError(path + ": read error");
-  return Parse(text.str(), path);
+  return Parse(text, path);
 }
 
 CsvTable CsvTable::Parse(const std::string& text, const std::string& path) {
+  CheckLineLengths(text, path);
   CsvTable table;
   table.path_ = path;
   std::size_t pos = text.compare(0, 3, "\xEF\xBB\xBF") == 0 ? 3 : 0;

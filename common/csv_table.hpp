@@ -4,6 +4,7 @@
 // RFC 4180 quoting ("a, b" and "" inside quotes); a UTF-8 byte-order mark is skipped; blank lines
 // and lines starting with '#' are skipped.
 
+#include <cstddef>
 #include <fstream>
 #include <optional>
 #include <string>
@@ -11,10 +12,18 @@
 
 namespace talus {
 
+// Bounds of an input table: a table is held in memory whole (about four times its bytes), and a
+// line is a few hundred bytes at most; so a wrong file (a device, a binary file) is refused at once
+// instead of being read until memory runs out.
+inline constexpr std::size_t kMaxCsvBytes = std::size_t{256} << 20;    // 256 MiB
+inline constexpr std::size_t kMaxCsvLineBytes = std::size_t{1} << 20;  // 1 MiB
+
 class CsvTable {
  public:
-  // Reads the whole file. Throws InputError "<path>: <reason>" when it cannot be read, has no
-  // header, a header names a column twice, or a row has more or fewer fields than the header.
+  // Reads the whole file. Throws InputError "<path>: <reason>" when it is not a regular file (a
+  // device, a directory, or a pipe, which cannot be read again for the inputs' hash), is larger
+  // than kMaxCsvBytes, cannot be read, has no header, a line longer than kMaxCsvLineBytes, a
+  // header naming a column twice, or a row with more or fewer fields than the header.
   static CsvTable Read(const std::string& path);
   // The same from text already in memory; `path` names it in errors.
   static CsvTable Parse(const std::string& text, const std::string& path);

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 #include <sstream>
+#include <string_view>
+#include <unordered_set>
 
 #include "solver/random.hpp"
 #include "solver/simulate.hpp"
@@ -192,15 +194,15 @@ bool ReleaseSpec::IsValid(std::string* why) const {
       return Fail(why, s.str());
     }
   }
-  for (std::size_t r = 0; r < runs.size(); ++r) {
-    const ReleaseRun& run = runs[r];
+  std::unordered_set<std::string_view> ids;  // a set: comparing each id with all before it was
+                                             // quadratic (a 10^5-run table took a minute)
+  for (const ReleaseRun& run : runs) {
     const auto bad = [&](const std::string& what) {
       s << "run " << run.id << ": " << what;
       return Fail(why, s.str());
     };
     if (run.id.empty()) return bad("empty id");
-    for (std::size_t q = 0; q < r; ++q)
-      if (runs[q].id == run.id) return bad("the id appears twice");
+    if (!ids.insert(run.id).second) return bad("the id appears twice");
     if (!run.xy_m.allFinite() || (run.z_m && !std::isfinite(*run.z_m)))
       return bad("non-finite position");
     if (run.height_m && (!std::isfinite(*run.height_m) || *run.height_m < 0))

@@ -94,15 +94,18 @@ EnsembleReport RunEnsemble(const Scene& scene, const ReleaseSpec& release,
     throw std::invalid_argument("RunEnsemble: rocks " + std::to_string(first) + ":" +
                                 std::to_string(end) + " are not within the ensemble's " +
                                 std::to_string(release.total_rocks()));
-  const long total = end - first;
+  if (options.stride < 1)
+    throw std::invalid_argument("RunEnsemble: stride " + std::to_string(options.stride) + " < 1");
+  const long stride = options.stride;
+  const long total = (end - first + stride - 1) / stride;
   const int threads = WorkerThreads(options.threads, total);
 
   // Worker side: release, run with the recorders, hand over the outcome.
   auto make_worker = [&]() -> std::function<RockOutcome(long)> {
     auto workspace = std::make_shared<SimulationWorkspace>();
     auto recorders = std::make_shared<RecorderSet>(MakeRecorders(scene, options));
-    return [&scene, &release, workspace, recorders, first](long item) {
-      const long rock = first + item;
+    return [&scene, &release, workspace, recorders, first, stride](long item) {
+      const long rock = first + item * stride;
       RockOutcome out;
       out.rock = rock;
       out.release = release.ReleaseOf(rock);

@@ -28,6 +28,7 @@ struct EnsembleOptions {
   // The rocks to run: [first_rock, end_rock) of the release; end_rock < 0: to the last one.
   long first_rock = 0;
   long end_rock = -1;
+  long stride = 1;  // run every stride-th rock of that range, from first_rock (a subsample)
   bool trajectories = false;            // record every rock's trajectory
   // Record also the trajectories of the rocks this accepts (e.g. a sample for a picture); empty: none.
   std::function<bool(long rock)> sample_trajectories;

@@ -121,6 +121,61 @@ double EnergyScore(std::span<const Eigen::Vector2d> ensemble, const Eigen::Vecto
   return std::max(sum_dist / nd - sum_pairs / (nd * (nd - 1)), 0.0);
 }
 
+std::vector<double> LeaveOneOutCrps(std::span<const double> values) {
+  const std::size_t size = values.size();
+  std::vector<double> out(size, std::numeric_limits<double>::quiet_NaN());
+  if (size < 2) return out;
+  RequireEnsemble("LeaveOneOutCrps", values);
+  const std::vector<double> x = Sorted(values);
+  // Prefix sums of the values less their median, which keeps them small (no cancellation of
+  // large sums); the pairs' sum as in CrpsSorted.
+  const double centre = x[size / 2];
+  std::vector<double> prefix(size + 1, 0.0);
+  for (std::size_t i = 0; i < size; ++i) prefix[i + 1] = prefix[i] + (x[i] - centre);
+  double sum_pairs = 0;
+  for (std::size_t k = 1; k < size; ++k)
+    sum_pairs += static_cast<double>(k) * static_cast<double>(size - k) * (x[k] - x[k - 1]);
+  const double n = static_cast<double>(size - 1);  // the others
+  for (std::size_t k = 0; k < size; ++k) {
+    const double y = values[k] - centre;
+    const auto below =
+        static_cast<std::size_t>(std::lower_bound(x.begin(), x.end(), values[k]) - x.begin());
+    const auto above =
+        static_cast<std::size_t>(std::upper_bound(x.begin(), x.end(), values[k]) - x.begin());
+    // sum_i |x_i - y| over the others (the value itself adds 0).
+    const double sum_abs = (y * static_cast<double>(below) - prefix[below]) +
+                           ((prefix[size] - prefix[above]) - y * static_cast<double>(size - above));
+    out[k] =
+        size == 2 ? sum_abs : std::max(sum_abs / n - (sum_pairs - sum_abs) / (n * (n - 1)), 0.0);
+  }
+  return out;
+}
+
+std::vector<double> LeaveOneOutEnergyScores(std::span<const Eigen::Vector2d> points) {
+  const std::size_t size = points.size();
+  std::vector<double> out(size, std::numeric_limits<double>::quiet_NaN());
+  if (size < 2) return out;
+  for (std::size_t i = 0; i < size; ++i)
+    if (!points[i].allFinite())
+      Fail("LeaveOneOutEnergyScores", "points[" + std::to_string(i) + "]", Text(points[i]),
+           "is not finite");
+  std::vector<double> to_others(size, 0.0);  // sum_j |x_i - x_j|
+  double sum_pairs = 0;                      // sum over i < j of |x_i - x_j|
+  for (std::size_t i = 0; i < size; ++i)
+    for (std::size_t j = i + 1; j < size; ++j) {
+      const double d = (points[i] - points[j]).norm();
+      to_others[i] += d;
+      to_others[j] += d;
+      sum_pairs += d;
+    }
+  const double n = static_cast<double>(size - 1);
+  for (std::size_t k = 0; k < size; ++k)
+    out[k] = size == 2
+                 ? to_others[k]
+                 : std::max(to_others[k] / n - (sum_pairs - to_others[k]) / (n * (n - 1)), 0.0);
+  return out;
+}
+
 double Pit(std::span<const double> ensemble, double observed, double u) {
   RequireEnsemble("Pit", ensemble);
   RequireFinite("Pit", "observed", observed);

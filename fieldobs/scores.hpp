@@ -36,6 +36,15 @@ double CrpsNormal(double mean, double sd, double observed);
 // few thousand (n = 5000: about 80 ms on one core). For n == 1 it is |x_1 - y|.
 double EnergyScore(std::span<const Eigen::Vector2d> ensemble, const Eigen::Vector2d& observed);
 
+// Leave-one-out climatologies of a set of observed values (or 2-D points): entry k is the score
+// of values[k] against all the other values, CrpsEnsemble(others, values[k]) and
+// EnergyScore(others, points[k]) up to rounding; NaN for fewer than 2 values. The CRPS for all k
+// in O(n log n) from sorted values and prefix sums (the pairs without k are all pairs less those
+// with k, and those are the same distances as between k and the others); the energy scores in
+// O(n^2) (about n^2 / 2 norms), instead of a sort or an O(n^2) score per k.
+std::vector<double> LeaveOneOutCrps(std::span<const double> values);
+std::vector<double> LeaveOneOutEnergyScores(std::span<const Eigen::Vector2d> points);
+
 // Probability integral transform of the observation within the ensemble (its rank, made
 // continuous): PIT = (below + u (equal + 1)) / (n + 1), with below and equal the numbers of
 // members < and == observed and u uniform on [0, 1) drawn by the caller. The one u both breaks

@@ -17,9 +17,8 @@ namespace {
 constexpr std::uint64_t kPitStream = 0x5049545049545049ULL;
 
 void ScoreScalarObservation(const ScalarObservation& o, const EnsembleSamples& sim,
-                            const EnsembleSamples* reference,
-                            const std::vector<double>& climatology, double u, int min_members,
-                            ObservationScore& s) {
+                            const EnsembleSamples* reference, double climatology_score, double u,
+                            int min_members, ObservationScore& s) {
   const std::vector<double> values = sim.Values(o.quantity, o.run, o.zone);
   s.members = static_cast<int>(values.size());
   if (!sim.HasRun(o.run)) {
@@ -45,13 +44,12 @@ void ScoreScalarObservation(const ScalarObservation& o, const EnsembleSamples& s
     const std::vector<double> ref = reference->Values(o.quantity, o.run, o.zone);
     if (static_cast<int>(ref.size()) >= min_members) s.reference_score = CrpsEnsemble(ref, o.value);
   }
-  if (static_cast<int>(climatology.size()) >= min_members)
-    s.climatology_score = CrpsEnsemble(climatology, o.value);
+  s.climatology_score = climatology_score;
 }
 
 void ScoreDeposit(const DepositObservation& o, const EnsembleSamples& sim,
-                  const EnsembleSamples* reference, const std::vector<Eigen::Vector2d>& climatology,
-                  int min_members, ObservationScore& s) {
+                  const EnsembleSamples* reference, double climatology_score, int min_members,
+                  ObservationScore& s) {
   const std::vector<Eigen::Vector2d> ends = sim.EndPositions(o.run);
   s.members = static_cast<int>(ends.size());
   if (!sim.HasRun(o.run)) {
@@ -84,8 +82,7 @@ void ScoreDeposit(const DepositObservation& o, const EnsembleSamples& sim,
     const std::vector<Eigen::Vector2d> ref = reference->EndPositions(o.run);
     if (static_cast<int>(ref.size()) >= min_members) s.reference_score = EnergyScore(ref, o.xy_m);
   }
-  if (static_cast<int>(climatology.size()) >= min_members)
-    s.climatology_score = EnergyScore(climatology, o.xy_m);
+  s.climatology_score = climatology_score;
 }
 
 // The report's numbers: "-" for one that does not exist.
@@ -119,10 +116,23 @@ ValidationReport Validate(const ObservationSet& observations, const EnsembleSamp
   ValidationReport report;
   RockRandom uniforms(options.seed, kPitStream);
 
-  // Scalars. Climatology: the other observations of the same quantity (leave-one-out).
+  // Scalars. Climatology: the other observations of the same quantity (leave-one-out), scored
+  // when there are at least min_members of them.
+  std::vector<double> scalar_climatology(observations.scalars.size(), kNaN);
+  {
+    std::map<Quantity, std::vector<std::size_t>> by_quantity;
+    for (std::size_t k = 0; k < observations.scalars.size(); ++k)
+      by_quantity[observations.scalars[k].quantity].push_back(k);
+    for (const auto& [quantity, indices] : by_quantity) {
+      if (static_cast<int>(indices.size()) - 1 < options.min_members) continue;
+      std::vector<double> values;
+      for (std::size_t k : indices) values.push_back(observations.scalars[k].value);
+      const std::vector<double> scores = LeaveOneOutCrps(values);
+      for (std::size_t i = 0; i < indices.size(); ++i) scalar_climatology[indices[i]] = scores[i];
+    }
+  }
   for (std::size_t k = 0; k < observations.scalars.size(); ++k) {
     const ScalarObservation& o = observations.scalars[k];
-    const std::vector<double> climatology = ScalarClimatology(observations.scalars, k);
     ObservationScore s;
     s.kind = ToString(o.quantity);
     s.unit = UnitOf(o.quantity);
@@ -130,25 +140,36 @@ ValidationReport Validate(const ObservationSet& observations, const EnsembleSamp
     s.where = o.where;
     s.observed = o.value;
     const double u = uniforms.Uniform();  // drawn for every observation: scores do not shift
-    ScoreScalarObservation(o, simulated, reference, climatology, u, options.min_members, s);
+    ScoreScalarObservation(o, simulated, reference, scalar_climatology[k], u, options.min_members,
+                           s);
     report.observations.push_back(s);
   }
   // Deposits. Climatology: the other runs' observed displacements from their release, applied to
-  // this run's release (leave-one-out); none for observations of the whole scene.
-  std::vector<std::optional<Eigen::Vector2d>> starts;
-  for (const DepositObservation& o : observations.deposits)
-    starts.push_back(simulated.StartOf(o.run));
+  // this run's release (leave-one-out); none for observations of the whole scene. Scored against
+  // this run's deposit, that is the energy score of this run's displacement against the others'.
+  std::vector<double> deposit_climatology(observations.deposits.size(), kNaN);
+  {
+    std::vector<std::size_t> indices;
+    std::vector<Eigen::Vector2d> displacements;
+    for (std::size_t k = 0; k < observations.deposits.size(); ++k)
+      if (const auto start = simulated.StartOf(observations.deposits[k].run)) {
+        indices.push_back(k);
+        displacements.push_back(observations.deposits[k].xy_m - *start);
+      }
+    if (static_cast<int>(indices.size()) - 1 >= options.min_members) {
+      const std::vector<double> scores = LeaveOneOutEnergyScores(displacements);
+      for (std::size_t i = 0; i < indices.size(); ++i) deposit_climatology[indices[i]] = scores[i];
+    }
+  }
   for (std::size_t k = 0; k < observations.deposits.size(); ++k) {
     const DepositObservation& o = observations.deposits[k];
-    const std::vector<Eigen::Vector2d> climatology =
-        DepositClimatology(observations.deposits, starts, k);
     ObservationScore s;
     s.kind = "deposit";
     s.unit = "m";
     s.run = o.run;
     s.where = o.where;
     s.observed_xy_m = o.xy_m;
-    ScoreDeposit(o, simulated, reference, climatology, options.min_members, s);
+    ScoreDeposit(o, simulated, reference, deposit_climatology[k], options.min_members, s);
     report.observations.push_back(s);
   }
 

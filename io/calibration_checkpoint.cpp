@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "common/error.hpp"
+#include "common/fnv1a.hpp"
 
 namespace talus::io {
 namespace {
@@ -67,17 +68,54 @@ Evaluation EvaluationOf(const json& j) {
   return e;
 }
 
-}  // namespace
-
-std::string CheckpointJson(const CalibrationCheckpoint& c) {
+// What the checkpoint holds, without its checksum: writing what was read gives the same bytes.
+json Body(const CalibrationCheckpoint& c) {
   json stages = json::object();
   for (const auto& [name, evaluations] : c.stages) {
     json list = json::array();
     for (const Evaluation& e : evaluations) list.push_back(ToJson(e));
     stages[name] = list;
   }
-  const json j = {
+  return {
       {"path_hash", c.path_hash}, {"holdout", c.holdout}, {"folds", c.folds}, {"stages", stages}};
+}
+
+// "" when `e` fits `shape` and holds finite numbers where an evaluation always does (u, values,
+// residuals, prior, and the value of a feasible one; data and the kinds' scores are NaN when not
+// computed), else what is wrong.
+std::string CheckEvaluation(const Evaluation& e, const EvaluationShape& shape) {
+  // Appended piece by piece (GCC 12 warns wrongly about chains of std::string operator+).
+  const auto size = [](const char* key, long have, int want, const char* what) {
+    std::string out = "\"";
+    out.append(key).append("\" has ").append(std::to_string(have));
+    out.append(" entries, the calibration ").append(std::to_string(want)).append(" ").append(what);
+    return out;
+  };
+  if (e.u.size() != shape.dimension) return size("u", e.u.size(), shape.dimension, "parameters");
+  if (e.values.size() != shape.dimension)
+    return size("values", e.values.size(), shape.dimension, "parameters");
+  const auto kinds = static_cast<long>(e.kind_scores.size());
+  if (kinds != shape.kinds) return size("kind_scores", kinds, shape.kinds, "observation kinds");
+  if (static_cast<long>(e.kind_scored.size()) != shape.kinds)
+    return size("kind_scored", static_cast<long>(e.kind_scored.size()), shape.kinds,
+                "observation kinds");
+  if (e.residuals.size() != shape.residuals)
+    return size("residuals", e.residuals.size(), shape.residuals, "residuals");
+  if (!e.u.allFinite()) return "\"u\" holds a number that is not finite";
+  if (!e.values.allFinite()) return "\"values\" holds a number that is not finite";
+  if (!e.residuals.allFinite()) return "\"residuals\" holds a number that is not finite";
+  if (e.feasible && !std::isfinite(e.value)) return "\"value\" is not a finite number";
+  if (!std::isfinite(e.prior)) return "\"prior\" is not a finite number";
+  if (e.rocks < 0 || e.failed_rocks < 0 || e.failed_rocks > e.rocks)
+    return "\"rocks\" and \"failed_rocks\" are not counts of rocks";
+  return "";
+}
+
+}  // namespace
+
+std::string CheckpointJson(const CalibrationCheckpoint& c) {
+  json j = Body(c);
+  j["fnv1a64"] = Fnv1a64Hex(j.dump());
   return j.dump() + "\n";
 }
 
@@ -86,17 +124,42 @@ CalibrationCheckpoint ReadCheckpoint(const std::string& path) {
   if (!in) throw InputError(path + ": cannot read the checkpoint");
   std::stringstream text;
   text << in.rdbuf();
+  CalibrationCheckpoint c;
+  std::string saved_hash;
   try {
     const json j = json::parse(text.str());
-    CalibrationCheckpoint c;
     c.path_hash = j.at("path_hash").get<std::string>();
     c.holdout = j.at("holdout").get<std::vector<std::string>>();
     c.folds = j.at("folds").get<int>();
     for (const auto& [name, list] : j.at("stages").items())
       for (const json& e : list) c.stages[name].push_back(EvaluationOf(e));
-    return c;
+    if (!j.contains("fnv1a64"))
+      throw InputError(path +
+                       ": the checkpoint has no checksum (fnv1a64; written by an older talus?): "
+                       "remove it to start afresh");
+    saved_hash = j.at("fnv1a64").get<std::string>();
   } catch (const json::exception& e) {
     throw InputError(path + ": not a calibration checkpoint: " + e.what());
+  }
+  if (const std::string hash = Fnv1a64Hex(Body(c).dump()); hash != saved_hash)
+    throw InputError(path + ": what the checkpoint holds does not match its checksum (fnv1a64 " +
+                     saved_hash + ", the contents give " + hash +
+                     "): the file was edited or damaged; remove it to start afresh");
+  return c;
+}
+
+void CheckEvaluations(const CalibrationCheckpoint& c, const std::string& path,
+                      const std::map<std::string, EvaluationShape>& shapes) {
+  for (const auto& [name, evaluations] : c.stages) {
+    const auto shape = shapes.find(name);
+    if (shape == shapes.end())
+      throw InputError(path + ": stages." + name +
+                       ": this calibration has no such optimisation; remove the checkpoint to "
+                       "start afresh");
+    for (std::size_t k = 0; k < evaluations.size(); ++k)
+      if (const std::string why = CheckEvaluation(evaluations[k], shape->second); !why.empty())
+        throw InputError(path + ": stages." + name + "[" + std::to_string(k) + "]: " + why +
+                         "; remove the checkpoint to start afresh");
   }
 }
 

@@ -22,8 +22,21 @@ struct CalibrationCheckpoint {
   std::map<std::string, std::vector<calibration::Evaluation>> stages;
 };
 
+// What every evaluation of a calibration holds: the sizes of its vectors.
+struct EvaluationShape {
+  int dimension = 0;  // coordinates: entries of u and values
+  int kinds = 0;      // observation kinds: entries of kind_scores and kind_scored
+  int residuals = 0;  // entries of residuals
+};
+
 std::string CheckpointJson(const CalibrationCheckpoint& checkpoint);
-// Throws InputError naming the file when it cannot be read or parsed.
+// Throws InputError naming the file when it cannot be read or parsed, or its checksum does not
+// match what it holds.
 CalibrationCheckpoint ReadCheckpoint(const std::string& path);
+// Throws InputError naming the file `path` and the evaluation ("stages.fit[3]") when the
+// checkpoint has a stage that `shapes` (by stage: "fit", "fold1", ...) lacks, or an evaluation
+// does not have its stage's shape or holds a non-finite number where an evaluation never does.
+void CheckEvaluations(const CalibrationCheckpoint& checkpoint, const std::string& path,
+                      const std::map<std::string, EvaluationShape>& shapes);
 
 }  // namespace talus::io

@@ -1,5 +1,7 @@
 #include "io/calibration_outputs.hpp"
 
+#include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <nlohmann/json.hpp>
@@ -7,6 +9,7 @@
 #include <set>
 
 #include "common/format.hpp"
+#include "io/rocks_csv.hpp"
 
 namespace talus::io {
 namespace {
@@ -26,6 +29,32 @@ json Vector(const Eigen::VectorXd& v) {
   json out = json::array();
   for (Eigen::Index k = 0; k < v.size(); ++k) out.push_back(Number(v[k]));
   return out;
+}
+
+// A category's name as a TOML key: bare when it may be ("medium_hard"), else a basic string
+// ("zone 1", "meadow.v2": a bare dotted key would be a nested table), with quotes, backslashes and
+// control characters escaped.
+std::string TomlKey(const std::string& name) {
+  const bool bare = !name.empty() && std::all_of(name.begin(), name.end(), [](char c) {
+    return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_' ||
+           c == '-';
+  });
+  if (bare) return name;
+  std::string out = "\"";
+  for (const char c : name) {
+    const auto u = static_cast<unsigned char>(c);
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += c;
+    } else if (u < 0x20 || u == 0x7f) {
+      char escaped[8];
+      std::snprintf(escaped, sizeof escaped, "\\u%04x", u);
+      out += escaped;
+    } else {
+      out += c;  // UTF-8 as it came from the scene's TOML
+    }
+  }
+  return out + "\"";
 }
 
 // Touched categories, in table order.
@@ -277,7 +306,7 @@ std::string GroundTableToml(const CalibrationFile& file, const Objective& object
                     " (docs/calibration.md).\n# Paste into a scene file, or append to one.\n";
   for (int k : Touched(objective, fitted)) {
     const GroundCategory& c = fitted.category(k);
-    out += "\n[ground." + c.name + "]\ncode = " + std::to_string(c.code) + "\n";
+    out += "\n[ground." + TomlKey(c.name) + "]\ncode = " + std::to_string(c.code) + "\n";
     if (c.params.IsSoil()) out.append("model = \"").append(ToString(c.params.model)).append("\"\n");
     for (const GroundFieldInfo& f : kGroundFields)
       if (f.group != GroundFieldInfo::Group::kDragLayer && GroundFieldApplies(f, c.params))
@@ -301,7 +330,7 @@ std::string GroundTableCsv(const Objective& objective, const GroundTable& fitted
   out += "\n";
   for (int k : touched) {
     const GroundCategory& c = fitted.category(k);
-    out += c.name + "," + std::to_string(c.code);
+    out += CsvField(c.name) + "," + std::to_string(c.code);
     if (soil) out.append(",").append(ToString(c.params.model));
     for (const GroundFieldInfo* f : columns) out.append(",").append(G(c.params.*f->member));
     out += "\n";
@@ -372,7 +401,7 @@ std::string HistoryCsv(const Objective& objective, const calibration::OptimizerS
     out += ',';
     out += text;
   };
-  for (const auto& c : objective.parameters().coordinates()) cell(c.name);
+  for (const auto& c : objective.parameters().coordinates()) cell(CsvField(c.name));
   for (const std::string& kind : objective.kinds()) cell("score_" + kind);
   out += ",wall_time_s,note\n";
   for (std::size_t i = 0; i < summary.history.size(); ++i) {

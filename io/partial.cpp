@@ -1,19 +1,25 @@
 #include "io/partial.hpp"
 
 #include <algorithm>
+#include <charconv>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "common/bytes.hpp"
+#include "common/csv_table.hpp"
 #include "common/error.hpp"
+#include "common/fnv1a.hpp"
+#include "io/evaluation_lines_csv.hpp"
+#include "io/rocks_csv.hpp"
 
 namespace talus::io {
 namespace {
 
 constexpr const char* kFormat = "talus partial result";
-constexpr int kFormatVersion = 1;
+constexpr int kFormatVersion = 2;  // 2: the files' sizes and checksums
 constexpr const char* kStateMagic = "talus partial state 1";
 
 std::string ReadWholeFile(const std::string& path) {
@@ -29,10 +35,53 @@ std::string Range(long first, long end) {
   return std::to_string(first) + ":" + std::to_string(end);
 }
 
+// Size and FNV-1a 64 of a file, read in chunks.
+PartialInfo::File FileEntry(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error("cannot read " + path);
+  PartialInfo::File f;
+  std::uint64_t h = kFnv1aStart;
+  char chunk[1 << 16];
+  while (in.read(chunk, sizeof chunk) || in.gcount() > 0) {
+    h = Fnv1a64(std::string_view(chunk, static_cast<std::size_t>(in.gcount())), h);
+    f.bytes += static_cast<std::uint64_t>(in.gcount());
+  }
+  if (in.bad()) throw std::runtime_error("cannot read " + path);
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
+  f.fnv1a64 = hex;
+  return f;
+}
+
+// The rock of each record of a CSV file of the part (column `rock`), checked by `check(rock, line)`
+// which returns "" or what is wrong. Throws InputError "<path>:<line>: ..." naming the problem.
+template <class Check>
+void CheckRockColumn(const std::string& path, const std::string& header, Check check) {
+  CsvReader in(path);
+  std::string first;
+  for (const std::string& c : in.header()) first += (first.empty() ? "" : ",") + c;
+  if (first != header)
+    throw InputError(path + ": not the header of talus's " +
+                     std::filesystem::path(path).filename().string());
+  const std::size_t column = in.Column("rock");
+  std::vector<std::string> fields;
+  while (in.Next(&fields)) {
+    long rock = -1;
+    const std::string& text = fields[column];
+    const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), rock);
+    if (error != std::errc() || end != text.data() + text.size())
+      throw InputError(path + ":" + std::to_string(in.line()) + ": rock '" + text +
+                       "' is not a rock number");
+    if (const std::string why = check(rock); !why.empty())
+      throw InputError(path + ":" + std::to_string(in.line()) + ": " + why);
+  }
+}
+
 }  // namespace
 
 std::string PartialJson(const SceneFile& scene, const std::string& version, long first_rock,
-                        long end_rock, const ensemble::EnsembleReport& report) {
+                        long end_rock, const ensemble::EnsembleReport& report,
+                        const std::vector<std::string>& files) {
   nlohmann::ordered_json j;
   j["format"] = kFormat;
   j["format_version"] = kFormatVersion;
@@ -46,6 +95,7 @@ std::string PartialJson(const SceneFile& scene, const std::string& version, long
   j["rocks_per_release"] =
       scene.release.release_first_rock.empty() ? scene.release.rocks_per_release : 0;
   j["solver_preset"] = ToString(scene.solver_preset);
+  j["solver_preset_from_command_line"] = scene.solver_preset_from_command_line;
   j["total_rocks"] = scene.release.total_rocks();
   j["first_rock"] = first_rock;
   j["end_rock"] = end_rock;
@@ -58,6 +108,13 @@ std::string PartialJson(const SceneFile& scene, const std::string& version, long
   j["unconverged_steps"] = report.unconverged_steps;
   j["threads"] = report.threads;
   j["wall_time_s"] = report.wall_time_s;
+  nlohmann::ordered_json entries = nlohmann::ordered_json::object();
+  for (const std::string& path : files) {
+    const PartialInfo::File f = FileEntry(path);
+    entries[std::filesystem::path(path).filename().string()] = {{"bytes", f.bytes},
+                                                                {"fnv1a64", f.fnv1a64}};
+  }
+  j["files"] = entries;
   return j.dump(2) + "\n";
 }
 
@@ -97,6 +154,7 @@ PartialInfo ReadPartialInfo(const std::string& dir) {
     p.seed = j.at("seed");
     p.rocks_per_release = j.at("rocks_per_release");
     p.solver_preset = j.at("solver_preset");
+    p.solver_preset_from_command_line = j.value("solver_preset_from_command_line", false);
     p.total_rocks = j.at("total_rocks");
     p.first_rock = j.at("first_rock");
     p.end_rock = j.at("end_rock");
@@ -109,6 +167,11 @@ PartialInfo ReadPartialInfo(const std::string& dir) {
     p.counts.unconverged_steps = j.at("unconverged_steps");
     p.counts.threads = j.at("threads");
     p.counts.wall_time_s = j.at("wall_time_s");
+    for (const auto& [name, f] : j.at("files").items()) {
+      if (name.empty() || name.find('/') != std::string::npos || name == "." || name == "..")
+        throw InputError(path + ": files: '" + name + "' is not a file name");
+      p.files[name] = {f.at("bytes").get<std::uint64_t>(), f.at("fnv1a64").get<std::string>()};
+    }
   } catch (const nlohmann::json::exception& e) {
     throw InputError(path + ": not a valid partial.json: " + e.what());
   }
@@ -116,6 +179,57 @@ PartialInfo ReadPartialInfo(const std::string& dir) {
       p.counts.rocks != p.end_rock - p.first_rock)
     throw InputError(path + ": inconsistent rock range " + Range(p.first_rock, p.end_rock));
   return p;
+}
+
+void CheckPartFiles(const PartialInfo& part) {
+  const std::string json = (std::filesystem::path(part.dir) / "partial.json").string();
+  std::vector<std::string> required = {"rocks.csv", "partial.bin"};
+  if (part.trajectories) required.push_back("trajectories.h5");
+  for (const std::string& name : required)
+    if (!part.files.count(name))
+      throw InputError(json + ": files: no " + name + " (every part has it)");
+  for (const auto& [name, want] : part.files) {
+    const std::string path = (std::filesystem::path(part.dir) / name).string();
+    if (!std::filesystem::is_regular_file(path))
+      throw InputError(path + ": missing (partial.json lists it)");
+    PartialInfo::File have;
+    try {
+      have = FileEntry(path);
+    } catch (const std::runtime_error& e) {
+      throw InputError(e.what());
+    }
+    if (have.bytes != want.bytes || have.fnv1a64 != want.fnv1a64)
+      throw InputError(path + ": " + std::to_string(have.bytes) + " bytes with checksum " +
+                       have.fnv1a64 + ", but partial.json says " + std::to_string(want.bytes) +
+                       " bytes with " + want.fnv1a64 +
+                       ": changed or damaged since the part was run");
+  }
+  // The rows: rocks.csv has each rock of the part once, in order; evaluation_lines.csv only rocks
+  // of the part, in order.
+  const std::string range = "the part holds rocks " + Range(part.first_rock, part.end_rock);
+  const std::string rocks_csv = (std::filesystem::path(part.dir) / "rocks.csv").string();
+  long next = part.first_rock;
+  CheckRockColumn(rocks_csv, RocksCsvWriter::Header(), [&](long rock) -> std::string {
+    if (rock != next)
+      return "rock " + std::to_string(rock) + " where rock " + std::to_string(next) + " was due (" +
+             range + ")";
+    ++next;
+    return "";
+  });
+  if (next != part.end_rock)
+    throw InputError(rocks_csv + ": no row of rock " + std::to_string(next) + " or later (" +
+                     range + ")");
+  if (part.files.count("evaluation_lines.csv")) {
+    long last = part.first_rock;
+    CheckRockColumn((std::filesystem::path(part.dir) / "evaluation_lines.csv").string(),
+                    EvaluationLinesCsvWriter::Header(), [&](long rock) -> std::string {
+                      if (rock < last || rock >= part.end_rock)
+                        return "rock " + std::to_string(rock) +
+                               " out of order or not of the part (" + range + ")";
+                      last = rock;
+                      return "";
+                    });
+  }
 }
 
 std::vector<PartialInfo> CheckPartials(std::vector<PartialInfo> parts) {
@@ -133,6 +247,9 @@ std::vector<PartialInfo> CheckPartials(std::vector<PartialInfo> parts) {
     if (b.seed != a.seed) differ("seeds", std::to_string(a.seed), std::to_string(b.seed));
     if (b.solver_preset != a.solver_preset)
       differ("solver presets", a.solver_preset, b.solver_preset);
+    if (b.solver_preset_from_command_line != a.solver_preset_from_command_line)
+      differ("solver presets", a.solver_preset_from_command_line ? "--preset" : "the scene's",
+             b.solver_preset_from_command_line ? "--preset" : "the scene's");
     if (b.rocks_per_release != a.rocks_per_release || b.total_rocks != a.total_rocks)
       differ("rocks", std::to_string(a.total_rocks), std::to_string(b.total_rocks));
   }

@@ -6,13 +6,18 @@
 //   evaluation_lines.csv  their crossings, when the scene has evaluation lines (the summary is
 //                    computed from the merged file),
 //   partial.bin      the raster accumulator (per-cell summaries) and the quick-look's sample paths,
-//   partial.json     what the part is (scene, its inputs' hash, seed, range, version, counts);
-//                    written last, so that a directory with a partial.json is a complete part.
+//   partial.json     what the part is (scene, its inputs' hash, seed, range, version, counts)
+//                    and the size and checksum (FNV-1a 64) of each of its other files; written
+//                    last, so that a directory with a partial.json is a complete part.
+// Before merging, each part's files are checked against partial.json (CheckPartFiles): a file
+// changed, swapped with another part's or damaged since the part was run is refused, as are rows
+// of rocks outside the part's range.
 // `talus merge` (and rank 0 of an MPI run) combine parts that tile the ensemble into exactly the
 // outputs of a single run.
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -33,10 +38,17 @@ struct PartialInfo {
   std::uint64_t seed = 0;
   long rocks_per_release = 0;
   std::string solver_preset;  // "fast", "default", "accurate" (the scene's or --preset)
+  bool solver_preset_from_command_line = false;  // --preset: it won over the scene's keys
   long total_rocks = 0;
   long first_rock = 0, end_rock = 0;  // rocks [first_rock, end_rock)
   bool trajectories = false;
   ensemble::EnsembleReport counts;  // rocks, ends, raised, steps, threads, wall time
+  // The part's other files (rocks.csv, partial.bin, ...) by name: size and FNV-1a 64 (hex).
+  struct File {
+    std::uint64_t bytes = 0;
+    std::string fnv1a64;
+  };
+  std::map<std::string, File> files;
 };
 
 // The paths drawn on the quick-look, by rock.
@@ -45,14 +57,23 @@ struct SamplePath {
   std::vector<Eigen::Vector2d> xy_m;
 };
 
-// partial.json and partial.bin of a part.
+// partial.json and partial.bin of a part. `files`: the paths of the part's other files, written
+// already (their names, sizes and checksums go into partial.json). Throws std::runtime_error when
+// one cannot be read.
 std::string PartialJson(const SceneFile& scene, const std::string& version, long first_rock,
-                        long end_rock, const ensemble::EnsembleReport& report);
+                        long end_rock, const ensemble::EnsembleReport& report,
+                        const std::vector<std::string>& files);
 std::string PartialState(const ensemble::EnsembleReport& report,
                          const std::vector<SamplePath>& paths);
 
 // Reads <dir>/partial.json. Throws InputError naming the directory and the problem.
 PartialInfo ReadPartialInfo(const std::string& dir);
+
+// Checks the files of a part against its partial.json: each listed file is there with its size
+// and checksum, rocks.csv and partial.bin (and trajectories.h5 when the part has trajectories)
+// are listed, rocks.csv holds exactly the part's rocks in order and evaluation_lines.csv only
+// crossings of them. Throws InputError naming the file (and line) and what is wrong.
+void CheckPartFiles(const PartialInfo& part);
 
 // Checks that parts belong to one ensemble (same version, scene inputs, seed, rocks) and that their
 // ranges cover it exactly once; returns them sorted by range. Throws InputError naming the parts

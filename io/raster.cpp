@@ -1,5 +1,6 @@
 #include "io/raster.hpp"
 
+#include <cpl_string.h>
 #include <gdal_alg.h>
 #include <gdal_priv.h>
 #include <gdal_utils.h>
@@ -85,6 +86,35 @@ Raster RasterOf(GDALDataset* dataset, const std::string& path, const std::string
   return raster;
 }
 
+// Throws InputError when the raster reprojected to `target_crs_wkt` would have more than
+// kMaxRasterCells cells: the size gdalwarp chooses (GDALSuggestedWarpOutput), computed from the
+// source's outline without reading a pixel, before the warp builds it in memory.
+void CheckWarpedSize(GDALDataset* dataset, const std::string& path, const std::string& source_wkt,
+                     const std::string& target_crs_wkt, const std::string& what) {
+  CPLStringList options;
+  options.SetNameValue("DST_SRS", target_crs_wkt.c_str());
+  CPLErrorReset();
+  void* transformer =
+      GDALCreateGenImgProjTransformer2(GDALDataset::ToHandle(dataset), nullptr, options.List());
+  if (!transformer)
+    throw InputError(what + ": cannot reproject " + path + " from " + DescribeCrs(source_wkt) +
+                     " to " + DescribeCrs(target_crs_wkt) + ": " + CPLGetLastErrorMsg());
+  double gt[6];
+  int nx = 0, ny = 0;
+  const CPLErr suggested = GDALSuggestedWarpOutput(
+      GDALDataset::ToHandle(dataset), GDALGenImgProjTransform, transformer, gt, &nx, &ny);
+  GDALDestroyGenImgProjTransformer(transformer);
+  if (suggested != CE_None)
+    throw InputError(what + ": cannot reproject " + path + " from " + DescribeCrs(source_wkt) +
+                     " to " + DescribeCrs(target_crs_wkt) + ": " + CPLGetLastErrorMsg());
+  if (static_cast<double>(nx) * ny > kMaxRasterCells)
+    throw InputError(what + ": " + path + " would have " + std::to_string(nx) + " x " +
+                     std::to_string(ny) + " cells once reprojected from " +
+                     DescribeCrs(source_wkt) + " to " + DescribeCrs(target_crs_wkt) +
+                     ", more than " + std::to_string(static_cast<long>(kMaxRasterCells)) +
+                     "; crop or resample it first (e.g. with gdalwarp -t_srs and -tr)");
+}
+
 }  // namespace
 
 Raster ReadRaster(const std::string& path, const std::string& what) {
@@ -109,6 +139,7 @@ Raster ReadRasterIn(const std::string& path, const std::string& target_crs_wkt,
   }
   if (target_crs_wkt.empty() || source_wkt.empty() || SameCrs(source_wkt, target_crs_wkt))
     return RasterOf(dataset.get(), path, what);
+  CheckWarpedSize(dataset.get(), path, source_wkt, target_crs_wkt, what);
   // gdalwarp -t_srs <target> -r near -ot Float64 -dstnodata nan -of MEM: every value stays a
   // value of the file (nearest neighbour), cells off the file are nodata.
   const std::vector<std::string> args = {"-t_srs",  target_crs_wkt, "-r",  "near", "-ot",

@@ -1,5 +1,6 @@
 #include "io/resources.hpp"
 
+#include <sys/resource.h>
 #include <sys/statvfs.h>
 
 #include <algorithm>
@@ -9,6 +10,7 @@
 #include <fstream>
 #include <limits>
 #include <numeric>
+#include <optional>
 #include <sstream>
 
 #include "ensemble/cell_summary.hpp"
@@ -28,8 +30,9 @@ constexpr double kTrajectoryBytesPerSample = 84;
 constexpr double kRocksCsvBytesPerRow = 150;
 // A row of evaluation_lines.csv (cases/tirol, two lines: 260 rows, 35 934 bytes, 138 per row).
 constexpr double kEvaluationLinesCsvBytesPerRow = 150;
-// rocks.gpkg: an end point with its fields and spatial index; a path's vertex (x, y, z) and per path
-// its row and index (1000 rocks on a plane: 2.26 MB, 1.46 MB of it path geometry, 61 vertices each).
+// rocks.gpkg: an end point with its fields and spatial index; a path's vertex (x, y, z) and per
+// path its row and index (1000 rocks on a plane: 2.26 MB, 1.46 MB of it path geometry, 61 vertices
+// each).
 constexpr double kGeoPackageBytesPerRock = 700;
 constexpr double kGeoPackageBytesPerVertex = 24;
 constexpr double kGeoTiffBytesPerCell = 4;
@@ -163,34 +166,99 @@ ResourceEstimate EstimateResources(const SceneFile& scene, int threads) {
   return e;
 }
 
+namespace {
+
+// The first word of a file as a number of bytes; nullopt when it cannot be read or is "max".
+std::optional<double> ReadBytes(const std::string& path) {
+  std::ifstream in(path);
+  std::string word;
+  if (!(in >> word) || word == "max") return std::nullopt;
+  char* end = nullptr;
+  const double v = std::strtod(word.c_str(), &end);
+  if (end == word.c_str() || !(v >= 0)) return std::nullopt;
+  return v;
+}
+
+// "<key>: <n> kB" of a /proc file (meminfo, self/status) in bytes.
+std::optional<double> ReadProcKb(const std::string& path, const std::string& key) {
+  std::ifstream in(path);
+  std::string line;
+  while (std::getline(in, line))
+    if (line.compare(0, key.size() + 1, key + ":") == 0) {
+      const double kb = std::strtod(line.c_str() + key.size() + 1, nullptr);
+      return kb * 1024;
+    }
+  return std::nullopt;
+}
+
+// The cgroup `path` ("/a/b") and each of its ancestors up to the root, inner first.
+std::vector<std::string> CgroupChain(std::string path) {
+  std::vector<std::string> chain;
+  while (!path.empty() && path.back() == '/') path.pop_back();
+  for (;;) {
+    chain.push_back(path.empty() ? "/" : path);
+    if (path.empty()) break;
+    path.erase(path.rfind('/'));
+  }
+  return chain;
+}
+
+}  // namespace
+
 MachineCapacity MeasureCapacity(const std::string& out_dir) {
+  return MeasureCapacity(out_dir, CapacitySources{});
+}
+
+MachineCapacity MeasureCapacity(const std::string& out_dir, const CapacitySources& sources) {
   constexpr double kUnknown = std::numeric_limits<double>::infinity();
   MachineCapacity c;
   c.memory_bytes = kUnknown;
   c.disk_bytes = kUnknown;
-  std::ifstream meminfo("/proc/meminfo");
-  std::string key;
-  double kb = 0;
-  std::string unit;
-  while (meminfo >> key >> kb) {
-    std::getline(meminfo, unit);
-    if (key == "MemAvailable:") {
-      c.memory_bytes = kb * 1024;
-      break;
-    }
-  }
-  // A container's own limit (cgroup v2), when it is lower.
-  std::ifstream max_file("/sys/fs/cgroup/memory.max"),
-      current_file("/sys/fs/cgroup/memory.current");
-  std::string max_text;
-  double current = 0;
-  if (max_file >> max_text && max_text != "max" && current_file >> current) {
-    const double left = std::max(0.0, std::strtod(max_text.c_str(), nullptr) - current);
+  if (const auto available = ReadProcKb(sources.proc + "/meminfo", "MemAvailable"))
+    c.memory_bytes = *available;
+  const auto lower = [&c](double left, const std::string& source) {
     if (left < c.memory_bytes) {
-      c.memory_bytes = left;
-      c.memory_source = "the cgroup's memory.max less memory.current";
+      c.memory_bytes = std::max(0.0, left);
+      c.memory_source = source;
+    }
+  };
+  // The limits of the process's own cgroup and of its ancestors (a batch job's, a container's):
+  // cgroup v2 (memory.max, at the unified mount or below "unified" in a hybrid layout) and v1
+  // (the memory controller's memory.limit_in_bytes; its "no limit" is about 2^63).
+  std::ifstream cgroups(sources.proc + "/self/cgroup");
+  for (std::string line; std::getline(cgroups, line);) {
+    const std::size_t first = line.find(':'), second = line.find(':', first + 1);
+    if (first == std::string::npos || second == std::string::npos) continue;
+    const std::string controllers = line.substr(first + 1, second - first - 1);
+    const std::string path = line.substr(second + 1);
+    if (line.compare(0, first, "0") == 0 && controllers.empty()) {
+      for (const std::string& dir : CgroupChain(path))
+        for (const char* mount : {"", "/unified"}) {
+          const std::string base = sources.cgroup + mount + (dir == "/" ? "" : dir);
+          const auto max = ReadBytes(base + "/memory.max");
+          const auto current = ReadBytes(base + "/memory.current");
+          if (max && current)
+            lower(*max - *current, "the memory.max of cgroup " + dir + " less its memory.current");
+        }
+    } else if (("," + controllers + ",").find(",memory,") != std::string::npos) {
+      for (const std::string& dir : CgroupChain(path)) {
+        const std::string base = sources.cgroup + "/memory" + (dir == "/" ? "" : dir);
+        const auto limit = ReadBytes(base + "/memory.limit_in_bytes");
+        const auto usage = ReadBytes(base + "/memory.usage_in_bytes");
+        if (limit && usage && *limit < 0x1p62)
+          lower(*limit - *usage,
+                "the memory.limit_in_bytes of cgroup " + dir + " less its memory.usage_in_bytes");
+      }
     }
   }
+  // The process's own limits (ulimit -v, ulimit -d) less what it uses of them already.
+  rlimit limit{};
+  if (::getrlimit(RLIMIT_AS, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY)
+    if (const auto used = ReadProcKb(sources.proc + "/self/status", "VmSize"))
+      lower(double(limit.rlim_cur) - *used, "RLIMIT_AS (ulimit -v) less the address space in use");
+  if (::getrlimit(RLIMIT_DATA, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY)
+    if (const auto used = ReadProcKb(sources.proc + "/self/status", "VmData"))
+      lower(double(limit.rlim_cur) - *used, "RLIMIT_DATA (ulimit -d) less the data in use");
   struct statvfs fs {};
   if (::statvfs(out_dir.c_str(), &fs) == 0)
     c.disk_bytes = double(fs.f_bavail) * double(fs.f_frsize);

@@ -40,21 +40,31 @@ ResourceEstimate EstimateResources(const SceneFile& scene, int threads);
 // average with max_time_s = 120; io/resources.cpp has the measured sizes behind the estimate).
 inline constexpr double kAssumedTravelTime_s = 100;
 
-// Bytes of the per-cell storage behind the percentile rasters for `stats` statistics (speed, energy,
-// jump height: 0 to 3) on `cells` raster cells, holding `passes` (rock, cell) values in all. The
-// one place that knows how RasterAccumulator keeps them.
+// Bytes of the per-cell storage behind the percentile rasters for `stats` statistics (speed,
+// energy, jump height: 0 to 3) on `cells` raster cells, holding `passes` (rock, cell) values in
+// all. The one place that knows how RasterAccumulator keeps them.
 double PercentileStorageBytes(int stats, double cells, double passes);
 
 // What the machine offers the run.
 struct MachineCapacity {
-  double memory_bytes = 0;  // MemAvailable (or the cgroup's remaining limit when lower)
+  double memory_bytes = 0;  // the smallest of the memory limits below
   double disk_bytes = 0;    // free space of the output directory for unprivileged users
-  std::string memory_source = "MemAvailable";
+  std::string memory_source = "MemAvailable";  // which limit memory_bytes is
 };
 
-// Reads /proc/meminfo (and a cgroup v2 memory.max, when set) and statvfs(out_dir). A value it
-// cannot read is infinite (no refusal on a guess).
+// Where MeasureCapacity reads (a test points them at files of its own).
+struct CapacitySources {
+  std::string proc = "/proc";
+  std::string cgroup = "/sys/fs/cgroup";
+};
+
+// The memory is the smallest of: MemAvailable (/proc/meminfo); for the process's own cgroup and
+// each of its ancestors (/proc/self/cgroup), a cgroup v2 memory.max less memory.current and a
+// cgroup v1 memory.limit_in_bytes less memory.usage_in_bytes; RLIMIT_AS (ulimit -v) less the
+// address space in use (VmSize) and RLIMIT_DATA less the data in use (VmData). The disk is
+// statvfs(out_dir). A value it cannot read is infinite (no refusal on a guess).
 MachineCapacity MeasureCapacity(const std::string& out_dir);
+MachineCapacity MeasureCapacity(const std::string& out_dir, const CapacitySources& sources);
 
 // "" when the run fits, else one line: the estimate, what is available and the largest terms
 // with their knobs.

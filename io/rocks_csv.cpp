@@ -6,7 +6,11 @@
 
 namespace talus::io {
 std::string CsvField(const std::string& text) {
-  if (text.find_first_of(",\"\n\r") == std::string::npos) return text;
+  // Blanks around a field are trimmed by readers (CsvTable) unless quoted.
+  const auto blank = [](char c) { return c == ' ' || c == '\t'; };
+  if (text.find_first_of(",\"\n\r") == std::string::npos &&
+      (text.empty() || (!blank(text.front()) && !blank(text.back()))))
+    return text;
   std::string out = "\"";
   for (char c : text) out += c == '"' ? std::string("\"\"") : std::string(1, c);
   return out + "\"";

@@ -12,7 +12,7 @@
 namespace talus::io {
 
 // A text field as written to the CSV outputs: quoted when it holds a comma, quote or line break
-// (RFC 4180).
+// (RFC 4180), or begins or ends with a blank.
 std::string CsvField(const std::string& text);
 
 class RocksCsvWriter {

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <fstream>
 
+#include "common/format.hpp"
 #include "common/closest_name.hpp"
 #include "common/error.hpp"
 #include "io/scene_tables.hpp"
@@ -154,6 +155,8 @@ void LoadSolver(const Section& s, SolverOptions& o, SolverPreset& preset,
     if (f.preset_knob) given.emplace_back(f.key);
     f.member.set(o, SolverValue(s, f));
   }
+  // One coefficient (SolverOptions): the tangential one follows the normal one unless given.
+  if (!s.Has("tangential_restitution")) o.tangential_restitution = o.normal_restitution;
   std::string why;
   if (!o.IsValid(&why)) s.FailCheck(why);
 }
@@ -218,12 +221,18 @@ void LoadOutput(const Section& s, OutputSpec& o) {
 void UseSolverPreset(SceneFile& scene, SolverPreset preset) {
   SolverOptions o = scene.scene.options;
   ApplyPreset(preset, &o);
+  // --preset wins over the scene's own knobs; each value it changes is named.
+  scene.solver_keys_overridden.clear();
   for (const std::string& key : scene.solver_keys_given) {
     const SolverOptionInfo* f = FindSolverOption(key);
-    f->member.set(o, f->member.get(scene.scene.options));
+    const double was = f->member.get(scene.scene.options), now = f->member.get(o);
+    if (was != now)
+      scene.solver_keys_overridden.push_back(key + " = " + RoundTrip(was) + " -> " +
+                                             RoundTrip(now));
   }
   scene.scene.options = o;
   scene.solver_preset = preset;
+  scene.solver_preset_from_command_line = true;
 }
 
 ensemble::RasterRequest OutputSpec::Request(const GridGeometry& grid) const {

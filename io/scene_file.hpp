@@ -54,6 +54,10 @@ struct SceneFile {
   std::string inputs_hash;          // FNV-1a 64 over the contents of `inputs`, hex
   SolverPreset solver_preset = SolverPreset::kDefault;  // [solver] preset, or --preset
   std::vector<std::string> solver_keys_given;           // the preset's knobs the scene sets itself
+  // --preset given on the command line (UseSolverPreset): it wins over the scene's own keys;
+  // solver_keys_overridden lists those whose values it changed, as "dt_s = 0.002 -> 0.001".
+  bool solver_preset_from_command_line = false;
+  std::vector<std::string> solver_keys_overridden;
   // Inputs that load but look wrong (e.g. a few points dominating the rock's hull), each naming
   // the file, line and key: printed by talus simulate and listed in summary.json.
   std::vector<std::string> warnings;
@@ -62,8 +66,9 @@ struct SceneFile {
 // Loads and validates a scene. Throws talus::InputError with "<file>:<line>: <key>: <reason>".
 SceneFile LoadScene(const std::string& path);
 
-// Sets the solver's accuracy knobs to `preset` (talus simulate --preset), but for those the
-// scene's [solver] gives itself, which keep the scene's values.
+// Sets the solver's accuracy knobs to `preset` as talus simulate --preset asks: the preset wins over
+// the values the scene's [solver] gives itself (a check with "accurate" must run accurately), and
+// the keys it changed are listed in scene.solver_keys_overridden.
 void UseSolverPreset(SceneFile& scene, SolverPreset preset);
 
 }  // namespace talus::io

@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <string>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -63,13 +64,15 @@ void LoadRuns(const Context& context, const Section& s, SceneFile& out) {
   }
   if (rows.rows() == 0) throw InputError(path + ": no run (the table has a header only)");
   const GridGeometry& g = out.scene.terrain.heights().grid;
+  std::unordered_map<std::string, int> first_row;  // of each run id
   for (int k = 0; k < rows.rows(); ++k) {
     ensemble::ReleaseRun run;
     run.id = rows.Text(k, "trajectory_id");
     if (run.id.empty()) throw InputError(rows.Where(k, "trajectory_id") + ": empty");
-    for (const ensemble::ReleaseRun& other : r.runs)
-      if (other.id == run.id)
-        throw InputError(rows.Where(k, "trajectory_id") + ": run '" + run.id + "' appears twice");
+    if (const auto [at, added] = first_row.emplace(run.id, k); !added)
+      throw InputError(rows.Where(k, "trajectory_id") + ": run '" + run.id +
+                       "' appears twice (first on line " + std::to_string(rows.line(at->second)) +
+                       ")");
     run.xy_m = Eigen::Vector2d(rows.Number(k, "x_m"), rows.Number(k, "y_m"));
     run.z_m = rows.OptionalNumber(k, "z_m");
     run.height_m = rows.OptionalNumber(k, "height_m");

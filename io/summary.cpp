@@ -64,9 +64,37 @@ nlohmann::ordered_json EvaluationLineJson(const EvaluationLineSummary& s) {
 
 std::string GroundTableJson(const GroundTable& table) { return GroundJson(table).dump(); }
 
+namespace {
+
+// talus simulate --self-check: the subsample, both settings, the verdict and every statistic.
+nlohmann::ordered_json SelfCheckJson(const ensemble::SelfCheckReport& r) {
+  nlohmann::ordered_json statistics = nlohmann::ordered_json::array();
+  for (const ensemble::SelfCheckStatistic& s : r.statistics)
+    statistics.push_back({{"name", s.name},
+                          {"unit", s.unit},
+                          {"as_run", s.as_run},
+                          {"refined", s.refined},
+                          {"difference", s.difference},
+                          {"standard_error", s.standard_error},
+                          {"significant", s.significant}});
+  return {{"rocks", r.rocks},
+          {"dt_s", r.dt_s},
+          {"refined_dt_s", r.refined_dt_s},
+          {"tolerance_m_s", r.tolerance_m_s},
+          {"refined_tolerance_m_s", r.refined_tolerance_m_s},
+          {"threshold_standard_errors", r.threshold},
+          {"converged", r.converged},
+          {"verdict", r.Verdict()},
+          {"statistics", statistics},
+          {"wall_time_s", r.wall_time_s}};
+}
+
+}  // namespace
+
 std::string SummaryJson(const SceneFile& scene, const ensemble::EnsembleReport& report,
                         const std::string& version, const std::vector<std::string>& outputs,
-                        const std::vector<EvaluationLineSummary>& evaluation_lines) {
+                        const std::vector<EvaluationLineSummary>& evaluation_lines,
+                        const ensemble::SelfCheckReport* self_check) {
   nlohmann::ordered_json j;
   j["talus_version"] = version;
   j["scene"] = scene.path;
@@ -113,6 +141,8 @@ std::string SummaryJson(const SceneFile& scene, const ensemble::EnsembleReport& 
   // summary.json alone (with the inputs of the same hash).
   j["solver"] = SolverJson(scene.scene.options);
   j["solver"]["preset"] = ToString(scene.solver_preset);
+  j["solver"]["preset_from"] = scene.solver_preset_from_command_line ? "command line" : "scene";
+  j["solver"]["preset_overrode"] = scene.solver_keys_overridden;
   j["ground"] = GroundJson(scene.scene.ground);
   // How the rasters were asked for (the statistics rasters' percentiles and the file layout).
   j["raster_output"] = {
@@ -124,6 +154,7 @@ std::string SummaryJson(const SceneFile& scene, const ensemble::EnsembleReport& 
     for (const EvaluationLineSummary& s : evaluation_lines) lines.push_back(EvaluationLineJson(s));
     j["evaluation_lines"] = lines;
   }
+  if (self_check) j["self_check"] = SelfCheckJson(*self_check);
   j["threads"] = report.threads;
   j["wall_time_s"] = report.wall_time_s;
   j["trajectories_per_s"] = report.trajectories_per_s();

@@ -6,16 +6,19 @@
 #include <vector>
 
 #include "ensemble/runner.hpp"
+#include "ensemble/self_check.hpp"
 #include "io/evaluation_lines_csv.hpp"
 #include "io/scene_file.hpp"
 
 namespace talus::io {
 
 // The summary as JSON text; `outputs` lists the files written next to it. `evaluation_lines`, the
-// per-line summary of a scene with evaluation lines, goes under "evaluation_lines".
+// per-line summary of a scene with evaluation lines, goes under "evaluation_lines"; a self-check's
+// report (talus simulate --self-check) under "self_check".
 std::string SummaryJson(const SceneFile& scene, const ensemble::EnsembleReport& report,
                         const std::string& version, const std::vector<std::string>& outputs,
-                        const std::vector<EvaluationLineSummary>& evaluation_lines = {});
+                        const std::vector<EvaluationLineSummary>& evaluation_lines = {},
+                        const ensemble::SelfCheckReport* self_check = nullptr);
 
 // The ground table as used, as summary.json's "ground" holds it, on one line (compact JSON).
 std::string GroundTableJson(const GroundTable& table);

@@ -1,5 +1,6 @@
 #include "io/trajectory_file.hpp"
 
+#include <fcntl.h>
 #include <hdf5.h>
 #include <sys/mman.h>
 #include <sys/resource.h>
@@ -74,6 +75,16 @@ struct Hdf5Failure {
 // HDF5 would print its error stack on stderr; every failure becomes one exception instead. (The
 // setting is per thread in thread-safe builds, so each entry point makes it.)
 void SilenceHdf5() { H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr); }
+
+// HDF5's exit handler (H5_term_library) closes the files still open at exit. A file whose close
+// failed is one HDF5 can neither close nor drop, and that handler then crashes on it (SIGSEGV in
+// H5F__close_cb). Abandon below avoids such failures where it can; where it cannot (a hard
+// file-size limit hit while HDF5 flushes), the process must still end normally. Every file is
+// closed explicitly here, so the handler has nothing else to do at exit but free memory: it is
+// turned off. This runs at static initialisation, before the first HDF5 call of a program that
+// links this file (afterwards the handler is registered already; HDF5's C++ library, which
+// talus does not use, registers one of its own when it is loaded).
+[[maybe_unused]] const bool kNoHdf5ExitHandler = H5dont_atexit() >= 0;
 
 hid_t Check(hid_t id, const char* what) {
   if (id < 0) Fail(what);
@@ -204,8 +215,10 @@ class Column {
 // Closes a file that is being abandoned (its temporary file is about to be removed) without
 // writing what HDF5 still holds for it to disk: its descriptor is first pointed at an anonymous
 // memory file, and a soft file-size limit is lifted meanwhile. HDF5 cannot drop a file whose close
-// fails: it keeps a half-freed file that crashes it at exit.
-// `close_objects` closes the file's open objects (their cached data goes to the memory file too).
+// fails: it keeps a half-freed file that crashes it at exit (SIGSEGV in H5F__close_cb). Under a
+// hard file-size limit (`ulimit -f` sets both) writes to the memory file past the limit would fail
+// too, so the descriptor is pointed at /dev/null instead, where every write succeeds.
+// `close_objects` closes the file's open objects (their cached data goes to the same place).
 template <class CloseObjects>
 void Abandon(Handle& file, CloseObjects close_objects) {
   void* vfd = nullptr;
@@ -215,12 +228,16 @@ void Abandon(Handle& file, CloseObjects close_objects) {
     return;
   }
   const int fd = *static_cast<int*>(vfd);  // the default (sec2) driver's descriptor
-  if (const int memory = ::memfd_create("talus-abandoned.h5", MFD_CLOEXEC); memory >= 0) {
-    ::dup2(memory, fd);
-    ::close(memory);
-  }
   rlimit limit{};
-  const bool lift = ::getrlimit(RLIMIT_FSIZE, &limit) == 0 && limit.rlim_cur != limit.rlim_max;
+  const bool got = ::getrlimit(RLIMIT_FSIZE, &limit) == 0;
+  const bool hard = got && limit.rlim_max != RLIM_INFINITY;
+  const int target = hard ? ::open("/dev/null", O_RDWR | O_CLOEXEC)
+                          : ::memfd_create("talus-abandoned.h5", MFD_CLOEXEC);
+  if (target >= 0) {
+    ::dup2(target, fd);
+    ::close(target);
+  }
+  const bool lift = got && limit.rlim_cur != limit.rlim_max;
   if (lift) {
     const rlimit lifted{limit.rlim_max, limit.rlim_max};
     ::setrlimit(RLIMIT_FSIZE, &lifted);

@@ -13,6 +13,9 @@ namespace talus {
 struct Contact {
   int vertex = 0;    // hull vertex index
   double gap_m = 0;  // open contact's gap along n at the midpoint; 0 for a closed one
+  // The second contact of a closed vertex heading across a concave change of the terrain: the
+  // face ahead, as a predicted contact (DetectContacts). Not warm-started.
+  bool corner = false;
   int ground = 0;    // ground index at the contact point
   // Body frame: where the percussion acts; the vertex itself, or for a predicted contact with
   // SolverOptions::predicted_lever = kTouch the vertex turned to where it touches.
@@ -28,8 +31,9 @@ struct Contact {
   // Contact-friction reading of the viscous term: nu dt m (kg), the tangential damping this
   // contact gets when it carries the whole normal load; 0 otherwise (SolveContacts).
   double viscous_kg = 0;
-  // Added to the end contact velocity in the laws: xi = gamma_E + eps (.) gamma_B + (gap_m/dt, 0,
-  // 0).
+  // Added to the end contact velocity in the laws: xi = gamma_E + eps gamma_B (Newton's law: a
+  // closed contact, or a predicted one reached within the step), else xi = gamma_E + (gap_m/dt,
+  // 0, 0).
   Eigen::Vector3d velocity_bias = Eigen::Vector3d::Zero();
   Eigen::Vector3d percussion = Eigen::Vector3d::Zero();  // (P_N, P_T1, P_T2), N s
 };

@@ -32,6 +32,33 @@ Eigen::Vector3d PredictedLeverArm(PredictedLever lever, const Eigen::Vector3d& b
   return Eigen::AngleAxisd(angle, omega.normalized()) * b;
 }
 
+// A closed vertex's law stops it moving into its own face, not along it: past a concave change of
+// the terrain (the foot of a slope) it may slide on below the next face, and nothing ever lifts it
+// out. When the predicted end point, less any motion into the own face (where that law lets the
+// vertex go at worst), lies on a face of another normal and deeper than allowed_depth_m below it,
+// the vertex gets a second contact with that face, as a predicted contact (gap to its plane plus
+// the allowed depth, never negative).
+void AddCornerContact(const Scene& scene, const RockState& mid, const Eigen::Matrix3d& rotation,
+                      const Eigen::Vector3d& velocity_m_s, const Eigen::Vector3d& omega_rad_s,
+                      double horizon_s, double allowed_depth_m, int vertex,
+                      const Eigen::Vector3d& b, const Eigen::Vector3d& x,
+                      const Eigen::Vector3d& normal, StepWorkspace& workspace) {
+  const Eigen::Vector3d move = horizon_s * (velocity_m_s + rotation * omega_rad_s.cross(b));
+  const Eigen::Vector3d x_end = x + move - std::min(0.0, normal.dot(move)) * normal;
+  TerrainSample end;
+  if (!scene.terrain.Sample(x_end.x(), x_end.y(), &end)) return;
+  const Eigen::Vector3d& n = end.normal;
+  if (n.dot(normal) >= 1 - 1e-12) return;  // the same face
+  if ((x_end.z() - end.height_m) * n.z() >= -allowed_depth_m) return;
+  const Eigen::Vector3d on_plane(x_end.x(), x_end.y(), end.height_m);
+  Contact& c = workspace.contacts.emplace_back();
+  c.vertex = vertex;
+  c.corner = true;
+  c.lever_m = b;
+  c.gap_m = std::max(0.0, n.dot(x - on_plane) + allowed_depth_m);
+  SetFrame(scene, mid, x_end, n, c);
+}
+
 }  // namespace
 
 // Whether the terrain point (x, y) is over a soil category, and then in *depth_m the depth of the
@@ -112,6 +139,9 @@ DetectResult DetectContacts(const Scene& scene, const RockShape& rock, const Roc
       c.lever_m = b;
       c.gap_m = 0;
       SetFrame(scene, mid, x, sample.normal, c);
+      if (horizon_s > 0 && depth == 0)
+        AddCornerContact(scene, mid, rotation, velocity_m_s, omega_rad_s, horizon_s,
+                         allowed_depth_m, k, b, x, sample.normal, workspace);
       continue;
     }
     if (horizon_s == 0) continue;

@@ -14,10 +14,9 @@ namespace talus {
 // contacts); kOk: the vertices that may touch were tested.
 enum class DetectResult { kClear, kOk, kOutsideDomain };
 
-// How far ahead contacts are predicted, s: one step with the plastic normal law, none otherwise.
-inline double PredictionHorizon(const SolverOptions& options) {
-  return options.normal_restitution == 0 ? options.dt_s : 0.0;
-}
+// How far ahead contacts are predicted, s: one step (with restitution too: a predicted contact
+// that the vertex reaches within the step takes Newton's law, SolveContacts).
+inline double PredictionHorizon(const SolverOptions& options) { return options.dt_s; }
 
 // Fills workspace.contacts with the vertices in contact, with their contact frame, ground index and
 // friction mu(scar_m):

@@ -273,16 +273,20 @@ void PrepareContacts(const Scene& scene, const RockShape& rock, const Eigen::Mat
     const double mean = 0.5 * (g(1, 1) + g(2, 2));
     const double half_diff = 0.5 * (g(1, 1) - g(2, 2));
     c.r_tangent = opt.prox_alpha / (mean + std::sqrt(half_diff * half_diff + g(1, 2) * g(1, 2)));
-    c.velocity_bias =
-        with_restitution
-            ? Eigen::Vector3d(restitution.cwiseProduct(c.directions.transpose() * v_begin +
-                                                       c.arms.transpose() * omega_begin))
-            : Eigen::Vector3d::Zero();
-    c.velocity_bias.x() += c.gap_m * inv_dt;
+    // Newton's law on a closed contact, and on a predicted one that the vertex reaches within the
+    // step at its begin velocity (it rebounds from where it stands, short of the surface by less
+    // than one step's travel); the plastic gap law on a predicted one it does not reach.
+    c.velocity_bias = Eigen::Vector3d(c.gap_m * inv_dt, 0, 0);
+    if (with_restitution) {
+      const Eigen::Vector3d gamma_begin =
+          c.directions.transpose() * v_begin + c.arms.transpose() * omega_begin;
+      if (c.gap_m == 0 || c.gap_m + opt.dt_s * gamma_begin.x() < 0)
+        c.velocity_bias = restitution.cwiseProduct(gamma_begin);
+    }
     c.viscous_kg =
         viscous_friction ? scene.ground.params(c.ground).nu_1_s * opt.dt_s * rock.mass_kg : 0.0;
     c.percussion.setZero();
-    if (workspace.last_closed[c.vertex]) {
+    if (workspace.last_closed[c.vertex] && !c.corner) {
       // Previous step's percussion, re-expressed in this frame and made admissible.
       Eigen::Vector3d p = c.directions.transpose() * workspace.last_percussion[c.vertex];
       p.x() = std::max(0.0, p.x());
@@ -353,10 +357,14 @@ void PrepareContacts(const Scene& scene, const RockShape& rock, const Eigen::Mat
 void RememberPercussions(StepWorkspace& workspace, ContactSolveReport& report) {
   workspace.ForgetPercussions();
   for (const Contact& c : workspace.contacts) {
+    if (c.percussion.x() > 0) report.loaded = true;
+    if (c.corner) {  // its vertex's closed contact comes first
+      workspace.last_percussion[c.vertex] += c.directions * c.percussion;
+      continue;
+    }
     workspace.last_closed[c.vertex] = 1;
     workspace.last_closed_list.push_back(c.vertex);
     workspace.last_percussion[c.vertex] = c.directions * c.percussion;
-    if (c.percussion.x() > 0) report.loaded = true;
   }
 }
 

@@ -100,13 +100,13 @@ constinit const std::array<SolverOptionInfo, 16> kSolverOptions = {{
      .member = MemberOf<&O::normal_restitution>(),
      .unit = "1",
      .valid = Bounds::Between(0, 1),
-     .doc = "epsilon_N; the model is fully plastic (0)"},
+     .doc = "epsilon of Newton's impact law; the model is fully plastic (0)"},
     {.key = "tangential_restitution",
      .type = Type::kNumber,
      .member = MemberOf<&O::tangential_restitution>(),
      .unit = "1",
-     .valid = Bounds::Between(-1, 1),
-     .doc = "epsilon_T; 0: no tangential rebound"},
+     .valid = Bounds::Between(0, 1),
+     .doc = "must equal normal_restitution, which it follows unless given (one coefficient)"},
     {.key = "viscous",
      .type = Type::kChoice,
      .member = MemberOf<&O::viscous>(),
@@ -220,6 +220,17 @@ bool SolverOptions::IsValid(std::string* why) const {
         msg << " violates " << f.valid.Describe(f.key);
         if (std::string_view(f.unit) != "1") msg << " " << f.unit;
       }
+      *why = msg.str();
+    }
+    return false;
+  }
+  // Across fields: Newton's law takes one coefficient (SolverOptions::normal_restitution).
+  if (tangential_restitution != normal_restitution) {
+    if (why) {
+      std::ostringstream msg;
+      msg << "tangential_restitution = " << tangential_restitution
+          << " violates tangential_restitution == normal_restitution (Newton's impact law adds "
+             "energy for unequal coefficients: Glocker 2013, Part I)";
       *why = msg.str();
     }
     return false;

@@ -77,8 +77,13 @@ struct SolverOptions {
   double dt_s = 0.002;                  // time step
   double max_time_s = 300;              // a rock still moving then ends as max_time
   double gravity_m_s2 = 9.81;           // along -z
-  double normal_restitution = 0.0;      // epsilon_N in [0, 1]; the model is fully plastic (0)
-  double tangential_restitution = 0.0;  // epsilon_T in [-1, 1]; 0: no tangential rebound
+  // Newton's impact law xi = gamma_E + epsilon gamma_A, one coefficient for the normal and the
+  // tangential directions: the model is fully plastic (0). Only equal coefficients in [0, 1] are
+  // energetically consistent for every contact configuration (Glocker 2013, Part I): with
+  // epsilon_T != epsilon_N a sticking contact of a rotating body can gain energy (Kane's
+  // paradox), so IsValid requires tangential_restitution == normal_restitution.
+  double normal_restitution = 0.0;      // epsilon_N in [0, 1]
+  double tangential_restitution = 0.0;  // epsilon_T, equal to epsilon_N
   // Reading of the viscous ground term: the seed paper's viscous friction by default, the one the
   // field data and the ramp support (docs/model.md, "Which reading the data support").
   ViscousReading viscous = ViscousReading::kContactFriction;

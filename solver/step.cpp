@@ -160,9 +160,9 @@ StepReport Step(const Scene& scene, const RockShape& rock, RockState& state,
   if (scene.ground.AnyDragLayer())
     DragLayer(scene, state.position_m, begin.velocity_m_s, velocity, omega, inertia);
 
-  // 4. Contact set at the midpoint: closed contacts and, with a plastic normal law, the vertices
-  // that the free motion (no contacts) would carry deeper than the penetration tolerance below the
-  // terrain by the next midpoint.
+  // 4. Contact set at the midpoint: closed contacts and the vertices that the free motion (no
+  // contacts) would carry deeper than the penetration tolerance below the terrain by the next
+  // midpoint.
   const double allowed_depth = opt.penetration_tolerance * rock.thickness_m;
   const Eigen::Matrix3d rotation = state.orientation.toRotationMatrix();
   const DetectResult detected = DetectContacts(scene, rock, state, rotation, velocity, omega,

@@ -82,8 +82,9 @@ class MergeCommand : public ::testing::Test {
 TEST_F(MergeCommand, AnySplitInAnyOrderGivesTheSingleRunsBytes) {
   std::string log;
   const auto single = SingleRun();
-  // 3 x (max, mean, p50, p95, p99) + 3 count rasters + 8 files: every output is compared
-  ASSERT_EQ(single.size(), 26u);
+  // 3 x (max, mean, p50, p95, p99) + 3 count rasters + 8 files + the list of outputs
+  // (.talus-outputs): every output is compared
+  ASSERT_EQ(single.size(), 27u);
   // Some rocks cross, and not every one: the rows to merge are not trivial.
   const std::string& crossings = single.at("evaluation_lines.csv");
   EXPECT_GT(std::count(crossings.begin(), crossings.end(), '\n'), 3);
@@ -182,6 +183,31 @@ TEST_F(MergeCommand, PartsOfDifferentRunsAreRefused) {
   // A directory that is not a complete part.
   EXPECT_EQ(Merge({a, dir_}, &log), 2);
   EXPECT_NE(log.find("not a complete partial result"), std::string::npos) << log;
+}
+
+// Parts whose files were swapped, cut or damaged since they ran (their partial.json's sizes and
+// checksums no longer match) are refused as bad input, naming the file; nothing is written.
+TEST_F(MergeCommand, PartsWithChangedFilesAreRefused) {
+  std::string log;
+  const fs::path a = Part("0:5"), b = Part("5:10");
+  const std::string rocks = Slurp(b / "rocks.csv"), bin = Slurp(b / "partial.bin");
+  talus::app::testing::Write(b / "rocks.csv", Slurp(a / "rocks.csv"));  // a's rows twice
+  EXPECT_EQ(Merge({a, b}, &log), 2);
+  EXPECT_NE(log.find((b / "rocks.csv").string() + ": "), std::string::npos) << log;
+  EXPECT_NE(log.find("changed or damaged since the part was run"), std::string::npos) << log;
+  talus::app::testing::Write(b / "rocks.csv",
+                             rocks.substr(0, rocks.rfind('\n', rocks.size() - 2) + 1));
+  EXPECT_EQ(Merge({a, b}, &log), 2);  // its last row deleted
+  EXPECT_NE(log.find((b / "rocks.csv").string() + ": "), std::string::npos) << log;
+  talus::app::testing::Write(b / "rocks.csv", rocks);
+  std::string flipped = bin;
+  flipped[flipped.size() / 2] = static_cast<char>(flipped[flipped.size() / 2] ^ 1);
+  talus::app::testing::Write(b / "partial.bin", flipped);
+  EXPECT_EQ(Merge({a, b}, &log), 2);
+  EXPECT_NE(log.find((b / "partial.bin").string() + ": "), std::string::npos) << log;
+  EXPECT_FALSE(fs::exists(dir_ / "merged" / "summary.json"));
+  talus::app::testing::Write(b / "partial.bin", bin);
+  EXPECT_EQ(Merge({a, b}, &log), 0) << log;  // as they were: merged
 }
 
 TEST_F(MergeCommand, ASceneChangedSinceThePartsRanIsRefused) {

@@ -53,12 +53,12 @@ std::map<std::string, std::string> Snapshot(const fs::path& dir) {
   return files;
 }
 
-// Names in `dir` of temporary files or staging directories (".<name>.tmp-<pid>").
+// Names in `dir` of temporary files or staging directories (".<name>.talus-tmp-<pid>").
 std::vector<std::string> Temporaries(const fs::path& dir) {
   std::vector<std::string> names;
   for (const auto& entry : fs::directory_iterator(dir)) {
     const std::string name = entry.path().filename().string();
-    if (name.find(".tmp-") != std::string::npos) names.push_back(name);
+    if (name.find(".talus-tmp-") != std::string::npos) names.push_back(name);
   }
   return names;
 }
@@ -123,7 +123,8 @@ TEST(SimulateCommand, WritesEveryOutputIdenticallyForOneAndTwoThreads) {
   int tifs = 0;
   for (const auto& entry : fs::directory_iterator(a)) {
     const std::string name = entry.path().filename().string();
-    EXPECT_NE(name[0], '.') << "temporary file left behind: " << name;
+    EXPECT_EQ(name.find(".talus-tmp-"), std::string::npos)
+        << "temporary file left behind: " << name;
     if (name != "summary.json") {  // it has the wall time and the threads
       EXPECT_EQ(Slurp(entry.path()), Slurp(b / name)) << name << " differs between 1 and 2 threads";
       tifs += entry.path().extension() == ".tif";
@@ -280,13 +281,63 @@ TEST(SimulateCommand, OverridesRocksAndSeed) {
       << log;
   const auto fast = nlohmann::json::parse(Slurp(dir / "fast" / "summary.json"));
   EXPECT_EQ(fast["solver"]["preset"], "fast");
+  EXPECT_EQ(fast["solver"]["preset_from"], "command line");
   EXPECT_EQ(fast["solver"]["tolerance_m_s"], 1e-2);
+  EXPECT_EQ(summary["solver"]["preset_from"], "scene");
+  // --preset accurate wins over the scene's own dt_s and says so.
+  std::string pinned = kScene;
+  pinned.replace(pinned.find("[solver]\n"), 9, "[solver]\ndt_s = 0.002\n");
+  std::ofstream(dir / "pinned.toml") << pinned;
+  ASSERT_EQ(RunCommand(std::string(TALUS_BINARY) + " simulate " + (dir / "pinned.toml").string() +
+                           " --out " + (dir / "accurate").string() + " --rocks 1 --preset accurate",
+                       &log),
+            0)
+      << log;
+  EXPECT_NE(log.find("--preset accurate overrides the scene's dt_s = 0.002 -> 0.001"),
+            std::string::npos)
+      << log;
+  const auto accurate = nlohmann::json::parse(Slurp(dir / "accurate" / "summary.json"));
+  EXPECT_EQ(accurate["solver"]["dt_s"], 0.001);
+  EXPECT_EQ(accurate["solver"]["tolerance_m_s"], 1e-7);
+  EXPECT_EQ(accurate["solver"]["preset_overrode"][0], "dt_s = 0.002 -> 0.001");
   EXPECT_EQ(RunCommand(std::string(TALUS_BINARY) + " simulate " + (dir / "scene.toml").string() +
                            " --out " + (dir / "bad").string() + " --preset quick",
                        &log),
             2)
       << log;
   EXPECT_NE(log.find("--preset: unknown preset 'quick'"), std::string::npos) << log;
+}
+
+// --self-check N: the subsample's statistics at dt and dt/2 with their verdict, printed and in
+// summary.json; refused for a part and for more rocks than the run has.
+TEST(SimulateCommand, SelfCheckIsPrintedAndWrittenToTheSummary) {
+  const fs::path dir = FreshDir("self_check");
+  std::ofstream(dir / "scene.toml") << kScene;
+  std::string log;
+  ASSERT_EQ(RunCommand(std::string(TALUS_BINARY) + " simulate " + (dir / "scene.toml").string() +
+                           " --out " + (dir / "out").string() + " --rocks 2 --self-check 4",
+                       &log),
+            0)
+      << log;
+  EXPECT_NE(log.find("Self-check: "), std::string::npos) << log;
+  const auto summary = nlohmann::json::parse(Slurp(dir / "out" / "summary.json"));
+  const auto& check = summary["self_check"];
+  EXPECT_EQ(check["rocks"], 4);
+  EXPECT_EQ(check["refined_dt_s"], 0.001);
+  EXPECT_EQ(check["statistics"][0]["name"], "run-out median");
+  EXPECT_TRUE(check["verdict"].is_string());
+  EXPECT_EQ(RunCommand(std::string(TALUS_BINARY) + " simulate " + (dir / "scene.toml").string() +
+                           " --out " + (dir / "part").string() + " --self-check 4 --rock-range 0:2",
+                       &log),
+            2)
+      << log;
+  EXPECT_NE(log.find("--self-check: not with --rock-range"), std::string::npos) << log;
+  EXPECT_EQ(RunCommand(std::string(TALUS_BINARY) + " simulate " + (dir / "scene.toml").string() +
+                           " --out " + (dir / "many").string() + " --rocks 1 --self-check 9",
+                       &log),
+            2)
+      << log;
+  EXPECT_NE(log.find("--self-check 9: the run has"), std::string::npos) << log;
 }
 
 // --rocks is checked like the scene's rocks: 2 releases x 2^63 - 1 rocks used to overflow to a
@@ -351,6 +402,46 @@ TEST(SimulateCommand, ARunRemovesOutputsOfAnEarlierRunThatItDoesNotWrite) {
   EXPECT_TRUE(fs::exists(dir / "out" / "notes.txt"));
 }
 
+// --out holding the user's own files named like talus outputs (report.html, which a scene with
+// report = false does not write; partial.json, which a whole run does not) and like a temporary
+// file of a dead process: all stay. Only what the earlier run's manifest lists is removed.
+TEST(SimulateCommand, AUsersFilesNamedLikeOutputsStay) {
+  const fs::path dir = FreshDir("users_files");
+  std::ofstream(dir / "lean.toml") << LeanScene() + "report = false\n";
+  const fs::path out = dir / "out";
+  fs::create_directories(out);
+  const std::string dead = std::to_string(DeadPid());
+  const std::vector<std::string> users_files = {"report.html", "partial.json", ".notes.tmp-" + dead,
+                                                "notes.txt"};
+  for (const std::string& name : users_files) std::ofstream(out / name) << "the user's own file";
+  std::string log;
+  ASSERT_EQ(RunCommand(Talus("simulate " + (dir / "lean.toml").string() + " --out " + out.string()),
+                       &log),
+            0)
+      << log;
+  EXPECT_EQ(log.find("Removed"), std::string::npos) << log;
+  for (const std::string& name : users_files)
+    EXPECT_EQ(Slurp(out / name), "the user's own file") << name;
+  EXPECT_EQ(Slurp(out / ".talus-outputs"), "rocks.csv\nsummary.json\n");
+  // The next run with a report removes nothing of the user's either; a third without one removes
+  // the report the second wrote (its manifest lists it), not the user's partial.json.
+  std::ofstream(dir / "report.toml") << LeanScene();
+  ASSERT_EQ(
+      RunCommand(Talus("simulate " + (dir / "report.toml").string() + " --out " + out.string()),
+                 &log),
+      0)
+      << log;
+  EXPECT_NE(Slurp(out / "report.html"), "the user's own file");
+  ASSERT_EQ(RunCommand(Talus("simulate " + (dir / "lean.toml").string() + " --out " + out.string()),
+                       &log),
+            0)
+      << log;
+  EXPECT_NE(log.find("Removed 1 outputs of an earlier run"), std::string::npos) << log;
+  EXPECT_FALSE(fs::exists(out / "report.html"));
+  EXPECT_EQ(Slurp(out / "partial.json"), "the user's own file");
+  EXPECT_EQ(Slurp(out / (".notes.tmp-" + dead)), "the user's own file");
+}
+
 // SIGINT or SIGTERM in the middle of a run: the workers stop, the temporary files go, the exit
 // code is 128 + the signal, and an earlier run's outputs in the directory are untouched.
 void InterruptARun(int signal, const std::string& name) {
@@ -365,15 +456,15 @@ void InterruptARun(int signal, const std::string& name) {
       0)
       << log;
   const auto earlier = Snapshot(out);
-  ASSERT_EQ(earlier.size(), 17u);
+  ASSERT_EQ(earlier.size(), 18u);  // with the list of outputs, .talus-outputs
 
   const pid_t pid = StartTalus(
       {"simulate", (dir / "slow.toml").string(), "--out", out.string(), "--threads", "2"},
       dir / "log.txt");
   ASSERT_GT(pid, 0);
   // Interrupt once the run is writing its temporary files (about a second into it).
-  const fs::path staging = out / (".talus-run.tmp-" + std::to_string(pid));
-  const fs::path trajectories = staging / (".trajectories.h5.tmp-" + std::to_string(pid));
+  const fs::path staging = out / (".talus-run.talus-tmp-" + std::to_string(pid));
+  const fs::path trajectories = staging / (".trajectories.h5.talus-tmp-" + std::to_string(pid));
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
   while (!fs::exists(trajectories) && std::chrono::steady_clock::now() < deadline)
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
@@ -431,8 +522,8 @@ TEST(SimulateCommand, AFullDiskIsOneErrorAndLeavesTheEarlierRunAsItWas) {
       {"simulate", (dir / "scene.toml").string(), "--out", out.string(), "--rocks", "500"},
       dir / "log.txt");
   ASSERT_GT(pid, 0);
-  const fs::path trajectories = out / (".talus-run.tmp-" + std::to_string(pid)) /
-                                (".trajectories.h5.tmp-" + std::to_string(pid));
+  const fs::path trajectories = out / (".talus-run.talus-tmp-" + std::to_string(pid)) /
+                                (".trajectories.h5.talus-tmp-" + std::to_string(pid));
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
   while (!fs::exists(trajectories) && std::chrono::steady_clock::now() < deadline)
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
@@ -461,22 +552,41 @@ TEST(SimulateCommand, AFullDiskIsOneErrorAndLeavesTheEarlierRunAsItWas) {
   EXPECT_TRUE(Snapshot(out) == earlier) << "the earlier run's outputs changed";
 }
 
+// A file-size limit (`ulimit -f` sets the soft and the hard one) hit while trajectories.h5 is
+// written: one error and exit 1, no output and no temporary file. The process crashed in HDF5's
+// exit handler (SIGSEGV, exit 139) after the error; talus merge did the same.
+TEST(SimulateCommand, AHardFileSizeLimitIsOneErrorNotACrash) {
+  const fs::path dir = FreshDir("hard_file_size_limit");
+  std::ofstream(dir / "scene.toml") << kScene;
+  const fs::path out = dir / "out";
+  std::string log;
+  EXPECT_EQ(RunCommand("ulimit -f 40; exec " + Talus("simulate " + (dir / "scene.toml").string() +
+                                                     " --rocks 40 --out " + out.string()),
+                       &log),
+            1)
+      << log;
+  EXPECT_NE(log.find("trajectories.h5: File too large (no output written)"), std::string::npos)
+      << log;
+  EXPECT_TRUE(!fs::exists(out) || fs::is_empty(out)) << log;
+}
+
 TEST(SimulateCommand, RemovesTheTemporariesOfDeadRunsOnly) {
   const fs::path dir = FreshDir("stale_temporaries");
   std::ofstream(dir / "lean.toml") << LeanScene();
   const fs::path out = dir / "out";
   const std::string dead = std::to_string(DeadPid()), alive = std::to_string(::getpid());
-  fs::create_directories(out / (".talus-run.tmp-" + dead));
-  std::ofstream(out / (".talus-run.tmp-" + dead) / (".trajectories.h5.tmp-" + dead)) << "x";
-  std::ofstream(out / (".rocks.csv.tmp-" + dead)) << "x";
-  std::ofstream(out / (".rocks.csv.tmp-" + alive)) << "x";
+  fs::create_directories(out / (".talus-run.talus-tmp-" + dead));
+  std::ofstream(out / (".talus-run.talus-tmp-" + dead) / (".trajectories.h5.talus-tmp-" + dead))
+      << "x";
+  std::ofstream(out / (".rocks.csv.talus-tmp-" + dead)) << "x";
+  std::ofstream(out / (".rocks.csv.talus-tmp-" + alive)) << "x";
   std::string log;
   ASSERT_EQ(RunCommand(Talus("simulate " + (dir / "lean.toml").string() + " --out " + out.string()),
                        &log),
             0)
       << log;
   EXPECT_NE(log.find("Removed 2 temporary files of interrupted runs"), std::string::npos) << log;
-  EXPECT_EQ(Temporaries(out), std::vector<std::string>{".rocks.csv.tmp-" + alive});
+  EXPECT_EQ(Temporaries(out), std::vector<std::string>{".rocks.csv.talus-tmp-" + alive});
 }
 
 // More threads than a few per core only cost memory (10 000 threads took 854 MB on a toy scene).

@@ -3,8 +3,11 @@
 // with an error and no output, never a hang.
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -33,6 +36,9 @@ fs::path FreshDir(const std::string& name) {
   return talus::app::testing::FreshDir("talus_mpi_tests", name);
 }
 
+// Where ranks other than 0 stage, below $TMPDIR.
+std::string Ranks() { return "talus-ranks-" + std::to_string(::geteuid()); }
+
 // The real Tirol DEM crop with its CRS, 12 rocks with trajectories, every raster and two
 // evaluation lines.
 TEST(SimulateMpi, RanksTimesThreadsGiveTheOneProcessBytes) {
@@ -42,7 +48,7 @@ TEST(SimulateMpi, RanksTimesThreadsGiveTheOneProcessBytes) {
   ASSERT_EQ(RunCommand(Talus() + args + (dir / "single").string() + " --threads 1", &log), 0)
       << log;
   const auto single = OutputsWithoutTimings(dir / "single");
-  ASSERT_EQ(single.size(), 19u);
+  ASSERT_EQ(single.size(), 20u);  // with the list of outputs, .talus-outputs
   ASSERT_GT(single.at("evaluation_lines.csv").size(), 200u);  // rocks crossed
   for (const auto& [ranks, threads] : {std::pair{2, 1}, std::pair{2, 2}, std::pair{3, 1}}) {
     const std::string name = "mpi-" + std::to_string(ranks) + "x" + std::to_string(threads);
@@ -112,10 +118,32 @@ TEST(SimulateMpi, ALostRankEndsTheRunWithoutOutputs) {
   EXPECT_NE(code, 0) << log;
   EXPECT_NE(code, -1) << log;  // ended by itself, not by the test's time limit
   EXPECT_TRUE(fs::is_empty(out)) << log;
-  ASSERT_FALSE(fs::is_empty(tmp / "talus-ranks"));  // the killed rank's staging directory
+  ASSERT_FALSE(fs::is_empty(tmp / Ranks()));  // the killed rank's staging directory
   ASSERT_EQ(RunCommand(env + MpiRun("-n 2 " + Talus()) + run + " --rocks 2", &log), 0) << log;
-  EXPECT_TRUE(fs::is_empty(tmp / "talus-ranks")) << log;
+  EXPECT_TRUE(fs::is_empty(tmp / Ranks())) << log;
   EXPECT_TRUE(fs::exists(out / "summary.json"));
+}
+
+// $TMPDIR/talus-ranks-<uid> a symbolic link someone planted: ranks other than 0 refuse to stage
+// there (they followed it, and removed a directory outside --out through it); the run fails with
+// the reason and the link's target is untouched.
+TEST(SimulateMpi, AStagingDirectoryThatIsALinkIsRefused) {
+  const fs::path dir = FreshDir("ranks_link");
+  const fs::path out = dir / "out", tmp = dir / "tmp", victim = dir / "victim";
+  fs::create_directories(tmp);
+  fs::create_directories(victim / ".precious.talus-tmp-999999");
+  std::ofstream(victim / ".precious.talus-tmp-999999" / "file") << "data";
+  fs::create_directory_symlink(victim, tmp / Ranks());
+  std::string log;
+  const int code =
+      RunCommand("TMPDIR=" + tmp.string() + " " + MpiRun("-n 2 " + Talus()) + " simulate " +
+                     kScene + " --threads 1 --rocks 2 --out " + out.string(),
+                 &log);
+  EXPECT_NE(code, 0) << log;
+  EXPECT_NE(log.find(Ranks() + ": is a symbolic link"), std::string::npos) << log;
+  EXPECT_TRUE(fs::exists(victim / ".precious.talus-tmp-999999" / "file"));
+  EXPECT_EQ(std::distance(fs::directory_iterator(victim), fs::directory_iterator()), 1);
+  EXPECT_FALSE(fs::exists(out / "summary.json"));
 }
 
 }  // namespace

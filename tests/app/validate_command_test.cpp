@@ -98,6 +98,22 @@ TEST(ValidateCommand, WritesScoresThatDoNotDependOnTheThreadCount) {
   EXPECT_NE(output.find("runout (m)"), std::string::npos) << output;
 }
 
+// A file-size limit (`ulimit -f`, soft and hard) hit while writing the outputs: one error and
+// exit 1 with no output and no temporary file left, as for a full disk. SIGXFSZ killed validate
+// (exit 153), leaving its staging directory.
+TEST(ValidateCommand, AFileSizeLimitIsOneErrorAndLeavesNothing) {
+  const fs::path dir = MakeEvent("file_size_limit");
+  const fs::path out = dir / "out";
+  std::string output;
+  EXPECT_EQ(RunCommand("ulimit -f 4; exec " + std::string(TALUS_BINARY) + " validate " +
+                           (dir / "event.toml").string() + " --out " + out.string(),
+                       &output),
+            1)
+      << output;
+  EXPECT_NE(output.find("talus validate: cannot write"), std::string::npos) << output;
+  EXPECT_TRUE(!fs::exists(out) || fs::is_empty(out)) << output;
+}
+
 TEST(ValidateCommand, BadEventsFailBeforeAnyRockNamingFileLineAndKey) {
   std::string output;
   const fs::path dir = MakeEvent("validate_bad",

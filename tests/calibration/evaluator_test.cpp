@@ -94,6 +94,22 @@ TEST(Evaluator, ACheckpointOfAnotherCalibrationIsRefused) {
   EXPECT_EQ(summary.evaluations(), 1);
 }
 
+// A replayed evaluation whose u has another number of coordinates (a damaged checkpoint) is the
+// same refusal, not a comparison of vectors of different sizes (which crashed).
+TEST(Evaluator, ACheckpointEvaluationOfAnotherDimensionIsRefused) {
+  for (const Eigen::VectorXd& u :
+       {Eigen::VectorXd(), Eigen::VectorXd(Eigen::VectorXd::Constant(3, 0.5))}) {
+    OptimizerOptions options;
+    Evaluation recorded = Recorded(0.5, 3.0);
+    recorded.u = u;
+    options.replay = {recorded};
+    OptimizerSummary summary;
+    Evaluator evaluate(MuMinObjective(), options, summary);
+    EXPECT_THROW(evaluate(U(0.5)), std::runtime_error) << u.size();
+    EXPECT_EQ(summary.evaluations(), 0);
+  }
+}
+
 TEST(Evaluator, StopsAtTheEvaluationBudgetButStillAnswersKnownPoints) {
   OptimizerOptions options;
   options.max_evaluations = 2;

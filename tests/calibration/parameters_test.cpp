@@ -95,6 +95,30 @@ TEST(ParameterSet, BadSpecsAreClearErrors) {
             "only with model = \"lu2019\")");
 }
 
+// A tie named as another free parameter outside the tie would label one parameter's values with
+// the other's name: tie = "medium.mu_max" on mu_min and "medium.mu_min" on mu_max swapped the
+// labels of every report. Refused; a tie that names a parameter inside it, or a plain name, is not.
+TEST(ParameterSet, ATieNamedAsAnotherFreeParameterIsRefused) {
+  EXPECT_EQ(ErrorOf({Spec("medium", GroundField::kMuMin, 0.1, 1, "medium.mu_max"),
+                     Spec("medium", GroundField::kMuMax, 0.1, 2, "medium.mu_min")}),
+            "medium.mu_min: tie 'medium.mu_max' is the name of the free parameter medium.mu_max, "
+            "which is not in the tie (its tie is 'medium.mu_min'): name the tie otherwise (e.g. "
+            "'mu_min'), or give medium.mu_max the same tie");
+  EXPECT_EQ(ErrorOf({Spec("medium", GroundField::kMuMax, 0.5, 3, "hard.mu_max"),
+                     Spec("hard", GroundField::kMuMax, 0.5, 3)}),
+            "medium.mu_max: tie 'hard.mu_max' is the name of the free parameter hard.mu_max, which "
+            "is not in the tie: name the tie otherwise (e.g. 'mu_max'), or give hard.mu_max the "
+            "same tie");
+  // Accepted: the named parameter is in the tie; the tie is the parameter's own name.
+  const ParameterSet joined({Spec("medium", GroundField::kMuMax, 0.5, 3, "hard.mu_max"),
+                             Spec("hard", GroundField::kMuMax, 0.5, 3, "hard.mu_max")},
+                            GroundTable::BuiltIn());
+  EXPECT_EQ(joined.size(), 1);
+  EXPECT_EQ(ErrorOf({Spec("medium", GroundField::kMuMin, 0.1, 1, "medium.mu_min"),
+                     Spec("medium", GroundField::kMuMax, 0.1, 2)}),
+            "");
+}
+
 // The calibrated fields are kGroundFields' rows in the enum's order, with their units and
 // default transforms: one list of names for the scene, the calibration file and the outputs.
 TEST(GroundField, IsTheGroundFieldTablesCalibratedRows) {

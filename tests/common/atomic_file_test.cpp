@@ -1,6 +1,7 @@
 #include "common/atomic_file.hpp"
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -9,6 +10,7 @@
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
+
 #include "tests/test_tmp.hpp"
 
 namespace talus {
@@ -120,26 +122,76 @@ TEST(StagingDirectory, TargetUntouchedUntilCommit) {
   EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator()), 3);
 }
 
+// Only talus's own temporary names (".<name>.talus-tmp-<pid>"): a user's ".notes.tmp-<pid>"
+// of a dead pid stays.
 TEST(RemoveStaleTemporaries, RemovesThoseOfDeadProcessesOnly) {
   const auto dir = FreshDir("stale");
   const std::string dead = std::to_string(DeadPid());
   const std::string alive = std::to_string(::getpid());
-  std::ofstream(dir / (".rocks.csv.tmp-" + dead)) << "x";
-  fs::create_directories(dir / (".talus-run.tmp-" + dead));
-  std::ofstream(dir / (".talus-run.tmp-" + dead) / "rocks.csv") << "x";
-  std::ofstream(dir / (".rocks.csv.tmp-" + alive)) << "x";
-  std::ofstream(dir / (".rocks.csv.tmp-1")) << "x";   // init, always alive
-  std::ofstream(dir / ("notes.tmp-" + dead)) << "x";  // not a temporary name
-  std::ofstream(dir / (".notes.tmp-" + dead + "x")) << "x";
+  std::ofstream(dir / (".rocks.csv.talus-tmp-" + dead)) << "x";
+  fs::create_directories(dir / (".talus-run.talus-tmp-" + dead));
+  std::ofstream(dir / (".talus-run.talus-tmp-" + dead) / "rocks.csv") << "x";
+  std::ofstream(dir / (".rocks.csv.talus-tmp-" + alive)) << "x";
+  std::ofstream(dir / (".rocks.csv.talus-tmp-1")) << "x";   // init, always alive
+  std::ofstream(dir / ("notes.talus-tmp-" + dead)) << "x";  // not a temporary name
+  std::ofstream(dir / (".notes.talus-tmp-" + dead + "x")) << "x";
+  std::ofstream(dir / (".notes.tmp-" + dead)) << "x";  // the user's
+  fs::create_directories(dir / (".precious.tmp-" + dead));
   std::ofstream(dir / "rocks.csv") << "x";
   const std::vector<std::string> removed = RemoveStaleTemporaries(dir.string());
   EXPECT_EQ(removed.size(), 2u);
-  EXPECT_FALSE(fs::exists(dir / (".rocks.csv.tmp-" + dead)));
-  EXPECT_FALSE(fs::exists(dir / (".talus-run.tmp-" + dead)));
+  EXPECT_FALSE(fs::exists(dir / (".rocks.csv.talus-tmp-" + dead)));
+  EXPECT_FALSE(fs::exists(dir / (".talus-run.talus-tmp-" + dead)));
   for (const std::string& kept :
-       {".rocks.csv.tmp-" + alive, std::string(".rocks.csv.tmp-1"), "notes.tmp-" + dead,
-        ".notes.tmp-" + dead + "x", std::string("rocks.csv")})
+       {".rocks.csv.talus-tmp-" + alive, std::string(".rocks.csv.talus-tmp-1"),
+        "notes.talus-tmp-" + dead, ".notes.talus-tmp-" + dead + "x", ".notes.tmp-" + dead,
+        ".precious.tmp-" + dead, std::string("rocks.csv")})
     EXPECT_TRUE(fs::exists(dir / kept)) << kept;
+}
+
+// The staging directory of MPI ranks in a shared $TMPDIR: created 0700; an existing one of this
+// user's is tightened to 0700; a symbolic link (anyone can plant one in /tmp) is refused without
+// touching its target, and so is a file.
+TEST(MakePrivateDirectory, CreatesOrAcceptsOnlyAnOwnDirectoryThatIsNoLink) {
+  const auto dir = FreshDir("private");
+  const auto mode = [](const fs::path& p) {
+    struct stat st {};
+    ::lstat(p.c_str(), &st);
+    return st.st_mode & 07777;
+  };
+  MakePrivateDirectory((dir / "new").string());
+  EXPECT_TRUE(fs::is_directory(dir / "new"));
+  EXPECT_EQ(mode(dir / "new"), 0700u);
+  fs::create_directory(dir / "loose");
+  fs::permissions(dir / "loose", fs::perms(0755));
+  MakePrivateDirectory((dir / "loose").string());
+  EXPECT_EQ(mode(dir / "loose"), 0700u);
+  fs::create_directories(dir / "victim" / ".precious.tmp-999999");
+  fs::permissions(dir / "victim", fs::perms(0755));
+  fs::create_directory_symlink(dir / "victim", dir / "link");
+  try {
+    MakePrivateDirectory((dir / "link").string());
+    ADD_FAILURE() << "a symbolic link was accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("link: is a symbolic link"), std::string::npos)
+        << e.what();
+  }
+  EXPECT_EQ(mode(dir / "victim"), 0755u);
+  EXPECT_TRUE(fs::exists(dir / "victim" / ".precious.tmp-999999"));
+  std::ofstream(dir / "file") << "x";
+  EXPECT_THROW(MakePrivateDirectory((dir / "file").string()), std::runtime_error);
+  // Another user's directory (testable as root only: chown).
+  if (::geteuid() == 0) {
+    fs::create_directory(dir / "theirs", dir / "new");
+    ASSERT_EQ(::chown((dir / "theirs").c_str(), 65534, 65534), 0);
+    try {
+      MakePrivateDirectory((dir / "theirs").string());
+      ADD_FAILURE() << "another user's directory was accepted";
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find("belongs to another user"), std::string::npos)
+          << e.what();
+    }
+  }
 }
 
 }  // namespace

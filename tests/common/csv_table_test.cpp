@@ -1,9 +1,13 @@
 #include "common/csv_table.hpp"
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <filesystem>
 #include <fstream>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "common/error.hpp"
 #include "tests/test_tmp.hpp"
@@ -66,6 +70,56 @@ TEST(CsvTable, NonNegativeNumbersNameTheCellOfANegativeOne) {
     EXPECT_STREQ(e.what(), "t.csv:3: column 'a': -1 must be >= 0");
   }
   EXPECT_THROW(t.NonNegativeNumber(1, "b"), InputError);  // not a number
+}
+
+// The message of the InputError that reading `path` throws ("" when it reads).
+std::string RefusalOf(const std::string& path) {
+  try {
+    CsvTable::Read(path);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// A run table, [blocks] file or observation table naming /dev/zero was read until memory ran out:
+// devices, directories and pipes are refused at once (a pipe could not be read a second time for
+// the inputs' hash), also behind a symbolic link, naming the file.
+TEST(CsvTable, ANonRegularFileIsRefusedBeforeReading) {
+  namespace fs = std::filesystem;
+  const fs::path dir = talus::testing::TestTmpRoot() / "csv_devices";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string fifo = (dir / "runs.csv").string();
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  fs::create_symlink("/dev/zero", dir / "zero.csv");
+  const std::vector<std::pair<std::string, std::string>> refused = {
+      {"/dev/zero", "/dev/zero: not a regular file (a character device)"},
+      {"/dev/urandom", "/dev/urandom: not a regular file (a character device)"},
+      {(dir / "zero.csv").string(), "zero.csv: not a regular file (a character device)"},
+      {fifo, "runs.csv: not a regular file (a pipe)"},
+      {dir.string(), "csv_devices: not a regular file (a directory)"},
+      {(dir / "none.csv").string(), "none.csv: cannot open"}};
+  for (const auto& [path, says] : refused)
+    EXPECT_NE(RefusalOf(path).find(says), std::string::npos) << path << ": " << RefusalOf(path);
+}
+
+// Larger than the bound: refused from its size, before reading (a sparse file of that size); a line
+// longer than its bound (a binary file, zeros without a line break) names the line.
+TEST(CsvTable, AFileOrALineBeyondItsBoundIsRefused) {
+  namespace fs = std::filesystem;
+  const std::string big = WriteFile("big.csv", "a,b\n1,2\n");
+  fs::resize_file(big, kMaxCsvBytes + 1);
+  EXPECT_NE(RefusalOf(big).find("big.csv: " + std::to_string(kMaxCsvBytes + 1) +
+                                " bytes, more than a table may have (256 MiB)"),
+            std::string::npos)
+      << RefusalOf(big);
+  const std::string at_bound = WriteFile("long_ok.csv", "a\n" + std::string(kMaxCsvLineBytes, 'x'));
+  EXPECT_EQ(RefusalOf(at_bound), "");
+  const std::string zeros =
+      WriteFile("zeros.csv", "a,b\n1,2\n" + std::string(kMaxCsvLineBytes + 1, '\0') + "\n3,4\n");
+  EXPECT_NE(RefusalOf(zeros).find("zeros.csv:3: a line longer than 1 MiB"), std::string::npos)
+      << RefusalOf(zeros);
 }
 
 }  // namespace

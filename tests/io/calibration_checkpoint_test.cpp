@@ -6,6 +6,8 @@
 #include <bit>
 #include <cstdint>
 #include <limits>
+#include <map>
+#include <nlohmann/json.hpp>
 #include <string>
 
 #include "common/error.hpp"
@@ -138,6 +140,89 @@ TEST(CalibrationCheckpoint, AMissingTruncatedOrForeignFileIsAnInputErrorNamingIt
                                 "{\"path_hash\": 1, \"holdout\": [], \"folds\": 0, "
                                 "\"stages\": {}}"),
                 "not a calibration checkpoint");
+}
+
+// The checkpoint's JSON with one edit.
+template <class Edit>
+std::string Edited(nlohmann::json j, Edit edit) {
+  edit(j);
+  return j.dump();
+}
+
+// A value edited by hand (here the last evaluation's, lowered to a fake optimum) no longer matches
+// the checksum: the checkpoint is refused instead of replayed. So are other edits, and a
+// checkpoint without a checksum.
+TEST(CalibrationCheckpoint, AnEditedValueIsRefusedByTheChecksum) {
+  CalibrationCheckpoint c;
+  c.path_hash = "abc123";
+  c.stages["fit"] = {Sample(0), Sample(0.25)};
+  const nlohmann::json j = nlohmann::json::parse(CheckpointJson(c));
+  using J = nlohmann::json;
+  ExpectRefused(
+      WriteCheckpoint("edited", Edited(j, [](J& e) { e["stages"]["fit"][1]["value"] = 1e-3; })),
+      "does not match its checksum");
+  ExpectRefused(
+      WriteCheckpoint("edited_u", Edited(j, [](J& e) { e["stages"]["fit"][0]["u"] = J::array(); })),
+      "does not match its checksum");
+  ExpectRefused(WriteCheckpoint("edited_hash", Edited(j, [](J& e) { e["path_hash"] = "abc124"; })),
+                "does not match its checksum");
+  ExpectRefused(WriteCheckpoint("no_checksum", Edited(j, [](J& e) { e.erase("fnv1a64"); })),
+                "has no checksum");
+  // Unchanged, it reads.
+  EXPECT_NO_THROW(ReadCheckpoint(WriteCheckpoint("unchanged", j.dump())));
+}
+
+// Every evaluation must have the calibration's shape (Sample's: 2 coordinates, 2 kinds, 3
+// residuals) and finite numbers where an evaluation always has them; the message names the file,
+// the stage and the evaluation. ("u": [] crashed talus calibrate --resume.)
+TEST(CalibrationCheckpoint, EvaluationsOfAnotherShapeOrNotFiniteAreRefusedNamingTheEntry) {
+  const std::map<std::string, EvaluationShape> shapes = {{"fit", {2, 2, 3}}, {"fold1", {2, 1, 4}}};
+  const auto refused = [&](const CalibrationCheckpoint& c, const std::string& says) {
+    const std::string path = "dir/checkpoint.json";
+    try {
+      CheckEvaluations(c, path, shapes);
+      ADD_FAILURE() << "accepted, expected: " << says;
+    } catch (const InputError& e) {
+      const std::string what = e.what();
+      EXPECT_EQ(what.rfind(path + ": ", 0), 0u) << what;
+      EXPECT_NE(what.find(says), std::string::npos) << what;
+    }
+  };
+  const auto with = [](auto edit) {
+    CalibrationCheckpoint c;
+    c.stages["fit"] = {Sample(0), Sample(0.25)};
+    edit(c.stages["fit"][1]);
+    return c;
+  };
+  EXPECT_NO_THROW(CheckEvaluations(with([](Evaluation&) {}), "x", shapes));
+  refused(with([](Evaluation& e) { e.u.resize(0); }),
+          "stages.fit[1]: \"u\" has 0 entries, the calibration 2 parameters");
+  refused(with([](Evaluation& e) { e.u = Eigen::VectorXd::Constant(6, 0.5); }),
+          "stages.fit[1]: \"u\" has 6 entries");
+  refused(with([](Evaluation& e) { e.values.resize(1); }), "stages.fit[1]: \"values\" has 1");
+  refused(with([](Evaluation& e) { e.kind_scores.push_back(1); }), "\"kind_scores\" has 3");
+  refused(with([](Evaluation& e) { e.kind_scored.clear(); }), "\"kind_scored\" has 0");
+  refused(with([](Evaluation& e) { e.residuals.resize(2); }), "\"residuals\" has 2");
+  refused(with([](Evaluation& e) { e.u[0] = std::numeric_limits<double>::quiet_NaN(); }),
+          "stages.fit[1]: \"u\" holds a number that is not finite");
+  refused(with([](Evaluation& e) { e.value = std::numeric_limits<double>::infinity(); }),
+          "\"value\" is not a finite number");
+  refused(with([](Evaluation& e) { e.residuals[2] = std::numeric_limits<double>::quiet_NaN(); }),
+          "\"residuals\" holds a number that is not finite");
+  refused(with([](Evaluation& e) { e.failed_rocks = e.rocks + 1; }), "not counts of rocks");
+  // A stage's own shape; a stage the calibration does not have.
+  CalibrationCheckpoint fold;
+  fold.stages["fold1"] = {Sample(0)};
+  refused(fold, "stages.fold1[0]: \"kind_scores\" has 2 entries, the calibration 1");
+  CalibrationCheckpoint other;
+  other.stages["fold2"] = {};
+  refused(other, "stages.fold2: this calibration has no such optimisation");
+  // An infeasible evaluation's value may be NaN; a feasible one's not.
+  EXPECT_NO_THROW(CheckEvaluations(with([](Evaluation& e) {
+                                     e.feasible = false;
+                                     e.value = std::numeric_limits<double>::quiet_NaN();
+                                   }),
+                                   "x", shapes));
 }
 
 }  // namespace

@@ -175,6 +175,63 @@ TEST(LoadEvent, ZonesAreLinesOrPolygonsThatZoneObservationsName) {
              "zones.csv:2: column 'zone_id': unknown zone 'fence' (the event's zones: none)");
 }
 
+// talus validate scored, with no word, rest positions and a zone off the terrain (another CRS,
+// swapped coordinates: no rock can get there), every row of a table whose run_column it lacks as
+// an observation of the whole scene, and a run listed twice twice. Each is an error naming the
+// file and line or key; repeated observations of the whole scene (no run) are not.
+TEST(LoadEvent, ObservationsNoRockCanReachOrOfAMisnamedOrRepeatedRunAreErrors) {
+  const auto dir = MakeEvent("unreachable", 32632);
+  const auto write = [&](const std::string& observations, const std::string& zones = "") {
+    testing::WriteText(dir / "event.toml", "scene = \"scene.toml\"\n" + zones + observations);
+    return ErrorOf(dir / "event.toml");
+  };
+  const std::string obs = (dir / "obs.csv").string();
+  // (a) A rest position 5 km north of the DEM (x 680000 .. 680200, y 5240000 .. 5240200).
+  testing::WriteText(dir / "obs.csv",
+                     "trajectory_id,x_m,y_m\nA,680060,5240100\nB,680060,5245100\n");
+  EXPECT_HAS(write("[[observations]]\nkind = \"deposits\"\nfile = \"obs.csv\"\n"),
+             obs +
+                 ":3: the rest position (680060, 5245100) is outside the DEM or on nodata (the "
+                 "DEM covers x 680005 .. 680195, y 5240005 .. 5240195)");
+  // (b) A zone line, and a polygon, 4 km off.
+  testing::WriteText(dir / "zones.csv", "trajectory_id,zone_id,quantity,value\nA,fence,passed,0\n");
+  const std::string zone_obs = "[[observations]]\nkind = \"zones\"\nfile = \"zones.csv\"\n";
+  EXPECT_HAS(write(zone_obs,
+                   "[[zones]]\nid = \"fence\"\nline = [[684000, 5240000], [684000, "
+                   "5240200]]\n"),
+             "event.toml:4: zones[0].line: the zone 'fence' lies entirely outside the DEM");
+  EXPECT_HAS(write(zone_obs,
+                   "[[zones]]\nid = \"fence\"\npolygon = [[684000, 5240000], [684100, "
+                   "5240000], [684100, 5240100]]\n"),
+             "event.toml:4: zones[0].polygon: the zone 'fence' lies entirely outside the DEM");
+  EXPECT_EQ(write(zone_obs,
+                  "[[zones]]\nid = \"fence\"\npolygon = [[679000, 5239000], [681000, "
+                  "5239000], [681000, 5241000], [679000, 5241000]]\n"),
+            "");  // around the whole DEM
+  // (c) run_column naming a column the table lacks; without run_column the default's absence
+  // still means observations of the whole scene.
+  testing::WriteText(dir / "obs.csv", "trajectory_id,observed_runout_m\nA,50\nB,44\n");
+  EXPECT_HAS(write("[[observations]]\nkind = \"runout\"\nfile = \"obs.csv\"\nrun_column = "
+                   "\"run\"\n"),
+             "event.toml:5: observations[0].run_column: " + obs +
+                 " has no column 'run' (the header has: trajectory_id, observed_runout_m)");
+  testing::WriteText(dir / "scene_obs.csv", "observed_runout_m\n50\n50\n44\n");
+  EXPECT_EQ(write("[[observations]]\nkind = \"runout\"\nfile = \"scene_obs.csv\"\n"), "");
+  // (d) A run listed twice, in one table or in two.
+  testing::WriteText(dir / "obs.csv", "trajectory_id,observed_runout_m\nA,50\nB,44\nA,80\n");
+  EXPECT_HAS(write("[[observations]]\nkind = \"runout\"\nfile = \"obs.csv\"\n"),
+             obs + ":4: run 'A' has a second runout observation (the first: " + obs + ":2)");
+  testing::WriteText(dir / "obs.csv", "trajectory_id,observed_runout_m\nA,50\n");
+  testing::WriteText(dir / "more.csv", "trajectory_id,observed_runout_m\nA,50\n");
+  EXPECT_HAS(write("[[observations]]\nkind = \"runout\"\nfile = \"obs.csv\"\n"
+                   "[[observations]]\nkind = \"runout\"\nfile = \"more.csv\"\n"),
+             "more.csv:2: run 'A' has a second runout observation");
+  testing::WriteText(dir / "obs.csv",
+                     "trajectory_id,x_m,y_m\nA,680060,5240100\nA,680070,5240100\n");
+  EXPECT_HAS(write("[[observations]]\nkind = \"deposits\"\nfile = \"obs.csv\"\n"),
+             obs + ":3: run 'A' has a second rest position (the first: " + obs + ":2)");
+}
+
 TEST(ReferenceGround, Table1ValuesForBuiltInCategoriesOnly) {
   GroundTable table = GroundTable::BuiltIn();
   bool differs = true;

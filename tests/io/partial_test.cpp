@@ -4,8 +4,13 @@
 
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <iterator>
+#include <string>
+#include <vector>
 
 #include "common/error.hpp"
+#include "io/rocks_csv.hpp"
 #include "tests/test_tmp.hpp"
 
 namespace talus::io {
@@ -84,6 +89,103 @@ TEST(ReadPartialInfo, ADirectoryWithoutPartialJsonIsNotAPart) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("partial.json"), std::string::npos) << e.what();
   }
+}
+
+// A part of rocks [first, end) of a 10-rock ensemble in `name`: rocks.csv with a row per rock
+// (only the rock column filled), a partial.bin of made-up bytes and partial.json; `edit` changes
+// the files before partial.json is written (so its checksums are those of the edited files).
+std::string MakePart(const std::string& name, long first, long end,
+                     const std::function<void(const std::filesystem::path&)>& edit = {}) {
+  const auto dir = talus::testing::TestTmpRoot() / "talus_partial_test_files" / name;
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  {
+    std::ofstream csv(dir / "rocks.csv");
+    csv << RocksCsvWriter::Header() << "\n";
+    for (long rock = first; rock < end; ++rock) csv << rock << std::string(22, ',') << "\n";
+    std::ofstream(dir / "partial.bin", std::ios::binary) << std::string("state \x01\x02\x03", 9);
+  }
+  if (edit) edit(dir);
+  SceneFile scene;
+  scene.path = "scene.toml";
+  scene.release.releases.resize(1);
+  scene.release.rocks_per_release = 10;
+  ensemble::EnsembleReport report;
+  report.rocks = end - first;
+  std::ofstream(dir / "partial.json")
+      << PartialJson(scene, "1.0", first, end, report,
+                     {(dir / "rocks.csv").string(), (dir / "partial.bin").string()});
+  return dir.string();
+}
+
+// The message of CheckPartFiles on the part in `dir` ("" when it passes).
+std::string FilesMessage(const std::string& dir) {
+  try {
+    CheckPartFiles(ReadPartialInfo(dir));
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+void FlipBit(const std::filesystem::path& path, std::size_t byte) {
+  std::string bytes;
+  {
+    std::ifstream in(path, std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  bytes.at(byte) = static_cast<char>(bytes[byte] ^ 1);
+  std::ofstream(path, std::ios::binary) << bytes;
+}
+
+// talus merge took parts with duplicated or missing rows and damaged partial.bin files without an
+// error: every file of a part is checked against the size and checksum in its partial.json.
+TEST(CheckPartFiles, AFileChangedSinceThePartRanIsRefused) {
+  const std::string a = MakePart("a", 0, 5), b = MakePart("b", 5, 10);
+  EXPECT_EQ(FilesMessage(a), "");
+  EXPECT_EQ(FilesMessage(b), "");
+  // Every single-bit flip of partial.bin.
+  const auto bin = std::filesystem::path(b) / "partial.bin";
+  for (std::size_t byte = 0; byte < 9; ++byte) {
+    FlipBit(bin, byte);
+    EXPECT_NE(FilesMessage(b).find("partial.bin: 9 bytes with checksum"), std::string::npos)
+        << byte << ": " << FilesMessage(b);
+    FlipBit(bin, byte);
+  }
+  EXPECT_EQ(FilesMessage(b), "");
+  // Another part's rocks.csv; a row deleted; a file gone.
+  std::filesystem::copy_file(std::filesystem::path(a) / "rocks.csv",
+                             std::filesystem::path(b) / "rocks.csv",
+                             std::filesystem::copy_options::overwrite_existing);
+  EXPECT_NE(FilesMessage(b).find("rocks.csv: "), std::string::npos) << FilesMessage(b);
+  EXPECT_NE(FilesMessage(b).find("changed or damaged since the part was run"), std::string::npos);
+  std::filesystem::remove(std::filesystem::path(b) / "partial.bin");
+  EXPECT_NE(FilesMessage(b).find("partial.bin: missing (partial.json lists it)"), std::string::npos)
+      << FilesMessage(b);
+}
+
+// Rows must be the part's rocks, each once and in order, even where the checksums agree (a
+// partial.json written for the wrong files).
+TEST(CheckPartFiles, RowsOutsideThePartsRangeAreRefusedNamingTheLine) {
+  const auto rewrite = [](long first, long end, long skip) {
+    return [=](const std::filesystem::path& dir) {
+      std::ofstream csv(dir / "rocks.csv");
+      csv << RocksCsvWriter::Header() << "\n";
+      for (long rock = first; rock < end; ++rock)
+        if (rock != skip) csv << rock << std::string(22, ',') << "\n";
+    };
+  };
+  EXPECT_NE(FilesMessage(MakePart("dup", 5, 10, rewrite(0, 5, -1)))
+                .find("rocks.csv:2: rock 0 where rock 5 was due (the part holds rocks 5:10)"),
+            std::string::npos)
+      << FilesMessage(MakePart("dup", 5, 10, rewrite(0, 5, -1)));
+  EXPECT_NE(FilesMessage(MakePart("gap", 5, 10, rewrite(5, 10, 7)))
+                .find("rocks.csv:4: rock 8 where rock 7 was due"),
+            std::string::npos);
+  EXPECT_NE(FilesMessage(MakePart("short", 5, 10, rewrite(5, 9, -1)))
+                .find("rocks.csv: no row of rock 9 or later (the part holds rocks 5:10)"),
+            std::string::npos)
+      << FilesMessage(MakePart("short", 5, 10, rewrite(5, 9, -1)));
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 #include <fstream>
 #include <iterator>
@@ -91,6 +92,50 @@ TEST(ReadRaster, HugeRasterIsAnInputError) {
         << e.what();
     EXPECT_NE(std::string(e.what()).find("200000 x 200000 cells"), std::string::npos) << e.what();
   }
+}
+
+// A raster in another CRS than the target's was reprojected in memory before its size was checked:
+// a 500-byte VRT of 21000 x 21000 cells in WGS 84 over a Swiss LV95 DEM took 30 s and 3.4 GB to be
+// refused. The size of the reprojected raster is now known without reading a pixel, and the file
+// refused at once, naming it and the two CRSs.
+TEST(ReadRasterIn, AReprojectionTooLargeIsRefusedBeforeTheWarp) {
+  const auto dir = testing::FreshDir("warp_huge");
+  testing::WriteText(dir / "ground.vrt",
+                     R"(<VRTDataset rasterXSize="21000" rasterYSize="21000">
+  <SRS>EPSG:4326</SRS>
+  <GeoTransform>7.43, 1e-06, 0, 46.961, 0, -1e-06</GeoTransform>
+  <VRTRasterBand dataType="Byte" band="1"><NoDataValue>255</NoDataValue></VRTRasterBand>
+</VRTDataset>)");
+  const auto t0 = std::chrono::steady_clock::now();
+  try {
+    ReadRasterIn((dir / "ground.vrt").string(), testing::Wkt(2056), "scene.toml:3: terrain.ground",
+                 nullptr);
+    FAIL() << "read";
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(
+        what.rfind(
+            "scene.toml:3: terrain.ground: " + (dir / "ground.vrt").string() + " would have ", 0),
+        0u)
+        << what;
+    EXPECT_NE(what.find("cells once reprojected from EPSG:4326"), std::string::npos) << what;
+    EXPECT_NE(what.find("to EPSG:2056"), std::string::npos) << what;
+  }
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  EXPECT_LT(seconds, 10.0);  // the outline only; the warp took 30 s
+  // A small raster in another CRS is still reprojected and read.
+  testing::WriteText(dir / "small.vrt",
+                     R"(<VRTDataset rasterXSize="20" rasterYSize="20">
+  <SRS>EPSG:4326</SRS>
+  <GeoTransform>7.43, 1e-04, 0, 46.961, 0, -1e-04</GeoTransform>
+  <VRTRasterBand dataType="Byte" band="1"><NoDataValue>255</NoDataValue></VRTRasterBand>
+</VRTDataset>)");
+  std::string from;
+  const Raster small =
+      ReadRasterIn((dir / "small.vrt").string(), testing::Wkt(2056), "terrain.ground", &from);
+  EXPECT_GT(small.grid.nx, 10);
+  EXPECT_FALSE(from.empty());
 }
 
 TEST(WriteGeoTiff, RoundTripsGridCrsAndValues) {

@@ -1,12 +1,17 @@
-#include "ensemble/cell_summary.hpp"
 #include "io/resources.hpp"
 
 #include <gtest/gtest.h>
+#include <sys/resource.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
 #include <limits>
+#include <string>
 
+#include "ensemble/cell_summary.hpp"
 #include "test_files.hpp"
 
 namespace talus::io {
@@ -155,6 +160,78 @@ TEST(MeasureCapacity, ReadsMemAvailableAndTheFreeSpaceOfTheDirectory) {
   EXPECT_GT(c.disk_bytes, 0);
   EXPECT_TRUE(std::isfinite(c.disk_bytes));
   EXPECT_TRUE(std::isinf(MeasureCapacity("/no/such/directory").disk_bytes));
+}
+
+// The memory of a batch job or container: the limits of the process's own cgroup and of its
+// ancestors, cgroup v2 and v1, whichever leaves least (files of the test's own, laid out as
+// /proc and /sys/fs/cgroup are). Only MemAvailable and a v2 memory.max at the root were read: under
+// an 8 GB job limit a run "fitting" 20 GB failed after 56 s with std::bad_alloc.
+TEST(MeasureCapacity, TakesTheSmallestLimitOfTheProcessesCgroupsAndTheirAncestors) {
+  const auto dir = testing::FreshDir("cgroups");
+  const std::string proc = (dir / "proc").string(), cgroup = (dir / "cgroup").string();
+  std::filesystem::create_directories(dir / "proc" / "self");
+  testing::WriteText(dir / "proc" / "meminfo",
+                     "MemTotal: 64000000 kB\nMemAvailable: 20000000 kB\n");
+  const auto write = [&](const std::string& file, const std::string& text) {
+    std::filesystem::create_directories((dir / "cgroup" / file).parent_path());
+    testing::WriteText(dir / "cgroup" / file, text + "\n");
+  };
+  const CapacitySources sources{proc, cgroup};
+  // cgroup v2: the job's cgroup has no limit, its parent 8 GB with 1 GB in use; the root none.
+  testing::WriteText(dir / "proc" / "self" / "cgroup", "0::/jobs/job42\n");
+  write("jobs/job42/memory.max", "max");
+  write("jobs/job42/memory.current", "300000000");
+  write("jobs/memory.max", "8000000000");
+  write("jobs/memory.current", "1000000000");
+  write("memory.max", "max");
+  write("memory.current", "40000000000");
+  MachineCapacity c = MeasureCapacity(dir.string(), sources);
+  EXPECT_EQ(c.memory_bytes, 7e9);
+  EXPECT_EQ(c.memory_source, "the memory.max of cgroup /jobs less its memory.current");
+  // The job's own limit, when lower.
+  write("jobs/job42/memory.max", "2000000000");
+  c = MeasureCapacity(dir.string(), sources);
+  EXPECT_EQ(c.memory_bytes, 1.7e9);
+  EXPECT_EQ(c.memory_source, "the memory.max of cgroup /jobs/job42 less its memory.current");
+  // cgroup v1 (memory among other controllers); its "no limit" is about 2^63.
+  testing::WriteText(dir / "proc" / "self" / "cgroup",
+                     "4:cpu,memory:/slurm/uid_0/job_7\n1:cpuset:/\n0::/\n");
+  write("memory/slurm/uid_0/job_7/memory.limit_in_bytes", "9223372036854771712");
+  write("memory/slurm/uid_0/job_7/memory.usage_in_bytes", "100");
+  write("memory/slurm/uid_0/memory.limit_in_bytes", "4000000000");
+  write("memory/slurm/uid_0/memory.usage_in_bytes", "500000000");
+  c = MeasureCapacity(dir.string(), sources);
+  EXPECT_EQ(c.memory_bytes, 3.5e9);
+  EXPECT_EQ(c.memory_source,
+            "the memory.limit_in_bytes of cgroup /slurm/uid_0 less its memory.usage_in_bytes");
+  // No limit anywhere: MemAvailable.
+  write("memory/slurm/uid_0/memory.limit_in_bytes", "9223372036854771712");
+  c = MeasureCapacity(dir.string(), sources);
+  EXPECT_EQ(c.memory_bytes, 20000000.0 * 1024);
+  EXPECT_EQ(c.memory_source, "MemAvailable");
+}
+
+// ulimit -v (RLIMIT_AS): what is left of it beside the address space the process uses already.
+// A run of the D9 scene under an 8 GB cap was said to fit in 20.7 GB and died of std::bad_alloc.
+TEST(MeasureCapacity, TakesTheAddressSpaceLimitLessWhatIsInUse) {
+  rlimit old{};
+  ASSERT_EQ(::getrlimit(RLIMIT_AS, &old), 0);
+  std::ifstream status("/proc/self/status");
+  double vm_kb = 0;
+  for (std::string line; std::getline(status, line);)
+    if (line.rfind("VmSize:", 0) == 0) vm_kb = std::strtod(line.c_str() + 7, nullptr);
+  ASSERT_GT(vm_kb, 0);
+  const double cap = vm_kb * 1024 + 3e9;  // 3 GB beyond what is mapped now
+  if (old.rlim_max != RLIM_INFINITY && double(old.rlim_max) < cap)
+    GTEST_SKIP() << "the hard address-space limit is below " << cap << " bytes";
+  const rlimit lowered{static_cast<rlim_t>(cap), old.rlim_max};
+  ASSERT_EQ(::setrlimit(RLIMIT_AS, &lowered), 0);
+  const MachineCapacity c = MeasureCapacity(testing::FreshDir("rlimit").string());
+  ::setrlimit(RLIMIT_AS, &old);
+  // Up to what the process mapped between reading VmSize and measuring (a few MB).
+  EXPECT_LE(c.memory_bytes, 3e9);
+  EXPECT_GT(c.memory_bytes, 2.9e9);
+  EXPECT_EQ(c.memory_source, "RLIMIT_AS (ulimit -v) less the address space in use");
 }
 
 TEST(FormatBytes, DecimalUnits) {

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <ogr_spatialref.h>
 
+#include <chrono>
 #include <cmath>
 #include <fstream>
 #include <limits>
@@ -244,6 +245,27 @@ TEST(LoadScene, ScarringSoilPerCategoryWithItsParametersAndBounds) {
              "solver.soil_drag: unknown drag point 'centroid'");
 }
 
+// Newton's impact law takes one coefficient (SolverOptions): tangential_restitution follows
+// normal_restitution unless given, and a different one is refused with the reason.
+TEST(LoadScene, RestitutionIsOneCoefficient) {
+  const auto dir = testing::FreshDir("restitution");
+  const auto with = [](const std::string& keys) {
+    return Replace(kPlaneScene, "max_time_s = 20", "max_time_s = 20\n" + keys);
+  };
+  testing::WriteText(dir / "scene.toml", with("normal_restitution = 0.4"));
+  const SolverOptions o = LoadScene((dir / "scene.toml").string()).scene.options;
+  EXPECT_EQ(o.normal_restitution, 0.4);
+  EXPECT_EQ(o.tangential_restitution, 0.4);
+  testing::WriteText(dir / "scene.toml",
+                     with("normal_restitution = 0.4\ntangential_restitution = 0.4"));
+  EXPECT_EQ(LoadScene((dir / "scene.toml").string()).scene.options.tangential_restitution, 0.4);
+  EXPECT_HAS(ErrorOf(with("normal_restitution = 1\ntangential_restitution = -1"), dir),
+             "tangential_restitution = -1 violates tangential_restitution == normal_restitution "
+             "(Newton's impact law adds energy for unequal coefficients");
+  EXPECT_HAS(ErrorOf(with("tangential_restitution = 0.5"), dir),
+             "tangential_restitution = 0.5 violates");
+}
+
 TEST(LoadScene, ContactSolveMethodIsChosenByNameWithDidYouMean) {
   const auto dir = testing::FreshDir("contact_solve");
   testing::WriteText(dir / "scene.toml", kPlaneScene);
@@ -274,8 +296,8 @@ TEST(LoadScene, PredictedLeverIsChosenByNameWithDidYouMean) {
              "scene.toml:23: solver.predicted_lever: unknown lever 'tuch' (did you mean 'touch'?)");
 }
 
-// [solver] preset sets the accuracy knobs (solver/options.hpp); keys the scene gives win, also
-// when talus simulate --preset (UseSolverPreset) changes the preset afterwards.
+// [solver] preset sets the accuracy knobs (solver/options.hpp) and keys the scene gives win over
+// it; talus simulate --preset (UseSolverPreset) wins over both and names the values it changed.
 TEST(LoadScene, SolverPresetSetsTheKnobsTheSceneDoesNotGive) {
   const auto dir = testing::FreshDir("preset");
   const auto load = [&](const std::string& extra) {
@@ -295,11 +317,19 @@ TEST(LoadScene, SolverPresetSetsTheKnobsTheSceneDoesNotGive) {
   EXPECT_EQ(scene.scene.options.dt_s, 0.001);
   EXPECT_EQ(scene.scene.options.max_iterations, 1000);
   EXPECT_EQ(scene.scene.options.tolerance_m_s, 1e-6);  // given: kept
+  EXPECT_FALSE(scene.solver_preset_from_command_line);
   UseSolverPreset(scene, SolverPreset::kFast);
   EXPECT_EQ(scene.solver_preset, SolverPreset::kFast);
+  EXPECT_TRUE(scene.solver_preset_from_command_line);
   EXPECT_EQ(scene.scene.options.dt_s, defaults.dt_s);
   EXPECT_EQ(scene.scene.options.max_iterations, defaults.max_iterations);
-  EXPECT_EQ(scene.scene.options.tolerance_m_s, 1e-6);  // still the scene's own
+  EXPECT_EQ(scene.scene.options.tolerance_m_s, 1e-2);  // the scene's own 1e-6 overridden
+  EXPECT_EQ(scene.solver_keys_overridden, std::vector<std::string>{"tolerance_m_s = 1e-06 -> 0.01"});
+  // The shipped scenes' case: dt_s = 0.002 given, --preset accurate halves it.
+  scene = load("dt_s = 0.002");
+  UseSolverPreset(scene, SolverPreset::kAccurate);
+  EXPECT_EQ(scene.scene.options.dt_s, 0.001);
+  EXPECT_EQ(scene.solver_keys_overridden, std::vector<std::string>{"dt_s = 0.002 -> 0.001"});
   EXPECT_HAS(
       ErrorOf(Replace(kPlaneScene, "max_time_s = 20", "max_time_s = 20\npreset = \"fats\""), dir),
       "scene.toml:23: solver.preset: unknown preset 'fats' (did you mean 'fast'?)");
@@ -932,6 +962,25 @@ TEST(LoadScene, RunTableWithBlocksLoadsAsGiven) {
   EXPECT_NEAR(plate.volume_m3, 0.46 * 0.30 * 0.20, 1e-12);
   EXPECT_EQ(s.release.ReleaseName(2), "v3");
   EXPECT_EQ(s.inputs.size(), 3u);  // scene, blocks, runs
+}
+
+// A run table of 100 000 rows took 72 s to load (each run's id compared with every earlier
+// one's); 200 000 rows now take about a second, the quadratic check would take minutes.
+TEST(LoadScene, ALargeRunTableLoadsInTimeInProportion) {
+  const auto dir = testing::FreshDir("runs_large");
+  std::string runs = "trajectory_id,x_m,y_m\n";
+  for (int k = 0; k < 200000; ++k) runs.append("r").append(std::to_string(k)).append(",5,0\n");
+  testing::WriteText(dir / "runs.csv", runs);
+  testing::WriteText(dir / "scene.toml",
+                     "[terrain]\nplane = { slope_deg = 35, slope_length_m = 40, runout_m = 20, "
+                     "width_m = 30, cell_m = 1 }\n[rock]\nshape = { box = [0.5, 0.4, 0.3] }\n"
+                     "[release]\nruns = \"runs.csv\"\nrocks = 1\n");
+  const auto t0 = std::chrono::steady_clock::now();
+  const SceneFile s = LoadScene((dir / "scene.toml").string());
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  EXPECT_EQ(s.release.runs.size(), 200000u);
+  EXPECT_LT(seconds, 60.0);  // a wide margin for sanitizer builds and loaded machines
 }
 
 TEST(LoadScene, RunTableErrorsNameFileLineAndColumn) {

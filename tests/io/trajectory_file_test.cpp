@@ -3,6 +3,7 @@
 #include <H5Cpp.h>
 #include <gtest/gtest.h>
 #include <sys/resource.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <array>
@@ -208,16 +209,16 @@ std::string WriteUntilFailure(const std::string& path, int rocks, int samples) {
   return "";
 }
 
-// A full disk: the writer's temporary file (".trajectories.h5.tmp-<pid>", common/atomic_file.hpp)
-// is made /dev/full, on which every write fails with ENOSPC. One exception naming the file and
-// the reason, nothing left behind, and no crash in HDF5's shutdown at exit (ctest runs each test
-// in a process of its own; HDF5's C++ API used to print "H5Dclose failed" for every dataset and
-// then crash there).
+// A full disk: the writer's temporary file (".trajectories.h5.talus-tmp-<pid>",
+// common/atomic_file.hpp) is made /dev/full, on which every write fails with ENOSPC. One exception
+// naming the file and the reason, nothing left behind, and no crash in HDF5's shutdown at exit
+// (ctest runs each test in a process of its own; HDF5's C++ API used to print "H5Dclose failed" for
+// every dataset and then crash there).
 TEST(TrajectoryWriter, FullDiskIsOneErrorNamingTheFileAndLeavesNothing) {
   const auto dir = testing::FreshDir("full");
   const auto path = (dir / "trajectories.h5").string();
-  std::filesystem::create_symlink("/dev/full",
-                                  dir / (".trajectories.h5.tmp-" + std::to_string(::getpid())));
+  std::filesystem::create_symlink(
+      "/dev/full", dir / (".trajectories.h5.talus-tmp-" + std::to_string(::getpid())));
   const std::string message = WriteUntilFailure(path, 20, 200);
   EXPECT_NE(message.find(path + ": No space left on device"), std::string::npos) << message;
   EXPECT_TRUE(std::filesystem::is_empty(dir));
@@ -239,6 +240,30 @@ TEST(TrajectoryWriter, FileSizeLimitIsOneErrorAndLeavesNothing) {
   ::setrlimit(RLIMIT_FSIZE, &old);
   EXPECT_NE(message.find(path + ": File too large"), std::string::npos) << message;
   EXPECT_NE(message.find("cannot write rock "), std::string::npos) << message;
+  EXPECT_TRUE(std::filesystem::is_empty(dir));
+}
+
+// A hard file-size limit (`ulimit -f` sets the soft and the hard one): the abandoned file's last
+// writes fail too, so HDF5 cannot close it. The process must still end normally: HDF5's exit
+// handler crashed on such a file (SIGSEGV at exit, after the error had been reported). In a child
+// process, whose limit cannot be raised again.
+TEST(TrajectoryWriter, AHardFileSizeLimitEndsTheProcessNormally) {
+  const auto dir = testing::FreshDir("hard_limit");
+  const auto path = (dir / "trajectories.h5").string();
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    std::signal(SIGXFSZ, SIG_IGN);
+    const rlimit hard{64 * 1024, 64 * 1024};
+    if (::setrlimit(RLIMIT_FSIZE, &hard) != 0) std::_Exit(3);
+    const std::string message = WriteUntilFailure(path, 2000, 400);
+    // exit, not _exit: the exit handlers run, as at the end of talus.
+    std::exit(message.find(path + ": File too large") != std::string::npos ? 0 : 4);
+  }
+  int status = 0;
+  ASSERT_EQ(::waitpid(child, &status, 0), child);
+  ASSERT_TRUE(WIFEXITED(status)) << "the child was killed by signal " << WTERMSIG(status);
+  EXPECT_EQ(WEXITSTATUS(status), 0) << "3: no limit set, 4: not the expected error";
   EXPECT_TRUE(std::filesystem::is_empty(dir));
 }
 

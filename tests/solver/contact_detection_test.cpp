@@ -219,11 +219,23 @@ std::vector<int> VerticesThatTouch(const Scene& scene, const RockState& mid,
     const Eigen::Vector3d x = mid.position_m + rotation * b;
     double h = 0;
     EXPECT_TRUE(scene.terrain.Height(x.x(), x.y(), &h));
-    const Eigen::Vector3d x_end = x + horizon_s * (v + rotation * omega.cross(b));
+    const Eigen::Vector3d move = horizon_s * (v + rotation * omega.cross(b));
+    const Eigen::Vector3d x_end = x + move;
     TerrainSample end;
-    if (x.z() <= h || (scene.terrain.Sample(x_end.x(), x_end.y(), &end) &&
-                       (x_end.z() - end.height_m) * end.normal.z() < -allowed_depth_m))
+    if (x.z() <= h) {
       touching.push_back(k);
+      // A second contact with the face ahead of a closed vertex (AddCornerContact).
+      TerrainSample own;
+      EXPECT_TRUE(scene.terrain.Sample(x.x(), x.y(), &own));
+      const Eigen::Vector3d slide = x + move - std::min(0.0, own.normal.dot(move)) * own.normal;
+      if (scene.terrain.Sample(slide.x(), slide.y(), &end) &&
+          end.normal.dot(own.normal) < 1 - 1e-12 &&
+          (slide.z() - end.height_m) * end.normal.z() < -allowed_depth_m)
+        touching.push_back(k);
+    } else if (scene.terrain.Sample(x_end.x(), x_end.y(), &end) &&
+               (x_end.z() - end.height_m) * end.normal.z() < -allowed_depth_m) {
+      touching.push_back(k);
+    }
   }
   return touching;
 }

@@ -17,7 +17,7 @@ constexpr double kG = 9.81;
 Scene Flat(double mu, double restitution = 0) {
   Scene scene =
       scenes::Incline(0, MakeRockShape(MakeBox(1, 1, 0.5), 2700), GroundParams{mu, mu, 150, 2, 0});
-  scene.options.normal_restitution = restitution;
+  scene.options.normal_restitution = scene.options.tangential_restitution = restitution;
   return scene;
 }
 

@@ -11,6 +11,7 @@
 #include <set>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "solver/ground.hpp"
@@ -41,6 +42,21 @@ TEST(Options, DefaultsAreValidAndBadValuesAreNamed) {
   o.normal_restitution = std::nan("");
   EXPECT_FALSE(o.IsValid(&why));
   EXPECT_NE(why.find("normal_restitution"), std::string::npos) << why;
+  // One coefficient: equal pairs in [0, 1] are accepted, any other pair is refused by name
+  // (Energy.NewtonRestitutionNeverAddsEnergyForAnyAcceptedCoefficient in step_test.cpp).
+  for (const double eps : {0.0, 0.3, 1.0}) {
+    o = SolverOptions{};
+    o.normal_restitution = o.tangential_restitution = eps;
+    EXPECT_TRUE(o.IsValid(&why)) << why;
+  }
+  for (const auto& [normal, tangential] :
+       {std::pair{1.0, -1.0}, std::pair{0.5, 0.0}, std::pair{0.0, 0.5}, std::pair{1.2, 1.2}}) {
+    o = SolverOptions{};
+    o.normal_restitution = normal;
+    o.tangential_restitution = tangential;
+    EXPECT_FALSE(o.IsValid(&why)) << normal << ", " << tangential;
+    EXPECT_NE(why.find("restitution"), std::string::npos) << why;
+  }
 }
 
 // IsValid's messages: the key, the value, the bound and the unit.
