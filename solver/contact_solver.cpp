@@ -357,7 +357,6 @@ void PrepareContacts(const Scene& scene, const RockShape& rock, const Eigen::Mat
 void RememberPercussions(StepWorkspace& workspace, ContactSolveReport& report) {
   workspace.ForgetPercussions();
   for (const Contact& c : workspace.contacts) {
-    if (c.percussion.x() > 0) report.loaded = true;
     if (c.corner) {  // its vertex's closed contact comes first
       workspace.last_percussion[c.vertex] += c.directions * c.percussion;
       continue;
@@ -365,6 +364,7 @@ void RememberPercussions(StepWorkspace& workspace, ContactSolveReport& report) {
     workspace.last_closed[c.vertex] = 1;
     workspace.last_closed_list.push_back(c.vertex);
     workspace.last_percussion[c.vertex] = c.directions * c.percussion;
+    if (c.percussion.x() > 0) report.loaded = true;
   }
 }
 

@@ -259,9 +259,11 @@ TEST(LoadScene, RestitutionIsOneCoefficient) {
   testing::WriteText(dir / "scene.toml",
                      with("normal_restitution = 0.4\ntangential_restitution = 0.4"));
   EXPECT_EQ(LoadScene((dir / "scene.toml").string()).scene.options.tangential_restitution, 0.4);
-  EXPECT_HAS(ErrorOf(with("normal_restitution = 1\ntangential_restitution = -1"), dir),
-             "tangential_restitution = -1 violates tangential_restitution == normal_restitution "
+  EXPECT_HAS(ErrorOf(with("normal_restitution = 1\ntangential_restitution = 0.5"), dir),
+             "tangential_restitution = 0.5 violates tangential_restitution == normal_restitution "
              "(Newton's impact law adds energy for unequal coefficients");
+  EXPECT_HAS(ErrorOf(with("normal_restitution = 1\ntangential_restitution = -1"), dir),
+             "tangential_restitution = -1 violates 0 <= tangential_restitution <= 1");
   EXPECT_HAS(ErrorOf(with("tangential_restitution = 0.5"), dir),
              "tangential_restitution = 0.5 violates");
 }
@@ -367,8 +369,11 @@ TEST(LoadScene, EverySolverOptionOfTheTableIsReadAndWrittenBack) {
           text.find_first_of(".e") == std::string::npos)
         text += ".0";  // a TOML float
     }
-    testing::WriteText(dir / "scene.toml", Replace(kPlaneScene, "dt_s = 0.004\nmax_time_s = 20",
-                                                   std::string(f.key) + " = " + text));
+    // The restitution coefficients are one (SolverOptions::IsValid): the pair is given together.
+    std::string keys = std::string(f.key) + " = " + text;
+    if (std::string(f.key) == "tangential_restitution") keys += "\nnormal_restitution = " + text;
+    testing::WriteText(dir / "scene.toml",
+                       Replace(kPlaneScene, "dt_s = 0.004\nmax_time_s = 20", keys));
     SceneFile scene;
     try {
       scene = LoadScene((dir / "scene.toml").string());

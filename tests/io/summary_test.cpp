@@ -48,7 +48,8 @@ TEST(SummaryJson, CarriesHashVersionCountsAndRate) {
   EXPECT_DOUBLE_EQ(j["wall_time_s"].get<double>(), 2.0);
 }
 
-// "solver": every option of kSolverOptions in the table's order, then the preset.
+// "solver": every option of kSolverOptions in the table's order, then the preset, where it came
+// from and what it overrode (talus simulate --preset).
 TEST(SummaryJson, SolverIsTheOptionsTableInItsOrderThenThePreset) {
   const auto dir = testing::FreshDir("summary_solver");
   testing::WriteText(dir / "scene.toml",
@@ -60,7 +61,7 @@ TEST(SummaryJson, SolverIsTheOptionsTableInItsOrderThenThePreset) {
   std::vector<std::string> keys, expected;
   for (const auto& [key, value] : j["solver"].items()) keys.push_back(key);
   for (const SolverOptionInfo& f : kSolverOptions) expected.emplace_back(f.key);
-  expected.emplace_back("preset");
+  for (const char* key : {"preset", "preset_from", "preset_overrode"}) expected.emplace_back(key);
   EXPECT_EQ(keys, expected);
   EXPECT_TRUE(j["solver"]["max_iterations"].is_number_integer());
   EXPECT_EQ(j["solver"]["penetration_tolerance"], 0.01);
