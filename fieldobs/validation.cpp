@@ -92,25 +92,6 @@ std::string Number(double v, const char* format = "%.3g") {
 
 }  // namespace
 
-std::vector<double> ScalarClimatology(const std::vector<ScalarObservation>& scalars,
-                                      std::size_t k) {
-  std::vector<double> climatology;
-  for (std::size_t q = 0; q < scalars.size(); ++q)
-    if (q != k && scalars[q].quantity == scalars[k].quantity)
-      climatology.push_back(scalars[q].value);
-  return climatology;
-}
-
-std::vector<Eigen::Vector2d> DepositClimatology(
-    const std::vector<DepositObservation>& deposits,
-    const std::vector<std::optional<Eigen::Vector2d>>& starts, std::size_t k) {
-  std::vector<Eigen::Vector2d> climatology;
-  if (!starts[k]) return climatology;
-  for (std::size_t q = 0; q < deposits.size(); ++q)
-    if (q != k && starts[q]) climatology.push_back(*starts[k] + deposits[q].xy_m - *starts[q]);
-  return climatology;
-}
-
 ValidationReport Validate(const ObservationSet& observations, const EnsembleSamples& simulated,
                           const EnsembleSamples* reference, const ValidationOptions& options) {
   ValidationReport report;

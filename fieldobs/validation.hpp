@@ -79,17 +79,6 @@ struct ValidationOptions {
   int min_members = 2;     // fewer simulated values: the observation is not scored
 };
 
-// The leave-one-out climatology of scalars[k]: the values of the other observations of its
-// quantity, in their order. (Validate's baseline, and calibration's scale of a kind's scores.)
-std::vector<double> ScalarClimatology(const std::vector<ScalarObservation>& scalars, std::size_t k);
-// The leave-one-out climatology of deposits[k]: every other deposit's displacement from the
-// start of its run, applied to the start of deposits[k]'s run, in their order. starts[q] is the
-// start of deposits[q]'s run (none for an observation of the whole scene: left out, and no
-// climatology for it).
-std::vector<Eigen::Vector2d> DepositClimatology(
-    const std::vector<DepositObservation>& deposits,
-    const std::vector<std::optional<Eigen::Vector2d>>& starts, std::size_t k);
-
 // Scores `observations` against `simulated`, and against `reference` when given (same rocks with
 // the reference parameter set).
 ValidationReport Validate(const ObservationSet& observations, const EnsembleSamples& simulated,

@@ -108,35 +108,6 @@ TEST(Validate, ScoresBaselinesAndSkillsByHand) {
   EXPECT_EQ(report.observations_scored, 3);
 }
 
-// The leave-one-out climatology: the other observations of the same quantity; for deposits the
-// other runs' displacements from their start, applied to this run's start.
-TEST(Climatology, LeavesTheObservationOutAndKeepsTheOrder) {
-  std::vector<ScalarObservation> scalars(4);
-  for (auto [k, quantity, value] :
-       {std::tuple{0, Quantity::kRunout, 10.0}, std::tuple{1, Quantity::kRunout, 20.0},
-        std::tuple{2, Quantity::kImpactSpeedOut, 5.0}, std::tuple{3, Quantity::kRunout, 30.0}}) {
-    scalars[static_cast<std::size_t>(k)].quantity = quantity;
-    scalars[static_cast<std::size_t>(k)].value = value;
-  }
-  EXPECT_EQ(ScalarClimatology(scalars, 0), (std::vector<double>{20, 30}));
-  EXPECT_EQ(ScalarClimatology(scalars, 3), (std::vector<double>{10, 20}));
-  EXPECT_TRUE(ScalarClimatology(scalars, 2).empty());  // no other speed
-
-  std::vector<DepositObservation> deposits(3);
-  deposits[0].xy_m = {10, 1};
-  deposits[1].xy_m = {25, 2};
-  deposits[2].xy_m = {7, 7};  // of the whole scene: no start
-  const std::vector<std::optional<Eigen::Vector2d>> starts = {Eigen::Vector2d(0, 0),
-                                                              Eigen::Vector2d(10, 0), std::nullopt};
-  const std::vector<Eigen::Vector2d> first = DepositClimatology(deposits, starts, 0);
-  ASSERT_EQ(first.size(), 1u);
-  EXPECT_EQ(first[0], Eigen::Vector2d(15, 2));  // run 1 went 15 m from its start
-  const std::vector<Eigen::Vector2d> second = DepositClimatology(deposits, starts, 1);
-  ASSERT_EQ(second.size(), 1u);
-  EXPECT_EQ(second[0], Eigen::Vector2d(20, 1));
-  EXPECT_TRUE(DepositClimatology(deposits, starts, 2).empty());
-}
-
 TEST(Validate, TooFewMembersIsNotScoredAndSaysWhy) {
   const Fake model(std::vector<std::vector<double>>{{10.0}});
   ObservationSet obs;
