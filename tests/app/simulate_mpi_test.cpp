@@ -99,10 +99,10 @@ TEST(SimulateMpi, RanksWithDifferentEnsemblesAreRefused) {
   EXPECT_FALSE(fs::exists(out / "summary.json"));
 }
 
-// Rank 1 is killed (SIGKILL) after 2 s, in the middle of its 2000 rocks (about 35 s of work on one
-// core, so a fast machine cannot finish them first): the run ends within the time limit with a
-// failure, --out holds neither outputs nor temporary files; the next run removes what the killed
-// rank left in its $TMPDIR.
+// Rank 1 is killed (SIGKILL) after 2 s, in the middle of its share of the 4000 rocks (2000 per
+// rank, about 35 s of work on one core, so a fast machine cannot finish them first): the run ends
+// within the time limit with a failure, --out holds neither outputs nor temporary files; the next
+// run removes what the killed rank left in its $TMPDIR.
 TEST(SimulateMpi, ALostRankEndsTheRunWithoutOutputs) {
   const fs::path dir = FreshDir("lost_rank");
   const fs::path out = dir / "out", tmp = dir / "tmp";

@@ -40,14 +40,6 @@ testing::DataError MeasuredDataError() {
   return error;
 }
 
-// mu_min from 0.2 (Table 1 is 0.40, the truth 0.50) with BOBYQA on the normalised mean CRPS of 24
-// run-outs. Tolerance, from the data: one observation per run is one draw of a runout whose
-// within-run sd is sigma; the mean runout moves by dm/dmu per unit mu_min; so N runs locate
-// mu_min to about sigma / (|dm/dmu| sqrt(N)), and the model's own ensemble of R rocks per run adds
-// a factor sqrt(1 + 1/R). The test allows 3 such standard errors, plus the optimiser's xtol
-// (1e-3 of the 0.1 .. 0.9 range). sigma and dm/dmu are measured here (central difference over
-// +-0.05 around the truth), not assumed. Measured: fitted 0.5215 in 12 evaluations; sigma 0.97 m,
-// dm/dmu -8.1 m, standard error 0.027, tolerance 0.081.
 TEST(Calibrate, TheStepChoiceDefaultsAreValidAndBadOnesNamed) {
   std::string why;
   EXPECT_TRUE(StepChoiceOptions().IsValid(&why)) << why;
@@ -65,6 +57,14 @@ TEST(Calibrate, TheStepChoiceDefaultsAreValidAndBadOnesNamed) {
   EXPECT_NE(why.find("max_step"), std::string::npos) << why;
 }
 
+// mu_min from 0.2 (Table 1 is 0.40, the truth 0.50) with BOBYQA on the normalised mean CRPS of 24
+// run-outs. Tolerance, from the data: one observation per run is one draw of a runout whose
+// within-run sd is sigma; the mean runout moves by dm/dmu per unit mu_min; so N runs locate
+// mu_min to about sigma / (|dm/dmu| sqrt(N)), and the model's own ensemble of R rocks per run adds
+// a factor sqrt(1 + 1/R). The test allows 3 such standard errors, plus the optimiser's xtol
+// (1e-3 of the 0.1 .. 0.9 range). sigma and dm/dmu are measured here (central difference over
+// +-0.05 around the truth), not assumed. Measured: fitted 0.5215 in 12 evaluations; sigma 0.97 m,
+// dm/dmu -8.1 m, standard error 0.027, tolerance 0.081.
 TEST(Calibrate, BobyqaRecoversMuMinFromADistantStart) {
   const auto& p = Problem();
   ObjectiveOptions objective_options;

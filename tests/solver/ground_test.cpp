@@ -23,14 +23,40 @@ TEST(GroundParams, FrictionFollowsSeedPaperEquation2) {
 }
 
 TEST(GroundTable, BuiltInMatchesTable1) {
+  // Seed paper, Table 1 ("Ground categories and associated friction parameters in the
+  // RAMMS::ROCKFALL program"), all 40 values as printed there, in the paper's order of categories
+  // (reference/000_e89aa5aad63e1e53.txt, lines 82-85), with the raster codes 1-8 of DESIGN.md in
+  // that order. Exact: the built-in table holds the printed decimals.
+  struct Row {
+    const char* name;
+    int code;
+    double mu_min, mu_max, beta_1_s, kappa_1_m, nu_1_s;
+  };
+  const Row table1[] = {
+      {"extra_soft", 1, 0.2, 2, 50, 1, 0.9},      // Extra Soft (moor)
+      {"soft", 2, 0.25, 2, 100, 1.25, 0.8},       // Soft (moist, deep meadow)
+      {"medium_soft", 3, 0.3, 2, 125, 1.5, 0.7},  // Medium Soft (deep meadow)
+      {"medium", 4, 0.35, 2, 150, 2, 0.6},        // Medium (meadow)
+      {"medium_hard", 5, 0.4, 2, 175, 2.5, 0.5},  // Medium Hard (shallow meadow)
+      {"hard", 6, 0.55, 2, 185, 3, 0.4},          // Hard (rock scree)
+      {"extra_hard", 7, 0.8, 2, 200, 4, 0.3},     // Extra Hard (rock face, bedrock)
+      {"snow", 8, 0.1, 0.35, 150, 2, 0.7},        // Snow
+  };
   const GroundTable t = GroundTable::BuiltIn();
   ASSERT_EQ(t.size(), 8);
-  const int hard = t.IndexOfName("hard");
-  ASSERT_GE(hard, 0);
-  EXPECT_EQ(t.category(hard).code, 6);
-  EXPECT_DOUBLE_EQ(t.params(hard).mu_min, 0.55);
-  EXPECT_DOUBLE_EQ(t.params(hard).beta_1_s, 185);
-  EXPECT_DOUBLE_EQ(t.params(t.IndexOfCode(8)).mu_max, 0.35);  // snow
+  for (const Row& row : table1) {
+    SCOPED_TRACE(row.name);
+    const int i = t.IndexOfName(row.name);
+    ASSERT_GE(i, 0);
+    EXPECT_EQ(t.IndexOfCode(row.code), i);
+    EXPECT_EQ(t.category(i).code, row.code);
+    const GroundParams& p = t.params(i);
+    EXPECT_EQ(p.mu_min, row.mu_min);
+    EXPECT_EQ(p.mu_max, row.mu_max);
+    EXPECT_EQ(p.beta_1_s, row.beta_1_s);
+    EXPECT_EQ(p.kappa_1_m, row.kappa_1_m);
+    EXPECT_EQ(p.nu_1_s, row.nu_1_s);
+  }
   EXPECT_EQ(t.IndexOfName("gravel"), -1);
 }
 
