@@ -99,10 +99,12 @@ TEST(SimulateMpi, RanksWithDifferentEnsemblesAreRefused) {
   EXPECT_FALSE(fs::exists(out / "summary.json"));
 }
 
-// Rank 1 is killed (SIGKILL) after 2 s, in the middle of its share of the 4000 rocks (2000 per
-// rank, about 35 s of work on one core, so a fast machine cannot finish them first): the run ends
-// within the time limit with a failure, --out holds neither outputs nor temporary files; the next
-// run removes what the killed rank left in its $TMPDIR.
+// Rank 1 is killed (SIGKILL) half a second after it has created its staging directory, in the
+// middle of its share of the 4000 rocks (2000 per rank, about 35 s of work on one core, so a fast
+// machine cannot finish them first; waited for, not timed, so that a loaded machine's slow start
+// does not kill it before it stages): the run ends within the time limit with a failure, --out
+// holds neither outputs nor temporary files; the next run removes what the killed rank left in its
+// $TMPDIR.
 TEST(SimulateMpi, ALostRankEndsTheRunWithoutOutputs) {
   const fs::path dir = FreshDir("lost_rank");
   const fs::path out = dir / "out", tmp = dir / "tmp";
@@ -111,10 +113,15 @@ TEST(SimulateMpi, ALostRankEndsTheRunWithoutOutputs) {
   std::string log;
   const std::string run = " simulate " + kScene + " --threads 1 --out " + out.string();
   const std::string env = "TMPDIR=" + tmp.string() + " ";
+  // Rank 1 under a shell that waits (at most 30 s) for something in the staging directory, then
+  // kills it and exits as `timeout -s KILL` would.
+  const std::string killed =
+      "sh -c '" + Talus() + run + " --rocks 4000 & p=$!; n=0; while [ -z \"$(ls -A " +
+      (tmp / Ranks()).string() +
+      " 2>/dev/null)\" ] && [ $n -lt 600 ]; do sleep 0.05; n=$((n+1)); done; sleep 0.5; "
+      "kill -KILL $p; wait $p; exit 137'";
   const int code =
-      RunCommand(env + MpiRun("-n 1 " + Talus() + run + " --rocks 4000 : -n 1 timeout -s KILL 2 " +
-                              Talus() + run + " --rocks 4000"),
-                 &log);
+      RunCommand(env + MpiRun("-n 1 " + Talus() + run + " --rocks 4000 : -n 1 " + killed), &log);
   EXPECT_NE(code, 0) << log;
   EXPECT_NE(code, -1) << log;  // ended by itself, not by the test's time limit
   EXPECT_TRUE(fs::is_empty(out)) << log;

@@ -163,27 +163,38 @@ inline Moments QuantityMoments(const Scene& scene, const ensemble::ReleaseSpec& 
 // The standard error of a parameter that the data allow: one observation per run is one draw of
 // a quantity whose within-run sd is sigma; the runs' mean moves by dm/dp per unit of the
 // parameter; so N observations locate it to about sigma / (|dm/dp| sqrt(N)), and the model's own
-// ensemble of R rocks per run adds a factor sqrt(1 + 1/R). sigma and dm/dp are measured (central
-// difference over truth +- delta, with `set` writing a value of the parameter into a scene), not
-// assumed.
+// ensemble of R rocks per run adds a factor sqrt(1 + 1/R). sigma and dm/dp are measured, not
+// assumed: sigma at the truth, dm/dp as the least-squares slope of the mean over `points` values
+// evenly spaced over truth +- delta (2: the central difference), with `set` writing a value of the
+// parameter into a scene. Where the mean turns erratically with the parameter (which gully a
+// block takes), more points keep one unlucky pair from making the slope, and with it the
+// tolerance, arbitrary.
 struct DataError {
   double sd = 0, slope = 0, se = 0;
 };
 inline DataError MeasuredDataError(const Scene& scene, const ensemble::ReleaseSpec& release,
                                    const fieldobs::ObservationSet& observations,
                                    const std::function<void(Scene&, double)>& set, double truth,
-                                   double delta) {
+                                   double delta, int points = 2) {
   const auto at = [&](double value) {
     Scene s = scene;
     set(s, value);
     return QuantityMoments(s, release, observations);
   };
-  const Moments lo = at(truth - delta), hi = at(truth + delta), mid = at(truth);
+  double sum_x = 0, sum_y = 0, sum_xx = 0, sum_xy = 0;
+  for (int k = 0; k < points; ++k) {
+    const double x = -delta + 2 * delta * k / (points - 1);
+    const double y = at(truth + x).mean;
+    sum_x += x;
+    sum_y += y;
+    sum_xx += x * x;
+    sum_xy += x * y;
+  }
   DataError e;
-  e.sd = mid.sd;
-  e.slope = (hi.mean - lo.mean) / (2 * delta);
+  e.sd = at(truth).sd;
+  e.slope = (points * sum_xy - sum_x * sum_y) / (points * sum_xx - sum_x * sum_x);
   const double n = double(observations.scalars.size());
-  e.se = mid.sd / (std::abs(e.slope) * std::sqrt(n)) *
+  e.se = e.sd / (std::abs(e.slope) * std::sqrt(n)) *
          std::sqrt(1 + 1.0 / double(release.rocks_per_release));
   return e;
 }

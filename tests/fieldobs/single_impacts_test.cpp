@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 
 #include "common/error.hpp"
 #include "ensemble/runner.hpp"
@@ -104,11 +105,9 @@ TEST(SingleImpacts, OutcomesAndScarDepthsAreObservationsOfTheRun) {
   EXPECT_EQ(set.scalars[4].run, "b");
   EXPECT_EQ(set.scalars[4].value, 0.2);
   ObservationSet none;
-  EXPECT_THROW(ReadSingleImpactOutcomes(Table("impact_id,mass_kg\na,780\n"), {}, none),
+  EXPECT_THROW(ReadSingleImpactOutcomes(Table("impact_id,mass_kg\na,780\n"), {}, none), InputError);
+  EXPECT_THROW(ReadSingleImpactOutcomes(Table("impact_id,energy_ratio\na,-0.1\n"), {}, none),
                InputError);
-  EXPECT_THROW(
-      ReadSingleImpactOutcomes(Table("impact_id,energy_ratio\na,-0.1\n"), {}, none),
-      InputError);
 }
 
 // A plane of `slope_deg` falling along +x (x in 0 .. 40 m, slope then 10 m of runout), a 0.4 m
@@ -166,14 +165,19 @@ TEST(SingleImpacts, ARandomlyOrientedBlockMeetsThePlaneWithTheGivenVelocity) {
 
 TEST(SingleImpacts, AFrictionlessPlasticImpactLosesExactlyTheNormalComponent) {
   // epsilon_N = 0 (the model's default) removes the normal contact velocity (tests/solver/
-  // step_test.cpp, Impact.PlasticDropDoesNotBounce: to the solver's tolerance_m_s). A cube landing
+  // step_test.cpp, Impact.PlasticDropDoesNotBounce: to the solve's stopping rule). A cube landing
   // flat on level, frictionless ground (mu = 0, nu = 0) then keeps its tangential velocity and
-  // gains no rotation, as a point mass: energy ratio out / in = cos^2 of the impact angle. The
-  // residual normal velocity (<= tolerance_m_s = 1e-7 m/s) and round-off bound the error: 1e-9.
+  // gains no rotation, as a point mass: energy ratio out / in = cos^2 of the impact angle. With
+  // the solve stopped at tolerance_m_s = delta (set to 1e-7 m/s here, not the default 1e-3), a
+  // residual normal velocity of about delta changes the ratio by (delta / v_in)^2, below 1e-14 at
+  // v_in >= 1.4 m/s (tolerance 1e-9), and a residual corner velocity of delta spins the 0.4 m
+  // cube by about delta / 0.2 m = 5e-7 rad/s (tolerance 1e-6 rad/s). Measured: exact to round-off
+  // (1e-16, 1e-17 rad/s), at the default tolerance too: a flat, symmetric landing ends exact.
   GroundParams frictionless;
   frictionless.mu_min = frictionless.mu_max = 0;
   frictionless.nu_1_s = 0;
-  const Scene scene = PlaneScene(0, frictionless);
+  Scene scene = PlaneScene(0, frictionless);
+  scene.options.tolerance_m_s = 1e-7;
   std::vector<ensemble::ReleaseRun> runs;
   for (double angle_deg : {10.0, 30.0, 60.0}) {
     const double a = angle_deg * kPi / 180;
@@ -187,8 +191,10 @@ TEST(SingleImpacts, AFrictionlessPlasticImpactLosesExactlyTheNormalComponent) {
     const double a = std::stod(runs[k].id) * kPi / 180;
     const double ratio =
         episodes[k].velocity_out_m_s.squaredNorm() / episodes[k].velocity_in_m_s.squaredNorm();
+    std::printf("%s deg: energy ratio off by %.2e, spin after %.2e rad/s\n", runs[k].id.c_str(),
+                ratio - std::cos(a) * std::cos(a), episodes[k].angular_velocity_out_rad_s.norm());
     EXPECT_NEAR(ratio, std::cos(a) * std::cos(a), 1e-9) << runs[k].id << " deg";
-    EXPECT_LT(episodes[k].angular_velocity_out_rad_s.norm(), 1e-9);
+    EXPECT_LT(episodes[k].angular_velocity_out_rad_s.norm(), 1e-6);
   }
 }
 
