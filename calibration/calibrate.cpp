@@ -5,6 +5,8 @@
 #include <stdexcept>
 #include <utility>
 
+#include "calibration/least_squares.hpp"
+
 namespace talus::calibration {
 namespace {
 
@@ -111,10 +113,20 @@ void Pipeline::Uncertainty() {
   if (!options_.uncertainty) return;
   const Evaluation& best = run_.fit.best;
   UncertaintyOptions uncertainty = options_.uncertainty_options;
-  if (!(uncertainty.fd_step > 0))
-    uncertainty.fd_step = run_.fit.fd_step > 0 ? run_.fit.fd_step
-                          : run_.roughness     ? run_.roughness->fd_step
-                                               : 0.01;
+  // The bootstrap's lattice: the fit's step, else the roughness'.
+  const double lattice = run_.fit.fd_step > 0 ? run_.fit.fd_step
+                         : run_.roughness     ? run_.roughness->fd_step
+                                              : 0.01;
+  if (!(uncertainty.fd_step > 0)) {
+    // The covariance's step is chosen at the optimum by the fit's rule, not taken from the start:
+    // near the optimum the residuals' trend is small against the ensemble's noise, and a step
+    // chosen where the trend was large reads noise as curvature (J^T J = S + N / w^2), which
+    // shrinks the stated standard error (docs/calibration.md, "Ceres and the uncertainty").
+    Say("Choosing the covariance's finite-difference step at the optimum...\n");
+    const StepChoice choice = ChooseFiniteDifferenceStep(objective_, best.u);
+    Say(choice.Report());
+    uncertainty.fd_step = choice.step;
+  }
   uncertainty.noise = run_.roughness ? run_.roughness->level() : 0;
   uncertainty.profiles = run_.profiles;
   Say("Estimating the covariance at the optimum...\n");
@@ -122,7 +134,7 @@ void Pipeline::Uncertainty() {
   Say(run_.uncertainty->Report());
   if (options_.bootstrap_options.resamples <= 0) return;
   BootstrapOptions bootstrap = options_.bootstrap_options;
-  bootstrap.resolution = options_.bootstrap_resolution.value_or(uncertainty.fd_step);
+  bootstrap.resolution = options_.bootstrap_resolution.value_or(lattice);
   bootstrap.profiles = run_.profiles;
   Say(Format("Bootstrap over runs: %d resamples, each refitted...\n", bootstrap.resamples));
   run_.bootstrap = BootstrapOverRuns(objective_, best.u, bootstrap, run_.fit.history);

@@ -175,6 +175,7 @@ Uncertainty EstimateUncertainty(const Objective& objective, const Eigen::VectorX
   const int n = objective.dimension();
   const int m = objective.residual_count();
   Uncertainty out = Unestimated(objective, u);
+  out.fd_step = options.fd_step;
 
   // Evaluations through the Evaluator's cache: the known ones (a calibration's history), else the
   // objective's, with no budget; an exception is kept and rethrown.
@@ -258,8 +259,11 @@ Uncertainty EstimateUncertainty(const Objective& objective, const Eigen::VectorX
 }
 
 std::string Uncertainty::Report() const {
+  char step[32];
+  std::snprintf(step, sizeof step, "%.3g", fd_step);
   std::string out = "Uncertainty (sandwich covariance from Ceres, " + std::to_string(groups) +
-                    " runs, " + std::to_string(evaluations) + " evaluations):\n";
+                    " runs, step " + step + ", " + std::to_string(evaluations) +
+                    " evaluations):\n";
   char line[256];
   std::snprintf(line, sizeof line, "  %-28s %14s %14s %10s  %s\n", "parameter", "value",
                 "std. error", "(of range)", "");

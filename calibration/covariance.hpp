@@ -26,7 +26,9 @@
 namespace talus::calibration {
 
 struct UncertaintyOptions {
-  double fd_step = 0.01;  // central-difference step, unit coordinates
+  // Central-difference step, unit coordinates. A calibration chooses it at the optimum by the
+  // rule of the Ceres fit (ChooseFiniteDifferenceStep, least_squares.hpp) unless it is given.
+  double fd_step = 0.01;
   // Ceres' Covariance::Options::min_reciprocal_condition_number: smaller eigenvalues of J^T J
   // (relative to the largest) make it rank-deficient.
   double min_reciprocal_condition_number = 1e-10;
@@ -51,6 +53,7 @@ struct Uncertainty {
   std::vector<std::string> names;
   Eigen::VectorXd u;         // where (unit coordinates)
   Eigen::VectorXd values;    // the parameters there
+  double fd_step = 0;         // the central-difference step it used, unit coordinates
   Eigen::MatrixXd jacobian;  // residuals x coordinates, unit coordinates
   Eigen::VectorXd residuals;
   int groups = 0;                   // independent groups (runs) in the sandwich

@@ -259,6 +259,7 @@ json UncertaintyJson(const calibration::CalibrationSummary& run) {
           {"identified", identified},
           {"weak", weak},
           {"runs", u.groups},
+          {"finite_difference_step", Number(u.fd_step)},
           {"note", u.note},
           {"evaluations", u.evaluations},
           {"wall_time_s", u.wall_time_s},

@@ -87,8 +87,9 @@ TEST(Bootstrap, IsBitIdenticalForAnyThreadCountAndWhateverIsKnown) {
 }
 
 // The synthetic run-outs of optimizer_test.cpp (24 runs x 5 rocks, mu_min true 0.50) under the
-// contact-friction reading, the default, where the sandwich covariance understates the
-// uncertainty (docs/calibration.md, "Limits"). BOBYQA fits mu_min from 0.2; the bootstrap over
+// contact-friction reading, the default, where the sandwich covariance at the start's step of
+// 0.05 understates the uncertainty (at the step measured at the optimum, as a calibration takes
+// it, it states about the spread of fits over data draws: optimizer_test.cpp). BOBYQA fits mu_min from 0.2; the bootstrap over
 // runs (B = 100, refits on a lattice of 0.01 of the range) must state a standard error within a
 // factor 2 of the data's (testing::MeasuredDataError, an independent estimate from the run-outs'
 // spread and sensitivity), and its 95 % percentile interval must cover the truth. Measured:

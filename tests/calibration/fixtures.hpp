@@ -112,14 +112,10 @@ struct PlaneRuns {
 struct SyntheticRunouts : PlaneRuns {
   fieldobs::ObservationSet observations;
 
-  // The tests of optimizer_test.cpp were established with the centre-of-mass reading: there the
-  // sandwich covariance's standard error agrees with the data's. Under the contact-friction
-  // reading (the default since 0.2) the Ceres fit lands at mu_min 0.547 (truth 0.50, within 3
-  // data standard errors) but its sandwich standard error, 0.019, is 2.5 times smaller than the
-  // data's 0.049 and does not cover the truth; the bootstrap over runs (bootstrap_test.cpp) states
-  // an honest one there (docs/calibration.md, "Limits").
+  // Under the default reading of the viscous term (contact friction), as every calibration test
+  // runs unless it says otherwise.
   SyntheticRunouts(int runs, long rocks, double truth_mu_min, double height_m = 0.5,
-                   ViscousReading reading = ViscousReading::kCentreOfMass)
+                   ViscousReading reading = ViscousReading::kContactFriction)
       : PlaneRuns(runs, rocks, height_m, reading) {
     medium_hard().kappa_1_m = 0.05;
     Scene truth = scene;

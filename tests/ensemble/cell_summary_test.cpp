@@ -1,4 +1,5 @@
 #include "ensemble/cell_summary.hpp"
+#include "tests/portable_random.hpp"
 
 #include <gtest/gtest.h>
 
@@ -33,10 +34,10 @@ std::string Bytes(const ValueSummary& s) {
 // (log-uniform), jump heights that can dip below zero (normal), and many repeated values.
 std::vector<float> Sample(int kind, int n, std::mt19937_64& rng) {
   std::vector<float> v(static_cast<std::size_t>(n));
-  std::uniform_real_distribution<double> uniform(0, 30);
-  std::uniform_real_distribution<double> decades(-3, 9);
-  std::normal_distribution<double> normal(0.5, 1.0);
-  std::uniform_int_distribution<int> few(1, 5);
+  talus::testing::UniformReal<double> uniform(0, 30);
+  talus::testing::UniformReal<double> decades(-3, 9);
+  talus::testing::Normal normal(0.5, 1.0);
+  talus::testing::UniformInt few(1, 5);
   for (float& x : v) {
     switch (kind) {
       case 0:
@@ -140,7 +141,7 @@ TEST(ValueSummary, MergingAnySplitInAnyOrderIsExact) {
 // A million values fill at most the bins of their range: memory does not grow with the count.
 TEST(ValueSummary, MemoryIsBoundedByTheRangeNotTheCount) {
   std::mt19937_64 rng(8);
-  std::uniform_real_distribution<float> one_octave(1.0f, 2.0f);
+  talus::testing::UniformReal<float> one_octave(1.0f, 2.0f);
   ValueSummary s;
   const float below_two = std::nextafter(2.0f, 0.0f);  // the distribution may return 2 itself
   for (int k = 0; k < 1000000; ++k) s.Add(std::min(one_octave(rng), below_two));

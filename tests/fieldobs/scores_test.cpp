@@ -1,4 +1,5 @@
 #include "fieldobs/scores.hpp"
+#include "tests/portable_random.hpp"
 
 #include <gtest/gtest.h>
 
@@ -18,16 +19,9 @@
 namespace talus::fieldobs {
 namespace {
 
-// Random numbers that are the same with every standard library: std::mt19937_64 is fully
-// specified, std::normal_distribution and std::uniform_real_distribution are not.
-double Uniform01(std::mt19937_64& rng) {  // [0, 1), 53 random bits
-  return static_cast<double>(rng() >> 11) * 0x1.0p-53;
-}
-double StandardNormal(std::mt19937_64& rng) {  // Box-Muller, cosine branch
-  const double u1 = 1 - Uniform01(rng);        // (0, 1]
-  const double u2 = Uniform01(rng);
-  return std::sqrt(-2 * std::log(u1)) * std::cos(2 * std::numbers::pi * u2);
-}
+// Random numbers that are the same with every standard library (tests/portable_random.hpp).
+double Uniform01(std::mt19937_64& rng) { return talus::testing::Uniform01(rng); }
+double StandardNormal(std::mt19937_64& rng) { return talus::testing::Normal()(rng); }
 std::vector<double> NormalSample(std::mt19937_64& rng, int n, double mean, double sd) {
   std::vector<double> x(static_cast<size_t>(n));
   for (double& v : x) v = mean + sd * StandardNormal(rng);

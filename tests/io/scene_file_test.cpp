@@ -15,6 +15,7 @@
 #include "common/error.hpp"
 #include "io/summary.hpp"
 #include "test_files.hpp"
+#include "tests/portable_random.hpp"
 
 namespace talus::io {
 namespace {
@@ -710,7 +711,7 @@ TEST(LoadScene, GroundRasterInAnotherCrsIsReprojected) {
   const SceneFile s = LoadScene((dir / "scene.toml").string());
   EXPECT_HAS(s.terrain_description, "ground map reprojected from EPSG:32632");
   std::mt19937_64 rng(3);
-  std::uniform_real_distribution<double> u(5, 995);
+  talus::testing::UniformReal<double> u(5, 995);
   int compared = 0;
   for (int k = 0; k < 400; ++k) {
     double px = e0 + u(rng), py = n0 + u(rng);
@@ -824,8 +825,8 @@ TEST(LoadScene, GroundPolygonsAreRasterisedOntoTheDem) {
 // `outliers` stray returns 3 .. 10 m from its centre, as an .xyz file.
 void WriteScan(const std::filesystem::path& path, int outliers) {
   std::mt19937_64 rng(51);
-  std::normal_distribution<double> g;
-  std::uniform_real_distribution<double> r(3, 10);
+  talus::testing::Normal g;
+  talus::testing::UniformReal<double> r(3, 10);
   std::ofstream out(path);
   out.precision(17);
   for (int i = 0; i < 6000; ++i) {

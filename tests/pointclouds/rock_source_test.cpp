@@ -11,6 +11,7 @@
 #include "common/error.hpp"
 #include "scenes/scenes.hpp"
 #include "test_clouds.hpp"
+#include "tests/portable_random.hpp"
 
 namespace talus::pointclouds {
 namespace {
@@ -233,7 +234,7 @@ TEST(MakeRock, InvariantUnderRotationAndGeoreferencedTranslation) {
   TempDir dir;
   std::mt19937_64 rng(16);
   auto points = testing::EllipsoidSurface(0.9, 0.6, 0.35, 1500, rng);
-  std::normal_distribution<double> noise(0, 0.01);
+  talus::testing::Normal noise(0, 0.01);
   for (auto& x : points) x += Eigen::Vector3d(noise(rng), noise(rng), noise(rng));
   const Eigen::Matrix3d turn = testing::RandomRotation(rng);
   const Eigen::Vector3d shift(2600123.4567, 1200456.789, 1543.21);

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "solver/polyhedron.hpp"
+#include "tests/portable_random.hpp"
 
 namespace talus::pointclouds::testing {
 
@@ -65,7 +66,7 @@ inline std::vector<Eigen::Vector3d> BoxCorners(double a, double b, double c) {
 // n points uniformly inside the box [-a/2, a/2] x [-b/2, b/2] x [-c/2, c/2] (shrunk by `margin`).
 inline std::vector<Eigen::Vector3d> BoxInterior(double a, double b, double c, int n,
                                                 std::mt19937_64& rng, double margin = 1e-3) {
-  std::uniform_real_distribution<double> u(-0.5 + margin, 0.5 - margin);
+  talus::testing::UniformReal<double> u(-0.5 + margin, 0.5 - margin);
   std::vector<Eigen::Vector3d> p;
   for (int i = 0; i < n; ++i) p.emplace_back(a * u(rng), b * u(rng), c * u(rng));
   return p;
@@ -74,7 +75,7 @@ inline std::vector<Eigen::Vector3d> BoxInterior(double a, double b, double c, in
 // n points uniformly distributed on the unit sphere, scaled to semi-axes (ra, rb, rc).
 inline std::vector<Eigen::Vector3d> EllipsoidSurface(double ra, double rb, double rc, int n,
                                                      std::mt19937_64& rng) {
-  std::normal_distribution<double> g;
+  talus::testing::Normal g;
   std::vector<Eigen::Vector3d> p;
   for (int i = 0; i < n; ++i) {
     const Eigen::Vector3d d = Eigen::Vector3d(g(rng), g(rng), g(rng)).normalized();
@@ -87,8 +88,8 @@ inline std::vector<Eigen::Vector3d> EllipsoidSurface(double ra, double rb, doubl
 // (faces chosen with equal probability).
 inline std::vector<Eigen::Vector3d> BoxSurface(double a, double b, double c, int n,
                                                std::mt19937_64& rng) {
-  std::uniform_real_distribution<double> u(-0.5, 0.5);
-  std::uniform_int_distribution<int> face(0, 5);
+  talus::testing::UniformReal<double> u(-0.5, 0.5);
+  talus::testing::UniformInt face(0, 5);
   std::vector<Eigen::Vector3d> p;
   for (int i = 0; i < n; ++i) {
     Eigen::Vector3d q(u(rng), u(rng), u(rng));
@@ -102,8 +103,8 @@ inline std::vector<Eigen::Vector3d> BoxSurface(double a, double b, double c, int
 // `count` stray returns in random directions, min_m .. max_m from the origin.
 inline std::vector<Eigen::Vector3d> FarOutliers(int count, double min_m, double max_m,
                                                 std::mt19937_64& rng) {
-  std::normal_distribution<double> g;
-  std::uniform_real_distribution<double> r(min_m, max_m);
+  talus::testing::Normal g;
+  talus::testing::UniformReal<double> r(min_m, max_m);
   std::vector<Eigen::Vector3d> p;
   for (int i = 0; i < count; ++i)
     p.push_back(Eigen::Vector3d(g(rng), g(rng), g(rng)).normalized() * r(rng));
@@ -111,7 +112,7 @@ inline std::vector<Eigen::Vector3d> FarOutliers(int count, double min_m, double 
 }
 
 inline Eigen::Matrix3d RandomRotation(std::mt19937_64& rng) {
-  std::normal_distribution<double> g;
+  talus::testing::Normal g;
   return Eigen::Quaterniond(g(rng), g(rng), g(rng), g(rng)).normalized().toRotationMatrix();
 }
 

@@ -111,10 +111,15 @@ TEST(Simulate, SameStartGivesBitIdenticalResults) {
 TEST(Simulate, CentreOfMassReadingIsBitIdenticalToWave1) {
   // The centre-of-mass reading of the viscous term must reproduce the results from before the
   // option existed bit for bit. Golden values recorded at d7e2d6e (g++ 12.2, Release, x86-64) for
-  // Ramp40 rocks 0 (rolls on an edge, 41.6 m/s) and 1 (tumbles, 6.4 m/s) of seed 1; another
-  // compiler or other flags may change the last bits: then re-record them from that commit.
-  // Tolerance: exact. Recorded with the contact solve's tolerance of then, 1e-7 m/s, which the
-  // test sets (the default is 1e-3 m/s since).
+  // Ramp40 rocks 0 (rolls on an edge, 41.6 m/s) and 1 (tumbles, 6.4 m/s) of seed 1: a regression
+  // check of the scheme's arithmetic, not physics. Tolerance: exact. Recorded with the contact
+  // solve's tolerance of then, 1e-7 m/s, which the test sets (the default is 1e-3 m/s since).
+  // Another compiler, flags or architecture rounds differently, and a tumbling rock's path
+  // amplifies the last bit: the values hold for the project's toolchain (g++ 12 on x86-64, as
+  // scripts/setup.sh installs it on Debian 12) and the test is skipped elsewhere, saying why.
+#if !(defined(__GNUC__) && !defined(__clang__) && __GNUC__ == 12 && defined(__x86_64__))
+  GTEST_SKIP() << "golden values of g++ 12 on x86-64; this build's compiler rounds differently";
+#endif
   struct Golden {
     int rock;
     long steps;
