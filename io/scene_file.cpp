@@ -137,11 +137,10 @@ double SolverValue(const Section& s, const SolverOptionInfo& f) {
   return 0;
 }
 
-// The keys of [solver]: preset and every scene key of kSolverOptions.
+// The keys of [solver]: preset and every key of kSolverOptions.
 std::vector<std::string> SolverKeys() {
   std::vector<std::string> keys = {"preset"};
-  for (const SolverOptionInfo& f : kSolverOptions)
-    if (f.scene_key) keys.emplace_back(f.key);
+  for (const SolverOptionInfo& f : kSolverOptions) keys.emplace_back(f.key);
   return keys;
 }
 
@@ -151,7 +150,7 @@ void LoadSolver(const Section& s, SolverOptions& o, SolverPreset& preset,
   if (s.Has("preset")) preset = static_cast<SolverPreset>(Choice(s, "preset", kSolverPresetNames));
   ApplyPreset(preset, &o);
   for (const SolverOptionInfo& f : kSolverOptions) {
-    if (!f.scene_key || !s.Has(f.key)) continue;
+    if (!s.Has(f.key)) continue;
     if (f.preset_knob) given.emplace_back(f.key);
     f.member.set(o, SolverValue(s, f));
   }

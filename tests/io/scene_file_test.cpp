@@ -350,7 +350,6 @@ TEST(LoadScene, EverySolverOptionOfTheTableIsReadAndWrittenBack) {
   const SolverOptions defaults;
   int read = 0;
   for (const SolverOptionInfo& f : kSolverOptions) {
-    if (!f.scene_key) continue;
     const double fallback = f.member.get(defaults);
     double value = 0;
     std::string text;
@@ -394,7 +393,27 @@ TEST(LoadScene, EverySolverOptionOfTheTableIsReadAndWrittenBack) {
       EXPECT_EQ(written.get<double>(), value) << f.key;
     }
   }
-  EXPECT_GE(read, 15);
+  EXPECT_EQ(read, static_cast<int>(kSolverOptions.size()));
+}
+
+// penetration_tolerance: a fraction of the rock's thickness in (0, 0.5], read from [solver] and
+// refused out of its bounds with a message naming the key.
+TEST(LoadScene, PenetrationToleranceIsASolverKeyWithItsBounds) {
+  const auto dir = testing::FreshDir("penetration_tolerance");
+  const auto with = [](const std::string& keys) {
+    return Replace(kPlaneScene, "max_time_s = 20", "max_time_s = 20\n" + keys);
+  };
+  testing::WriteText(dir / "scene.toml", kPlaneScene);
+  EXPECT_EQ(LoadScene((dir / "scene.toml").string()).scene.options.penetration_tolerance, 0.01);
+  testing::WriteText(dir / "scene.toml", with("penetration_tolerance = 0.05"));
+  EXPECT_EQ(LoadScene((dir / "scene.toml").string()).scene.options.penetration_tolerance, 0.05);
+  EXPECT_HAS(ErrorOf(with("penetration_tolerance = 0.8"), dir),
+             "scene.toml:23: solver.penetration_tolerance: penetration_tolerance = 0.8 violates "
+             "0 < penetration_tolerance <= 0.5");
+  EXPECT_HAS(ErrorOf(with("penetration_tolerance = 0"), dir),
+             "solver.penetration_tolerance: penetration_tolerance = 0 violates");
+  EXPECT_HAS(ErrorOf(with("penetration_tolerance = -1"), dir),
+             "solver.penetration_tolerance: penetration_tolerance = -1 violates");
 }
 
 // [output] percentiles: integers 1 .. 99, sorted and without repeats; the default is the p95
