@@ -116,7 +116,9 @@ TEST(LoadScene, UnknownKeysAreErrorsWithDidYouMean) {
   const std::string e3 = ErrorOf(Replace(kPlaneScene, "cell_m = 1", "cell = 1"), dir);
   EXPECT_HAS(e3, "terrain.plane.cell: unknown key (did you mean 'cell_m'?)");
   const std::string e4 = ErrorOf(Replace(kPlaneScene, "\"speed\",", "\"speeds\","), dir);
-  EXPECT_HAS(e4, "output.rasters: unknown raster 'speeds' (did you mean 'speed'?)");
+  EXPECT_HAS(e4,
+             "output.rasters: unknown raster 'speeds' (did you mean 'speed'?); known: speed, "
+             "energy, jump_height, passages, deposits, reach_probability");
   const std::string e5 = ErrorOf(Replace(kPlaneScene, "\"hard\"", "\"hrad\""), dir);
   EXPECT_HAS(e5, "terrain.default_ground: unknown ground category 'hrad' (did you mean 'hard'?)");
   const std::string e6 = ErrorOf(Replace(kPlaneScene, "seed = 42", "colour = \"red\""), dir);
@@ -414,6 +416,24 @@ TEST(LoadScene, PenetrationToleranceIsASolverKeyWithItsBounds) {
              "solver.penetration_tolerance: penetration_tolerance = 0 violates");
   EXPECT_HAS(ErrorOf(with("penetration_tolerance = -1"), dir),
              "solver.penetration_tolerance: penetration_tolerance = -1 violates");
+}
+
+// docs/scenes.md's rows of [output] rasters and raster_format name the values of the code's tables
+// (ensemble::kRasterKindNames, kRasterFormatNames), in their order.
+TEST(LoadScene, DocsNameTheRastersAndFormatsOfTheTables) {
+  std::ifstream in(std::string(TALUS_SOURCE_DIR) + "/docs/scenes.md");
+  ASSERT_TRUE(in) << "docs/scenes.md";
+  std::string rasters, formats;
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind("| `rasters` |", 0) == 0) rasters = line;
+    if (line.rfind("| `raster_format` |", 0) == 0) formats = line;
+  }
+  std::string names, quoted;
+  for (int k = 0; k < ensemble::kRasterKindNames.size(); ++k)
+    names += (k ? ", `" : "`") + std::string(ensemble::kRasterKindNames.Name(k)) + "`";
+  EXPECT_HAS(rasters, "| any of " + names + ";");
+  for (int k = 0; k < kRasterFormatNames.size(); ++k)
+    EXPECT_HAS(formats, "`\"" + std::string(kRasterFormatNames.Name(k)) + "\"`");
 }
 
 // [output] percentiles: integers 1 .. 99, sorted and without repeats; the default is the p95
