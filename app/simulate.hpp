@@ -12,6 +12,7 @@
 #include <string>
 #include <utility>
 
+#include "app/ensemble_args.hpp"
 #include "io/scene_file.hpp"
 
 namespace talus::app {
@@ -19,9 +20,7 @@ namespace talus::app {
 struct SimulateArgs {
   std::string scene;
   std::string out;
-  long rocks = 0;  // per release; 0: the scene's
-  int threads = 0;
-  std::optional<std::uint64_t> seed;
+  EnsembleArgs ensemble;   // --rocks (per release), --threads, --seed
   std::string rock_range;  // "A:B": write a partial result of rocks A .. B - 1
   std::string preset;      // --preset: fast, default, accurate; empty: the scene's
   long self_check = 0;     // --self-check N: rerun N rocks at dt/2 and compare; 0: none

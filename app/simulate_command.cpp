@@ -76,8 +76,6 @@ int LoadForSimulate(const SimulateArgs& args, io::SceneFile* scene, std::pair<lo
   }
   try {
     *scene = io::LoadScene(args.scene);
-    if (args.rocks > 0) scene->release.SetRocksPerRelease(args.rocks);
-    if (args.seed) scene->release.seed = *args.seed;
     if (!args.preset.empty()) {
       SolverPreset preset = SolverPreset::kDefault;
       if (!ParseSolverPreset(args.preset, &preset))
@@ -87,9 +85,7 @@ int LoadForSimulate(const SimulateArgs& args, io::SceneFile* scene, std::pair<lo
       for (const std::string& key : scene->solver_keys_overridden)
         std::printf("--preset %s overrides the scene's %s\n", args.preset.c_str(), key.c_str());
     }
-    // The scene was valid; only --rocks can break it now (too many rocks in all).
-    if (std::string why; !scene->release.IsValid(&why))
-      throw InputError("--rocks " + std::to_string(args.rocks) + ": " + why);
+    args.ensemble.ApplyTo(scene->release);
     if (args.self_check > 0 && !args.rock_range.empty())
       throw InputError("--self-check: not with --rock-range (check the whole run, not a part)");
     if (args.self_check > scene->release.total_rocks())
@@ -125,7 +121,7 @@ int RunSimulate(const SimulateArgs& args) {
   Verb verb{.name = "simulate", .out = args.out};
   // A run too large for this machine fails now, with the estimate and the knob to turn.
   const io::ResourceEstimate needs = io::EstimateResources(
-      scene, ensemble::WorkerThreads(args.threads, scene.release.total_rocks()));
+      scene, ensemble::WorkerThreads(args.ensemble.threads, scene.release.total_rocks()));
   io::MachineCapacity capacity;
   verb.checks = [&] {
     capacity = io::MeasureCapacity(args.out);
@@ -157,7 +153,7 @@ int RunSimulate(const SimulateArgs& args) {
     if (args.self_check > 0) {
       ensemble::SelfCheckOptions check;
       check.rocks = args.self_check;
-      check.threads = args.threads;
+      check.threads = args.ensemble.threads;
       if (!scene.evaluation_lines.empty())
         check.evaluation_lines =
             std::make_shared<const std::vector<ensemble::EvaluationLine>>(scene.evaluation_lines);
@@ -168,16 +164,16 @@ int RunSimulate(const SimulateArgs& args) {
       ThrowIfInterrupted();
     }
     ensemble::EnsembleReport report;
-    const std::vector<std::string> files =
-        RunIntoStaging(scene, args.threads, range.first, range.second, !args.rock_range.empty(),
-                       *staging, show_progress, &report, self_check ? &*self_check : nullptr);
+    const std::vector<std::string> files = RunIntoStaging(
+        scene, args.ensemble.threads, range.first, range.second, !args.rock_range.empty(), *staging,
+        show_progress, &report, self_check ? &*self_check : nullptr);
     CommitOutputs(*staging, files, args.out);
     std::printf("%s\n", report.BriefReport().c_str());
     if (self_check)
-      std::printf("%s(%.1f s; statistics as run, refined, difference +- standard error; * beyond "
-                  "%.2f standard errors, a 5 %% chance of a false alarm over all)\n",
-                  self_check->BriefReport().c_str(), self_check->wall_time_s,
-                  self_check->threshold);
+      std::printf(
+          "%s(%.1f s; statistics as run, refined, difference +- standard error; * beyond "
+          "%.2f standard errors, a 5 %% chance of a false alarm over all)\n",
+          self_check->BriefReport().c_str(), self_check->wall_time_s, self_check->threshold);
     if (!args.rock_range.empty())
       std::printf("Wrote rocks %ld:%ld of %ld as a partial result (merge with talus merge)\n",
                   range.first, range.second, scene.release.total_rocks());
@@ -197,15 +193,7 @@ Runner AddSimulateCommand(CLI::App& app) {
       "simulate", "Run a scene's rocks and write rocks.csv, rasters, trajectories");
   cmd->add_option("scene", args->scene, "Scene file (TOML)")->required();
   cmd->add_option("--out", args->out, "Output directory")->required();
-  cmd->add_option("--rocks", args->rocks, "Rocks per release (overrides the scene)")
-      ->check(IntegerRange(1, std::numeric_limits<long>::max()));
-  cmd->add_option("--threads", args->threads, "Worker threads (default: all cores)")
-      ->check(ThreadCount());
-  // The scene's range: a seed given here can be written in the scene file and the other way round.
-  cmd->add_option_function<std::uint64_t>(
-         "--seed", [args](const std::uint64_t& seed) { args->seed = seed; },
-         "Random seed (overrides the scene)")
-      ->check(IntegerRange(0, std::numeric_limits<std::int64_t>::max()));
+  AddEnsembleOptions(cmd, &args->ensemble, "release");
   cmd->add_option("--preset", args->preset,
                   "Solver accuracy: fast, default or accurate (wins over the scene's [solver] "
                   "preset and its dt_s, tolerance_m_s and max_iterations; each value it changes "

@@ -199,7 +199,8 @@ int SimulateOnRanks(const MpiSession& mpi, const SimulateArgs& args) {
           ThrowIfInterrupted();
           if (root) progress(done, rocks);
         };
-        RunIntoStaging(scene, args.threads, first, end, true, *part, show_progress, &report);
+        RunIntoStaging(scene, args.ensemble.threads, first, end, true, *part, show_progress,
+                       &report);
       },
       hooks);
   progress.Break();

@@ -13,6 +13,7 @@
 #include <optional>
 
 #include "app/commands.hpp"
+#include "app/ensemble_args.hpp"
 #include "app/interrupt.hpp"
 #include "app/run_verb.hpp"
 #include "app/simulate.hpp"
@@ -30,9 +31,7 @@ namespace {
 struct ValidateArgs {
   std::string event;
   std::string out;
-  long rocks = 0;  // per run; 0: the scene's
-  int threads = 0;
-  std::optional<std::uint64_t> seed;
+  EnsembleArgs ensemble;  // --rocks (per run), --threads, --seed
 };
 
 int RunValidate(const ValidateArgs& args) {
@@ -40,11 +39,7 @@ int RunValidate(const ValidateArgs& args) {
   io::EventFile event;
   try {
     event = io::LoadEvent(args.event);
-    ensemble::ReleaseSpec& release = event.scene.release;
-    if (args.rocks > 0) release.SetRocksPerRelease(args.rocks);
-    if (args.seed) release.seed = *args.seed;
-    if (std::string why; !release.IsValid(&why))
-      throw InputError("--rocks " + std::to_string(args.rocks) + ": " + why);
+    args.ensemble.ApplyTo(event.scene.release);
   } catch (const InputError& e) {
     std::cerr << "talus validate: " << e.what() << "\n";
     return kExitBadInput;
@@ -66,7 +61,7 @@ int RunValidate(const ValidateArgs& args) {
     staging.emplace(args.out);
     const auto out = [&](const std::string& name) { return staging->path(name); };
     ensemble::EnsembleOptions options;
-    options.threads = args.threads;
+    options.threads = args.ensemble.threads;
     options.episodes = event.needs_episodes;
     options.progress = [](long, long) { ThrowIfInterrupted(); };
     // Trajectory segments and zones: what each rock gives for them.
@@ -130,14 +125,7 @@ Runner AddValidateCommand(CLI::App& app) {
   cmd->add_option("event", args->event, "Event file (TOML): scene and observation tables")
       ->required();
   cmd->add_option("--out", args->out, "Output directory")->required();
-  cmd->add_option("--rocks", args->rocks, "Rocks per run (overrides the scene)")
-      ->check(IntegerRange(1, std::numeric_limits<long>::max()));
-  cmd->add_option("--threads", args->threads, "Worker threads (default: all cores)")
-      ->check(ThreadCount());
-  cmd->add_option_function<std::uint64_t>(
-         "--seed", [args](const std::uint64_t& seed) { args->seed = seed; },
-         "Random seed (overrides the scene)")
-      ->check(IntegerRange(0, std::numeric_limits<std::int64_t>::max()));
+  AddEnsembleOptions(cmd, &args->ensemble, "run");
   return [cmd, args]() { return *cmd ? RunValidate(*args) : -1; };
 }
 

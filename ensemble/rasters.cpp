@@ -1,11 +1,34 @@
 #include "ensemble/rasters.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cassert>
 #include <cmath>
-#include <tuple>
+#include <utility>
 
 namespace talus::ensemble {
+
+namespace {
+
+constexpr std::array<const char*, 6> kRasterKinds = {"speed",    "energy",   "jump_height",
+                                                     "passages", "deposits", "reach_probability"};
+// RasterRequest's flag of each kind, in RasterKind's order.
+constexpr std::array<bool RasterRequest::*, 6> kRasterFlags = {
+    &RasterRequest::speed,    &RasterRequest::energy,   &RasterRequest::jump_height,
+    &RasterRequest::passages, &RasterRequest::deposits, &RasterRequest::reach_probability};
+
+}  // namespace
+
+constinit const EnumNames kRasterKindNames{"raster", kRasterKinds};
+
+const char* ToString(RasterKind kind) { return kRasterKindNames.NameOf(kind); }
+
+bool& RasterRequest::Wants(RasterKind kind) {
+  return this->*kRasterFlags[static_cast<std::size_t>(kind)];
+}
+bool RasterRequest::Wants(RasterKind kind) const {
+  return this->*kRasterFlags[static_cast<std::size_t>(kind)];
+}
 
 FootprintRecorder::FootprintRecorder(const RasterRequest& request, const Terrain& terrain)
     : request_(request),
@@ -171,12 +194,12 @@ std::vector<RasterLayer> RasterAccumulator::Finish(const Heightfield& dem) const
                        quantity, statistic, description};
   };
   int quantity = 0;
-  for (auto [wanted, name, unit] :
-       {std::tuple{request_.speed, "speed", "m/s"}, std::tuple{request_.energy, "energy", "J"},
-        std::tuple{request_.jump_height, "jump_height", "m"}}) {
-    if (!wanted) continue;
-    const std::string what = name;
-    const std::string shown = what == "jump_height" ? "jump height" : what;
+  for (auto [kind, unit] :
+       {std::pair{RasterKind::kSpeed, "m/s"}, std::pair{RasterKind::kEnergy, "J"},
+        std::pair{RasterKind::kJumpHeight, "m"}}) {
+    if (!request_.Wants(kind)) continue;
+    const std::string what = ToString(kind);
+    const std::string shown = kind == RasterKind::kJumpHeight ? "jump height" : what;
     const std::size_t first = out.size();
     out.push_back(
         layer(what, "max", unit, shown + ", largest over passing rocks", RasterLayer::kNoData));
@@ -200,15 +223,17 @@ std::vector<RasterLayer> RasterAccumulator::Finish(const Heightfield& dem) const
     ++quantity;
   }
   if (request_.passages) {
-    out.push_back(layer("passages", "count", "count", "passages, rocks that passed the cell", 0));
+    out.push_back(layer(ToString(RasterKind::kPassages), "count", "count",
+                        "passages, rocks that passed the cell", 0));
     std::copy(passages_.begin(), passages_.end(), out.back().values.begin());
   }
   if (request_.deposits) {
-    out.push_back(layer("deposits", "count", "count", "deposits, rocks at rest in the cell", 0));
+    out.push_back(layer(ToString(RasterKind::kDeposits), "count", "count",
+                        "deposits, rocks at rest in the cell", 0));
     std::copy(deposits_.begin(), deposits_.end(), out.back().values.begin());
   }
   if (request_.reach_probability) {
-    out.push_back(layer("reach_probability", "fraction", "1",
+    out.push_back(layer(ToString(RasterKind::kReachProbability), "fraction", "1",
                         "reach probability, fraction of all rocks that passed the cell", 0));
     for (std::size_t c = 0; c < cells; ++c)
       out.back().values[c] =
@@ -241,10 +266,12 @@ std::string PercentileList(const std::vector<std::int32_t>& percentiles) {
   return text.empty() ? "none" : text;
 }
 
+// Bit k: the raster of kind k (RasterKind's order) is requested.
 std::uint32_t RequestBits(const RasterRequest& r) {
-  return std::uint32_t(r.speed) | std::uint32_t(r.energy) << 1 | std::uint32_t(r.jump_height) << 2 |
-         std::uint32_t(r.passages) << 3 | std::uint32_t(r.deposits) << 4 |
-         std::uint32_t(r.reach_probability) << 5;
+  std::uint32_t bits = 0;
+  for (int k = 0; k < kRasterKindNames.size(); ++k)
+    bits |= std::uint32_t(r.Wants(static_cast<RasterKind>(k))) << k;
+  return bits;
 }
 
 // The cells with a non-zero count, and their counts.

@@ -11,10 +11,19 @@
 #include "ensemble/cell_summary.hpp"
 #include "ensemble/outcome.hpp"
 #include "ensemble/recorders.hpp"
+#include "solver/option_table.hpp"
 #include "solver/simulate.hpp"
 #include "solver/terrain.hpp"
 
 namespace talus::ensemble {
+
+// The rasters a scene's [output] rasters may name, in the order of RasterRequest's flags. The first
+// three are statistics rasters (<name>_max, _mean, _p<NN>), the others one raster each.
+enum class RasterKind { kSpeed, kEnergy, kJumpHeight, kPassages, kDeposits, kReachProbability };
+// "speed", "energy", "jump_height", "passages", "deposits", "reach_probability": the scene's
+// [output] rasters, summary.json's raster_output and the rasters' file names read this one list.
+extern const EnumNames kRasterKindNames;
+const char* ToString(RasterKind kind);
 
 // Which rasters to accumulate; nothing requested means no raster work at all. Cells are those of
 // `grid`: node (i, j) is the centre of cell (i, j), as for the DEM.
@@ -30,6 +39,10 @@ struct RasterRequest {
   // The percentiles (percent, ascending, each 1 .. 99) of the *_p<NN> rasters of speed, energy
   // and jump height.
   std::vector<int> percentiles = {95};
+
+  // The flag of `kind`.
+  bool& Wants(RasterKind kind);
+  bool Wants(RasterKind kind) const;
 
   bool any() const {
     return speed || energy || jump_height || passages || deposits || reach_probability;

@@ -90,71 +90,82 @@ std::string Number(double v, const char* format = "%.3g") {
   return FormatOrMissing(v, format, "-");
 }
 
-}  // namespace
-
-ValidationReport Validate(const ObservationSet& observations, const EnsembleSamples& simulated,
-                          const EnsembleSamples* reference, const ValidationOptions& options) {
-  ValidationReport report;
-  RockRandom uniforms(options.seed, kPitStream);
-
-  // Scalars. Climatology: the other observations of the same quantity (leave-one-out), scored
-  // when there are at least min_members of them.
+// Scalars' climatology: the other observations of the same quantity (leave-one-out), scored
+// when there are at least min_members of them; NaN where there is none.
+std::vector<double> ScalarClimatologyScores(const ObservationSet& observations, int min_members) {
   std::vector<double> scalar_climatology(observations.scalars.size(), kNaN);
-  {
-    std::map<Quantity, std::vector<std::size_t>> by_quantity;
-    for (std::size_t k = 0; k < observations.scalars.size(); ++k)
-      by_quantity[observations.scalars[k].quantity].push_back(k);
-    for (const auto& [quantity, indices] : by_quantity) {
-      if (static_cast<int>(indices.size()) - 1 < options.min_members) continue;
-      std::vector<double> values;
-      for (std::size_t k : indices) values.push_back(observations.scalars[k].value);
-      const std::vector<double> scores = LeaveOneOutCrps(values);
-      for (std::size_t i = 0; i < indices.size(); ++i) scalar_climatology[indices[i]] = scores[i];
-    }
+  std::map<Quantity, std::vector<std::size_t>> by_quantity;
+  for (std::size_t k = 0; k < observations.scalars.size(); ++k)
+    by_quantity[observations.scalars[k].quantity].push_back(k);
+  for (const auto& [quantity, indices] : by_quantity) {
+    if (static_cast<int>(indices.size()) - 1 < min_members) continue;
+    std::vector<double> values;
+    for (std::size_t k : indices) values.push_back(observations.scalars[k].value);
+    const std::vector<double> scores = LeaveOneOutCrps(values);
+    for (std::size_t i = 0; i < indices.size(); ++i) scalar_climatology[indices[i]] = scores[i];
   }
+  return scalar_climatology;
+}
+
+// Deposits' climatology: the other runs' observed displacements from their release, applied to
+// this run's release (leave-one-out); none (NaN) for observations of the whole scene. Scored
+// against this run's deposit, that is the energy score of this run's displacement against the
+// others'.
+std::vector<double> DepositClimatologyScores(const ObservationSet& observations,
+                                             const EnsembleSamples& simulated, int min_members) {
+  std::vector<double> deposit_climatology(observations.deposits.size(), kNaN);
+  std::vector<std::size_t> indices;
+  std::vector<Eigen::Vector2d> displacements;
+  for (std::size_t k = 0; k < observations.deposits.size(); ++k)
+    if (const auto start = simulated.StartOf(observations.deposits[k].run)) {
+      indices.push_back(k);
+      displacements.push_back(observations.deposits[k].xy_m - *start);
+    }
+  if (static_cast<int>(indices.size()) - 1 >= min_members) {
+    const std::vector<double> scores = LeaveOneOutEnergyScores(displacements);
+    for (std::size_t i = 0; i < indices.size(); ++i) deposit_climatology[indices[i]] = scores[i];
+  }
+  return deposit_climatology;
+}
+
+// Every scalar observation's score, with its leave-one-out climatology.
+void ScoreScalars(const ObservationSet& observations, const EnsembleSamples& simulated,
+                  const EnsembleSamples* reference, const ValidationOptions& options,
+                  ValidationReport& report) {
+  RockRandom uniforms(options.seed, kPitStream);
+  const std::vector<double> scalar_climatology =
+      ScalarClimatologyScores(observations, options.min_members);
   for (std::size_t k = 0; k < observations.scalars.size(); ++k) {
     const ScalarObservation& o = observations.scalars[k];
-    ObservationScore s;
-    s.kind = ToString(o.quantity);
-    s.unit = UnitOf(o.quantity);
-    s.run = o.run;
-    s.where = o.where;
-    s.observed = o.value;
+    ObservationScore s{.kind = ToString(o.quantity),
+                       .unit = UnitOf(o.quantity),
+                       .run = o.run,
+                       .where = o.where,
+                       .observed = o.value};
     const double u = uniforms.Uniform();  // drawn for every observation: scores do not shift
     ScoreScalarObservation(o, simulated, reference, scalar_climatology[k], u, options.min_members,
                            s);
     report.observations.push_back(s);
   }
-  // Deposits. Climatology: the other runs' observed displacements from their release, applied to
-  // this run's release (leave-one-out); none for observations of the whole scene. Scored against
-  // this run's deposit, that is the energy score of this run's displacement against the others'.
-  std::vector<double> deposit_climatology(observations.deposits.size(), kNaN);
-  {
-    std::vector<std::size_t> indices;
-    std::vector<Eigen::Vector2d> displacements;
-    for (std::size_t k = 0; k < observations.deposits.size(); ++k)
-      if (const auto start = simulated.StartOf(observations.deposits[k].run)) {
-        indices.push_back(k);
-        displacements.push_back(observations.deposits[k].xy_m - *start);
-      }
-    if (static_cast<int>(indices.size()) - 1 >= options.min_members) {
-      const std::vector<double> scores = LeaveOneOutEnergyScores(displacements);
-      for (std::size_t i = 0; i < indices.size(); ++i) deposit_climatology[indices[i]] = scores[i];
-    }
-  }
+}
+
+// Every deposit observation's score, with its leave-one-out climatology.
+void ScoreDeposits(const ObservationSet& observations, const EnsembleSamples& simulated,
+                   const EnsembleSamples* reference, const ValidationOptions& options,
+                   ValidationReport& report) {
+  const std::vector<double> deposit_climatology =
+      DepositClimatologyScores(observations, simulated, options.min_members);
   for (std::size_t k = 0; k < observations.deposits.size(); ++k) {
     const DepositObservation& o = observations.deposits[k];
-    ObservationScore s;
-    s.kind = "deposit";
-    s.unit = "m";
-    s.run = o.run;
-    s.where = o.where;
-    s.observed_xy_m = o.xy_m;
+    ObservationScore s{
+        .kind = "deposit", .unit = "m", .run = o.run, .where = o.where, .observed_xy_m = o.xy_m};
     ScoreDeposit(o, simulated, reference, deposit_climatology[k], options.min_members, s);
     report.observations.push_back(s);
   }
+}
 
-  // Per kind.
+// The per-kind summaries of the observation scores and the report's skill scores.
+void SummarizeKinds(ValidationReport& report) {
   std::map<std::string, std::size_t> index;
   for (const ObservationScore& s : report.observations) {
     if (!index.count(s.kind)) {
@@ -211,6 +222,16 @@ ValidationReport Validate(const ObservationSet& observations, const EnsembleSamp
   }
   report.skill_vs_reference = Mean(ref_skills);
   report.skill_vs_climatology = Mean(clim_skills);
+}
+
+}  // namespace
+
+ValidationReport Validate(const ObservationSet& observations, const EnsembleSamples& simulated,
+                          const EnsembleSamples* reference, const ValidationOptions& options) {
+  ValidationReport report;
+  ScoreScalars(observations, simulated, reference, options, report);
+  ScoreDeposits(observations, simulated, reference, options, report);
+  SummarizeKinds(report);
   return report;
 }
 

@@ -34,7 +34,7 @@ struct ObservationScore {
   double observed = kNaN;
   Eigen::Vector2d observed_xy_m = Eigen::Vector2d::Constant(kNaN);  // deposits
   bool scored = false;
-  std::string not_scored;  // why, when not scored
+  std::string not_scored = {};  // why, when not scored
   int members = 0;
   double score = kNaN;  // CRPS or energy score, in `unit`
   double pit = kNaN;

@@ -13,6 +13,8 @@
 #include "common/closest_name.hpp"
 #include "common/csv_table.hpp"
 #include "common/error.hpp"
+#include "common/fnv1a.hpp"
+#include "common/format.hpp"
 #include "ensemble/release.hpp"
 #include "fieldobs/single_impacts.hpp"
 #include "io/toml_section.hpp"
@@ -36,18 +38,11 @@ fieldobs::SingleImpactColumns SingleImpactColumnsOf(const Section& o) {
   return c;
 }
 
-// A number for messages: 10 significant digits.
-std::string Fmt(double v) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof buffer, "%.10g", v);
-  return buffer;
-}
-
 // "(the DEM covers x .. y ..)" of a scene, for messages about places off it.
 std::string DemCover(const SceneFile& scene) {
   const GridGeometry& g = scene.scene.terrain.heights().grid;
-  return "(the DEM covers x " + Fmt(g.x0_m) + " .. " + Fmt(g.x_max_m()) + ", y " + Fmt(g.y0_m) +
-         " .. " + Fmt(g.y_max_m()) + ")";
+  return "(the DEM covers x " + TenDigits(g.x0_m) + " .. " + TenDigits(g.x_max_m()) + ", y " +
+         TenDigits(g.y0_m) + " .. " + TenDigits(g.y_max_m()) + ")";
 }
 
 // The header of a table, for messages: "a, b, c".
@@ -77,6 +72,217 @@ GroundTable ReferenceGround(const GroundTable& scene_ground, bool* differs) {
   return out;
 }
 
+namespace {
+
+// [[zones]]: lines and polygons that zone observations refer to.
+void LoadZones(const Context& context, const Section& top, EventFile& event) {
+  const toml::node* zones = top.Node("zones");
+  if (!zones) return;
+  const toml::array* list = zones->as_array();
+  if (!list) top.Fail("zones", "expected [[zones]] tables (id, line or polygon)");
+  for (std::size_t k = 0; k < list->size(); ++k) {
+    const std::string name = "zones[" + std::to_string(k) + "]";
+    const toml::table* t = list->get(k)->as_table();
+    if (!t) context.Fail(list->get(k), name, "expected a table (id, line or polygon)");
+    const Section z(context, t, name, {"id", "line", "polygon"});
+    fieldobs::Zone zone;
+    if (!z.Has("id")) context.Fail(t, name + ".id", "missing");
+    zone.id = z.String("id", "");
+    for (const fieldobs::Zone& other : event.observations.zones)
+      if (other.id == zone.id) z.Fail("id", "zone '" + zone.id + "' is defined twice");
+    zone.polygon = z.Has("polygon");
+    if (zone.polygon == z.Has("line"))
+      context.Fail(t, name,
+                   "give exactly one of line and polygon ([[x, y], ...], map coordinates)");
+    const char* key = zone.polygon ? "polygon" : "line";
+    const toml::array* points = z.Node(key)->as_array();
+    if (!points) z.Fail(key, "expected a list of [x, y] points (finite, m)");
+    for (std::size_t p = 0; p < points->size(); ++p) {
+      const std::vector<double> xy =
+          z.NumbersOf(points->get(p), z.Key(key) + "[" + std::to_string(p) + "]", 2);
+      zone.points.emplace_back(xy[0], xy[1]);
+    }
+    if (zone.points.size() < (zone.polygon ? 3u : 2u))
+      z.Fail(key,
+             zone.polygon ? "a polygon needs at least 3 points" : "a line needs at least 2 points");
+    // A zone no rock can reach would score its observations against no rock ('passed' = 0 as
+    // perfect): an error (another CRS, swapped coordinates), as for evaluation lines.
+    ensemble::ReleaseGeometry geometry;
+    geometry.kind = zone.polygon ? ensemble::ReleaseGeometry::Kind::kPolygon
+                                 : ensemble::ReleaseGeometry::Kind::kLine;
+    geometry.rings = {zone.points};
+    if (!(ensemble::FractionOnTerrain(event.scene.scene.terrain, geometry) > 0))
+      z.Fail(key, "the zone '" + zone.id + "' lies entirely outside the DEM or on nodata " +
+                      DemCover(event.scene) + ", so no rock can reach it");
+    event.observations.zones.push_back(zone);
+  }
+}
+
+// The keys of one [[observations]] table that depend on its kind; returns the kind.
+std::string CheckObservationKeys(const Context& context, const toml::table* t, const Section& o) {
+  for (const char* required : {"kind", "file"})
+    if (!o.Has(required)) context.Fail(t, o.Key(required), "missing");
+  const std::string kind = o.String("kind", "");
+  if (std::find(kKinds.begin(), kKinds.end(), kind) == kKinds.end()) {
+    const std::string hint = ClosestName(kind, kKinds);
+    o.Fail("kind", "unknown kind '" + kind + "'" +
+                       (hint.empty() ? "" : " (did you mean '" + hint + "'?)") +
+                       "; known: runout, deposits, impacts, scars, trajectories, zones, "
+                       "single_impacts");
+  }
+  for (const char* key :
+       {"id_column", "energy_ratio_column", "speed_out_column", "scar_depth_column"})
+    if (o.Has(key) && kind != "single_impacts")
+      o.Fail(key, "only single_impacts tables take " + std::string(key));
+  if (o.Has("run_column") && kind == "single_impacts")
+    o.Fail("run_column", "single_impacts name their runs by id_column (default impact_id)");
+  return kind;
+}
+
+// Rest positions as points of a vector file, placed in the DEM's CRS.
+void ReadDepositVector(const Context& context, const Section& o, const std::string& file,
+                       const fieldobs::TableColumns& columns, EventFile& event) {
+  const auto points = ReadDepositPoints(file, event.scene.crs_wkt, columns.run,
+                                        context.Where(o.Node("file")) + ": " + o.Key("file"));
+  // A point without a run has no field run_column (a present field's empty value is an error).
+  if (o.Has("run_column"))
+    for (const fieldobs::DepositObservation& d : points)
+      if (d.run.empty()) o.Fail("run_column", d.where + " has no field '" + columns.run + "'");
+  event.observations.deposits.insert(event.observations.deposits.end(), points.begin(),
+                                     points.end());
+}
+
+// The observations of one CSV table, read by the reader of its kind.
+void ReadObservationCsv(const Section& o, const std::string& kind, const std::string& file,
+                        const fieldobs::TableColumns& columns, const CsvTable* omega_samples,
+                        EventFile& event) {
+  const CsvTable table = CsvTable::Read(file);
+  // Without its run column every row would be an observation of the whole scene: a run column
+  // named on purpose must be there.
+  if (o.Has("run_column") && !table.Has(columns.run))
+    o.Fail("run_column", file + " has no column '" + columns.run +
+                             "' (the header has: " + ColumnsOf(table) + ")");
+  fieldobs::ObservationSet& into = event.observations;
+  if (kind == "runout") fieldobs::ReadRunouts(table, columns, into);
+  if (kind == "deposits") fieldobs::ReadDeposits(table, columns, into);
+  if (kind == "impacts") fieldobs::ReadImpacts(table, columns, into, omega_samples);
+  if (kind == "scars") fieldobs::ReadScars(table, columns, into);
+  if (kind == "trajectories")
+    fieldobs::ReadTrajectories(table, columns, event.scene.scene.terrain, into);
+  if (kind == "zones") fieldobs::ReadZoneObservations(table, columns, into);
+  if (kind == "single_impacts")
+    fieldobs::ReadSingleImpactOutcomes(table, SingleImpactColumnsOf(o), into);
+}
+
+// One [[observations]] table (kind, file, ...): its observations and input files join `event`.
+void LoadObservationTable(const Context& context, const toml::node* node, const std::string& name,
+                          EventFile& event) {
+  const toml::table* t = node->as_table();
+  if (!t) context.Fail(node, name, "expected a table (kind, file)");
+  const Section o(context, t, name,
+                  {"kind", "file", "run_column", "omega_from", "id_column", "energy_ratio_column",
+                   "speed_out_column", "scar_depth_column"});
+  const std::string kind = CheckObservationKeys(context, t, o);
+  const std::string file = context.Resolve(o.String("file", ""));
+  if (!fs::exists(file)) o.Fail("file", "file not found: " + file);
+  fieldobs::TableColumns columns;
+  columns.run = o.String("run_column", columns.run);
+  // Impacts: the angular speed after each impact from the next segment's first sample.
+  std::optional<CsvTable> omega_samples;
+  std::string omega_file;
+  if (o.Has("omega_from")) {
+    if (kind != "impacts")
+      o.Fail("omega_from", "only impacts take omega_from (a table of trajectory samples)");
+    omega_file = context.Resolve(o.String("omega_from", ""));
+    if (!fs::exists(omega_file)) o.Fail("omega_from", "file not found: " + omega_file);
+    omega_samples = CsvTable::Read(omega_file);
+  }
+  const std::size_t before = event.observations.size();
+  const std::string extension = fs::path(file).extension().string();
+  const bool csv = extension == ".csv" || extension == ".txt";
+  if (!csv && kind != "deposits")
+    o.Fail("file",
+           file + ": " + kind + " observations are CSV tables (.csv); vector files hold deposits");
+  if (csv)
+    ReadObservationCsv(o, kind, file, columns, omega_samples ? &*omega_samples : nullptr, event);
+  else
+    ReadDepositVector(context, o, file, columns, event);
+  if (event.observations.size() == before) o.Fail("file", file + " holds no observation");
+  event.needs_episodes =
+      event.needs_episodes || kind == "impacts" || kind == "scars" || kind == "single_impacts";
+  for (const std::string& input : {file, omega_file})
+    if (!input.empty() &&
+        std::find(event.inputs.begin(), event.inputs.end(), input) == event.inputs.end())
+      event.inputs.push_back(input);
+}
+
+// Every observation's run must be a run of the scene.
+void CheckObservationRuns(const EventFile& event) {
+  std::set<std::string> runs;
+  const ensemble::ReleaseSpec& release = event.scene.release;
+  for (long r = 0; r < release.release_count(); ++r)
+    runs.insert(release.ReleaseName(static_cast<int>(r)));
+  const auto check = [&](const std::string& run, const std::string& where) {
+    if (!run.empty() && !runs.count(run))
+      throw InputError(
+          where + ": run '" + run + "' is not a run of the scene " + event.scene.path +
+          (release.runs.empty() ? " (it has no run table; runs are named 0, 1, ...)" : ""));
+  };
+  for (const auto& o : event.observations.scalars) check(o.run, o.where);
+  for (const auto& o : event.observations.deposits) check(o.run, o.where);
+}
+
+// A run is one release of one block: each quantity of it (at each zone) was observed once. A
+// second row would count twice, or contradict the first; observations of the whole scene (no
+// run) may repeat.
+void CheckObservedOnce(const fieldobs::ObservationSet& observations) {
+  std::map<std::tuple<fieldobs::Quantity, std::string, int>, std::string> first_scalar;
+  for (const auto& o : observations.scalars) {
+    if (o.run.empty()) continue;
+    if (const auto [at, added] =
+            first_scalar.emplace(std::tuple(o.quantity, o.run, o.zone), o.where);
+        !added)
+      throw InputError(
+          o.where + ": run '" + o.run + "' has a second " + fieldobs::ToString(o.quantity) +
+          " observation" +
+          (o.zone >= 0
+               ? " at zone '" + observations.zones[static_cast<std::size_t>(o.zone)].id + "'"
+               : std::string()) +
+          " (the first: " + at->second + "); a run's quantity is observed once");
+  }
+  std::map<std::string, std::string> first_deposit;
+  for (const auto& o : observations.deposits) {
+    if (o.run.empty()) continue;
+    if (const auto [at, added] = first_deposit.emplace(o.run, o.where); !added)
+      throw InputError(o.where + ": run '" + o.run + "' has a second rest position (the first: " +
+                       at->second + "); a run's block rests at one place");
+  }
+}
+
+// A rest position off the terrain is one no rock can reach: another CRS or swapped coordinates.
+void CheckDepositsOnTerrain(const EventFile& event) {
+  for (const auto& o : event.observations.deposits)
+    if (!ensemble::OnTerrain(event.scene.scene.terrain, o.xy_m))
+      throw InputError(o.where + ": the rest position (" + TenDigits(o.xy_m.x()) + ", " +
+                       TenDigits(o.xy_m.y()) + ") is outside the DEM or on nodata " +
+                       DemCover(event.scene) + ", so no rock can rest there");
+}
+
+// The hash covers the event file, the observation tables and the scene's own hash.
+std::string InputsHash(const EventFile& event) {
+  std::uint64_t h = kFnv1aStart;
+  for (std::size_t k = 0; k < event.inputs.size() - event.scene.inputs.size(); ++k) {
+    std::ifstream in(event.inputs[k], std::ios::binary);
+    h = Fnv1a64(std::string(std::istreambuf_iterator<char>(in), {}), h);
+  }
+  h = Fnv1a64(event.scene.inputs_hash, h);
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
+  return hex;
+}
+
+}  // namespace
+
 EventFile LoadEvent(const std::string& path) {
   const toml::table root = ParseTomlFile(path, "event file");
   const Context context(path);
@@ -95,47 +301,7 @@ EventFile LoadEvent(const std::string& path) {
   if (event.reference != "table1" && event.reference != "none")
     top.Fail("reference", "'" + event.reference + "': expected \"table1\" or \"none\"");
 
-  // [[zones]]: lines and polygons that zone observations refer to.
-  if (const toml::node* zones = top.Node("zones")) {
-    const toml::array* list = zones->as_array();
-    if (!list) top.Fail("zones", "expected [[zones]] tables (id, line or polygon)");
-    for (std::size_t k = 0; k < list->size(); ++k) {
-      const std::string name = "zones[" + std::to_string(k) + "]";
-      const toml::table* t = list->get(k)->as_table();
-      if (!t) context.Fail(list->get(k), name, "expected a table (id, line or polygon)");
-      const Section z(context, t, name, {"id", "line", "polygon"});
-      fieldobs::Zone zone;
-      if (!z.Has("id")) context.Fail(t, name + ".id", "missing");
-      zone.id = z.String("id", "");
-      for (const fieldobs::Zone& other : event.observations.zones)
-        if (other.id == zone.id) z.Fail("id", "zone '" + zone.id + "' is defined twice");
-      zone.polygon = z.Has("polygon");
-      if (zone.polygon == z.Has("line"))
-        context.Fail(t, name,
-                     "give exactly one of line and polygon ([[x, y], ...], map coordinates)");
-      const char* key = zone.polygon ? "polygon" : "line";
-      const toml::array* points = z.Node(key)->as_array();
-      if (!points) z.Fail(key, "expected a list of [x, y] points (finite, m)");
-      for (std::size_t p = 0; p < points->size(); ++p) {
-        const std::vector<double> xy =
-            z.NumbersOf(points->get(p), z.Key(key) + "[" + std::to_string(p) + "]", 2);
-        zone.points.emplace_back(xy[0], xy[1]);
-      }
-      if (zone.points.size() < (zone.polygon ? 3u : 2u))
-        z.Fail(key, zone.polygon ? "a polygon needs at least 3 points"
-                                 : "a line needs at least 2 points");
-      // A zone no rock can reach would score its observations against no rock ('passed' = 0 as
-      // perfect): an error (another CRS, swapped coordinates), as for evaluation lines.
-      ensemble::ReleaseGeometry geometry;
-      geometry.kind = zone.polygon ? ensemble::ReleaseGeometry::Kind::kPolygon
-                                   : ensemble::ReleaseGeometry::Kind::kLine;
-      geometry.rings = {zone.points};
-      if (!(ensemble::FractionOnTerrain(event.scene.scene.terrain, geometry) > 0))
-        z.Fail(key, "the zone '" + zone.id + "' lies entirely outside the DEM or on nodata " +
-                        DemCover(event.scene) + ", so no rock can reach it");
-      event.observations.zones.push_back(zone);
-    }
-  }
+  LoadZones(context, top, event);
 
   const toml::node* list = top.Node("observations");
   if (!list) context.Fail(&root, "observations", "missing: give [[observations]] tables");
@@ -143,149 +309,15 @@ EventFile LoadEvent(const std::string& path) {
   if (!tables || tables->empty())
     top.Fail("observations", "expected [[observations]] tables (kind, file)");
   event.inputs.push_back(path);
-  for (std::size_t k = 0; k < tables->size(); ++k) {
-    const std::string name = "observations[" + std::to_string(k) + "]";
-    const toml::table* t = tables->get(k)->as_table();
-    if (!t) context.Fail(tables->get(k), name, "expected a table (kind, file)");
-    const Section o(context, t, name,
-                    {"kind", "file", "run_column", "omega_from", "id_column", "energy_ratio_column",
-                     "speed_out_column", "scar_depth_column"});
-    for (const char* required : {"kind", "file"})
-      if (!o.Has(required)) context.Fail(t, o.Key(required), "missing");
-    const std::string kind = o.String("kind", "");
-    if (std::find(kKinds.begin(), kKinds.end(), kind) == kKinds.end()) {
-      const std::string hint = ClosestName(kind, kKinds);
-      o.Fail("kind", "unknown kind '" + kind + "'" +
-                         (hint.empty() ? "" : " (did you mean '" + hint + "'?)") +
-                         "; known: runout, deposits, impacts, scars, trajectories, zones, "
-                         "single_impacts");
-    }
-    for (const char* key :
-         {"id_column", "energy_ratio_column", "speed_out_column", "scar_depth_column"})
-      if (o.Has(key) && kind != "single_impacts")
-        o.Fail(key, "only single_impacts tables take " + std::string(key));
-    if (o.Has("run_column") && kind == "single_impacts")
-      o.Fail("run_column", "single_impacts name their runs by id_column (default impact_id)");
-    const std::string file = context.Resolve(o.String("file", ""));
-    if (!fs::exists(file)) o.Fail("file", "file not found: " + file);
-    fieldobs::TableColumns columns;
-    columns.run = o.String("run_column", columns.run);
-    // Impacts: the angular speed after each impact from the next segment's first sample.
-    std::optional<CsvTable> omega_samples;
-    std::string omega_file;
-    if (o.Has("omega_from")) {
-      if (kind != "impacts")
-        o.Fail("omega_from", "only impacts take omega_from (a table of trajectory samples)");
-      omega_file = context.Resolve(o.String("omega_from", ""));
-      if (!fs::exists(omega_file)) o.Fail("omega_from", "file not found: " + omega_file);
-      omega_samples = CsvTable::Read(omega_file);
-    }
-    const std::size_t before = event.observations.size();
-    const std::string extension = fs::path(file).extension().string();
-    const bool csv = extension == ".csv" || extension == ".txt";
-    if (!csv && kind != "deposits")
-      o.Fail("file", file + ": " + kind +
-                         " observations are CSV tables (.csv); vector files hold deposits");
-    if (!csv) {
-      // Rest positions as points of a vector file, placed in the DEM's CRS.
-      const auto points = ReadDepositPoints(file, event.scene.crs_wkt, columns.run,
-                                            context.Where(o.Node("file")) + ": " + o.Key("file"));
-      // A point without a run has no field run_column (a present field's empty value is an error).
-      if (o.Has("run_column"))
-        for (const fieldobs::DepositObservation& d : points)
-          if (d.run.empty()) o.Fail("run_column", d.where + " has no field '" + columns.run + "'");
-      event.observations.deposits.insert(event.observations.deposits.end(), points.begin(),
-                                         points.end());
-    } else {
-      const CsvTable table = CsvTable::Read(file);
-      // Without its run column every row would be an observation of the whole scene: a run column
-      // named on purpose must be there.
-      if (o.Has("run_column") && !table.Has(columns.run))
-        o.Fail("run_column", file + " has no column '" + columns.run +
-                                 "' (the header has: " + ColumnsOf(table) + ")");
-      if (kind == "runout") fieldobs::ReadRunouts(table, columns, event.observations);
-      if (kind == "deposits") fieldobs::ReadDeposits(table, columns, event.observations);
-      if (kind == "impacts")
-        fieldobs::ReadImpacts(table, columns, event.observations,
-                              omega_samples ? &*omega_samples : nullptr);
-      if (kind == "scars") fieldobs::ReadScars(table, columns, event.observations);
-      if (kind == "trajectories")
-        fieldobs::ReadTrajectories(table, columns, event.scene.scene.terrain, event.observations);
-      if (kind == "zones") fieldobs::ReadZoneObservations(table, columns, event.observations);
-      if (kind == "single_impacts")
-        fieldobs::ReadSingleImpactOutcomes(table, SingleImpactColumnsOf(o), event.observations);
-    }
-    if (event.observations.size() == before) o.Fail("file", file + " holds no observation");
-    event.needs_episodes =
-        event.needs_episodes || kind == "impacts" || kind == "scars" || kind == "single_impacts";
-    for (const std::string& input : {file, omega_file})
-      if (!input.empty() &&
-          std::find(event.inputs.begin(), event.inputs.end(), input) == event.inputs.end())
-        event.inputs.push_back(input);
-  }
+  for (std::size_t k = 0; k < tables->size(); ++k)
+    LoadObservationTable(context, tables->get(k), "observations[" + std::to_string(k) + "]", event);
 
-  // Every observation's run must be a run of the scene.
-  std::set<std::string> runs;
-  const ensemble::ReleaseSpec& release = event.scene.release;
-  for (long r = 0; r < release.release_count(); ++r)
-    runs.insert(release.ReleaseName(static_cast<int>(r)));
-  const auto check = [&](const std::string& run, const std::string& where) {
-    if (!run.empty() && !runs.count(run))
-      throw InputError(
-          where + ": run '" + run + "' is not a run of the scene " + event.scene.path +
-          (release.runs.empty() ? " (it has no run table; runs are named 0, 1, ...)" : ""));
-  };
-  for (const auto& o : event.observations.scalars) check(o.run, o.where);
-  for (const auto& o : event.observations.deposits) check(o.run, o.where);
-
-  // A run is one release of one block: each quantity of it (at each zone) was observed once. A
-  // second row would count twice, or contradict the first; observations of the whole scene (no
-  // run) may repeat.
-  std::map<std::tuple<fieldobs::Quantity, std::string, int>, std::string> first_scalar;
-  for (const auto& o : event.observations.scalars) {
-    if (o.run.empty()) continue;
-    if (const auto [at, added] =
-            first_scalar.emplace(std::tuple(o.quantity, o.run, o.zone), o.where);
-        !added)
-      throw InputError(
-          o.where + ": run '" + o.run + "' has a second " + fieldobs::ToString(o.quantity) +
-          " observation" +
-          (o.zone >= 0
-               ? " at zone '" + event.observations.zones[static_cast<std::size_t>(o.zone)].id + "'"
-               : std::string()) +
-          " (the first: " + at->second + "); a run's quantity is observed once");
-  }
-  std::map<std::string, std::string> first_deposit;
-  for (const auto& o : event.observations.deposits) {
-    if (o.run.empty()) continue;
-    if (const auto [at, added] = first_deposit.emplace(o.run, o.where); !added)
-      throw InputError(o.where + ": run '" + o.run + "' has a second rest position (the first: " +
-                       at->second + "); a run's block rests at one place");
-  }
-  // A rest position off the terrain is one no rock can reach: another CRS or swapped coordinates.
-  for (const auto& o : event.observations.deposits)
-    if (!ensemble::OnTerrain(event.scene.scene.terrain, o.xy_m))
-      throw InputError(o.where + ": the rest position (" + Fmt(o.xy_m.x()) + ", " +
-                       Fmt(o.xy_m.y()) + ") is outside the DEM or on nodata " +
-                       DemCover(event.scene) + ", so no rock can rest there");
+  CheckObservationRuns(event);
+  CheckObservedOnce(event.observations);
+  CheckDepositsOnTerrain(event);
 
   for (const std::string& input : event.scene.inputs) event.inputs.push_back(input);
-  // The hash covers the event file, the observation tables and the scene's own hash.
-  std::uint64_t h = 1469598103934665603ULL;
-  const auto mix = [&](const std::string& bytes) {
-    for (unsigned char c : bytes) {
-      h ^= c;
-      h *= 1099511628211ULL;
-    }
-  };
-  for (std::size_t k = 0; k < event.inputs.size() - event.scene.inputs.size(); ++k) {
-    std::ifstream in(event.inputs[k], std::ios::binary);
-    mix(std::string(std::istreambuf_iterator<char>(in), {}));
-  }
-  mix(event.scene.inputs_hash);
-  char hex[17];
-  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
-  event.inputs_hash = hex;
+  event.inputs_hash = InputsHash(event);
   return event;
 }
 

@@ -7,6 +7,7 @@
 #include <ogr_geometry.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <memory>
@@ -25,7 +26,13 @@ struct DatasetCloser {
 };
 using Dataset = std::unique_ptr<GDALDataset, DatasetCloser>;
 
+constexpr std::array<const char*, 2> kRasterFormats = {"gtiff", "cog"};
+
 }  // namespace
+
+constinit const EnumNames kRasterFormatNames{"format", kRasterFormats};
+
+const char* ToString(RasterFormat format) { return kRasterFormatNames.NameOf(format); }
 
 void RegisterGdal() {
   static std::once_flag once;

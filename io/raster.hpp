@@ -8,6 +8,7 @@
 #include <utility>
 #include <vector>
 
+#include "solver/option_table.hpp"
 #include "solver/terrain.hpp"
 
 namespace talus::io {
@@ -56,6 +57,9 @@ std::array<double, 6> GeoTransformOf(const GridGeometry& grid);
 // tiles of 512 x 512, nearest-neighbour overviews down to one tile, header first, so that a
 // viewer reads only what it shows).
 enum class RasterFormat { kGeoTiff, kCog };
+// "gtiff", "cog": [output] raster_format and summary.json's raster_output read this one list.
+extern const EnumNames kRasterFormatNames;
+const char* ToString(RasterFormat format);
 
 // What a written raster says about itself: the band's description and unit
 // (GDALRasterBand::SetDescription / SetUnitType) and dataset metadata items (name, value).

@@ -20,9 +20,6 @@ namespace {
 using scene_tables::kPositive;
 using scene_tables::RequireWithin;
 
-const std::vector<std::string> kRasterNames = {"speed",    "energy",   "jump_height",
-                                               "passages", "deposits", "reach_probability"};
-
 // The keys of a [ground.<name>] table: code, model and every field of kGroundFields.
 std::vector<std::string> GroundKeys() {
   std::vector<std::string> keys = {"code", "model"};
@@ -102,17 +99,21 @@ std::string HashFiles(const std::vector<std::string>& files) {
   return Hex(h);
 }
 
+// "unknown <what> 'name' (did you mean '...'?); known: a, b, c".
+std::string UnknownName(const std::string& name, const EnumNames& names) {
+  const std::vector<std::string> known(names.names.begin(), names.names.end());
+  const std::string hint = ClosestName(name, known);
+  return "unknown " + std::string(names.what) + " '" + name + "'" +
+         (hint.empty() ? "" : " (did you mean '" + hint + "'?)") + "; known: " + names.List();
+}
+
 // A key naming one value of an enum: its number, or an error naming the known names and the
 // closest one.
 int Choice(const Section& s, const std::string& key, const EnumNames& names) {
   const std::string name = s.String(key, "");
   const int value = names.Find(name);
   if (value >= 0) return value;
-  const std::vector<std::string> known(names.names.begin(), names.names.end());
-  const std::string hint = ClosestName(name, known);
-  s.Fail(key, "unknown " + std::string(names.what) + " '" + name + "'" +
-                  (hint.empty() ? "" : " (did you mean '" + hint + "'?)") +
-                  "; known: " + names.List());
+  s.Fail(key, UnknownName(name, names));
 }
 
 // The value [solver] gives for option `f` (the key is there), as SolverOptionInfo::Member sets it.
@@ -137,11 +138,10 @@ double SolverValue(const Section& s, const SolverOptionInfo& f) {
   return 0;
 }
 
-// The keys of [solver]: preset and every scene key of kSolverOptions.
+// The keys of [solver]: preset and every key of kSolverOptions.
 std::vector<std::string> SolverKeys() {
   std::vector<std::string> keys = {"preset"};
-  for (const SolverOptionInfo& f : kSolverOptions)
-    if (f.scene_key) keys.emplace_back(f.key);
+  for (const SolverOptionInfo& f : kSolverOptions) keys.emplace_back(f.key);
   return keys;
 }
 
@@ -151,7 +151,7 @@ void LoadSolver(const Section& s, SolverOptions& o, SolverPreset& preset,
   if (s.Has("preset")) preset = static_cast<SolverPreset>(Choice(s, "preset", kSolverPresetNames));
   ApplyPreset(preset, &o);
   for (const SolverOptionInfo& f : kSolverOptions) {
-    if (!f.scene_key || !s.Has(f.key)) continue;
+    if (!s.Has(f.key)) continue;
     if (f.preset_knob) given.emplace_back(f.key);
     f.member.set(o, SolverValue(s, f));
   }
@@ -175,15 +175,11 @@ void LoadOutput(const Section& s, OutputSpec& o) {
       const auto name = item.value<std::string>();
       if (!name || !item.is_string())
         s.Fail("rasters", "expected a list of raster names (strings)");
-      if (std::find(kRasterNames.begin(), kRasterNames.end(), *name) == kRasterNames.end()) {
-        const std::string hint = ClosestName(*name, kRasterNames);
-        s.Fail("rasters",
-               "unknown raster '" + *name + "'" +
-                   (hint.empty() ? "" : " (did you mean '" + hint + "'?)") +
-                   "; known: speed, energy, jump_height, passages, deposits, reach_probability");
-      }
-      if (std::find(o.rasters.begin(), o.rasters.end(), *name) == o.rasters.end())
-        o.rasters.push_back(*name);
+      ensemble::RasterKind kind;
+      if (!ensemble::kRasterKindNames.Parse(*name, &kind))
+        s.Fail("rasters", UnknownName(*name, ensemble::kRasterKindNames));
+      if (std::find(o.rasters.begin(), o.rasters.end(), kind) == o.rasters.end())
+        o.rasters.push_back(kind);
     }
   }
   if (const toml::node* node = s.Node("percentiles")) {
@@ -201,19 +197,8 @@ void LoadOutput(const Section& s, OutputSpec& o) {
     o.percentiles.erase(std::unique(o.percentiles.begin(), o.percentiles.end()),
                         o.percentiles.end());
   }
-  if (s.Has("raster_format")) {
-    const std::string name = s.String("raster_format", "");
-    if (name == "gtiff") {
-      o.raster_format = RasterFormat::kGeoTiff;
-    } else if (name == "cog") {
-      o.raster_format = RasterFormat::kCog;
-    } else {
-      const std::string hint = ClosestName(name, {"gtiff", "cog"});
-      s.Fail("raster_format", "unknown format '" + name + "'" +
-                                  (hint.empty() ? "" : " (did you mean '" + hint + "'?)") +
-                                  "; known: gtiff, cog");
-    }
-  }
+  if (s.Has("raster_format"))
+    o.raster_format = static_cast<RasterFormat>(Choice(s, "raster_format", kRasterFormatNames));
 }
 
 }  // namespace
@@ -238,15 +223,7 @@ void UseSolverPreset(SceneFile& scene, SolverPreset preset) {
 ensemble::RasterRequest OutputSpec::Request(const GridGeometry& grid) const {
   ensemble::RasterRequest r;
   r.grid = grid;
-  auto has = [&](const char* name) {
-    return std::find(rasters.begin(), rasters.end(), name) != rasters.end();
-  };
-  r.speed = has("speed");
-  r.energy = has("energy");
-  r.jump_height = has("jump_height");
-  r.passages = has("passages");
-  r.deposits = has("deposits");
-  r.reach_probability = has("reach_probability");
+  for (ensemble::RasterKind kind : rasters) r.Wants(kind) = true;
   r.percentiles = percentiles;
   return r;
 }

@@ -19,15 +19,15 @@ namespace talus::io {
 struct OutputSpec {
   bool trajectories = false;
   double trajectory_interval_s = 0.01;
-  // Any of "speed", "energy", "jump_height", "passages", "deposits", "reach_probability".
-  std::vector<std::string> rasters;
+  // The rasters asked for, in the order given, each once (names: ensemble::kRasterKindNames).
+  std::vector<ensemble::RasterKind> rasters;
   bool quicklook =
       true;  // quicklook.png: hillshade, reach probability or energy, sample trajectories
   bool geopackage = false;  // rocks.gpkg: end points and (with trajectories) paths as GIS layers
   bool report = true;       // report.html: one page with what ran, endings, maps and histograms
   // The percentiles (percent, ascending, each 1 .. 99) of the <quantity>_p<NN> rasters.
   std::vector<int> percentiles = {95};
-  io::RasterFormat raster_format = io::RasterFormat::kGeoTiff;  // "gtiff" or "cog"
+  io::RasterFormat raster_format = io::RasterFormat::kGeoTiff;  // kRasterFormatNames
 
   // The raster request on `grid` (nothing when no raster is listed).
   ensemble::RasterRequest Request(const GridGeometry& grid) const;
@@ -66,9 +66,9 @@ struct SceneFile {
 // Loads and validates a scene. Throws talus::InputError with "<file>:<line>: <key>: <reason>".
 SceneFile LoadScene(const std::string& path);
 
-// Sets the solver's accuracy knobs to `preset` as talus simulate --preset asks: the preset wins over
-// the values the scene's [solver] gives itself (a check with "accurate" must run accurately), and
-// the keys it changed are listed in scene.solver_keys_overridden.
+// Sets the solver's accuracy knobs to `preset` as talus simulate --preset asks: the preset wins
+// over the values the scene's [solver] gives itself (a check with "accurate" must run accurately),
+// and the keys it changed are listed in scene.solver_keys_overridden.
 void UseSolverPreset(SceneFile& scene, SolverPreset preset);
 
 }  // namespace talus::io

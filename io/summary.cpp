@@ -5,6 +5,13 @@
 namespace talus::io {
 namespace {
 
+// The names of `kinds`, in their order.
+std::vector<std::string> RasterNames(const std::vector<ensemble::RasterKind>& kinds) {
+  std::vector<std::string> names;
+  for (ensemble::RasterKind kind : kinds) names.emplace_back(ToString(kind));
+  return names;
+}
+
 // Every solver option (kSolverOptions), by the names of the scene's [solver] table.
 nlohmann::ordered_json SolverJson(const SolverOptions& o) {
   nlohmann::ordered_json j = nlohmann::ordered_json::object();
@@ -145,10 +152,9 @@ std::string SummaryJson(const SceneFile& scene, const ensemble::EnsembleReport& 
   j["solver"]["preset_overrode"] = scene.solver_keys_overridden;
   j["ground"] = GroundJson(scene.scene.ground);
   // How the rasters were asked for (the statistics rasters' percentiles and the file layout).
-  j["raster_output"] = {
-      {"rasters", scene.output.rasters},
-      {"percentiles", scene.output.percentiles},
-      {"format", scene.output.raster_format == RasterFormat::kCog ? "cog" : "gtiff"}};
+  j["raster_output"] = {{"rasters", RasterNames(scene.output.rasters)},
+                        {"percentiles", scene.output.percentiles},
+                        {"format", ToString(scene.output.raster_format)}};
   if (!scene.evaluation_lines.empty()) {
     nlohmann::ordered_json lines = nlohmann::ordered_json::array();
     for (const EvaluationLineSummary& s : evaluation_lines) lines.push_back(EvaluationLineJson(s));

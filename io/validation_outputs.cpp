@@ -11,6 +11,7 @@
 #include "common/format.hpp"
 #include "io/quicklook.hpp"
 #include "io/rocks_csv.hpp"
+#include "io/svg_plot.hpp"
 
 namespace talus::io {
 namespace {
@@ -22,21 +23,6 @@ nlohmann::ordered_json Num(double v) {
 
 // "%.10g", or an empty field for NaN (a value that does not exist).
 std::string Csv(double v) { return FormatOrMissing(v, "%.10g", ""); }
-
-std::string Xml(const std::string& text) {
-  std::string out;
-  for (char c : text) {
-    if (c == '<')
-      out += "&lt;";
-    else if (c == '>')
-      out += "&gt;";
-    else if (c == '&')
-      out += "&amp;";
-    else
-      out += c;
-  }
-  return out;
-}
 
 std::string Fmt(double v, const char* format = "%.3g") { return FormatDouble(v, format); }
 
@@ -141,8 +127,9 @@ std::string ObservedVsSimulatedSvg(const fieldobs::ValidationReport& report) {
     hi += pad;
     const int x0 = margin + 10, x1 = width - 20, y0 = top + 20, y1 = top + panel;
     auto y = [&](double v) { return y1 - (v - lo) / (hi - lo) * (y1 - y0); };
-    svg << "<text x=\"" << x0 << "\" y=\"" << top + 12 << "\" font-weight=\"bold\">" << Xml(k->kind)
-        << " (" << Xml(k->unit) << "): observed (red) vs simulated 5-95 % band "
+    svg << "<text x=\"" << x0 << "\" y=\"" << top + 12 << "\" font-weight=\"bold\">"
+        << svg::Escape(k->kind) << " (" << svg::Escape(k->unit)
+        << "): observed (red) vs simulated 5-95 % band "
         << "and median (blue); mean CRPS " << Fmt(k->mean_score) << "</text>\n";
     svg << "<rect x=\"" << x0 << "\" y=\"" << y0 << "\" width=\"" << x1 - x0 << "\" height=\""
         << y1 - y0 << "\" fill=\"none\" stroke=\"#888\"/>\n";
@@ -157,7 +144,7 @@ std::string ObservedVsSimulatedSvg(const fieldobs::ValidationReport& report) {
       const auto* s = obs[i];
       svg << "<line x1=\"" << x << "\" x2=\"" << x << "\" y1=\"" << y(s->q05) << "\" y2=\""
           << y(s->q95) << "\" stroke=\"#bbb\" stroke-width=\"" << std::max(1.0, 0.6 * step)
-          << "\"><title>" << Xml(s->run) << "</title></line>\n";
+          << "\"><title>" << svg::Escape(s->run) << "</title></line>\n";
       svg << "<line x1=\"" << x - 0.4 * step << "\" x2=\"" << x + 0.4 * step << "\" y1=\""
           << y(s->median) << "\" y2=\"" << y(s->median) << "\" stroke=\"#1f4fbf\" "
           << "stroke-width=\"2\"/>\n";
@@ -193,7 +180,8 @@ std::string PitSvg(const fieldobs::ValidationReport& report) {
     const double expected = double(total) / double(pit.counts.size());
     const double top_value = std::max(double(most), 1.5 * expected);
     const double bar = double(w - 50) / double(pit.counts.size());
-    svg << "<text x=\"" << left << "\" y=\"16\" font-weight=\"bold\">PIT: " << Xml(kinds[p]->kind)
+    svg << "<text x=\"" << left
+        << "\" y=\"16\" font-weight=\"bold\">PIT: " << svg::Escape(kinds[p]->kind)
         << "</text>\n<text x=\"" << left
         << "\" y=\"32\">chi-square p = " << Fmt(pit.p_value, "%.2g") << " (" << total
         << " observations)</text>\n";

@@ -141,13 +141,12 @@ constinit const std::array<SolverOptionInfo, 16> kSolverOptions = {{
      .unit = "1",
      .valid = Bounds::Inside(0, 2),
      .doc = "step length of the contact solve's prox iteration"},
-    // Not a scene key (yet): summary.json records it so that a run's options are all stated.
+    // A fraction of the rock's thickness (its smallest extent along the principal axes).
     {.key = "penetration_tolerance",
      .type = Type::kNumber,
      .member = MemberOf<&O::penetration_tolerance>(),
      .unit = "1",
      .valid = Bounds::AboveAtMost(0, 0.5),
-     .scene_key = false,
      .doc = "a predicted contact is stopped at this fraction of the rock's thickness"},
     {.key = "predicted_lever",
      .type = Type::kChoice,

@@ -100,7 +100,11 @@ struct SolverOptions {
   double prox_alpha = 1.0;  // step length r = alpha / diag(W' M^-1 W), in (0, 2)
   // Contact prediction (plastic normal law only): a vertex that would sink deeper than this
   // fraction of the rock's thickness by the next midpoint joins the contact set early and is
-  // stopped at that depth. In (0, 0.5].
+  // stopped at that depth. In (0, 0.5]: above 0, since stopping vertices at the surface puts a
+  // slowly arriving contact's percussion ahead of the pivot, a rolling resistance of order
+  // v dt / r (docs/model.md, "Why delta > 0"); at most one half, since a resting rock sinks by
+  // about this much and at half its thickness the centre of a symmetric rock reaches the surface
+  // (a buried rock, not a tolerance).
   double penetration_tolerance = 0.01;
   // Where a predicted contact's percussion acts.
   PredictedLever predicted_lever = PredictedLever::kMidpoint;
@@ -140,7 +144,6 @@ struct SolverOptionInfo {
   // wrong unit that would otherwise run), where that is narrower than `valid`.
   double plausible_lower = -Bounds::kInf, plausible_upper = Bounds::kInf;
   const EnumNames* choices = nullptr;  // kChoice: the names of the values
-  bool scene_key = true;               // read from [solver] (else only written to summary.json)
   bool preset_knob = false;            // set by a SolverPreset (ApplyPreset)
   const char* doc = "";                // one line for the docs' table
 

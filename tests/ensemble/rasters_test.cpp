@@ -7,6 +7,7 @@
 #include <cmath>
 #include <map>
 #include <numeric>
+#include <utility>
 
 #include "ensemble/runner.hpp"
 #include "fixtures.hpp"
@@ -293,6 +294,27 @@ TEST(Rasters, LayersAreNamedAndDescribedInOrder) {
   EXPECT_EQ(layers[14].unit, "1");
   EXPECT_EQ(layers[14].statistic, "fraction");
   EXPECT_EQ(descriptions[14], "reach probability, fraction of all rocks that passed the cell");
+}
+
+// Each raster kind has its name (the one list that scenes, summary.json and the file names read)
+// and its own flag of the request.
+TEST(RasterRequest, EveryKindHasItsNameAndItsOwnFlag) {
+  EXPECT_EQ(kRasterKindNames.List(),
+            "speed, energy, jump_height, passages, deposits, reach_probability");
+  for (int k = 0; k < kRasterKindNames.size(); ++k) {
+    const auto kind = static_cast<RasterKind>(k);
+    EXPECT_STREQ(ToString(kind), kRasterKindNames.Name(k));
+    RasterRequest request;
+    EXPECT_FALSE(request.any());
+    request.Wants(kind) = true;
+    EXPECT_TRUE(request.any()) << ToString(kind);
+    for (int other = 0; other < kRasterKindNames.size(); ++other)
+      EXPECT_EQ(std::as_const(request).Wants(static_cast<RasterKind>(other)), other == k)
+          << ToString(kind) << " sets " << kRasterKindNames.Name(other);
+  }
+  RasterRequest request;
+  request.jump_height = true;
+  EXPECT_TRUE(request.Wants(RasterKind::kJumpHeight));
 }
 
 TEST(RasterRequest, PercentilesAreAscendingIntegersInOneToNinetyNine) {

@@ -117,7 +117,9 @@ TEST(LoadScene, UnknownKeysAreErrorsWithDidYouMean) {
   const std::string e3 = ErrorOf(Replace(kPlaneScene, "cell_m = 1", "cell = 1"), dir);
   EXPECT_HAS(e3, "terrain.plane.cell: unknown key (did you mean 'cell_m'?)");
   const std::string e4 = ErrorOf(Replace(kPlaneScene, "\"speed\",", "\"speeds\","), dir);
-  EXPECT_HAS(e4, "output.rasters: unknown raster 'speeds' (did you mean 'speed'?)");
+  EXPECT_HAS(e4,
+             "output.rasters: unknown raster 'speeds' (did you mean 'speed'?); known: speed, "
+             "energy, jump_height, passages, deposits, reach_probability");
   const std::string e5 = ErrorOf(Replace(kPlaneScene, "\"hard\"", "\"hrad\""), dir);
   EXPECT_HAS(e5, "terrain.default_ground: unknown ground category 'hrad' (did you mean 'hard'?)");
   const std::string e6 = ErrorOf(Replace(kPlaneScene, "seed = 42", "colour = \"red\""), dir);
@@ -351,7 +353,6 @@ TEST(LoadScene, EverySolverOptionOfTheTableIsReadAndWrittenBack) {
   const SolverOptions defaults;
   int read = 0;
   for (const SolverOptionInfo& f : kSolverOptions) {
-    if (!f.scene_key) continue;
     const double fallback = f.member.get(defaults);
     double value = 0;
     std::string text;
@@ -395,7 +396,45 @@ TEST(LoadScene, EverySolverOptionOfTheTableIsReadAndWrittenBack) {
       EXPECT_EQ(written.get<double>(), value) << f.key;
     }
   }
-  EXPECT_GE(read, 15);
+  EXPECT_EQ(read, static_cast<int>(kSolverOptions.size()));
+}
+
+// penetration_tolerance: a fraction of the rock's thickness in (0, 0.5], read from [solver] and
+// refused out of its bounds with a message naming the key.
+TEST(LoadScene, PenetrationToleranceIsASolverKeyWithItsBounds) {
+  const auto dir = testing::FreshDir("penetration_tolerance");
+  const auto with = [](const std::string& keys) {
+    return Replace(kPlaneScene, "max_time_s = 20", "max_time_s = 20\n" + keys);
+  };
+  testing::WriteText(dir / "scene.toml", kPlaneScene);
+  EXPECT_EQ(LoadScene((dir / "scene.toml").string()).scene.options.penetration_tolerance, 0.01);
+  testing::WriteText(dir / "scene.toml", with("penetration_tolerance = 0.05"));
+  EXPECT_EQ(LoadScene((dir / "scene.toml").string()).scene.options.penetration_tolerance, 0.05);
+  EXPECT_HAS(ErrorOf(with("penetration_tolerance = 0.8"), dir),
+             "scene.toml:23: solver.penetration_tolerance: penetration_tolerance = 0.8 violates "
+             "0 < penetration_tolerance <= 0.5");
+  EXPECT_HAS(ErrorOf(with("penetration_tolerance = 0"), dir),
+             "solver.penetration_tolerance: penetration_tolerance = 0 violates");
+  EXPECT_HAS(ErrorOf(with("penetration_tolerance = -1"), dir),
+             "solver.penetration_tolerance: penetration_tolerance = -1 violates");
+}
+
+// docs/scenes.md's rows of [output] rasters and raster_format name the values of the code's tables
+// (ensemble::kRasterKindNames, kRasterFormatNames), in their order.
+TEST(LoadScene, DocsNameTheRastersAndFormatsOfTheTables) {
+  std::ifstream in(std::string(TALUS_SOURCE_DIR) + "/docs/scenes.md");
+  ASSERT_TRUE(in) << "docs/scenes.md";
+  std::string rasters, formats;
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind("| `rasters` |", 0) == 0) rasters = line;
+    if (line.rfind("| `raster_format` |", 0) == 0) formats = line;
+  }
+  std::string names, quoted;
+  for (int k = 0; k < ensemble::kRasterKindNames.size(); ++k)
+    names += (k ? ", `" : "`") + std::string(ensemble::kRasterKindNames.Name(k)) + "`";
+  EXPECT_HAS(rasters, "| any of " + names + ";");
+  for (int k = 0; k < kRasterFormatNames.size(); ++k)
+    EXPECT_HAS(formats, "`\"" + std::string(kRasterFormatNames.Name(k)) + "\"`");
 }
 
 // [output] percentiles: integers 1 .. 99, sorted and without repeats; the default is the p95
