@@ -1,0 +1,96 @@
+// [release] of a scene file (io/scene_release.cpp) through io::LoadScene: rocks by area per
+// cell and per square metre against the polygon's area, and the errors scene_file_test.cpp does
+// not reach (conflicting counts, area densities on points, a header-only run table, an empty block
+// column, a single-impact table that is not a table or is combined with start keys, no release),
+// each naming the file, line and key.
+
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "common/error.hpp"
+#include "io/scene_file.hpp"
+#include "test_files.hpp"
+
+namespace talus::io {
+namespace {
+
+// A 60 x 30 m plane of 1 m cells (x 0 .. 60, y -15 .. 15); [release] is appended.
+const std::string kHead = R"([terrain]
+plane = { slope_deg = 30, slope_length_m = 40, runout_m = 20, width_m = 30, cell_m = 1 }
+
+[rock]
+shape = { box = [0.5, 0.4, 0.3] }
+
+[release]
+)";
+
+SceneFile Load(const std::string& release, const std::string& runs_csv = "") {
+  const auto dir = testing::FreshDir("scene");
+  testing::WriteText(dir / "scene.toml", kHead + release);
+  if (!runs_csv.empty()) testing::WriteText(dir / "runs.csv", runs_csv);
+  return LoadScene((dir / "scene.toml").string());
+}
+
+std::string ErrorOf(const std::string& release, const std::string& runs_csv = "") {
+  try {
+    Load(release, runs_csv);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+#define EXPECT_HAS(text, part) EXPECT_NE(std::string(text).find(part), std::string::npos) << (text)
+
+// A 10 x 4 m rectangle (40 m^2, 40 cells of 1 m^2) and a 2 x 2 m square (4 m^2): 0.5 rocks per cell
+// give round(20) and round(2) rocks; 0.3 per m^2 give round(12) and round(1.2) = 1; a density that
+// rounds to 0 still starts one rock per polygon.
+TEST(SceneRelease, RocksByAreaAreTheDensityTimesEachPolygonsArea) {
+  const std::string polygons =
+      "polygons = [[[10, -2], [20, -2], [20, 2], [10, 2]], [[30, 0], [32, 0], [32, 2], [30, 2]]]\n";
+  const SceneFile per_cell = Load(polygons + "rocks_per_cell = 0.5\n");
+  EXPECT_EQ(per_cell.release.RocksOf(0), 20);
+  EXPECT_EQ(per_cell.release.RocksOf(1), 2);
+  const SceneFile per_m2 = Load(polygons + "rocks_per_m2 = 0.3\n");
+  EXPECT_EQ(per_m2.release.RocksOf(0), 12);
+  EXPECT_EQ(per_m2.release.RocksOf(1), 1);
+  const SceneFile sparse = Load(polygons + "rocks_per_m2 = 0.01\n");
+  EXPECT_EQ(sparse.release.RocksOf(0), 1);
+  EXPECT_EQ(sparse.release.RocksOf(1), 1);
+}
+
+TEST(SceneRelease, CountsAndAreaDensitiesThatConflictAreErrors) {
+  EXPECT_HAS(ErrorOf("polygons = [[[10, -2], [20, -2], [20, 2], [10, 2]]]\nrocks = 5\n"
+                     "rocks_per_cell = 1\n"),
+             "scene.toml:10: release.rocks_per_cell: give one of rocks, rocks_per_m2 and "
+             "rocks_per_cell, not rocks as well");
+  EXPECT_HAS(ErrorOf("points = [[5, 0]]\nrocks_per_cell = 1\n"),
+             "scene.toml:9: release.rocks_per_cell: rocks by area are for polygons only, but ");
+  EXPECT_HAS(ErrorOf("points = [[5, 0]]\nrocks_per_cell = 1\n"), "is a point: give rocks instead");
+  EXPECT_HAS(ErrorOf("polygons = [[[10, -2], [20, -2], [20, 2], [10, 2]]]\nrocks_per_cell = 0\n"),
+             "release.rocks_per_cell: ");
+  EXPECT_HAS(ErrorOf("rocks = 3\n"),
+             "scene.toml:7: release.points: missing: give points, lines, polygons, a vector file, "
+             "a run table (runs) or a single-impact table (single_impacts)");
+}
+
+TEST(SceneRelease, RunTableAndSingleImpactErrorsNameTheKey) {
+  std::string e = ErrorOf("runs = \"runs.csv\"\n", "trajectory_id,x_m,y_m\n");
+  EXPECT_HAS(e, "runs.csv: no run (the table has a header only)");
+  e = ErrorOf("runs = \"runs.csv\"\nblock_column = \"\"\n", "trajectory_id,x_m,y_m\nr1,5,0\n");
+  EXPECT_HAS(e, "scene.toml:9: release.block_column: empty: name a column of the run table");
+  e = ErrorOf("single_impacts = \"impacts.csv\"\n");
+  EXPECT_HAS(e, "scene.toml:8: release.single_impacts: expected an inline table { file = "
+                "\"impacts.csv\", ... }");
+  e = ErrorOf("single_impacts = { file = \"impacts.csv\" }\nheight_m = 2\n");
+  EXPECT_HAS(e, "scene.toml:9: release.height_m: a single-impact table sets each run's start "
+                "(single_impacts)");
+  e = ErrorOf("single_impacts = { at = [5, 0] }\n");
+  EXPECT_HAS(e, "release.single_impacts.file: missing");
+  e = ErrorOf("points = [[5, 0]]\nsingle_impacts = { file = \"impacts.csv\" }\n");
+  EXPECT_HAS(e, "release.single_impacts: a single-impact table cannot be combined with points");
+}
+
+}  // namespace
+}  // namespace talus::io
