@@ -138,7 +138,7 @@ std::string HistogramSvg(const std::string& title, const std::string& x_label,
   const long top = std::max<long>(1, *std::max_element(count.begin(), count.end()));
   const svg::Axis x{lo, hi, svg::kLeft, svg::kWidth - svg::kRight};
   const svg::Axis y{0, static_cast<double>(top) * 1.1, svg::kHeight - svg::kBottom, svg::kTop};
-  std::string out = svg::Frame(Escape(title), Escape(x_label), "rocks", x, y);
+  std::string out = svg::Frame(title, x_label, "rocks", x, y);
   for (int b = 0; b < bins; ++b) {
     const double left = lo + (hi - lo) * b / bins, right = lo + (hi - lo) * (b + 1) / bins;
     const double h = static_cast<double>(count[static_cast<std::size_t>(b)]);

@@ -31,7 +31,7 @@ std::string Frame(const std::string& title, const std::string& x_label, const st
   Add(out, "<rect x=\"0\" y=\"0\" width=\"", F(kWidth), "\" height=\"", F(kHeight),
       "\" fill=\"white\"/>\n");
   Add(out, "<text x=\"", F(kWidth / 2), "\" y=\"18\" text-anchor=\"middle\" font-size=\"13\">",
-      title, "</text>\n");
+      Escape(title), "</text>\n");
   Add(out, "<rect x=\"", F(kLeft), "\" y=\"", F(kTop), "\" width=\"", F(kWidth - kLeft - kRight),
       "\" height=\"", F(kHeight - kTop - kBottom), "\" fill=\"none\" stroke=\"black\"/>\n");
   for (int k = 0; k <= 4; ++k) {
@@ -42,9 +42,9 @@ std::string Frame(const std::string& title, const std::string& x_label, const st
         Label(vy), "</text>\n");
   }
   Add(out, "<text x=\"", F(kLeft + (kWidth - kLeft - kRight) / 2), "\" y=\"", F(kHeight - 10),
-      "\" text-anchor=\"middle\">", x_label, "</text>\n");
+      "\" text-anchor=\"middle\">", Escape(x_label), "</text>\n");
   Add(out, "<text transform=\"translate(14,", F(kTop + (kHeight - kTop - kBottom) / 2),
-      ") rotate(-90)\" text-anchor=\"middle\">", y_label, "</text>\n");
+      ") rotate(-90)\" text-anchor=\"middle\">", Escape(y_label), "</text>\n");
   return out;
 }
 

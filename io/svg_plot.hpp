@@ -31,7 +31,8 @@ struct Axis {
 void Pad(double& lo, double& hi);
 
 // The opening of a kWidth × kHeight plot: white background, title, plot box, five ticks on each
-// axis and the axis labels. The caller adds the marks and closes it with "</svg>\n".
+// axis and the axis labels (the title and labels are escaped here: pass them as plain text). The
+// caller adds the marks and closes it with "</svg>\n".
 std::string Frame(const std::string& title, const std::string& x_label, const std::string& y_label,
                   const Axis& x, const Axis& y);
 

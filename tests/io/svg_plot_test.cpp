@@ -77,6 +77,17 @@ TEST(SvgPlot, FrameHasTitleLabelsAndFiveTicksPerAxis) {
   EXPECT_EQ(svg.find("</svg>"), std::string::npos);
 }
 
+TEST(SvgPlot, FrameEscapesItsTitleAndLabels) {
+  // A category or unit name from a user's file ("a<b & c") must not break the SVG.
+  const Axis x{0, 1, kLeft, kWidth - kRight};
+  const Axis y{0, 1, kHeight - kBottom, kTop};
+  const std::string svg = Frame("kind <a&b>", "observed (m<sup>)", "\"y\"", x, y);
+  EXPECT_NE(svg.find(">kind &lt;a&amp;b&gt;</text>"), std::string::npos) << svg;
+  EXPECT_NE(svg.find(">observed (m&lt;sup&gt;)</text>"), std::string::npos) << svg;
+  EXPECT_NE(svg.find(">&quot;y&quot;</text>"), std::string::npos) << svg;
+  EXPECT_EQ(svg.find("<a&b>"), std::string::npos);
+}
+
 TEST(SvgPlot, FrameIsByteIdenticalForTheSameInput) {
   const Axis x{0.1, 0.7, kLeft, kWidth - kRight};
   const Axis y{3, 9, kHeight - kBottom, kTop};
