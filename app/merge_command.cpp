@@ -13,6 +13,7 @@
 #include "app/interrupt.hpp"
 #include "app/run_outputs.hpp"
 #include "app/run_verb.hpp"
+#include "app/simulate.hpp"
 #include "common/error.hpp"
 
 namespace talus::app {
@@ -62,6 +63,8 @@ int RunMerge(const MergeArgs& args) {
     std::printf("Merged %zu parts of %s: %s\n", parts.size(), scene.path.c_str(),
                 report.BriefReport().c_str());
     std::printf("Wrote %zu files to %s\n", files.size(), args.out.c_str());
+    std::fflush(stdout);
+    PrintRunWarnings(report, scene, "merge");
   });
 }
 

@@ -13,6 +13,7 @@
 #include <utility>
 
 #include "app/ensemble_args.hpp"
+#include "ensemble/runner.hpp"
 #include "io/scene_file.hpp"
 
 namespace talus::app {
@@ -38,6 +39,10 @@ std::string DescribeRocks(const io::SceneFile& scene);
 // Prints the scene's warnings (io::SceneFile::warnings) on stderr, one "talus <command>: WARNING:"
 // line each.
 void PrintSceneWarnings(const io::SceneFile& scene, const char* command = "simulate");
+// Prints what the run's endings censor (ensemble::RunWarnings) on stderr, one
+// "talus <command>: WARNING:" line each.
+void PrintRunWarnings(const ensemble::EnsembleReport& report, const io::SceneFile& scene,
+                      const char* command = "simulate");
 // Prints each observed value an event holds but does not score (io::EventFile::not_scored).
 void PrintNotScored(const std::vector<std::string>& not_scored);
 

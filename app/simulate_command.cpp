@@ -21,6 +21,7 @@
 #include "app/simulate.hpp"
 #include "common/atomic_file.hpp"
 #include "common/error.hpp"
+#include "ensemble/run_warnings.hpp"
 #include "ensemble/runner.hpp"
 #include "io/resources.hpp"
 #include "io/scene_file.hpp"
@@ -56,6 +57,13 @@ std::string DescribeRocks(const io::SceneFile& scene) {
 
 void PrintSceneWarnings(const io::SceneFile& scene, const char* command) {
   for (const std::string& warning : scene.warnings)
+    std::fprintf(stderr, "talus %s: WARNING: %s\n", command, warning.c_str());
+  std::fflush(stderr);
+}
+
+void PrintRunWarnings(const ensemble::EnsembleReport& report, const io::SceneFile& scene,
+                      const char* command) {
+  for (const std::string& warning : ensemble::RunWarnings(report, scene.scene.options))
     std::fprintf(stderr, "talus %s: WARNING: %s\n", command, warning.c_str());
   std::fflush(stderr);
 }
@@ -178,10 +186,8 @@ int RunSimulate(const SimulateArgs& args) {
       std::printf("Wrote rocks %ld:%ld of %ld as a partial result (merge with talus merge)\n",
                   range.first, range.second, scene.release.total_rocks());
     std::printf("Wrote %zu files to %s\n", files.size(), args.out.c_str());
-    if (report.count(EndReason::kFailed) > 0)
-      std::fprintf(stderr,
-                   "talus simulate: %ld rocks failed numerically (end = failed in rocks.csv)\n",
-                   report.count(EndReason::kFailed));
+    std::fflush(stdout);
+    PrintRunWarnings(report, scene);
   });
 }
 

@@ -231,10 +231,8 @@ int SimulateOnRanks(const MpiSession& mpi, const SimulateArgs& args) {
       CommitOutputs(*staging, files, args.out);
       std::printf("%s on %d ranks\n", merged.BriefReport().c_str(), mpi.size());
       std::printf("Wrote %zu files to %s\n", files.size(), args.out.c_str());
-      if (merged.count(EndReason::kFailed) > 0)
-        std::fprintf(stderr,
-                     "talus simulate: %ld rocks failed numerically (end = failed in rocks.csv)\n",
-                     merged.count(EndReason::kFailed));
+      std::fflush(stdout);
+      PrintRunWarnings(merged, scene);
     }
   });
   part.reset();

@@ -71,14 +71,15 @@ std::string RowsTable(const Json& object, const std::string& first_column) {
 }
 
 std::string Base64(const std::string& bytes) {
-  char* encoded = CPLBase64Encode(static_cast<int>(bytes.size()),
-                                  reinterpret_cast<const GByte*>(bytes.data()));
+  char* encoded =
+      CPLBase64Encode(static_cast<int>(bytes.size()), reinterpret_cast<const GByte*>(bytes.data()));
   std::string out = encoded ? encoded : "";
   CPLFree(encoded);
   return out;
 }
 
-constexpr const char* kStyle = R"(body{font-family:sans-serif;max-width:1100px;margin:2em auto;color:#222}
+constexpr const char* kStyle =
+    R"(body{font-family:sans-serif;max-width:1100px;margin:2em auto;color:#222}
 h1{font-size:1.5em}h2{font-size:1.2em;border-bottom:1px solid #ccc;padding-bottom:.2em;margin-top:1.6em}
 table{border-collapse:collapse;margin:.5em 0}th,td{border:1px solid #ccc;padding:.2em .6em;text-align:left}
 td{font-variant-numeric:tabular-nums}figure{display:inline-block;margin:.5em 1em .5em 0;vertical-align:top}
@@ -146,8 +147,8 @@ std::string HistogramSvg(const std::string& title, const std::string& x_label,
         svg::F(x(right) - x(left)), "\" height=\"", svg::F(y(0) - y(h)),
         "\" fill=\"#1f5fbf\" fill-opacity=\"0.75\" stroke=\"white\"/>\n");
   }
-  const std::string stats = "n = " + std::to_string(finite.size()) +
-                            ", median " + Number(NearestRankPercentile(finite, 50)) + ", 95 % " +
+  const std::string stats = "n = " + std::to_string(finite.size()) + ", median " +
+                            Number(NearestRankPercentile(finite, 50)) + ", 95 % " +
                             Number(NearestRankPercentile(finite, 95)) + ", largest " +
                             Number(finite.empty() ? NAN : hi);
   Add(out, "<text x=\"", svg::F(svg::kWidth - svg::kRight - 6), "\" y=\"", svg::F(svg::kTop + 14),
@@ -157,6 +158,17 @@ std::string HistogramSvg(const std::string& title, const std::string& x_label,
 
 namespace {
 
+// The run's warnings (summary.json "warnings"), before anything else; nothing when there are none.
+std::string WarningsSection(const Json& summary) {
+  if (!summary.contains("warnings") || !summary["warnings"].is_array() ||
+      summary["warnings"].empty())
+    return "";
+  std::string html = "<h2>Warnings</h2>\n<ul class=\"warnings\">\n";
+  for (const Json& w : summary["warnings"])
+    if (w.is_string()) Add(html, "<li>", Escape(w.get<std::string>()), "</li>\n");
+  return html + "</ul>\n";
+}
+
 // The page's head and "What ran": scene, version, inputs hash, the summary's settings, the rock.
 std::string WhatRanSection(const Json& summary) {
   const auto get = [&](const char* key) { return summary.contains(key) ? summary[key] : Json(); };
@@ -165,14 +177,16 @@ std::string WhatRanSection(const Json& summary) {
       "\n</style>\n</head>\n<body>\n");
   Add(html, "<h1>Talus run: ", Cell(get("scene")), "</h1>\n");
   Add(html, "<p class=\"note\">Talus ", Cell(get("talus_version")), ", inputs hash (FNV-1a 64) ",
-      Cell(get("inputs_hash_fnv1a64")), ". Everything here is also in summary.json, rocks.csv and "
+      Cell(get("inputs_hash_fnv1a64")),
+      ". Everything here is also in summary.json, rocks.csv and "
       "the GeoTIFFs next to this file.</p>\n");
+  html += WarningsSection(summary);
 
   html += "<h2>What ran</h2>\n";
   html += KeyValueTable(
       summary, {"ends", "raised_at_release", "stayed_at_release", "steps", "unconverged_steps",
                 "threads", "wall_time_s", "trajectories_per_s", "outputs", "blocks",
-                "talus_version", "inputs_hash_fnv1a64", "evaluation_lines"});
+                "talus_version", "inputs_hash_fnv1a64", "evaluation_lines", "warnings"});
   if (summary.contains("rock") && summary["rock"].is_object()) {
     html += "<h3>Rock</h3>\n";
     html += KeyValueTable(summary["rock"]);
@@ -230,8 +244,9 @@ std::string DistributionsSection(const RockColumns& r) {
   html += HistogramSvg("Largest kinetic energy", "energy (kJ)", energy_kj);
   html += HistogramSvg("Largest jump height", "jump height of the centre of mass (m)",
                        r.max_jump_height_m);
-  html += "</div>\n<table>\n<tr><th></th><th>mean</th><th>median</th><th>90 %</th><th>95 %</th>"
-          "<th>99 %</th><th>largest</th></tr>\n";
+  html +=
+      "</div>\n<table>\n<tr><th></th><th>mean</th><th>median</th><th>90 %</th><th>95 %</th>"
+      "<th>99 %</th><th>largest</th></tr>\n";
   const auto stats_row = [&](const char* label, const std::vector<double>& values) {
     Add(html, "<tr><th>", label, "</th><td>", Number(Mean(values)), "</td>");
     for (double p : {50.0, 90.0, 95.0, 99.0, 100.0})
@@ -243,8 +258,9 @@ std::string DistributionsSection(const RockColumns& r) {
   stats_row("largest kinetic energy (kJ)", energy_kj);
   stats_row("largest jump height (m)", r.max_jump_height_m);
   stats_row("travel angle (&deg;)", r.travel_angle_deg);
-  html += "</table>\n<p class=\"note\">Percentiles are nearest-rank, over the rocks (one value per "
-          "rock).</p>\n";
+  html +=
+      "</table>\n<p class=\"note\">Percentiles are nearest-rank, over the rocks (one value per "
+      "rock).</p>\n";
   return html;
 }
 

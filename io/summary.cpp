@@ -2,6 +2,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "ensemble/run_warnings.hpp"
+
 namespace talus::io {
 namespace {
 
@@ -165,7 +167,11 @@ std::string SummaryJson(const SceneFile& scene, const ensemble::EnsembleReport& 
   j["wall_time_s"] = report.wall_time_s;
   j["trajectories_per_s"] = report.trajectories_per_s();
   j["outputs"] = outputs;
-  j["warnings"] = scene.warnings;
+  // The scene's warnings, then what the run's endings censor (ensemble/run_warnings.hpp).
+  std::vector<std::string> warnings = scene.warnings;
+  for (std::string& w : ensemble::RunWarnings(report, scene.scene.options))
+    warnings.push_back(std::move(w));
+  j["warnings"] = warnings;
   return j.dump(2) + "\n";
 }
 

@@ -619,6 +619,33 @@ TEST(TalusCommandLine, ThreadsAreCappedAtAFewPerCore) {
       << log;  // 16 are allowed on any machine
 }
 
+// Censored endings are said where the user looks: rocks still moving at max_time are a WARNING
+// line on stderr, an entry of summary.json's "warnings" and the "Warnings" list at the top of
+// report.html (ensemble/run_warnings.hpp; each rule has its own test in run_warnings_test.cpp).
+TEST(SimulateCommand, RocksAtMaxTimeAreWarnedInTheConsoleTheSummaryAndTheReport) {
+  const fs::path dir = FreshDir("max_time_warning");
+  std::string scene = kScene;
+  scene.replace(scene.find("max_time_s = 4"), 14, "max_time_s = 0.5");
+  std::ofstream(dir / "scene.toml") << scene;
+  const fs::path out = dir / "out";
+  std::string log;
+  ASSERT_EQ(RunCommand(Talus("simulate " + (dir / "scene.toml").string() + " --out " +
+                             out.string() + " --threads 1"),
+                       &log),
+            0)
+      << log;
+  const std::string expected = "6 of 6 rocks (100.0 %) were still moving at max_time_s = 0.5 s";
+  EXPECT_NE(log.find("talus simulate: WARNING: " + expected), std::string::npos) << log;
+  const auto summary = nlohmann::json::parse(Slurp(out / "summary.json"));
+  ASSERT_EQ(summary["warnings"].size(), 1u) << summary["warnings"];
+  EXPECT_NE(summary["warnings"][0].get<std::string>().find(expected), std::string::npos);
+  const std::string report = Slurp(out / "report.html");
+  const auto warnings = report.find("<h2>Warnings</h2>");
+  ASSERT_NE(warnings, std::string::npos);
+  EXPECT_LT(warnings, report.find("<h2>What ran</h2>"));  // at the top
+  EXPECT_NE(report.find("<li>" + expected, warnings), std::string::npos);
+}
+
 // A run whose estimated memory or disk exceeds what the machine has is refused before any rock
 // runs (exit 2, nothing written), with the estimate, what is available and the knob to turn. The
 // run's address space is capped at 16 GB (ulimit -v, which the estimate honours), so the memory
