@@ -301,7 +301,7 @@ void WriteOutputs(const CalibrateArgs& args, const Loaded& loaded,
   ThrowIfInterrupted();
   staging.emplace(args.out);
   WriteFileAtomically(staging->path("ground_table.toml"),
-                      io::GroundTableToml(file, objective, run.fitted));
+                      io::GroundTableToml(file, objective, run.fitted, &run));
   WriteFileAtomically(staging->path("ground_table.csv"), io::GroundTableCsv(objective, run.fitted));
   WriteFileAtomically(staging->path("history.csv"), io::HistoryCsv(objective, run.fit));
   std::vector<std::string> outputs = {"ground_table.toml", "ground_table.csv", "history.csv",

@@ -236,6 +236,23 @@ json StartsJson(const calibration::OptimizerSummary& s) {
   return starts;
 }
 
+// The covariance in physical units, null in the rows and columns of unidentified parameters (they
+// have none: the value 0 there would read as certainty).
+json CovarianceJson(const calibration::Uncertainty& u) {
+  json rows = json::array();
+  for (Eigen::Index i = 0; i < u.covariance.rows(); ++i) {
+    json row = json::array();
+    for (Eigen::Index k = 0; k < u.covariance.cols(); ++k) {
+      const bool known = static_cast<std::size_t>(std::max(i, k)) < u.identified.size() &&
+                         u.identified[static_cast<std::size_t>(i)] &&
+                         u.identified[static_cast<std::size_t>(k)];
+      row.push_back(known ? Number(u.covariance(i, k)) : json(nullptr));
+    }
+    rows.push_back(row);
+  }
+  return rows;
+}
+
 // The sandwich covariance, with the bootstrap and the seed refits beside it; null without one.
 json UncertaintyJson(const calibration::CalibrationSummary& run) {
   if (!run.uncertainty) return nullptr;
@@ -255,7 +272,7 @@ json UncertaintyJson(const calibration::CalibrationSummary& run) {
           {"standard_error", Vector(u.standard_error)},
           {"standard_error_unit", Vector(u.standard_error_unit)},
           {"correlation", Matrix(u.correlation)},
-          {"covariance", Matrix(u.covariance)},
+          {"covariance", CovarianceJson(u)},
           {"identified", identified},
           {"weak", weak},
           {"runs", u.groups},
@@ -301,17 +318,60 @@ json RoughnessJson(const std::optional<calibration::RoughnessReport>& roughness)
 
 // The fields written for a fitted category: every row of kGroundFields that applies to it, with
 // its model when that is not the default.
+// Why a fitted value deserves a second look, as a TOML comment (" # ..."), or "": the coordinate
+// of `category`'s `field` is unidentified (its profile is flat, or the covariance found it so), or
+// the fit lies at a bound of its range (within 1e-3 of the range: the optimum may lie beyond).
+std::string FittedValueNote(const Objective& objective, const calibration::CalibrationSummary& run,
+                            const std::string& category, calibration::GroundField field) {
+  const auto& coordinates = objective.parameters().coordinates();
+  const auto& specs = objective.parameters().specs();
+  for (std::size_t j = 0; j < coordinates.size(); ++j) {
+    const calibration::Coordinate& c = coordinates[j];
+    const bool here = std::any_of(c.members.begin(), c.members.end(), [&](int m) {
+      return specs[static_cast<std::size_t>(m)].category == category &&
+             specs[static_cast<std::size_t>(m)].field == field;
+    });
+    if (!here) continue;
+    std::string note;
+    const bool unidentified = (j < run.profiles.size() && !run.profiles[j].identified) ||
+                              (run.uncertainty && j < run.uncertainty->identified.size() &&
+                               !run.uncertainty->identified[j]);
+    if (unidentified)
+      note +=
+          "unidentified: the observations do not constrain it (flat profile); the value is "
+          "where the fit left it";
+    const auto jj = static_cast<Eigen::Index>(j);
+    if (run.fit.best.u.size() > jj) {
+      const double u = run.fit.best.u[jj];
+      if (u <= 1e-3 || u >= 1 - 1e-3) {
+        if (!note.empty()) note += "; ";
+        note += std::string("at the ") + (u <= 1e-3 ? "lower" : "upper") + " bound of its range (" +
+                G(u <= 1e-3 ? c.lower : c.upper) + "): the optimum may lie beyond it";
+      }
+    }
+    return note.empty() ? "" : "  # " + note;
+  }
+  return "";
+}
+
 std::string GroundTableToml(const CalibrationFile& file, const Objective& objective,
-                            const GroundTable& fitted) {
+                            const GroundTable& fitted, const calibration::CalibrationSummary* run) {
   std::string out = "# Ground table fitted by talus calibrate " + file.path +
-                    " (docs/calibration.md).\n# Paste into a scene file, or append to one.\n";
+                    " (docs/calibration.md).\n# Paste into a scene file, or append to one. A value "
+                    "with a comment is not supported by the observations.\n";
   for (int k : Touched(objective, fitted)) {
     const GroundCategory& c = fitted.category(k);
     out += "\n[ground." + TomlKey(c.name) + "]\ncode = " + std::to_string(c.code) + "\n";
     if (c.params.IsSoil()) out.append("model = \"").append(ToString(c.params.model)).append("\"\n");
-    for (const GroundFieldInfo& f : kGroundFields)
-      if (f.group != GroundFieldInfo::Group::kDragLayer && GroundFieldApplies(f, c.params))
-        out.append(f.key).append(" = ").append(G(c.params.*f.member)).append("\n");
+    for (std::size_t i = 0; i < kGroundFields.size(); ++i) {
+      const GroundFieldInfo& f = kGroundFields[i];
+      if (f.group == GroundFieldInfo::Group::kDragLayer || !GroundFieldApplies(f, c.params))
+        continue;
+      out.append(f.key).append(" = ").append(G(c.params.*f.member));
+      if (run)
+        out += FittedValueNote(objective, *run, c.name, static_cast<calibration::GroundField>(i));
+      out += "\n";
+    }
   }
   return out;
 }

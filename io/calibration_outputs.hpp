@@ -12,10 +12,13 @@
 
 namespace talus::io {
 
-// The categories the calibration touched, with every field, as [ground.<name>] blocks.
+// The categories the calibration touched, with every field, as [ground.<name>] blocks. With the
+// run, a fitted value that is unidentified or at a bound of its range carries a comment saying so.
 std::string GroundTableToml(const CalibrationFile& file, const calibration::Objective& objective,
-                            const GroundTable& fitted);
-// category, code[, model], then the fields of kGroundFields that apply: one row per touched category.
+                            const GroundTable& fitted,
+                            const calibration::CalibrationSummary* run = nullptr);
+// category, code[, model], then the fields of kGroundFields that apply: one row per touched
+// category.
 std::string GroundTableCsv(const calibration::Objective& objective, const GroundTable& fitted);
 // Everything the run gave, with the version of the program that ran it.
 std::string CalibrationJson(const CalibrationFile& file, const calibration::Objective& objective,

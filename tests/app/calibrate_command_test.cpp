@@ -268,6 +268,15 @@ TEST(CalibrateCommand, CeresWithAHeldOutRunAndCrossValidation) {
   EXPECT_EQ(json["cross_validation"]["kinds"][0]["scored"], 6);
   EXPECT_TRUE(json["uncertainty"].is_object());
   EXPECT_TRUE(json["uncertainty"]["note"].is_string());
+  // The covariance has numbers between identified parameters and null elsewhere, never a 0 that
+  // would read as certainty.
+  const auto& uncertainty = json["uncertainty"];
+  for (std::size_t i = 0; i < uncertainty["identified"].size(); ++i)
+    for (std::size_t k = 0; k < uncertainty["identified"].size(); ++k)
+      EXPECT_EQ(
+          uncertainty["covariance"][i][k].is_null(),
+          !(uncertainty["identified"][i].get<bool>() && uncertainty["identified"][k].get<bool>()))
+          << uncertainty.dump(2);
   EXPECT_TRUE(json["uncertainty"]["bootstrap"].is_null());  // off by default
   EXPECT_TRUE(json["uncertainty"]["seeds"].is_null());      // off by default
   EXPECT_GT(json["finite_difference_step"].get<double>(), 0);

@@ -70,6 +70,49 @@ TEST(CalibrationOutputs, GroundTableTomlQuotesNamesThatAreNoBareKeys) {
   EXPECT_NE(text.find("[ground.plain-name]"), std::string::npos) << text;  // bare where it may be
 }
 
+// A fitted value the observations do not support is marked in ground_table.toml, with the reason:
+// unidentified (flat profile) or at a bound of its range; the others carry no comment, and the
+// file still reads back every value exactly.
+TEST(CalibrationOutputs, GroundTableTomlMarksUnidentifiedAndAtBoundValues) {
+  const OddNames odd;
+  CalibrationFile file;
+  file.path = "cal.toml";
+  calibration::CalibrationSummary run;
+  const int n = odd.objective->dimension();
+  run.fit.best.u = Eigen::VectorXd::Constant(n, 0.5);
+  run.fit.best.u[0] = 1.0;  // "zone 1" at its upper bound, 1.0
+  run.fit.best.u[5] = 0.0;  // "plain-name" at its lower bound, 0.1
+  run.profiles.resize(static_cast<std::size_t>(n));
+  for (auto& profile : run.profiles) profile.identified = true;
+  run.profiles[1].identified = false;  // "meadow.v2"
+  const std::string text = GroundTableToml(file, *odd.objective, odd.scene.ground, &run);
+  const toml::table parsed = toml::parse(text);
+  for (std::size_t k = 0; k < odd.names.size(); ++k) {
+    const GroundCategory& c = odd.scene.ground.category(odd.scene.ground.IndexOfName(odd.names[k]));
+    EXPECT_EQ(parsed["ground"][odd.names[k]]["mu_min"].value<double>(), c.params.mu_min) << text;
+  }
+  const auto line_of = [&](const std::string& category_header) {
+    const std::size_t block = text.find(category_header);
+    const std::size_t at = text.find("mu_min = ", block);
+    return text.substr(at, text.find('\n', at) - at);
+  };
+  EXPECT_NE(line_of("[ground.\"zone 1\"]").find("# at the upper bound of its range (1)"),
+            std::string::npos)
+      << text;
+  EXPECT_NE(line_of("[ground.\"meadow.v2\"]").find("# unidentified: the observations do not"),
+            std::string::npos)
+      << text;
+  EXPECT_NE(line_of("[ground.plain-name]").find("# at the lower bound of its range (0.1)"),
+            std::string::npos)
+      << text;
+  EXPECT_EQ(line_of("[ground.\"a,b\"]").find('#'), std::string::npos) << text;
+  EXPECT_EQ(line_of("[ground.plain-name]").find("unidentified"), std::string::npos) << text;
+  // Without the run (the fit alone), no comment at all.
+  const std::string bare = GroundTableToml(file, *odd.objective, odd.scene.ground);
+  EXPECT_EQ(bare.find("# at the"), std::string::npos);
+  EXPECT_EQ(bare.find("# unidentified"), std::string::npos);
+}
+
 // ground_table.csv and history.csv: a name with a comma, quote or line break is one quoted field.
 TEST(CalibrationOutputs, GroundTableCsvAndHistoryQuoteNames) {
   const OddNames odd;
