@@ -306,6 +306,11 @@ void WriteOutputs(const CalibrateArgs& args, const Loaded& loaded,
   WriteFileAtomically(staging->path("history.csv"), io::HistoryCsv(objective, run.fit));
   std::vector<std::string> outputs = {"ground_table.toml", "ground_table.csv", "history.csv",
                                       "convergence.svg"};
+  if (objective.parameters().has_shapes()) {
+    WriteFileAtomically(staging->path("shape_table.toml"),
+                        io::ShapeTableToml(file, objective, run));
+    outputs.push_back("shape_table.toml");
+  }
   WriteFileAtomically(staging->path("convergence.svg"), io::ConvergenceSvg(run.fit));
   for (const std::string& kind : objective.kinds()) {
     if (kind == "deposit") continue;

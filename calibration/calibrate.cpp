@@ -58,11 +58,17 @@ class Pipeline {
     if (options_.on_progress) options_.on_progress(text);
   }
   OptimizerSummary Optimise(const Objective& objective, const std::string& stage) const;
-  HeldOutScores Score(const RunSubset& runs, const GroundTable& table,
+  // Scores `runs` at unit vector u of `objective` (its ground table and, with shape parameters,
+  // its blocks), and with the reference table on the scene's own blocks.
+  HeldOutScores Score(const RunSubset& runs, const Objective& objective, const Eigen::VectorXd& u,
                       const GroundTable* reference) const {
     // Every scoring runs the scene as the objective does (its contact-solve tolerance).
-    return ScoreRuns(objective_.scene(), runs, table, reference, objective_.options().threads,
-                     objective_.needs_episodes(), objective_.options().run_ensemble);
+    std::vector<ensemble::Block> blocks;
+    if (objective.parameters().has_shapes()) blocks = objective.BlocksOf(u);
+    return ScoreRuns(objective_.scene(), runs, objective.GroundOf(u), reference,
+                     objective_.options().threads, objective_.needs_episodes(),
+                     objective_.options().run_ensemble,
+                     objective.parameters().has_shapes() ? &blocks : nullptr);
   }
   const GroundTable* reference() const {
     return problem_.reference() ? &*problem_.reference() : nullptr;
@@ -94,6 +100,7 @@ void Pipeline::Fit() {
   Say(run_.fit.FullReport());
   if (!run_.fit.IsSolutionUsable()) throw std::runtime_error(run_.fit.message);
   run_.fitted = objective_.GroundOf(run_.fit.best.u);
+  if (objective_.parameters().has_shapes()) run_.fitted_blocks = objective_.BlocksOf(run_.fit.best.u);
 }
 
 void Pipeline::Roughness() {
@@ -147,14 +154,14 @@ void Pipeline::Uncertainty() {
 
 void Pipeline::ScoreBeforeAndAfter() {
   Say("Scoring the observations before and after for the plots...\n");
-  run_.before = Score(problem_.fitted_runs(), objective_.GroundOf(run_.fit.initial.u), nullptr);
-  run_.after = Score(problem_.fitted_runs(), run_.fitted, nullptr);
+  run_.before = Score(problem_.fitted_runs(), objective_, run_.fit.initial.u, nullptr);
+  run_.after = Score(problem_.fitted_runs(), objective_, run_.fit.best.u, nullptr);
 }
 
 void Pipeline::HoldOut() {
   if (problem_.holdout().empty()) return;
   Say(Format("Scoring the %zu held-out runs...\n", problem_.holdout().size()));
-  run_.holdout = Score(problem_.HeldOutRuns(), run_.fitted, reference());
+  run_.holdout = Score(problem_.HeldOutRuns(), objective_, run_.fit.best.u, reference());
   Say(run_.holdout->Report());
 }
 
@@ -169,8 +176,8 @@ void Pipeline::CrossValidate() {
     Say(fold.summary.BriefReport() + "\n");
     if (!fold.summary.IsSolutionUsable())
       throw std::runtime_error("fold " + std::to_string(f + 1) + ": " + fold.summary.message);
-    fold.scores = Score(problem_.FoldRuns(static_cast<int>(f)),
-                        objective.GroundOf(fold.summary.best.u), reference());
+    fold.scores = Score(problem_.FoldRuns(static_cast<int>(f)), objective, fold.summary.best.u,
+                        reference());
     run_.folds.push_back(std::move(fold));
   }
   if (run_.folds.empty()) return;

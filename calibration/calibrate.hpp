@@ -120,6 +120,8 @@ struct FoldRun {
 struct CalibrationSummary {
   OptimizerSummary fit;  // the fit; fit.best is the fitted point
   GroundTable fitted;    // the scene's table with the fitted values
+  // The release's blocks with the fitted shape parameters; empty without shape parameters.
+  std::vector<ensemble::Block> fitted_blocks;
   std::optional<RoughnessReport> roughness;
   std::vector<ParameterProfile> profiles;
   std::optional<Uncertainty> uncertainty;

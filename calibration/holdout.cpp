@@ -96,7 +96,8 @@ std::vector<std::vector<std::string>> Folds(const ensemble::ReleaseSpec& release
 
 HeldOutScores ScoreRuns(const Scene& scene, const RunSubset& subset, const GroundTable& fitted,
                         const GroundTable* reference, int threads, bool episodes,
-                        const EnsembleRunner& runner) {
+                        const EnsembleRunner& runner,
+                        const std::vector<ensemble::Block>* fitted_blocks) {
   const auto t0 = std::chrono::steady_clock::now();
   HeldOutScores out;
   for (const ensemble::ReleaseRun& r : subset.release.runs) out.runs.push_back(r.id);
@@ -104,14 +105,21 @@ HeldOutScores ScoreRuns(const Scene& scene, const RunSubset& subset, const Groun
   options.threads = threads;
   options.episodes = episodes;
   fieldobs::AddRecordersFor(subset.observations, scene.terrain, subset.release, options);
-  const auto run = [&](const GroundTable& table, fieldobs::EnsembleSamples* samples) {
+  const auto run = [&](const GroundTable& table, const ensemble::ReleaseSpec& release,
+                       fieldobs::EnsembleSamples* samples) {
     Scene edited = scene;  // shares terrain and shapes; only the ground table differs
     edited.ground = table;
-    out.rocks += RunWith(runner, edited, subset.release, options, samples).rocks;
+    out.rocks += RunWith(runner, edited, release, options, samples).rocks;
   };
   fieldobs::EnsembleSamples with_fitted(subset.release), with_reference(subset.release);
-  run(fitted, &with_fitted);
-  if (reference) run(*reference, &with_reference);
+  if (fitted_blocks) {
+    ensemble::ReleaseSpec shaped = subset.release;
+    shaped.blocks = *fitted_blocks;
+    run(fitted, shaped, &with_fitted);
+  } else {
+    run(fitted, subset.release, &with_fitted);
+  }
+  if (reference) run(*reference, subset.release, &with_reference);
   fieldobs::ValidationOptions validation;
   validation.min_members = kMinMembers;
   const fieldobs::ValidationReport report = fieldobs::Validate(

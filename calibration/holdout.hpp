@@ -60,12 +60,15 @@ struct HeldOutScores {
   std::string Report() const;  // per kind, fitted against reference, a few lines for people
 };
 
-// Runs `subset` on `scene` with the ground table `fitted`, and with `reference` when given, and
-// scores its observations. threads 0: all cores; episodes: record contact episodes (impact and
-// scar observations need them); runner: how the rocks run (objective.hpp; empty: here).
+// Runs `subset` on `scene` with the ground table `fitted` (and the blocks `fitted_blocks` in place
+// of the subset's, when given: fitted shapes), and with `reference` and the subset's own blocks
+// when given, and scores its observations. threads 0: all cores; episodes: record contact
+// episodes (impact and scar observations need them); runner: how the rocks run (objective.hpp;
+// empty: here).
 HeldOutScores ScoreRuns(const Scene& scene, const RunSubset& subset, const GroundTable& fitted,
                         const GroundTable* reference, int threads, bool episodes,
-                        const EnsembleRunner& runner = {});
+                        const EnsembleRunner& runner = {},
+                        const std::vector<ensemble::Block>* fitted_blocks = nullptr);
 
 // Per kind, the means over every observation of several held-out sets (the folds of a
 // cross-validation), fitted and reference.

@@ -46,7 +46,7 @@ Objective::Objective(const Scene& scene, const ensemble::ReleaseSpec& release,
     : scene_(scene),
       release_(release),
       observations_(observations),
-      parameters_(std::move(parameters), scene.ground),
+      parameters_(std::move(parameters), scene.ground, release.blocks),
       options_(std::move(options)) {
   std::string why;
   if (!options_.IsValid(&why)) throw InputError(why);
@@ -147,6 +147,13 @@ GroundTable Objective::GroundOf(const Eigen::VectorXd& u) const {
   return table;
 }
 
+std::vector<ensemble::Block> Objective::BlocksOf(const Eigen::VectorXd& u) const {
+  std::vector<ensemble::Block> blocks = release_.blocks;
+  std::string why;
+  if (!parameters_.ApplyShapes(u, blocks, &why)) throw InputError(why);
+  return blocks;
+}
+
 ensemble::EnsembleReport RunWith(const EnsembleRunner& runner, const Scene& scene,
                                  const ensemble::ReleaseSpec& release,
                                  const ensemble::EnsembleOptions& options,
@@ -191,15 +198,22 @@ Evaluation Objective::Run(const Eigen::VectorXd& u, const ensemble::ReleaseSpec&
   std::string why;
   double violation = 0;
   if (!parameters_.Apply(u, scene.ground, &why, &violation)) return infeasible(why, violation);
+  // With shape parameters, a copy of the release whose blocks have the vector's knobs.
+  ensemble::ReleaseSpec shaped;
+  if (parameters_.has_shapes()) {
+    shaped = release;
+    if (!parameters_.ApplyShapes(u, shaped.blocks, &why)) return infeasible(why, 0);
+  }
+  const ensemble::ReleaseSpec& runs = parameters_.has_shapes() ? shaped : release;
 
   ensemble::EnsembleOptions options;
   options.threads = options_.threads;
   options.episodes = episodes_;
   options.progress = options_.progress;
-  fieldobs::AddRecordersFor(observations_, scene_.terrain, release, options);
-  fieldobs::EnsembleSamples samples(release);
+  fieldobs::AddRecordersFor(observations_, scene_.terrain, runs, options);
+  fieldobs::EnsembleSamples samples(runs);
   const ensemble::EnsembleReport report =
-      RunWith(options_.run_ensemble, scene, release, options, &samples);
+      RunWith(options_.run_ensemble, scene, runs, options, &samples);
   e.rocks = report.rocks;
   e.failed_rocks = report.count(EndReason::kFailed);
   fieldobs::ValidationOptions validation;

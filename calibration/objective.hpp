@@ -134,6 +134,9 @@ class Objective {
   Eigen::VectorXd StartPoint() const { return parameters_.UnitOf(scene_.ground); }
   // The ground table of a unit vector (the scene's table with the free fields set).
   GroundTable GroundOf(const Eigen::VectorXd& u) const;
+  // The release's blocks with the shape parameters of a unit vector (clamped to [0, 1]); the
+  // release's own without shape parameters. Throws talus::InputError when a shape cannot be made.
+  std::vector<ensemble::Block> BlocksOf(const Eigen::VectorXd& u) const;
 
   const ParameterSet& parameters() const { return parameters_; }
   int dimension() const { return parameters_.size(); }

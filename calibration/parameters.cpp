@@ -40,23 +40,84 @@ double& FieldOf(GroundParams& p, GroundField field) { return p.*InfoOf(field).me
 
 double FieldOf(const GroundParams& p, GroundField field) { return p.*InfoOf(field).member; }
 
-bool ParameterSpec::UsesLog() const {
-  return log.value_or(InfoOf(field).log_scale);
+namespace {
+struct ShapeFieldInfo {
+  ShapeField field;
+  const char* key;
+  const char* unit;
+};
+constexpr ShapeFieldInfo kShapeFields[] = {{ShapeField::kRoughness, "roughness", "1"},
+                                           {ShapeField::kSizeX, "size_x_m", "m"},
+                                           {ShapeField::kSizeY, "size_y_m", "m"},
+                                           {ShapeField::kSizeZ, "size_z_m", "m"}};
+}  // namespace
+
+const char* ToString(ShapeField field) { return kShapeFields[static_cast<int>(field)].key; }
+
+const char* UnitOf(ShapeField field) { return kShapeFields[static_cast<int>(field)].unit; }
+
+bool ParseShapeField(const std::string& name, ShapeField* field) {
+  for (const ShapeFieldInfo& info : kShapeFields)
+    if (name == info.key) {
+      *field = info.field;
+      return true;
+    }
+  return false;
 }
 
-std::string ParameterSpec::Name() const { return category + "." + ToString(field); }
+double& KnobOf(ensemble::ShapeKnobs& knobs, ShapeField field) {
+  switch (field) {
+    case ShapeField::kRoughness:
+      return knobs.roughness;
+    case ShapeField::kSizeX:
+      return knobs.size_m.x();
+    case ShapeField::kSizeY:
+      return knobs.size_m.y();
+    case ShapeField::kSizeZ:
+      break;
+  }
+  return knobs.size_m.z();
+}
+
+double KnobOf(const ensemble::ShapeKnobs& knobs, ShapeField field) {
+  return KnobOf(const_cast<ensemble::ShapeKnobs&>(knobs), field);
+}
+
+bool ParameterSpec::UsesLog() const {
+  return log.value_or(IsShape() ? false : InfoOf(field).log_scale);
+}
+
+std::string ParameterSpec::Name() const {
+  return IsShape() ? "blocks." + block + "." + FieldName() : category + "." + FieldName();
+}
+
+std::string ParameterSpec::FieldName() const {
+  return IsShape() ? ToString(shape_field) : ToString(field);
+}
+
+const char* ParameterSpec::Unit() const {
+  return IsShape() ? UnitOf(shape_field) : UnitOf(field);
+}
 
 bool ParameterSpec::IsValid(std::string* why) const {
   std::ostringstream msg;
-  const bool friction = field == GroundField::kMuMin || field == GroundField::kMuMax;
-  if (category.empty())
+  const bool friction = !IsShape() && (field == GroundField::kMuMin || field == GroundField::kMuMax);
+  const bool roughness = IsShape() && shape_field == ShapeField::kRoughness;
+  if (category.empty() && !IsShape())
     msg << "category is empty";
-  else if (!std::isfinite(lower) || !(lower > 0))
-    msg << "lower = " << lower << " must be > 0 (every ground parameter is positive)";
+  else if (!category.empty() && IsShape())
+    msg << "names both a ground category and a block";
+  else if (roughness && (!std::isfinite(lower) || lower < 0 || (UsesLog() && lower == 0)))
+    msg << "lower = " << lower << " must be >= 0 (> 0 on a log scale)";
+  else if (!roughness && (!std::isfinite(lower) || !(lower > 0)))
+    msg << "lower = " << lower << " must be > 0 ("
+        << (IsShape() ? "a size is positive" : "every ground parameter is positive") << ")";
   else if (!std::isfinite(upper) || !(upper > lower))
     msg << "upper = " << upper << " must be > lower = " << lower << " (the bounds are empty)";
   else if (friction && upper > kMaxFriction)
     msg << "upper = " << upper << " must be <= " << kMaxFriction << " for a friction coefficient";
+  else if (roughness && upper > kMaxRoughness)
+    msg << "upper = " << upper << " must be <= " << kMaxRoughness << " for a roughness";
   if (msg.str().empty()) return true;
   if (why) *why = Name() + ": " + msg.str();
   return false;
@@ -75,23 +136,29 @@ double Coordinate::ToUnit(double value) const {
   return (value - lower) / (upper - lower);
 }
 
-ParameterSet::ParameterSet(std::vector<ParameterSpec> specs, const GroundTable& table)
+ParameterSet::ParameterSet(std::vector<ParameterSpec> specs, const GroundTable& table,
+                           const std::vector<ensemble::Block>& blocks)
     : specs_(std::move(specs)) {
   if (specs_.empty()) throw InputError("no free parameter");
+  for (const ensemble::Block& b : blocks) base_knobs_.push_back(b.knobs);
   for (std::size_t k = 0; k < specs_.size(); ++k) {
     const ParameterSpec& s = specs_[k];
     std::string why;
     if (!s.IsValid(&why)) throw InputError(why);
-    const int index = table.IndexOfName(s.category);
-    if (index < 0) throw InputError(s.Name() + ": no ground category '" + s.category + "'");
-    category_index_.push_back(index);
-    if (InfoOf(s.field).group == GroundFieldInfo::Group::kSoil && !table.params(index).IsSoil())
-      throw InputError(s.Name() + ": category '" + s.category +
-                       "' has no scarring soil (a soil parameter acts only with model = "
-                       "\"lu2019\")");
+    if (s.IsShape()) {
+      ResolveShape(s, blocks);
+    } else {
+      const int index = table.IndexOfName(s.category);
+      if (index < 0) throw InputError(s.Name() + ": no ground category '" + s.category + "'");
+      category_index_.push_back(index);
+      block_index_.push_back(-1);
+      if (InfoOf(s.field).group == GroundFieldInfo::Group::kSoil && !table.params(index).IsSoil())
+        throw InputError(s.Name() + ": category '" + s.category +
+                         "' has no scarring soil (a soil parameter acts only with model = "
+                         "\"lu2019\")");
+    }
     for (std::size_t j = 0; j < k; ++j)
-      if (specs_[j].category == s.category && specs_[j].field == s.field)
-        throw InputError(s.Name() + ": freed twice");
+      if (specs_[j].Name() == s.Name()) throw InputError(s.Name() + ": freed twice");
     // A tie named as another free parameter that is not in the tie would label this parameter's
     // values with that one's name (tie = "medium.mu_max" on mu_min swapped the labels).
     if (!s.tie.empty())
@@ -101,7 +168,7 @@ ParameterSet::ParameterSet(std::vector<ParameterSpec> specs, const GroundTable& 
               s.Name() + ": tie '" + s.tie + "' is the name of the free parameter " + other.Name() +
               ", which is not in the tie" +
               (other.tie.empty() ? std::string() : " (its tie is '" + other.tie + "')") +
-              ": name the tie otherwise (e.g. '" + ToString(s.field) + "'), or give " +
+              ": name the tie otherwise (e.g. '" + s.FieldName() + "'), or give " +
               other.Name() + " the same tie");
     // A tie joins the coordinate of its name; else the parameter has a coordinate of its own.
     Coordinate* joined = nullptr;
@@ -110,8 +177,8 @@ ParameterSet::ParameterSet(std::vector<ParameterSpec> specs, const GroundTable& 
         if (c.name == s.tie) joined = &c;
     if (joined) {
       const ParameterSpec& first = specs_[joined->members.front()];
-      if (first.field != s.field || first.lower != s.lower || first.upper != s.upper ||
-          first.UsesLog() != s.UsesLog())
+      if (first.IsShape() != s.IsShape() || first.FieldName() != s.FieldName() ||
+          first.lower != s.lower || first.upper != s.upper || first.UsesLog() != s.UsesLog())
         throw InputError(s.Name() + ": tie '" + s.tie + "' joins parameters of one field with " +
                          "equal bounds and transform, unlike " + first.Name());
       joined->members.push_back(static_cast<int>(k));
@@ -158,10 +225,60 @@ Eigen::VectorXd ParameterSet::Values(const Eigen::VectorXd& u) const {
 Eigen::VectorXd ParameterSet::UnitOf(const GroundTable& table) const {
   Eigen::VectorXd u(size());
   for (int j = 0; j < size(); ++j) {
-    const int k = coordinates_[j].members.front();
-    u[j] = coordinates_[j].ToUnit(FieldOf(table.params(category_index_[k]), specs_[k].field));
+    const auto k = static_cast<std::size_t>(coordinates_[j].members.front());
+    const double value =
+        specs_[k].IsShape()
+            ? KnobOf(base_knobs_[static_cast<std::size_t>(block_index_[k])], specs_[k].shape_field)
+            : FieldOf(table.params(category_index_[k]), specs_[k].field);
+    u[j] = coordinates_[j].ToUnit(value);
   }
   return u;
+}
+
+void ParameterSet::ResolveShape(const ParameterSpec& s, const std::vector<ensemble::Block>& blocks) {
+  int index = -1;
+  for (std::size_t b = 0; b < blocks.size(); ++b)
+    if (blocks[b].id == s.block) index = static_cast<int>(b);
+  if (index < 0)
+    throw InputError(s.Name() + ": no block '" + s.block + "'" +
+                     (blocks.empty() ? std::string(" (the release has no [blocks])") : ""));
+  const ensemble::Block& block = blocks[static_cast<std::size_t>(index)];
+  if (!block.make)
+    throw InputError(s.Name() + ": block '" + s.block +
+                     "' has a fixed shape (a point cloud): only built-in blocks have knobs");
+  if (!std::isfinite(KnobOf(block.knobs, s.shape_field)))
+    throw InputError(s.Name() + ": block '" + s.block + "' has no " + s.FieldName() +
+                     (s.shape_field == ShapeField::kRoughness ? " (only a rock block has one)"
+                                                              : ""));
+  category_index_.push_back(-1);
+  block_index_.push_back(index);
+  has_shapes_ = true;
+}
+
+bool ParameterSet::ApplyShapes(const Eigen::VectorXd& u, std::vector<ensemble::Block>& blocks,
+                               std::string* why) const {
+  if (!has_shapes_) return true;
+  std::vector<bool> touched(blocks.size(), false);
+  for (int j = 0; j < size(); ++j) {
+    const double value = coordinates_[j].ToValue(std::clamp(u[j], 0.0, 1.0));
+    for (int k : coordinates_[j].members) {
+      const ParameterSpec& s = specs_[static_cast<std::size_t>(k)];
+      if (!s.IsShape()) continue;
+      const auto b = static_cast<std::size_t>(block_index_[static_cast<std::size_t>(k)]);
+      KnobOf(blocks[b].knobs, s.shape_field) = value;
+      touched[b] = true;
+    }
+  }
+  for (std::size_t b = 0; b < blocks.size(); ++b) {
+    if (!touched[b]) continue;
+    try {
+      blocks[b].shape = std::make_shared<const RockShape>(blocks[b].make(blocks[b].knobs));
+    } catch (const InputError& e) {
+      if (why) *why = "block '" + blocks[b].id + "': " + e.what();
+      return false;
+    }
+  }
+  return true;
 }
 
 bool ParameterSet::Apply(const Eigen::VectorXd& u, GroundTable& table, std::string* why,
@@ -188,10 +305,12 @@ bool ParameterSet::Apply(const Eigen::VectorXd& u, GroundTable& table, std::stri
   for (int j = 0; j < size(); ++j) {
     const double value = coordinates_[j].ToValue(u[j]);
     for (int k : coordinates_[j].members)
-      FieldOf(table.mutable_params(category_index_[k]), specs_[k].field) = value;
+      if (!specs_[k].IsShape())
+        FieldOf(table.mutable_params(category_index_[k]), specs_[k].field) = value;
   }
   double crossing = 0;
   for (std::size_t k = 0; k < specs_.size(); ++k) {
+    if (specs_[k].IsShape()) continue;
     const GroundParams& p = table.params(category_index_[k]);
     std::string reason;
     if (!p.IsValid(&reason)) {

@@ -8,12 +8,17 @@
 // so that every coordinate is dimensionless, bounded by [0, 1], and steps, tolerances, designs
 // (Sobol, Latin hypercube) and the prior are all stated in the same "fraction of the range".
 // Several parameters sharing a tie name share one coordinate (e.g. one mu_max for all categories).
+//
+// A parameter is a field of a ground category, or a knob of a block's shape (a shape parameter:
+// the roughness of a built-in rock block, an axis of a built-in block's size), so that ground and
+// shape can be fitted together; the shape's knobs are ensemble::Block's.
 
 #include <Eigen/Core>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "ensemble/release.hpp"
 #include "solver/ground.hpp"
 
 namespace talus::calibration {
@@ -37,20 +42,37 @@ bool ParseGroundField(const std::string& name, GroundField* field);
 double& FieldOf(GroundParams& params, GroundField field);
 double FieldOf(const GroundParams& params, GroundField field);
 
-// One free parameter: a field of one ground category, its physical bounds and its transform.
+// The knobs of a block's shape that a calibration may free (ensemble::ShapeKnobs).
+enum class ShapeField { kRoughness, kSizeX, kSizeY, kSizeZ };
+const char* ToString(ShapeField field);  // "roughness", "size_x_m", "size_y_m", "size_z_m"
+const char* UnitOf(ShapeField field);    // "1", "m", "m", "m"
+bool ParseShapeField(const std::string& name, ShapeField* field);
+double& KnobOf(ensemble::ShapeKnobs& knobs, ShapeField field);
+double KnobOf(const ensemble::ShapeKnobs& knobs, ShapeField field);
+
+// One free parameter: a field of one ground category or a knob of one block's shape, its
+// physical bounds and its transform.
 struct ParameterSpec {
   std::string category;  // a category of the scene's ground table, e.g. "medium"
   GroundField field = GroundField::kMuMin;
-  double lower = 0;  // in the field's unit; > 0
-  double upper = 0;  // > lower; mu <= kMaxFriction
+  // A shape parameter instead: a block of the release (ensemble::Block::id) and its knob; then
+  // `category` is empty.
+  std::string block;
+  ShapeField shape_field = ShapeField::kRoughness;
+  double lower = 0;  // in the field's unit; > 0 (a roughness: >= 0)
+  double upper = 0;  // > lower; mu <= kMaxFriction, roughness <= kMaxRoughness
   // Log transform of the coordinate; nullopt: on for beta, kappa, nu and soil_strength, off for
-  // mu_min, mu_max and compaction_drag (GroundFieldInfo::log_scale).
+  // mu_min, mu_max, compaction_drag (GroundFieldInfo::log_scale) and every shape knob.
   std::optional<bool> log;
   std::string tie;  // parameters with the same non-empty tie share one coordinate
 
-  static constexpr double kMaxFriction = 5.0;  // bound on mu_min and mu_max
+  static constexpr double kMaxFriction = 5.0;   // bound on mu_min and mu_max
+  static constexpr double kMaxRoughness = 0.5;  // as the built-in rock takes it
+  bool IsShape() const { return !block.empty(); }
   bool UsesLog() const;
-  std::string Name() const;  // "medium.mu_min"
+  std::string Name() const;       // "medium.mu_min", or "blocks.<id>.roughness"
+  std::string FieldName() const;  // "mu_min", "roughness", ...
+  const char* Unit() const;       // the field's unit
   // False with the field, the value and the violated bound in *why.
   bool IsValid(std::string* why) const;
 };
@@ -65,13 +87,15 @@ struct Coordinate {
   double ToUnit(double value) const;  // value -> unit coordinate (not clamped)
 };
 
-// The free parameters, resolved against a ground table.
+// The free parameters, resolved against a ground table and the release's blocks.
 class ParameterSet {
  public:
-  // Checks every spec, that its category exists in `table`, that no field is freed twice, that
-  // the members of a tie share field bounds and transform, and that mu_min <= mu_max is possible
-  // within the bounds of each category. Throws talus::InputError naming the parameter.
-  ParameterSet(std::vector<ParameterSpec> specs, const GroundTable& table);
+  // Checks every spec, that its category exists in `table` (a shape parameter: that its block
+  // is in `blocks` and has the knob), that no field is freed twice, that the members of a tie
+  // share field bounds and transform, and that mu_min <= mu_max is possible within the bounds of
+  // each category. Throws talus::InputError naming the parameter.
+  ParameterSet(std::vector<ParameterSpec> specs, const GroundTable& table,
+               const std::vector<ensemble::Block>& blocks = {});
 
   int size() const { return static_cast<int>(coordinates_.size()); }  // optimiser dimension
   const std::vector<ParameterSpec>& specs() const { return specs_; }
@@ -79,9 +103,11 @@ class ParameterSet {
 
   // The parameter values (one per coordinate) of a unit vector.
   Eigen::VectorXd Values(const Eigen::VectorXd& u) const;
-  // The unit vector of the values `table` holds (not clamped: a table outside the bounds gives
-  // coordinates outside [0, 1]). A tie takes its first member's value.
+  // The unit vector of the values `table` holds, and of shape parameters the knobs of the blocks
+  // given at construction (not clamped: a value outside the bounds gives a coordinate outside
+  // [0, 1]). A tie takes its first member's value.
   Eigen::VectorXd UnitOf(const GroundTable& table) const;
+  bool has_shapes() const { return has_shapes_; }
 
   // Writes the values of unit vector u into `table` (only the freed fields), then checks every
   // category it touched with GroundParams::IsValid (which includes mu_min <= mu_max). False, with
@@ -89,13 +115,27 @@ class ParameterSet {
   // then edited but invalid and must not be run. *violation (when given) measures how far u is
   // from feasibility: the largest mu_min - mu_max over the touched categories (if > 0) plus the
   // distance of u outside the unit cube (0 when feasible; infinity for a non-finite u).
+  // Shape parameters are not written here (ApplyShapes).
   bool Apply(const Eigen::VectorXd& u, GroundTable& table, std::string* why,
              double* violation = nullptr) const;
+  // Writes the shape parameters of unit vector u (clamped to [0, 1]) into the knobs of `blocks`
+  // (the blocks given at construction, in the same order) and remakes the shapes of the blocks it
+  // touched. False, with the block and the reason in *why, when a shape cannot be made (e.g. a
+  // size whose density, with the block's mass, is impossible): the blocks are then edited but
+  // must not be run. Nothing to do, and true, without shape parameters.
+  bool ApplyShapes(const Eigen::VectorXd& u, std::vector<ensemble::Block>& blocks,
+                   std::string* why) const;
 
  private:
   std::vector<ParameterSpec> specs_;
-  std::vector<int> category_index_;  // per spec, into the table given at construction
+  std::vector<int> category_index_;  // per spec, into the table given at construction; -1: shape
+  std::vector<int> block_index_;     // per spec, into the blocks given at construction; -1: ground
+  std::vector<ensemble::ShapeKnobs> base_knobs_;  // of the blocks given at construction
   std::vector<Coordinate> coordinates_;
+  bool has_shapes_ = false;
+
+  // The block of shape parameter `s` and its checks (the constructor's).
+  void ResolveShape(const ParameterSpec& s, const std::vector<ensemble::Block>& blocks);
 };
 
 }  // namespace talus::calibration

@@ -371,7 +371,8 @@ ReleasedRock Release(const Scene& scene, const ReleaseSpec& spec, long rock) {
   ReleasedRock out;
   if (spec.shape_per_rock) {
     out.shape = std::make_shared<const RockShape>(
-        spec.shape_per_rock(block, RockShapeSeed(spec.seed, rock)));
+        spec.shape_per_rock(block >= 0 ? &spec.blocks[static_cast<std::size_t>(block)] : nullptr,
+                            RockShapeSeed(spec.seed, rock)));
   } else if (block >= 0) {
     out.shape = spec.blocks[static_cast<std::size_t>(block)].shape;
   } else {

@@ -6,6 +6,7 @@
 #include <Eigen/Geometry>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -39,10 +40,26 @@ struct ReleaseRun {
   std::optional<Eigen::Quaterniond> orientation;
 };
 
+// The knobs of a block's shape that a calibration may change (calibration/parameters.hpp), and
+// the seed of its random hull. NaN where the shape has no such knob: a box has no roughness, a
+// scanned hull no size.
+struct ShapeKnobs {
+  double roughness = std::numeric_limits<double>::quiet_NaN();  // built-in rock, 0 .. 0.5
+  // Bounding box (m) of a built-in box, ellipsoid, rock or EOTA block.
+  Eigen::Vector3d size_m = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+  std::uint64_t shape_seed = 0;  // of a built-in rock's random points
+};
+
+// Makes a block's shape from knobs. Throws talus::InputError for knobs that give no usable rock
+// (e.g. a mass that makes the density of a smaller block impossible). Thread-safe.
+using ShapeMaker = std::function<RockShape(const ShapeKnobs& knobs)>;
+
 // A named rock shape that runs refer to (e.g. the blocks of an experiment campaign).
 struct Block {
   std::string id;
   std::shared_ptr<const RockShape> shape;
+  ShapeKnobs knobs;  // what `shape` was made from
+  ShapeMaker make;   // the same block with other knobs; empty: the shape is fixed
 };
 
 struct ReleaseSpec {
@@ -53,9 +70,10 @@ struct ReleaseSpec {
   std::vector<ReleaseRun> runs;
   std::vector<Block> blocks;  // shapes the runs name
   // When set, every rock gets a shape of its own: shape_per_rock(block, shape seed) with the
-  // block of its run (-1: the scene's rock) and a seed that depends on (seed, rock) only. It is
-  // called from worker threads and must be thread-safe; a bad shape is an exception.
-  std::function<RockShape(int block, std::uint64_t shape_seed)> shape_per_rock;
+  // block of its run (an element of `blocks`; null: the scene's rock) and a seed that depends on
+  // (seed, rock) only. It is called from worker threads and must be thread-safe; a bad shape is
+  // an exception.
+  std::function<RockShape(const Block* block, std::uint64_t shape_seed)> shape_per_rock;
   long rocks_per_release = 1;  // per release geometry or per run (when release_first_rock is empty)
   // When not empty: release r holds rocks [release_first_rock[r], release_first_rock[r + 1])
   // (release_count() + 1 entries from 0, e.g. rocks per m2 of each polygon); set it with

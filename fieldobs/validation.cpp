@@ -264,4 +264,43 @@ std::string ValidationReport::FullReport() const {
   return out + BriefReport() + "\n";
 }
 
+std::vector<BlockBias> BiasByBlock(const std::vector<ObservationScore>& scores,
+                                   const ensemble::ReleaseSpec& release) {
+  std::map<std::string, std::string> block_of;  // run id -> block id
+  for (const ensemble::ReleaseRun& r : release.runs)
+    block_of[r.id] =
+        r.block >= 0 ? release.blocks[static_cast<std::size_t>(r.block)].id : std::string("[rock]");
+  std::vector<std::string> blocks;  // release order: the blocks, then runs without one
+  for (const ensemble::Block& b : release.blocks) blocks.push_back(b.id);
+  blocks.emplace_back("[rock]");
+  std::vector<std::string> kinds;
+  for (const ObservationScore& s : scores)
+    if (s.scored && std::isfinite(s.bias) &&
+        std::find(kinds.begin(), kinds.end(), s.kind) == kinds.end())
+      kinds.push_back(s.kind);
+  std::vector<BlockBias> out;
+  for (const std::string& block : blocks)
+    for (const std::string& kind : kinds) {
+      BlockBias b;
+      b.block = block;
+      b.kind = kind;
+      double bias = 0, score = 0;
+      for (const ObservationScore& s : scores) {
+        const auto it = block_of.find(s.run);
+        if (!s.scored || !std::isfinite(s.bias) || s.kind != kind || it == block_of.end() ||
+            it->second != block)
+          continue;
+        b.unit = s.unit;
+        bias += s.bias;
+        score += s.score;
+        ++b.scored;
+      }
+      if (b.scored == 0) continue;
+      b.mean_bias = bias / b.scored;
+      b.mean_score = score / b.scored;
+      out.push_back(b);
+    }
+  return out;
+}
+
 }  // namespace talus::fieldobs

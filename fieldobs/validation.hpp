@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "ensemble/release.hpp"
 #include "fieldobs/observations.hpp"
 #include "fieldobs/samples.hpp"
 #include "fieldobs/scores.hpp"
@@ -78,6 +79,23 @@ struct ValidationOptions {
   std::uint64_t seed = 1;  // for the PITs' tie-breaking uniforms: scores are deterministic
   int min_members = 2;     // fewer simulated values: the observation is not scored
 };
+
+// Per block of the runs and scalar kind: how far the simulated mean lies from the observed, over
+// the scored observations of that block's runs. A bias of opposite sign per block is what a
+// ground table cannot remove and a block's shape can (docs/calibration.md, "Shape parameters").
+struct BlockBias {
+  std::string block;  // ensemble::Block::id; "[rock]" for runs without a block
+  std::string kind, unit;
+  int scored = 0;
+  double mean_bias = kNaN;  // mean over the observations of (simulated mean - observed)
+  double mean_score = kNaN;
+};
+
+// The biases of `scores` (of scalar observations of runs; others are left out) by the block of
+// each observation's run in `release`, blocks in release order, then kinds in order of first
+// appearance. Runs not in `release` are left out.
+std::vector<BlockBias> BiasByBlock(const std::vector<ObservationScore>& scores,
+                                   const ensemble::ReleaseSpec& release);
 
 // Scores `observations` against `simulated`, and against `reference` when given (same rocks with
 // the reference parameter set).

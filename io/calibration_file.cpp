@@ -25,6 +25,7 @@ std::vector<std::string> CalibratedFields() {
   return fields;
 }
 const std::vector<std::string> kFields = CalibratedFields();
+const std::vector<std::string> kShapeFields = {"roughness", "size_x_m", "size_y_m", "size_z_m"};
 
 std::string Hint(const std::string& word, const std::vector<std::string>& known) {
   const std::string hint = ClosestName(word, known);
@@ -64,23 +65,42 @@ void LoadParameters(const Context& context, const toml::table& root, Calibration
     const std::string name = "parameters[" + std::to_string(k) + "]";
     const toml::table* t = array->get(k)->as_table();
     if (!t) context.Fail(array->get(k), name, "expected a table (category, field, lower, upper)");
-    const Section s(context, t, name, {"category", "field", "lower", "upper", "log", "tie"});
+    const Section s(context, t, name,
+                    {"category", "block", "field", "lower", "upper", "log", "tie"});
     ParameterSpec spec;
-    if (!s.Has("category")) s.Fail("category", "missing: a ground category of the scene");
-    spec.category = s.String("category", "");
-    if (table.IndexOfName(spec.category) < 0)
-      s.Fail("category", "unknown ground category '" + spec.category + "'" +
-                             Hint(spec.category, categories) + "; the scene has " +
-                             Join(categories));
-    if (!s.Has("field")) s.Fail("field", "missing: one of " + Join(kFields));
-    const std::string field = s.String("field", "");
-    if (!calibration::ParseGroundField(field, &spec.field))
-      s.Fail("field", "unknown parameter '" + field + "'" + Hint(field, kFields) +
-                          "; known: " + Join(kFields));
+    if (s.Has("category") == s.Has("block"))
+      s.Fail(s.Has("block") ? "block" : "category",
+             s.Has("block") ? "give a ground category or a block, not both"
+                            : "missing: a ground category of the scene (or a block, for a "
+                              "shape parameter)");
+    if (s.Has("block")) {
+      spec.block = s.String("block", "");
+      std::vector<std::string> blocks;
+      for (const ensemble::Block& b : out.event.scene.release.blocks) blocks.push_back(b.id);
+      if (std::find(blocks.begin(), blocks.end(), spec.block) == blocks.end())
+        s.Fail("block", "unknown block '" + spec.block + "'" + Hint(spec.block, blocks) +
+                            (blocks.empty() ? "; the scene has no [blocks]"
+                                            : "; the scene has " + Join(blocks)));
+      if (!s.Has("field")) s.Fail("field", "missing: one of " + Join(kShapeFields));
+      const std::string field = s.String("field", "");
+      if (!calibration::ParseShapeField(field, &spec.shape_field))
+        s.Fail("field", "unknown shape parameter '" + field + "'" + Hint(field, kShapeFields) +
+                            "; known: " + Join(kShapeFields));
+    } else {
+      spec.category = s.String("category", "");
+      if (table.IndexOfName(spec.category) < 0)
+        s.Fail("category", "unknown ground category '" + spec.category + "'" +
+                               Hint(spec.category, categories) + "; the scene has " +
+                               Join(categories));
+      if (!s.Has("field")) s.Fail("field", "missing: one of " + Join(kFields));
+      const std::string field = s.String("field", "");
+      if (!calibration::ParseGroundField(field, &spec.field))
+        s.Fail("field", "unknown parameter '" + field + "'" + Hint(field, kFields) +
+                            "; known: " + Join(kFields));
+    }
     for (const char* bound : {"lower", "upper"})
       if (!s.Has(bound))
-        s.Fail(bound, std::string("missing: the ") + bound + " bound, in " +
-                          calibration::UnitOf(spec.field));
+        s.Fail(bound, std::string("missing: the ") + bound + " bound, in " + spec.Unit());
     spec.lower = s.Number("lower", 0);
     spec.upper = s.Number("upper", 0);
     if (s.Has("log")) spec.log = s.Bool("log", false);
@@ -92,7 +112,7 @@ void LoadParameters(const Context& context, const toml::table& root, Calibration
   }
   // Ties, duplicates and mu_min <= mu_max, against the scene's table.
   try {
-    const calibration::ParameterSet set(out.parameters, table);
+    const calibration::ParameterSet set(out.parameters, table, out.event.scene.release.blocks);
   } catch (const InputError& e) {
     // Name the parameter the message starts with.
     const std::string message = e.what();

@@ -10,6 +10,7 @@
 
 #include "common/format.hpp"
 #include "io/rocks_csv.hpp"
+#include "io/validation_outputs.hpp"
 
 namespace talus::io {
 namespace {
@@ -61,7 +62,7 @@ std::string TomlKey(const std::string& name) {
 std::vector<int> Touched(const Objective& objective, const GroundTable& table) {
   std::set<int> indices;
   for (const auto& spec : objective.parameters().specs())
-    indices.insert(table.IndexOfName(spec.category));
+    if (!spec.IsShape()) indices.insert(table.IndexOfName(spec.category));
   return {indices.begin(), indices.end()};
 }
 
@@ -157,9 +158,17 @@ json HeldOutKinds(const std::vector<calibration::HeldOutKind>& kinds) {
   return out;
 }
 
-json HeldOut(const calibration::HeldOutScores& s) {
+// Per block and kind, the simulated mean's bias against the observed (fieldobs::BiasByBlock), over
+// the runs of `observations` (the runs' blocks from `release`, the event's whole release).
+json BlocksJson(const std::vector<fieldobs::ObservationScore>& observations,
+                const ensemble::ReleaseSpec& release) {
+  return json(BlockBiasJson(fieldobs::BiasByBlock(observations, release)));
+}
+
+json HeldOut(const calibration::HeldOutScores& s, const ensemble::ReleaseSpec& release) {
   return {{"runs", s.runs},
           {"kinds", HeldOutKinds(s.kinds)},
+          {"blocks", BlocksJson(s.observations, release)},
           {"rocks", s.rocks},
           {"wall_time_s", s.wall_time_s}};
 }
@@ -177,8 +186,10 @@ json ParametersJson(const Objective& objective, const calibration::CalibrationSu
     const auto& first = objective.parameters().specs()[c.members.front()];
     json p = {{"name", c.name},
               {"parameters", members},
-              {"field", calibration::ToString(first.field)},
-              {"unit", calibration::UnitOf(first.field)},
+              // Which part of the fit: the ground table, or a block's shape.
+              {"part", first.IsShape() ? "shape" : "ground"},
+              {"field", first.FieldName()},
+              {"unit", first.Unit()},
               {"lower", c.lower},
               {"upper", c.upper},
               {"log", c.log},
@@ -285,18 +296,23 @@ json UncertaintyJson(const calibration::CalibrationSummary& run) {
 }
 
 // Each fold's fit and scores, and the scores pooled over the folds; null without folds.
-json CrossValidationJson(const calibration::CalibrationSummary& run) {
+json CrossValidationJson(const calibration::CalibrationSummary& run,
+                         const ensemble::ReleaseSpec& release) {
   if (run.folds.empty()) return nullptr;
   json folds = json::array();
+  std::vector<fieldobs::ObservationScore> pooled;
   for (const calibration::FoldRun& f : run.folds) {
-    json fold = HeldOut(f.scores);
+    pooled.insert(pooled.end(), f.scores.observations.begin(), f.scores.observations.end());
+    json fold = HeldOut(f.scores, release);
     fold["fitted"] = Vector(f.summary.best.values);
     fold["objective"] = Number(f.summary.best.value);
     fold["evaluations"] = f.summary.evaluations();
     fold["termination"] = calibration::ToString(f.summary.termination);
     folds.push_back(fold);
   }
-  return {{"folds", folds}, {"kinds", HeldOutKinds(run.cross_validated)}};
+  return {{"folds", folds},
+          {"kinds", HeldOutKinds(run.cross_validated)},
+          {"blocks", BlocksJson(pooled, release)}};
 }
 
 json RoughnessJson(const std::optional<calibration::RoughnessReport>& roughness) {
@@ -318,18 +334,29 @@ json RoughnessJson(const std::optional<calibration::RoughnessReport>& roughness)
 
 // The fields written for a fitted category: every row of kGroundFields that applies to it, with
 // its model when that is not the default.
+std::string FittedValueNote(const Objective& objective, const calibration::CalibrationSummary& run,
+                            const std::string& name);
+
 // Why a fitted value deserves a second look, as a TOML comment (" # ..."), or "": the coordinate
 // of `category`'s `field` is unidentified (its profile is flat, or the covariance found it so), or
 // the fit lies at a bound of its range (within 1e-3 of the range: the optimum may lie beyond).
 std::string FittedValueNote(const Objective& objective, const calibration::CalibrationSummary& run,
                             const std::string& category, calibration::GroundField field) {
+  calibration::ParameterSpec spec;
+  spec.category = category;
+  spec.field = field;
+  return FittedValueNote(objective, run, spec.Name());
+}
+
+// The same for the parameter named `name` (ParameterSpec::Name()).
+std::string FittedValueNote(const Objective& objective, const calibration::CalibrationSummary& run,
+                            const std::string& name) {
   const auto& coordinates = objective.parameters().coordinates();
   const auto& specs = objective.parameters().specs();
   for (std::size_t j = 0; j < coordinates.size(); ++j) {
     const calibration::Coordinate& c = coordinates[j];
     const bool here = std::any_of(c.members.begin(), c.members.end(), [&](int m) {
-      return specs[static_cast<std::size_t>(m)].category == category &&
-             specs[static_cast<std::size_t>(m)].field == field;
+      return specs[static_cast<std::size_t>(m)].Name() == name;
     });
     if (!here) continue;
     std::string note;
@@ -372,6 +399,41 @@ std::string GroundTableToml(const CalibrationFile& file, const Objective& object
         out += FittedValueNote(objective, *run, c.name, static_cast<calibration::GroundField>(i));
       out += "\n";
     }
+  }
+  return out;
+}
+
+std::string ShapeTableToml(const CalibrationFile& file, const Objective& objective,
+                           const calibration::CalibrationSummary& run) {
+  std::string out =
+      "# Block shapes fitted by talus calibrate " + file.path +
+      " (docs/calibration.md), jointly with\n# the ground table in ground_table.toml: use the "
+      "two together. Each block's fitted knobs replace\n# its own in the scene's [blocks] (a "
+      "block of the blocks file: move it to a [blocks.<id>]\n# table). A value with a comment "
+      "is not supported by the observations.\n";
+  const auto& specs = objective.parameters().specs();
+  for (const ensemble::Block& block : run.fitted_blocks) {
+    std::string lines;
+    bool size = false;
+    for (const calibration::ParameterSpec& spec : specs) {
+      if (!spec.IsShape() || spec.block != block.id) continue;
+      if (spec.shape_field == calibration::ShapeField::kRoughness) {
+        lines += "roughness = " + G(block.knobs.roughness) +
+                 FittedValueNote(objective, run, spec.Name()) + "\n";
+      } else if (!size) {
+        size = true;
+        lines += "size_m = [" + G(block.knobs.size_m.x()) + ", " + G(block.knobs.size_m.y()) +
+                 ", " + G(block.knobs.size_m.z()) + "]\n";
+      }
+    }
+    for (const calibration::ParameterSpec& spec : specs)
+      if (spec.IsShape() && spec.block == block.id &&
+          spec.shape_field != calibration::ShapeField::kRoughness) {
+        const std::string note = FittedValueNote(objective, run, spec.Name());
+        if (!note.empty()) lines += "# " + spec.FieldName() + ":" + note.substr(3) + "\n";
+      }
+    if (lines.empty()) continue;
+    out += "\n[blocks." + TomlKey(block.id) + "]\n" + lines;
   }
   return out;
 }
@@ -449,8 +511,11 @@ std::string CalibrationJson(const CalibrationFile& file, const Objective& object
               {"total_s", run.wall_time_s}}}};
   j["uncertainty"] = UncertaintyJson(run);
   j["not_scored"] = file.event.not_scored;  // observed values without a simulated counterpart
-  j["holdout"] = run.holdout ? HeldOut(*run.holdout) : json(nullptr);
-  j["cross_validation"] = CrossValidationJson(run);
+  const ensemble::ReleaseSpec& all_runs = file.event.scene.release;
+  // The fitted runs scored with the fitted values, per block: what the fit leaves in each block.
+  j["fitted_runs_blocks"] = BlocksJson(run.after.observations, all_runs);
+  j["holdout"] = run.holdout ? HeldOut(*run.holdout, all_runs) : json(nullptr);
+  j["cross_validation"] = CrossValidationJson(run, all_runs);
   j["roughness"] = RoughnessJson(run.roughness);
   return j.dump(2) + "\n";
 }

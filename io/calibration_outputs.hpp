@@ -17,6 +17,10 @@ namespace talus::io {
 std::string GroundTableToml(const CalibrationFile& file, const calibration::Objective& objective,
                             const GroundTable& fitted,
                             const calibration::CalibrationSummary* run = nullptr);
+// The fitted shape knobs of every block with shape parameters, as [blocks.<id>] tables with a
+// comment on values the observations do not support; only the header without shape parameters.
+std::string ShapeTableToml(const CalibrationFile& file, const calibration::Objective& objective,
+                           const calibration::CalibrationSummary& run);
 // category, code[, model], then the fields of kGroundFields that apply: one row per touched
 // category.
 std::string GroundTableCsv(const calibration::Objective& objective, const GroundTable& fitted);

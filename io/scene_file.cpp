@@ -284,13 +284,20 @@ SceneFile LoadScene(const std::string& path) {
     context.Fail(root.get("blocks"), "blocks",
                  "blocks are for the runs of a run table ([release] runs = \"file.csv\")");
   if (out.shape_per_rock) {
-    // Each rock its own seeded shape, from its run's block (or the scene's rock).
-    const std::vector<pointclouds::RockSpec> blocks = out.block_specs;
+    // Each rock its own seeded shape: of its run's block (with the block's knobs as the release
+    // holds them, which a calibration may change), or of the scene's rock.
     const pointclouds::RockSpec rock = out.rock;
-    out.release.shape_per_rock = [blocks, rock](int block, std::uint64_t seed) {
-      pointclouds::RockSpec spec = block >= 0 ? blocks[static_cast<std::size_t>(block)] : rock;
-      spec.shape_seed = seed;
-      return pointclouds::MakeRock(spec);
+    const ShapeVariation variation = out.shape_variation;
+    out.release.shape_per_rock = [rock, variation](const ensemble::Block* block,
+                                                   std::uint64_t seed) {
+      if (!block) {
+        pointclouds::RockSpec spec = rock;
+        spec.shape_seed = seed;
+        return pointclouds::MakeRock(spec);
+      }
+      ensemble::ShapeKnobs knobs = VariedKnobs(block->knobs, variation, seed);
+      knobs.shape_seed = seed;
+      return block->make(knobs);
     };
   }
   std::string why;

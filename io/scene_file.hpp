@@ -33,6 +33,19 @@ struct OutputSpec {
   ensemble::RasterRequest Request(const GridGeometry& grid) const;
 };
 
+// How the shape of each rock of a block varies about the block's ([blocks] size_variation,
+// roughness_variation; with shape_per_rock): every axis by a factor exp(a (2U - 1)), the three
+// then divided by their geometric mean (the ratios vary, the product of the axes does not); the
+// roughness by b (2U - 1), kept in 0 .. 0.5. U uniform on [0, 1) from the rock's shape seed.
+struct ShapeVariation {
+  double size = 0;       // a, 0 .. 0.5
+  double roughness = 0;  // b, 0 .. 0.25
+};
+
+// The knobs of one rock of a block whose shapes vary per rock, drawn from the rock's shape seed.
+ensemble::ShapeKnobs VariedKnobs(const ensemble::ShapeKnobs& knobs, const ShapeVariation& v,
+                                 std::uint64_t seed);
+
 // A loaded, validated scene file.
 struct SceneFile {
   std::string path;               // as given
@@ -46,6 +59,7 @@ struct SceneFile {
   bool has_rock = false;       // the scene has a [rock] table (else only [blocks])
   std::vector<pointclouds::RockSpec> block_specs;  // [blocks], parallel to release.blocks
   bool shape_per_rock = false;                     // every rock has a seeded shape of its own
+  ShapeVariation shape_variation;                  // of blocks' shapes per rock ([blocks])
   std::string rock_description;     // e.g. "eota221 0.93 x 0.93 x 0.47 m, bevel 0.12 m"
   std::string crs_wkt;              // the DEM's CRS; empty for the plane or a DEM without CRS
   std::optional<PlaneSpec> plane;   // [terrain] plane, when the terrain is the analytic plane

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -179,27 +180,97 @@ void LoadRock(const Context& context, const Section& s, SceneFile& out) {
   }
 }
 
-// [blocks]: named rocks that runs refer to, from a table file (block_id, mass_kg, size_x_m,
-// size_y_m, size_z_m, optional shape) and/or [blocks.<id>] tables (mass_kg, size_m = [x, y, z],
-// optional shape), each a built-in shape built from its size: `shape` of the block, else that of
-// [blocks]. EOTA blocks keep the size as their bounding box and take the bevel for the volume
-// mass_kg / density_kg_m3 (without a mass: the standard bevel-to-side ratio).
+namespace {
+
+const std::vector<std::string> kBlockShapes = {"box", "ellipsoid", "rock", "eota111", "eota221"};
+const char* const kBlockShapesExpected =
+    "expected \"box\", \"ellipsoid\", \"rock\", \"eota111\" or \"eota221\"";
+
+bool KnownBlockShape(const std::string& name) {
+  return std::find(kBlockShapes.begin(), kBlockShapes.end(), name) != kBlockShapes.end();
+}
+
+// The knobs a block's shape was made from (NaN where it has none).
+ensemble::ShapeKnobs KnobsOf(const pointclouds::RockSpec& spec) {
+  ensemble::ShapeKnobs knobs;
+  if (spec.builtin == "rock") knobs.roughness = spec.roughness;
+  if (spec.file.empty() && spec.dimensions_m.size() == 3)
+    knobs.size_m = Eigen::Vector3d(spec.dimensions_m[0], spec.dimensions_m[1], spec.dimensions_m[2]);
+  knobs.shape_seed = spec.shape_seed;
+  return knobs;
+}
+
+// The block of `spec` with other knobs: a built-in's size, a rock's roughness and seed. The
+// mass, when given, stays, so the density follows the volume; a density or volume outside the
+// scene's bounds is an InputError.
+ensemble::ShapeMaker MakerOf(const pointclouds::RockSpec& spec) {
+  return [spec](const ensemble::ShapeKnobs& knobs) {
+    pointclouds::RockSpec s = spec;
+    if (std::isfinite(knobs.roughness)) s.roughness = knobs.roughness;
+    if (knobs.size_m.allFinite()) s.dimensions_m = {knobs.size_m.x(), knobs.size_m.y(), knobs.size_m.z()};
+    s.shape_seed = knobs.shape_seed;
+    std::string why;
+    if (!s.IsValid(&why)) throw InputError(why);
+    RockShape shape = pointclouds::MakeRock(s);
+    if (std::string bad = OutsideBounds(shape.volume_m3, kMinVolume_m3, kMaxVolume_m3, "m3");
+        !bad.empty())
+      throw InputError("the volume " + bad);
+    if (std::string bad = OutsideBounds(shape.mass_kg / shape.volume_m3, kMinDensity_kg_m3,
+                                        kMaxDensity_kg_m3, "kg/m3");
+        !bad.empty())
+      throw InputError("the density (mass / volume) " + bad);
+    return shape;
+  };
+}
+
+// The per-block knobs of a rock shape (`roughness`, `points`, `shape_seed`) from a [blocks.<id>]
+// table or a row of the blocks file, read by `number` (nullopt when not given); errors by `fail`.
+struct RockKnobs {
+  std::optional<double> roughness, points, shape_seed;
+};
+
+void ApplyRockKnobs(const RockKnobs& k, pointclouds::RockSpec& spec,
+                    const std::function<void(const std::string&, const std::string&)>& fail) {
+  const bool rock = spec.builtin == "rock";
+  if (k.roughness) {
+    if (!rock) fail("roughness", "only a rock block has a roughness");
+    if (!(*k.roughness >= 0 && *k.roughness <= 0.5))
+      fail("roughness", TenDigits(*k.roughness) + " must be in 0 .. 0.5");
+    spec.roughness = *k.roughness;
+  }
+  if (k.points) {
+    if (!rock) fail("points", "only a rock block has points");
+    if (!(*k.points >= 4 && *k.points <= 1e6) || *k.points != std::floor(*k.points))
+      fail("points", TenDigits(*k.points) + " must be an integer in 4 .. 1000000");
+    spec.points = static_cast<int>(*k.points);
+  }
+  if (k.shape_seed) {
+    if (!rock) fail("shape_seed", "only a rock block has a shape seed");
+    if (!(*k.shape_seed >= 0 && *k.shape_seed <= 9007199254740992.0) ||
+        *k.shape_seed != std::floor(*k.shape_seed))
+      fail("shape_seed", TenDigits(*k.shape_seed) + " must be an integer in 0 .. 2^53");
+    spec.shape_seed = static_cast<std::uint64_t>(*k.shape_seed);
+  }
+}
+
+}  // namespace
+
+// [blocks]: named rocks that runs refer to, from a table file and/or [blocks.<id>] tables. Each is
+// a scanned point cloud (`file`), or a built-in shape built from its size (`shape` of the block,
+// else that of [blocks]) with, for a rock, its own roughness, points and seed. EOTA blocks keep
+// the size as their bounding box and take the bevel for the volume mass_kg / density_kg_m3
+// (without a mass: the standard bevel-to-side ratio).
 void LoadBlocks(const Context& context, const toml::table* table, SceneFile& out) {
   if (!table) return;
-  const std::vector<std::string> reserved = {"file",      "shape",         "points",
-                                             "roughness", "density_kg_m3", "shape_per_rock"};
+  const std::vector<std::string> reserved = {
+      "file",           "shape",          "points",        "roughness",          "density_kg_m3",
+      "shape_per_rock", "max_vertices",   "size_variation", "roughness_variation"};
   std::vector<std::string> known = reserved;
   for (const auto& [key, node] : *table)
     if (node.is_table()) known.emplace_back(key.str());
   const Section s(context, table, "blocks", known);
-  const std::vector<std::string> shapes = {"box", "ellipsoid", "rock", "eota111", "eota221"};
-  const std::string kShapes =
-      "expected \"box\", \"ellipsoid\", \"rock\", \"eota111\" or \"eota221\"";
-  const auto known_shape = [&](const std::string& name) {
-    return std::find(shapes.begin(), shapes.end(), name) != shapes.end();
-  };
   const std::string shape = s.String("shape", "box");
-  if (!known_shape(shape)) s.Fail("shape", "'" + shape + "': " + kShapes);
+  if (!KnownBlockShape(shape)) s.Fail("shape", "'" + shape + "': " + kBlockShapesExpected);
   pointclouds::RockSpec base;
   base.builtin = shape;
   base.density_kg_m3 = s.Checked("density_kg_m3", 2700, kPositive, "must be > 0");
@@ -212,74 +283,158 @@ void LoadBlocks(const Context& context, const toml::table* table, SceneFile& out
   base.roughness = s.Checked(
       "roughness", base.roughness, [](double v) { return v >= 0 && v <= 0.5; },
       "must be in 0 .. 0.5");
+  const long max_vertices = s.Integer("max_vertices", 0);
+  if (max_vertices != 0 && (max_vertices < 4 || max_vertices > 100000))
+    s.Fail("max_vertices",
+           std::to_string(max_vertices) + " must be 0 (no simplification) or in 4 .. 100000");
   out.shape_per_rock = s.Bool("shape_per_rock", false);
+  out.shape_variation.size = s.Checked(
+      "size_variation", 0.0, [](double v) { return v >= 0 && v <= 0.5; }, "must be in 0 .. 0.5");
+  out.shape_variation.roughness = s.Checked(
+      "roughness_variation", 0.0, [](double v) { return v >= 0 && v <= 0.25; },
+      "must be in 0 .. 0.25");
+  for (const char* key : {"size_variation", "roughness_variation"})
+    if (s.Has(key) && !out.shape_per_rock)
+      s.Fail(key, "varies the shape per rock: needs shape_per_rock = true");
 
-  auto add = [&](const std::string& id, const std::string& block_shape, std::optional<double> mass,
-                 const std::vector<double>& size, const std::string& where) {
+  // One block: a point cloud when `file` is given, else the built-in `block_shape` of `size`.
+  auto add = [&](const std::string& id, const std::string& block_shape, const std::string& file,
+                 std::optional<double> mass, const std::vector<double>& size,
+                 const RockKnobs& knobs, const std::string& where) {
     for (const ensemble::Block& b : out.release.blocks)
       if (b.id == id) throw InputError(where + ": block '" + id + "' is defined twice");
     pointclouds::RockSpec spec = base;
-    spec.builtin = block_shape;
-    spec.dimensions_m = size;
+    if (file.empty()) {
+      spec.builtin = block_shape;
+      spec.dimensions_m = size;
+    } else {
+      spec.builtin.clear();
+      spec.file = file;
+      spec.max_vertices = static_cast<int>(max_vertices);
+      out.inputs.push_back(file);
+    }
     spec.mass_kg = mass;
-    spec.density_kg_m3 = base.density_kg_m3;
+    ApplyRockKnobs(knobs, spec, [&](const std::string& key, const std::string& why) {
+      throw InputError(where + ": block '" + id + "': " + key + ": " + why);
+    });
     out.block_specs.push_back(spec);
-    auto block_shape_made = MakeBlockShape(spec, where);
-    if (const std::string bad =
-            OutsideBounds(block_shape_made->volume_m3, kMinVolume_m3, kMaxVolume_m3, "m3");
+    auto made = MakeBlockShape(spec, where);
+    if (const std::string bad = OutsideBounds(made->volume_m3, kMinVolume_m3, kMaxVolume_m3, "m3");
         !bad.empty())
       throw InputError(where + ": block '" + id + "': the volume " + bad);
-    out.release.blocks.push_back({id, std::move(block_shape_made)});
+    ensemble::Block block{id, std::move(made), KnobsOf(spec), {}};
+    if (file.empty()) block.make = MakerOf(spec);
+    out.release.blocks.push_back(std::move(block));
   };
   if (s.Has("file")) {
     const std::string path = context.Resolve(s.String("file", ""));
     if (!fs::exists(path)) s.Fail("file", "file not found: " + path);
     out.inputs.push_back(path);
     const CsvTable rows = CsvTable::Read(path);
-    rows.Require({"block_id", "size_x_m", "size_y_m", "size_z_m"});
+    rows.Require({"block_id"});
+    if (!rows.Has("file")) rows.Require({"size_x_m", "size_y_m", "size_z_m"});
+    const fs::path folder = fs::path(path).parent_path();
     for (int k = 0; k < rows.rows(); ++k) {
-      std::vector<double> size;
-      for (const char* c : {"size_x_m", "size_y_m", "size_z_m"}) {
-        size.push_back(rows.Number(k, c));
-        if (size.back() <= 0) throw InputError(rows.Where(k, c) + ": must be > 0");
-      }
-      const std::optional<double> mass = rows.OptionalNumber(k, "mass_kg");
-      if (mass && *mass <= 0) throw InputError(rows.Where(k, "mass_kg") + ": must be > 0");
       const std::string id = rows.Text(k, "block_id");
       if (id.empty()) throw InputError(rows.Where(k, "block_id") + ": empty");
+      std::string file;
+      if (!rows.Empty(k, "file")) {
+        file = (folder / rows.Text(k, "file")).lexically_normal().string();
+        if (!fs::exists(file)) throw InputError(rows.Where(k, "file") + ": file not found: " + file);
+        for (const char* c : {"size_x_m", "size_y_m", "size_z_m", "shape"})
+          if (!rows.Empty(k, c))
+            throw InputError(rows.Where(k, c) + ": a point cloud block takes its shape and size "
+                                                "from the file; leave this cell empty");
+      }
+      std::vector<double> size;
+      if (file.empty())
+        for (const char* c : {"size_x_m", "size_y_m", "size_z_m"}) {
+          size.push_back(rows.Number(k, c));
+          if (size.back() <= 0) throw InputError(rows.Where(k, c) + ": must be > 0");
+        }
+      const std::optional<double> mass = rows.OptionalNumber(k, "mass_kg");
+      if (mass && *mass <= 0) throw InputError(rows.Where(k, "mass_kg") + ": must be > 0");
       const std::string block_shape = rows.Empty(k, "shape") ? shape : rows.Text(k, "shape");
-      if (!known_shape(block_shape))
-        throw InputError(rows.Where(k, "shape") + ": '" + block_shape + "': " + kShapes);
-      add(id, block_shape, mass, size, rows.Where(k, "block_id"));
+      if (!KnownBlockShape(block_shape))
+        throw InputError(rows.Where(k, "shape") + ": '" + block_shape + "': " +
+                         kBlockShapesExpected);
+      RockKnobs knobs{rows.OptionalNumber(k, "roughness"), rows.OptionalNumber(k, "points"),
+                      rows.OptionalNumber(k, "shape_seed")};
+      add(id, block_shape, file, mass, size, knobs, rows.Where(k, "block_id"));
     }
   }
   for (const auto& [key, node] : *table) {
     if (!node.is_table()) continue;
     const std::string id(key.str());
-    const Section b(context, node.as_table(), "blocks." + id, {"mass_kg", "size_m", "shape"});
-    if (!b.Has("size_m")) b.Fail("size_m", "missing: the block's size [x, y, z] in m");
-    const std::vector<double> size = b.Numbers("size_m", 3);
-    for (double v : size)
-      if (v <= 0) b.Fail("size_m", "dimensions must be > 0");
+    const Section b(context, node.as_table(), "blocks." + id,
+                    {"mass_kg", "size_m", "shape", "file", "roughness", "points", "shape_seed"});
+    std::string file;
+    if (b.Has("file")) {
+      for (const char* k : {"size_m", "shape"})
+        if (b.Has(k))
+          b.Fail(k, "a point cloud block takes its shape and size from its file");
+      file = context.Resolve(b.String("file", ""));
+      if (!fs::exists(file)) b.Fail("file", "file not found: " + file);
+    } else if (!b.Has("size_m")) {
+      b.Fail("size_m", "missing: the block's size [x, y, z] in m (or a point cloud `file`)");
+    }
+    std::vector<double> size;
+    if (file.empty()) {
+      size = b.Numbers("size_m", 3);
+      for (double v : size)
+        if (v <= 0) b.Fail("size_m", "dimensions must be > 0");
+    }
     std::optional<double> mass;
     if (b.Has("mass_kg")) mass = b.Checked("mass_kg", 0, kPositive, "must be > 0");
     const std::string block_shape = b.String("shape", shape);
-    if (!known_shape(block_shape)) b.Fail("shape", "'" + block_shape + "': " + kShapes);
-    add(id, block_shape, mass, size, context.Where(&node) + ": blocks." + id);
+    if (!KnownBlockShape(block_shape))
+      b.Fail("shape", "'" + block_shape + "': " + kBlockShapesExpected);
+    RockKnobs knobs;
+    if (b.Has("roughness")) knobs.roughness = b.Number("roughness", 0);
+    if (b.Has("points")) knobs.points = static_cast<double>(b.Integer("points", 0));
+    if (b.Has("shape_seed")) knobs.shape_seed = static_cast<double>(b.Integer("shape_seed", 0));
+    add(id, block_shape, file, mass, size, knobs, context.Where(&node) + ": blocks." + id);
   }
   if (out.release.blocks.empty())
     context.Fail(table, "blocks", "no block: give a file or [blocks.<id>] tables");
   // Knobs of the random rock shape need rock blocks.
-  const bool all_rocks =
-      std::all_of(out.block_specs.begin(), out.block_specs.end(),
-                  [](const pointclouds::RockSpec& b) { return b.builtin == "rock"; });
-  const bool any_rock =
-      std::any_of(out.block_specs.begin(), out.block_specs.end(),
-                  [](const pointclouds::RockSpec& b) { return b.builtin == "rock"; });
+  const auto is_rock = [](const pointclouds::RockSpec& b) { return b.builtin == "rock"; };
+  const bool all_rocks = std::all_of(out.block_specs.begin(), out.block_specs.end(), is_rock);
+  const bool any_rock = std::any_of(out.block_specs.begin(), out.block_specs.end(), is_rock);
   if ((s.Has("points") || s.Has("roughness")) && !any_rock)
     s.Fail(s.Has("points") ? "points" : "roughness", "only rock blocks take points and roughness");
+  if (s.Has("max_vertices") &&
+      std::none_of(out.block_specs.begin(), out.block_specs.end(),
+                   [](const pointclouds::RockSpec& b) { return !b.file.empty(); }))
+    s.Fail("max_vertices", "only point cloud blocks (file) are simplified");
   if (out.shape_per_rock && !all_rocks)
     s.Fail("shape_per_rock", "only rock blocks have a shape of their own per rock");
 }
 
 }  // namespace talus::io::scene_tables
+
+namespace talus::io {
+
+ensemble::ShapeKnobs VariedKnobs(const ensemble::ShapeKnobs& knobs, const ShapeVariation& v,
+                                 std::uint64_t seed) {
+  // Uniform draws in [0, 1) from a stream of the seed's own (53 bits of SplitMix64 outputs),
+  // apart from the one that places the hull's points.
+  const std::uint64_t stream = seed ^ 0x5851F42D4C957F2DULL;
+  const auto uniform = [&](std::uint64_t i) {
+    return double(pointclouds::ShapeSeed(stream, i) >> 11) * 0x1p-53;
+  };
+  ensemble::ShapeKnobs out = knobs;
+  if (v.size > 0 && knobs.size_m.allFinite()) {
+    // Each axis by exp(a (2U - 1)), over the factors' geometric mean: the axis ratios vary, the
+    // product of the axes (so the volume of the envelope, and with a mass the density) does not.
+    Eigen::Vector3d log_factor;
+    for (int i = 0; i < 3; ++i) log_factor[i] = v.size * (2 * uniform(std::uint64_t(i)) - 1);
+    log_factor.array() -= log_factor.mean();
+    out.size_m = knobs.size_m.cwiseProduct(log_factor.array().exp().matrix());
+  }
+  if (v.roughness > 0 && std::isfinite(knobs.roughness))
+    out.roughness = std::clamp(knobs.roughness + v.roughness * (2 * uniform(3) - 1), 0.0, 0.5);
+  return out;
+}
+
+}  // namespace talus::io

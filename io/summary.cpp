@@ -119,11 +119,25 @@ std::string SummaryJson(const SceneFile& scene, const ensemble::EnsembleReport& 
   if (!scene.release.runs.empty()) {
     j["runs"] = scene.release.runs.size();
     nlohmann::ordered_json blocks = nlohmann::ordered_json::array();
-    for (const ensemble::Block& b : scene.release.blocks)
-      blocks.push_back({{"id", b.id},
-                        {"mass_kg", b.shape->mass_kg},
-                        {"volume_m3", b.shape->volume_m3},
-                        {"hull_vertices", b.shape->vertices_m.size()}});
+    for (std::size_t k = 0; k < scene.release.blocks.size(); ++k) {
+      const ensemble::Block& b = scene.release.blocks[k];
+      nlohmann::ordered_json block = {{"id", b.id},
+                                      {"mass_kg", b.shape->mass_kg},
+                                      {"volume_m3", b.shape->volume_m3},
+                                      {"hull_vertices", b.shape->vertices_m.size()}};
+      // What the shape was made from: the scan, or the built-in with its knobs.
+      if (k < scene.block_specs.size()) {
+        const pointclouds::RockSpec& spec = scene.block_specs[k];
+        if (!spec.file.empty()) {
+          block["file"] = spec.file;
+        } else {
+          block["shape"] = spec.builtin;
+          block["size_m"] = {b.knobs.size_m.x(), b.knobs.size_m.y(), b.knobs.size_m.z()};
+          if (spec.builtin == "rock") block["roughness"] = b.knobs.roughness;
+        }
+      }
+      blocks.push_back(block);
+    }
     j["blocks"] = blocks;
   }
   j["shape_per_rock"] = static_cast<bool>(scene.release.shape_per_rock);

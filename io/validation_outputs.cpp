@@ -28,6 +28,18 @@ std::string Fmt(double v, const char* format = "%.3g") { return FormatDouble(v, 
 
 }  // namespace
 
+nlohmann::ordered_json BlockBiasJson(const std::vector<fieldobs::BlockBias>& biases) {
+  nlohmann::ordered_json out = nlohmann::ordered_json::array();
+  for (const fieldobs::BlockBias& b : biases)
+    out.push_back({{"block", b.block},
+                   {"kind", b.kind},
+                   {"unit", b.unit},
+                   {"scored", b.scored},
+                   {"mean_bias", Num(b.mean_bias)},
+                   {"mean_score", Num(b.mean_score)}});
+  return out;
+}
+
 std::string ScoresJson(const EventFile& event, const fieldobs::ValidationReport& report,
                        const ValidationRun& run) {
   nlohmann::ordered_json j;
@@ -76,6 +88,7 @@ std::string ScoresJson(const EventFile& event, const fieldobs::ValidationReport&
     kinds[k.kind] = kind;
   }
   j["kinds"] = kinds;
+  j["blocks"] = BlockBiasJson(fieldobs::BiasByBlock(report.observations, event.scene.release));
   j["wall_time_s"] = run.wall_time_s;
   j["threads"] = run.threads;
   return j.dump(2) + "\n";

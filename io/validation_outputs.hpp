@@ -5,6 +5,7 @@
 // median), pit.svg (PIT histogram per kind) and deposits.png (observed and simulated rest
 // positions over the hillshade). Every file is written completely or not at all.
 
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -28,6 +29,8 @@ struct ValidationRun {
 
 std::string ScoresJson(const EventFile& event, const fieldobs::ValidationReport& report,
                        const ValidationRun& run);
+// Per block and kind: scored count, mean bias (simulated mean - observed) and mean score.
+nlohmann::ordered_json BlockBiasJson(const std::vector<fieldobs::BlockBias>& biases);
 std::string ObservationsCsv(const fieldobs::ValidationReport& report);
 std::string ObservedVsSimulatedSvg(const fieldobs::ValidationReport& report);
 std::string PitSvg(const fieldobs::ValidationReport& report);

@@ -236,6 +236,93 @@ std::string Calibrate(const fs::path& dir, const std::string& options, std::stri
                                    output));
 }
 
+// Shape and ground fitted together: a rock block's roughness beside the ground's mu_min, a held-out
+// run. shape_table.toml holds the block's fitted roughness as a [blocks.<id>] table and is used
+// with the ground table (a scene with both simulates); calibration.json says which parameter is
+// ground and which shape, and gives the bias per block of the fitted and the held-out runs.
+TEST(CalibrateCommand, ShapeAndGroundFittedTogetherAreWrittenApart) {
+  fs::path dir = FreshDir("shape");
+  const std::string blocks = R"([blocks]
+shape = "rock"
+[blocks.round]
+size_m = [0.4, 0.4, 0.3]
+[blocks.slab]
+size_m = [0.5, 0.4, 0.2]
+shape = "box"
+)";
+  const std::string scene = R"([terrain]
+plane = { slope_deg = 35, slope_length_m = 20, runout_m = 10, width_m = 12, cell_m = 1 }
+default_ground = "medium_soft"
+[release]
+runs = "runs.csv"
+rocks = 4
+[solver]
+max_time_s = 3
+)";
+  Write(dir / "scene.toml", scene + blocks);
+  Write(dir / "runs.csv",
+        "trajectory_id,x_m,y_m,height_m,block_id\nr1,3,0,1,round\nr2,3,2,1,slab\nr3,4,-2,1,round\n"
+        "r4,4,3,1,slab\nr5,3,-4,1,round\n");
+  Write(dir / "observed.csv",
+        "trajectory_id,observed_runout_m\nr1,17\nr2,19\nr3,14\nr4,16\nr5,18\n");
+  Write(dir / "event.toml", "scene = \"scene.toml\"\n[[observations]]\nkind = \"runout\"\n"
+                            "file = \"observed.csv\"\n");
+  Write(dir / "cal.toml", R"(event = "event.toml"
+[[parameters]]
+category = "medium_soft"
+field = "mu_min"
+lower = 0.1
+upper = 0.9
+[[parameters]]
+block = "round"
+field = "roughness"
+lower = 0
+upper = 0.4
+[optimizer]
+max_evaluations = 6
+[roughness]
+enabled = false
+[uncertainty]
+enabled = false
+)");
+  std::string output;
+  ASSERT_EQ(Calibrate(dir, "--holdout r5", &output), "0") << output;
+  const auto json = nlohmann::json::parse(Slurp(dir / "out" / "calibration.json"));
+  EXPECT_EQ(json["parameters"][0]["part"], "ground");
+  EXPECT_EQ(json["parameters"][1]["name"], "blocks.round.roughness");
+  EXPECT_EQ(json["parameters"][1]["part"], "shape");
+  EXPECT_EQ(json["parameters"][1]["unit"], "1");
+  ASSERT_EQ(json["fitted_runs_blocks"].size(), 2u);  // round (r1, r3) and slab (r2, r4)
+  EXPECT_EQ(json["fitted_runs_blocks"][0]["block"], "round");
+  EXPECT_EQ(json["fitted_runs_blocks"][0]["scored"], 2);
+  ASSERT_EQ(json["holdout"]["blocks"].size(), 1u);  // r5, a round one
+  EXPECT_EQ(json["holdout"]["blocks"][0]["block"], "round");
+  const std::string ground = Slurp(dir / "out" / "ground_table.toml");
+  EXPECT_EQ(ground.find("roughness"), std::string::npos) << ground;
+  const std::string shapes = Slurp(dir / "out" / "shape_table.toml");
+  const double roughness = json["parameters"][1]["final"].get<double>();
+  EXPECT_NE(shapes.find("\n[blocks.round]\nroughness = "), std::string::npos) << shapes;
+  EXPECT_EQ(shapes.find("[blocks.slab]"), std::string::npos) << shapes;
+  // The fitted scene: the ground table, and the block's fitted roughness in its own table.
+  Write(dir / "fitted_scene.toml",
+        scene + ground + R"([blocks]
+shape = "rock"
+[blocks.slab]
+size_m = [0.5, 0.4, 0.2]
+shape = "box"
+)" + shapes.substr(shapes.find("[blocks.round]")) +
+            "size_m = [0.4, 0.4, 0.3]\n");
+  ASSERT_EQ(RunCommand(std::string(TALUS_BINARY) + " simulate " +
+                           (dir / "fitted_scene.toml").string() + " --out " +
+                           (dir / "sim").string() + " --rocks 2",
+                       &output),
+            0)
+      << output;
+  const auto summary = nlohmann::json::parse(Slurp(dir / "sim" / "summary.json"));
+  EXPECT_EQ(summary["blocks"][0]["id"], "round");  // blocks in key order
+  EXPECT_EQ(summary["blocks"][0]["roughness"].get<double>(), roughness);
+}
+
 // Ceres with one run held out (--holdout r2) and 2-fold cross-validation of the other six: the
 // held-out run is scored with the fitted and the reference (Table 1) parameters, each fold's runs
 // by the fit without them, the folds split the six runs, and the covariance is reported.

@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "common/error.hpp"
+#include "solver/shapes.hpp"
 #include "tests/calibration/fixtures.hpp"
 
 namespace talus::calibration {
@@ -173,6 +174,119 @@ TEST(ParameterSet, InfeasibleVectorsAreRefusedWithTheirViolation) {
   EXPECT_TRUE(std::isinf(violation));
   EXPECT_TRUE(set.Apply(Eigen::Vector2d(0.5, 0.5), table, &why, &violation));
   EXPECT_EQ(violation, 0);
+}
+
+// --- shape parameters ---------------------------------------------------------------------------
+
+// Two blocks for the shape tests: "slab", a box whose knobs are its size (no roughness), and
+// "scan", a fixed shape (as a point cloud's: no maker). The slab's maker keeps its density, so the
+// made shape's mass says which size it was made from; a size with an axis above 5 m is refused
+// (as a density outside the scene's bounds would be).
+std::vector<ensemble::Block> TestBlocks() {
+  ensemble::Block slab;
+  slab.id = "slab";
+  slab.knobs.size_m = Eigen::Vector3d(1.0, 0.5, 0.25);
+  slab.make = [](const ensemble::ShapeKnobs& k) {
+    if (k.size_m.maxCoeff() > 5) throw InputError("the volume is outside the bounds");
+    return MakeRockShape(MakeBox(k.size_m.x(), k.size_m.y(), k.size_m.z()), 2000);
+  };
+  slab.shape = std::make_shared<const RockShape>(slab.make(slab.knobs));
+  ensemble::Block scan;
+  scan.id = "scan";
+  scan.shape = std::make_shared<const RockShape>(MakeRockShape(MakeBox(1, 1, 1), 2700));
+  return {slab, scan};
+}
+
+ParameterSpec ShapeSpec(const std::string& block, ShapeField field, double lower, double upper,
+                        const std::string& tie = "") {
+  ParameterSpec s;
+  s.block = block;
+  s.shape_field = field;
+  s.lower = lower;
+  s.upper = upper;
+  s.tie = tie;
+  return s;
+}
+
+std::string ShapeErrorOf(std::vector<ParameterSpec> specs) {
+  try {
+    ParameterSet set(std::move(specs), GroundTable::BuiltIn(), TestBlocks());
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// A shape parameter beside a ground one: named after its block, linear, its start the block's own
+// knob; Apply leaves it alone, ApplyShapes writes it into the block's knobs and remakes that
+// block's shape (mass 2000 kg/m3 x the new volume), leaving the other block's shape as it was.
+TEST(ParameterSet, ShapeParametersRemakeTheirBlock) {
+  GroundTable table = GroundTable::BuiltIn();
+  std::vector<ensemble::Block> blocks = TestBlocks();
+  const ParameterSet set(
+      {Spec("medium", GroundField::kMuMin, 0.1, 0.9), ShapeSpec("slab", ShapeField::kSizeX, 0.5, 2)},
+      table, blocks);
+  ASSERT_EQ(set.size(), 2);
+  EXPECT_TRUE(set.has_shapes());
+  EXPECT_EQ(set.coordinates()[1].name, "blocks.slab.size_x_m");
+  EXPECT_FALSE(set.coordinates()[1].log);
+  EXPECT_EQ(set.specs()[1].Unit(), std::string("m"));
+  EXPECT_NEAR(set.UnitOf(table)[1], (1.0 - 0.5) / 1.5, 1e-15);
+
+  std::string why;
+  const GroundTable before = table;
+  ASSERT_TRUE(set.Apply(Eigen::Vector2d(0.5, 1), table, &why)) << why;
+  EXPECT_EQ(table.params(table.IndexOfName("medium")).mu_min, 0.5);
+  const std::shared_ptr<const RockShape> scan = blocks[1].shape;
+  ASSERT_TRUE(set.ApplyShapes(Eigen::Vector2d(0.5, 1), blocks, &why)) << why;
+  EXPECT_EQ(blocks[0].knobs.size_m, Eigen::Vector3d(2, 0.5, 0.25));
+  EXPECT_NEAR(blocks[0].shape->mass_kg, 2000 * 2 * 0.5 * 0.25, 1e-9);
+  EXPECT_EQ(blocks[1].shape, scan);  // not touched
+  // Without shape parameters there is nothing to do.
+  const ParameterSet ground({Spec("medium", GroundField::kMuMin, 0.1, 0.9)}, before, blocks);
+  EXPECT_FALSE(ground.has_shapes());
+  EXPECT_TRUE(ground.ApplyShapes(Eigen::VectorXd::Constant(1, 0.3), blocks, &why));
+  EXPECT_EQ(blocks[0].knobs.size_m.x(), 2);
+}
+
+// A knob whose shape cannot be made makes the vector infeasible, naming the block.
+TEST(ParameterSet, AShapeThatCannotBeMadeIsRefused) {
+  std::vector<ensemble::Block> blocks = TestBlocks();
+  const ParameterSet set({ShapeSpec("slab", ShapeField::kSizeY, 0.1, 8)}, GroundTable::BuiltIn(),
+                         blocks);
+  std::string why;
+  EXPECT_FALSE(set.ApplyShapes(Eigen::VectorXd::Constant(1, 1.0), blocks, &why));
+  EXPECT_EQ(why, "block 'slab': the volume is outside the bounds");
+}
+
+TEST(ParameterSet, ShapeParametersNeedABlockWithTheKnob) {
+  EXPECT_EQ(ShapeErrorOf({ShapeSpec("boulder", ShapeField::kSizeX, 0.5, 2)}),
+            "blocks.boulder.size_x_m: no block 'boulder'");
+  EXPECT_EQ(ShapeErrorOf({ShapeSpec("slab", ShapeField::kRoughness, 0, 0.3)}),
+            "blocks.slab.roughness: block 'slab' has no roughness (only a rock block has one)");
+  EXPECT_EQ(ShapeErrorOf({ShapeSpec("scan", ShapeField::kSizeX, 0.5, 2)}),
+            "blocks.scan.size_x_m: block 'scan' has a fixed shape (a point cloud): only built-in "
+            "blocks have knobs");
+  EXPECT_EQ(ShapeErrorOf({ShapeSpec("slab", ShapeField::kSizeX, 0, 2)}),
+            "blocks.slab.size_x_m: lower = 0 must be > 0 (a size is positive)");
+  ParameterSpec both = ShapeSpec("slab", ShapeField::kSizeX, 0.5, 2);
+  both.category = "medium";
+  EXPECT_EQ(ShapeErrorOf({both}), "blocks.slab.size_x_m: names both a ground category and a block");
+  // A tie joins one field: a size and a friction coefficient cannot share a coordinate.
+  EXPECT_NE(ShapeErrorOf({ShapeSpec("slab", ShapeField::kSizeX, 0.5, 2, "t"),
+                          Spec("medium", GroundField::kMuMin, 0.5, 2, "t")})
+                .find("joins parameters of one field"),
+            std::string::npos);
+  EXPECT_EQ(ShapeErrorOf({ShapeSpec("slab", ShapeField::kSizeX, 0.5, 2),
+                          ShapeSpec("slab", ShapeField::kSizeX, 0.6, 2)}),
+            "blocks.slab.size_x_m: freed twice");
+  // A roughness may start at 0 (a smooth ellipsoid), and stops at 0.5.
+  ParameterSpec r = ShapeSpec("any", ShapeField::kRoughness, 0, 0.6);
+  std::string why;
+  EXPECT_FALSE(r.IsValid(&why));
+  EXPECT_EQ(why, "blocks.any.roughness: upper = 0.6 must be <= 0.5 for a roughness");
+  r.upper = 0.5;
+  EXPECT_TRUE(r.IsValid(&why));
 }
 
 }  // namespace

@@ -29,7 +29,8 @@ TEST(RunEnsemble, RunsWithShapesPerRockAreBitIdenticalForAnyThreadCount) {
   scene.options.max_time_s = 4;
   ReleaseSpec release;
   release.blocks.push_back(
-      {"slab", std::make_shared<const RockShape>(MakeRockShape(MakeBox(0.6, 0.4, 0.15), 2700))});
+      {"slab", std::make_shared<const RockShape>(MakeRockShape(MakeBox(0.6, 0.4, 0.15), 2700)),
+       {}, {}});
   ReleaseRun a;
   a.id = "a";
   a.xy_m = {3, 0};
@@ -41,9 +42,9 @@ TEST(RunEnsemble, RunsWithShapesPerRockAreBitIdenticalForAnyThreadCount) {
   b.z_m = 25;  // well above ground: falls first
   release.runs = {a, b};
   release.rocks_per_release = 3;
-  release.shape_per_rock = [](int block, std::uint64_t seed) {
+  release.shape_per_rock = [](const Block* block, std::uint64_t seed) {
     const double c = 0.1 + double(seed % 1000) / 5000.0;  // 0.1 .. 0.3 m
-    return MakeRockShape(MakeBox(block >= 0 ? 0.6 : 0.4, 0.4, c), 2700);
+    return MakeRockShape(MakeBox(block ? 0.6 : 0.4, 0.4, c), 2700);
   };
   std::string why;
   ASSERT_TRUE(release.IsValid(&why)) << why;
@@ -62,7 +63,8 @@ TEST(RunEnsemble, RunsWithShapesPerRockAreBitIdenticalForAnyThreadCount) {
     EXPECT_TRUE(SameBits(x.result.final_state.position_m, y.result.final_state.position_m));
     EXPECT_TRUE(SameBits(x.shape->mass_kg, y.shape->mass_kg));
     const RockShape expected =
-        release.shape_per_rock(x.release == 1 ? 0 : -1, RockShapeSeed(release.seed, x.rock));
+        release.shape_per_rock(x.release == 1 ? &release.blocks[0] : nullptr,
+                               RockShapeSeed(release.seed, x.rock));
     EXPECT_EQ(x.shape->mass_kg, expected.mass_kg);
     ASSERT_EQ(x.episodes.size(), y.episodes.size());
     EXPECT_FALSE(x.episodes.empty());

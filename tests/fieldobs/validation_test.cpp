@@ -341,5 +341,48 @@ TEST(Observations, TrajectorySegmentsWithoutAngularVelocityGiveNoAngularSpeed) {
   EXPECT_EQ(speeds, 3);
 }
 
+// Per block: the scored observations of each block's runs, their mean bias and score by hand; an
+// observation not scored, of a deposit (no bias), or of a run the release does not have is left
+// out, and a run without a block counts under "[rock]".
+TEST(BiasByBlock, MeansOverEachBlocksRunsByHand) {
+  ensemble::ReleaseSpec release;
+  release.blocks = {{"St. Leonard", nullptr, {}, {}}, {"Plate", nullptr, {}, {}}};
+  for (const auto& [id, block] : std::vector<std::pair<std::string, int>>{
+           {"a", 0}, {"b", 1}, {"c", 0}, {"d", -1}}) {
+    ensemble::ReleaseRun run;
+    run.id = id;
+    run.block = block;
+    release.runs.push_back(run);
+  }
+  const auto score = [](const std::string& run, const std::string& kind, double bias, double crps,
+                        bool scored = true) {
+    ObservationScore s;
+    s.run = run;
+    s.kind = kind;
+    s.unit = "m";
+    s.bias = bias;
+    s.score = crps;
+    s.scored = scored;
+    return s;
+  };
+  const std::vector<ObservationScore> scores = {
+      score("a", "runout", 30, 20), score("c", "runout", 10, 8),  score("b", "runout", -20, 15),
+      score("d", "runout", 4, 3),   score("b", "runout", 99, 9, false),
+      score("e", "runout", 50, 40), score("a", "deposit", kNaN, 12)};
+  const std::vector<BlockBias> biases = BiasByBlock(scores, release);
+  ASSERT_EQ(biases.size(), 3u);
+  EXPECT_EQ(biases[0].block, "St. Leonard");
+  EXPECT_EQ(biases[0].scored, 2);
+  EXPECT_EQ(biases[0].mean_bias, 20);
+  EXPECT_EQ(biases[0].mean_score, 14);
+  EXPECT_EQ(biases[1].block, "Plate");
+  EXPECT_EQ(biases[1].scored, 1);
+  EXPECT_EQ(biases[1].mean_bias, -20);
+  EXPECT_EQ(biases[2].block, "[rock]");
+  EXPECT_EQ(biases[2].mean_bias, 4);
+  EXPECT_EQ(biases[2].kind, "runout");
+  EXPECT_EQ(biases[2].unit, "m");
+}
+
 }  // namespace
 }  // namespace talus::fieldobs

@@ -116,5 +116,80 @@ TEST(LoadCalibration, BadTolerancesAreRefusedNamingFileLineAndKey) {
   EXPECT_EQ(ErrorOf(path).rfind(path + ":8: solver.dt_s: unknown key", 0), 0u) << ErrorOf(path);
 }
 
+// Shape parameters: [[parameters]] with `block` instead of `category` frees a knob of a block's
+// shape (docs/calibration.md); a block that is not in the scene, a knob the block has not, an
+// unknown knob, or both a category and a block are refused naming the file, line and key.
+std::string MakeShapeCalibration(const std::string& name, const std::string& parameter) {
+  const auto dir = testing::FreshDir(name);
+  testing::WriteText(dir / "scene.toml", R"([terrain]
+plane = { slope_deg = 35, slope_length_m = 20, runout_m = 10, width_m = 12, cell_m = 1 }
+default_ground = "medium_soft"
+[blocks]
+shape = "rock"
+[blocks.round]
+size_m = [0.4, 0.4, 0.3]
+[blocks.slab]
+size_m = [0.5, 0.4, 0.2]
+shape = "box"
+[release]
+runs = "runs.csv"
+rocks = 4
+[solver]
+max_time_s = 3
+)");
+  testing::WriteText(dir / "runs.csv",
+                     "trajectory_id,x_m,y_m,height_m,block_id\nr1,3,0,1,round\nr2,3,2,1,slab\n"
+                     "r3,4,-2,1,round\nr4,4,3,1,slab\n");
+  testing::WriteText(dir / "observed.csv",
+                     "trajectory_id,observed_runout_m\nr1,17\nr2,19\nr3,14\nr4,16\n");
+  testing::WriteText(dir / "event.toml",
+                     "scene = \"scene.toml\"\n[[observations]]\nkind = \"runout\"\n"
+                     "file = \"observed.csv\"\n");
+  testing::WriteText(dir / "cal.toml", R"(event = "event.toml"
+[[parameters]]
+category = "medium_soft"
+field = "mu_min"
+lower = 0.1
+upper = 0.9
+[[parameters]]
+)" + parameter);
+  return (dir / "cal.toml").string();
+}
+
+TEST(LoadCalibration, ShapeParametersNameABlockAndItsKnob) {
+  const CalibrationFile file = LoadCalibration(MakeShapeCalibration(
+      "shape_ok", "block = \"round\"\nfield = \"roughness\"\nlower = 0\nupper = 0.4\n"));
+  ASSERT_EQ(file.parameters.size(), 2u);
+  EXPECT_TRUE(file.parameters[1].IsShape());
+  EXPECT_EQ(file.parameters[1].Name(), "blocks.round.roughness");
+  const CalibrationFile sizes = LoadCalibration(MakeShapeCalibration(
+      "shape_size", "block = \"slab\"\nfield = \"size_z_m\"\nlower = 0.15\nupper = 0.25\n"));
+  EXPECT_EQ(sizes.parameters[1].Name(), "blocks.slab.size_z_m");
+
+  const std::string unknown = ErrorOf(MakeShapeCalibration(
+      "shape_unknown", "block = \"rund\"\nfield = \"roughness\"\nlower = 0\nupper = 0.4\n"));
+  EXPECT_NE(unknown.find("cal.toml:8: parameters[1].block: unknown block 'rund' (did you mean "
+                         "'round'?); the scene has round, slab"),
+            std::string::npos)
+      << unknown;
+  const std::string no_knob = ErrorOf(MakeShapeCalibration(
+      "shape_no_knob", "block = \"slab\"\nfield = \"roughness\"\nlower = 0\nupper = 0.4\n"));
+  EXPECT_NE(no_knob.find("blocks.slab.roughness: block 'slab' has no roughness"), std::string::npos)
+      << no_knob;
+  const std::string field = ErrorOf(MakeShapeCalibration(
+      "shape_field", "block = \"round\"\nfield = \"roughnes\"\nlower = 0\nupper = 0.4\n"));
+  EXPECT_NE(field.find("parameters[1].field: unknown shape parameter 'roughnes' (did you mean "
+                       "'roughness'?)"),
+            std::string::npos)
+      << field;
+  const std::string both = ErrorOf(MakeShapeCalibration(
+      "shape_both",
+      "category = \"medium_soft\"\nblock = \"round\"\nfield = \"roughness\"\nlower = 0\nupper = "
+      "0.4\n"));
+  EXPECT_NE(both.find("parameters[1].block: give a ground category or a block, not both"),
+            std::string::npos)
+      << both;
+}
+
 }  // namespace
 }  // namespace talus::io

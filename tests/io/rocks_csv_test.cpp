@@ -15,7 +15,7 @@ TEST(RocksCsvWriter, OneRowPerRockWithTheContractColumns) {
   {
     ensemble::ReleaseSpec release;
     release.seed = 7;
-    release.blocks.push_back({"plate, thin", nullptr});
+    release.blocks.push_back({"plate, thin", nullptr, {}, {}});
     release.runs.resize(2);
     release.runs[0].id = "v001";
     release.runs[1].id = "v002";

@@ -1172,10 +1172,118 @@ TEST(LoadScene, ShapePerRockNeedsRockShapes) {
                                                  "shape = \"rock\"\nshape_per_rock = true"));
   const SceneFile s = LoadScene((dir / "scene.toml").string());
   ASSERT_TRUE(static_cast<bool>(s.release.shape_per_rock));
-  const RockShape a = s.release.shape_per_rock(0, 1), b = s.release.shape_per_rock(0, 2);
+  const RockShape a = s.release.shape_per_rock(&s.release.blocks[0], 1), b = s.release.shape_per_rock(&s.release.blocks[0], 2);
   EXPECT_NEAR(a.mass_kg, 69, 1e-9);  // size and mass kept, whatever the seed
   EXPECT_NEAR(b.mass_kg, 69, 1e-9);
   EXPECT_NE(a.vertices_m.size() == b.vertices_m.size() && a.vertices_m[0] == b.vertices_m[0], true);
+}
+
+// Shape per block: each rock block its own roughness, points and seed (in [blocks.<id>] or as
+// columns of the blocks file), a scanned point cloud as a block (`file`), and the knobs a
+// calibration may change recorded with a maker that rebuilds the block from them.
+TEST(LoadScene, EachBlockHasAShapeOfItsOwn) {
+  const auto dir = testing::FreshDir("block_shapes");
+  testing::WriteText(dir / "blocks.csv",
+                     "block_id,mass_kg,size_x_m,size_y_m,size_z_m,roughness,points,shape_seed,file\n"
+                     "1,69,0.37,0.32,0.37,0.3,40,7,\n"
+                     "4,40,0.46,0.30,0.20,,,,\n"
+                     "scan,,,,,,,,cube.xyz\n");
+  // The corners of a 0.4 m cube and its centre: the hull is the cube.
+  std::string cube;
+  for (int i = 0; i < 8; ++i)
+    cube += std::to_string(0.4 * (i & 1)) + " " + std::to_string(0.4 * ((i >> 1) & 1)) + " " +
+            std::to_string(0.4 * ((i >> 2) & 1)) + "\n";
+  testing::WriteText(dir / "cube.xyz", cube + "0.2 0.2 0.2\n");
+  testing::WriteText(dir / "runs.csv", "trajectory_id,x_m,y_m,block_id\nv1,5,0,1\nv2,5,1,slab\n");
+  const std::string scene = Replace(Replace(kRunScene, "shape = \"box\"", "shape = \"rock\""),
+                                    "mass_kg = 250", "mass_kg = 250\nroughness = 0.05");
+  testing::WriteText(dir / "scene.toml", scene);
+  const SceneFile s = LoadScene((dir / "scene.toml").string());
+  ASSERT_EQ(s.release.blocks.size(), 4u);
+  const ensemble::Block& first = s.release.blocks[0];
+  EXPECT_EQ(first.id, "1");
+  EXPECT_EQ(first.knobs.roughness, 0.3);
+  EXPECT_EQ(first.knobs.shape_seed, 7u);
+  EXPECT_EQ(first.knobs.size_m, Eigen::Vector3d(0.37, 0.32, 0.37));
+  EXPECT_EQ(s.block_specs[0].points, 40);
+  EXPECT_NEAR(first.shape->mass_kg, 69, 1e-9);
+  EXPECT_EQ(s.release.blocks[1].knobs.roughness, 0.15);  // [blocks]' default
+  EXPECT_EQ(s.release.blocks[3].id, "slab");
+  EXPECT_EQ(s.release.blocks[3].knobs.roughness, 0.05);
+  // The maker gives the block back from its knobs, and another block from other knobs.
+  ASSERT_TRUE(static_cast<bool>(first.make));
+  const RockShape again = first.make(first.knobs);
+  ASSERT_EQ(again.vertices_m.size(), first.shape->vertices_m.size());
+  EXPECT_EQ(again.vertices_m[0], first.shape->vertices_m[0]);
+  ensemble::ShapeKnobs smoother = first.knobs;
+  smoother.roughness = 0;
+  EXPECT_NE(first.make(smoother).vertices_m[0], first.shape->vertices_m[0]);
+  EXPECT_NEAR(first.make(smoother).mass_kg, 69, 1e-9);  // the mass stays
+  // The scanned block: its hull, no knobs, no maker; the file is an input of the scene.
+  const ensemble::Block& scan = s.release.blocks[2];
+  EXPECT_EQ(scan.shape->vertices_m.size(), 8u);
+  EXPECT_NEAR(scan.shape->volume_m3, 0.064, 1e-12);
+  EXPECT_FALSE(static_cast<bool>(scan.make));
+  EXPECT_TRUE(std::isnan(scan.knobs.roughness));
+  EXPECT_FALSE(scan.knobs.size_m.allFinite());
+  EXPECT_NE(std::find(s.inputs.begin(), s.inputs.end(), (dir / "cube.xyz").string()),
+            s.inputs.end());
+}
+
+TEST(LoadScene, BlockShapeKnobsAreChecked) {
+  const auto dir = testing::FreshDir("block_shape_errors");
+  testing::WriteText(dir / "blocks.csv", kBlocksCsv);
+  testing::WriteText(dir / "runs.csv", "trajectory_id,x_m,y_m,block_id\nv1,5,0,1\n");
+  testing::WriteText(dir / "cube.xyz", "0 0 0\n1 0 0\n0 1 0\n0 0 1\n1 1 1\n");
+  EXPECT_HAS(ErrorOf(Replace(kRunScene, "mass_kg = 250", "mass_kg = 250\nroughness = 0.1"), dir),
+             "block 'slab': roughness: only a rock block has a roughness");
+  EXPECT_HAS(ErrorOf(Replace(Replace(kRunScene, "shape = \"box\"", "shape = \"rock\""),
+                             "mass_kg = 250", "mass_kg = 250\nroughness = 0.7"),
+                     dir),
+             "block 'slab': roughness: 0.7 must be in 0 .. 0.5");
+  EXPECT_HAS(ErrorOf(Replace(kRunScene, "size_m = [1.0, 0.5, 0.2]", "file = \"cube.xyz\"\nsize_m = [1, 1, 1]"),
+                     dir),
+             "blocks.slab.size_m: a point cloud block takes its shape and size from its file");
+  EXPECT_HAS(ErrorOf(Replace(kRunScene, "size_m = [1.0, 0.5, 0.2]", "file = \"missing.xyz\""), dir),
+             "file not found");
+  EXPECT_HAS(ErrorOf(Replace(kRunScene, "shape = \"box\"", "shape = \"rock\"\nsize_variation = 0.1"),
+                     dir),
+             "blocks.size_variation: varies the shape per rock: needs shape_per_rock = true");
+  testing::WriteText(dir / "blocks.csv",
+                     "block_id,size_x_m,size_y_m,size_z_m,file\n1,0.3,0.3,0.3,cube.xyz\n");
+  EXPECT_HAS(ErrorOf(kRunScene, dir),
+             "blocks.csv:2: column 'size_x_m': a point cloud block takes its shape and size from "
+             "the file");
+}
+
+// size_variation: the axes of each rock's shape vary about the block's within exp(+-4a/3) of
+// their ratios while the product of the axes, and with it the block's mass, stays; the draws
+// depend on the rock's shape seed only.
+TEST(LoadScene, ShapeVariationPerRockKeepsTheMassAndBoundsTheAxes) {
+  const auto dir = testing::FreshDir("shape_variation");
+  testing::WriteText(dir / "blocks.csv", kBlocksCsv);
+  testing::WriteText(dir / "runs.csv", "trajectory_id,x_m,y_m,block_id\nv1,5,0,1\n");
+  testing::WriteText(dir / "scene.toml",
+                     Replace(kRunScene, "shape = \"box\"",
+                             "shape = \"rock\"\nshape_per_rock = true\nsize_variation = 0.2"));
+  const SceneFile s = LoadScene((dir / "scene.toml").string());
+  const ensemble::Block& block = s.release.blocks[0];
+  const Eigen::Vector3d size = block.knobs.size_m;
+  double spread = 0;
+  for (std::uint64_t seed = 1; seed <= 20; ++seed) {
+    const ensemble::ShapeKnobs k = VariedKnobs(block.knobs, s.shape_variation, seed);
+    EXPECT_NEAR(k.size_m.prod(), size.prod(), 1e-12 * size.prod());
+    for (int i = 0; i < 3; ++i) {
+      EXPECT_LE(std::abs(std::log(k.size_m[i] / size[i])), 4 * 0.2 / 3 + 1e-12);
+      spread = std::max(spread, std::abs(std::log(k.size_m[i] / size[i])));
+    }
+    const RockShape rock = s.release.shape_per_rock(&block, seed);
+    EXPECT_NEAR(rock.mass_kg, 69, 1e-9);
+    const ensemble::ShapeKnobs again =
+        VariedKnobs(block.knobs, s.shape_variation, seed);
+    EXPECT_EQ(again.size_m, k.size_m);
+  }
+  EXPECT_GT(spread, 0.1);  // the draws do vary
 }
 
 // Reliability item 4: inputs that used to be accepted without a word and give wrong results.
