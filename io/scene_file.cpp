@@ -265,7 +265,8 @@ SceneFile LoadScene(const std::string& path) {
       context,
       Section(context, SubTable(context, root, "release"), "release",
               {"points", "lines", "polygons", "file", "layer", "where", "runs", "single_impacts",
-               "block_column", "height_m", "height_reference", "rocks", "rocks_per_m2",
+               "block_column", "ground_z_tolerance_m", "height_m", "height_reference", "rocks",
+               "rocks_per_m2",
                "rocks_per_cell", "clip_to_dem", "orientation", "velocity_m_s",
                "angular_velocity_rad_s", "seed"}),
       out);

@@ -46,6 +46,14 @@ struct ShapeVariation {
 ensemble::ShapeKnobs VariedKnobs(const ensemble::ShapeKnobs& knobs, const ShapeVariation& v,
                                  std::uint64_t seed);
 
+// A run of a run table whose start lies where the DEM's height departs from the surveyed ground
+// height (column ground_z_m) by more than [release] ground_z_tolerance_m.
+struct GroundMismatch {
+  std::string run;
+  std::string where;  // "file:line: column 'ground_z_m'"
+  double dem_z_m = 0, surveyed_z_m = 0;
+};
+
 // A loaded, validated scene file.
 struct SceneFile {
   std::string path;               // as given
@@ -58,6 +66,7 @@ struct SceneFile {
   pointclouds::RockSpec rock;  // the [rock] table
   bool has_rock = false;       // the scene has a [rock] table (else only [blocks])
   std::vector<pointclouds::RockSpec> block_specs;  // [blocks], parallel to release.blocks
+  std::vector<GroundMismatch> ground_mismatches;    // runs starting off the surveyed ground
   bool shape_per_rock = false;                     // every rock has a seeded shape of its own
   ShapeVariation shape_variation;                  // of blocks' shapes per rock ([blocks])
   std::string rock_description;     // e.g. "eota221 0.93 x 0.93 x 0.47 m, bevel 0.12 m"

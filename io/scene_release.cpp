@@ -63,6 +63,13 @@ void LoadRuns(const Context& context, const Section& s, SceneFile& out) {
     }
   }
   if (rows.rows() == 0) throw InputError(path + ": no run (the table has a header only)");
+  // A surveyed ground height per start (column ground_z_m) further than this from the DEM's is
+  // warned of: the run starts on other terrain than the field's.
+  const double ground_tolerance_m = s.Checked(
+      "ground_z_tolerance_m", 1.0, [](double v) { return v > 0 && v <= 1000; },
+      "must be in (0, 1000] m");
+  if (s.Has("ground_z_tolerance_m") && !rows.Has("ground_z_m"))
+    s.Fail("ground_z_tolerance_m", "the run table has no ground_z_m column to compare");
   const GridGeometry& g = out.scene.terrain.heights().grid;
   std::unordered_map<std::string, int> first_row;  // of each run id
   for (int k = 0; k < rows.rows(); ++k) {
@@ -123,7 +130,25 @@ void LoadRuns(const Context& context, const Section& s, SceneFile& out) {
       throw InputError(rows.Where(k, "z_m") + ": " + TenDigits(*run.z_m) + " m is " +
                        TenDigits(*run.z_m - ground_m) + " m above the ground, more than " +
                        TenDigits(kMaxReleaseHeight_m) + " m");
+    if (const std::optional<double> surveyed = rows.OptionalNumber(k, "ground_z_m");
+        surveyed && std::abs(*surveyed - ground_m) > ground_tolerance_m)
+      out.ground_mismatches.push_back({run.id, rows.Where(k, "ground_z_m"), ground_m, *surveyed});
     r.runs.push_back(run);
+  }
+  if (!out.ground_mismatches.empty()) {
+    const auto worst = std::max_element(
+        out.ground_mismatches.begin(), out.ground_mismatches.end(),
+        [](const GroundMismatch& a, const GroundMismatch& b) {
+          return std::abs(a.dem_z_m - a.surveyed_z_m) < std::abs(b.dem_z_m - b.surveyed_z_m);
+        });
+    out.warnings.push_back(
+        path + ": " + std::to_string(out.ground_mismatches.size()) + " of " +
+        std::to_string(rows.rows()) + " runs start where the DEM departs from the surveyed ground " +
+        "(ground_z_m) by more than ground_z_tolerance_m = " + TenDigits(ground_tolerance_m) +
+        " m (largest: run '" + worst->run + "', DEM " + FormatDouble(worst->dem_z_m, "%.2f") +
+        " m, survey " + FormatDouble(worst->surveyed_z_m, "%.2f") +
+        " m): they start on other terrain than the field's, and their scores measure the DEM as "
+        "much as the model (listed in scores.json, start_ground_mismatch)");
   }
 }
 

@@ -89,6 +89,14 @@ std::string ScoresJson(const EventFile& event, const fieldobs::ValidationReport&
   }
   j["kinds"] = kinds;
   j["blocks"] = BlockBiasJson(fieldobs::BiasByBlock(report.observations, event.scene.release));
+  j["warnings"] = event.scene.warnings;
+  nlohmann::ordered_json mismatches = nlohmann::ordered_json::array();
+  for (const GroundMismatch& m : event.scene.ground_mismatches)
+    mismatches.push_back({{"run", m.run},
+                          {"where", m.where},
+                          {"dem_z_m", m.dem_z_m},
+                          {"surveyed_ground_z_m", m.surveyed_z_m}});
+  j["start_ground_mismatch"] = mismatches;
   j["wall_time_s"] = run.wall_time_s;
   j["threads"] = run.threads;
   return j.dump(2) + "\n";

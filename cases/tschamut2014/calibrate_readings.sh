@@ -26,7 +26,7 @@ write_scene() {
 }
 # event.toml in directory $1 for the scene there and the observations of $2.
 write_event() {
-  sed -e "s#\"observed_deposition.csv\"#\"$2\"#" "$case_dir/event.toml" > "$1/event.toml"
+  sed -e "s#\"observed_deposition.csv\"#\"$2\"#" "$case_dir/event_variants.toml" > "$1/event.toml"
 }
 write_calibration() {
   cat > "$1/cal.toml" <<'CAL'

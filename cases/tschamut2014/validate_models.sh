@@ -1,6 +1,6 @@
 #!/bin/sh
 # Run-out and rest-position scores of the 62 runs for the ground models (README.md, "Ground
-# models"): `talus validate` of event.toml with the rock-like shape (32 points, roughness 0.15),
+# models"): `talus validate` of event_variants.toml with the rock-like shape (32 points, roughness 0.15),
 # contact friction, each ground category in GROUNDS as the meadow, with the seed's hard contact and
 # with the scarring soil (model = "lu2019", the paper's M_E 15 MN/m^2 and C_s 1.5) under it.
 # Usage: cases/tschamut2014/validate_models.sh [TALUS] [OUT] [ROCKS] [SEED]
@@ -28,7 +28,7 @@ for ground in ${GROUNDS:-hard medium}; do
         "$case_dir/scene.toml" > "$dir/scene.toml"
     [ "$model" = hard ] || printf '\n[ground.%s]\nmodel = "%s"\n' "$ground" "$model" >> "$dir/scene.toml"
     sed -e "s|\"observed_deposition.csv\"|\"$case_dir/observed_deposition.csv\"|" \
-        "$case_dir/event.toml" > "$dir/event.toml"
+        "$case_dir/event_variants.toml" > "$dir/event.toml"
     "$talus" validate "$dir/event.toml" --out "$dir/out" --rocks "$rocks" --seed "$seed" \
       > "$dir/validate.log"
     jq -r --arg g "$ground" --arg m "$model" '"| \($g) | \($m) | \(.kinds.runout.mean_score*100|round/100) | \(.kinds.deposit.mean_score*100|round/100) | \(.kinds.runout.mean_climatology_score*100|round/100) | " ' \

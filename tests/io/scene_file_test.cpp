@@ -1286,6 +1286,36 @@ TEST(LoadScene, ShapeVariationPerRockKeepsTheMassAndBoundsTheAxes) {
   EXPECT_GT(spread, 0.1);  // the draws do vary
 }
 
+// A run table's surveyed ground height (ground_z_m) is compared with the DEM's at each start: the
+// plane is 35 degrees down x from height 40 * tan(35 deg) at x = 0 (its 40 m slope), so at x = 5
+// the ground is 35 * tan(35 deg) = 24.507 m. A run 2 m off is listed and warned of once; one 0.3 m
+// off is not (tolerance 1 m by default; 0.2 m lists both).
+TEST(LoadScene, StartsOffTheSurveyedGroundAreListedAndWarned) {
+  const auto dir = testing::FreshDir("ground_z");
+  testing::WriteText(dir / "blocks.csv", kBlocksCsv);
+  const double ground = 35 * std::tan(35 * M_PI / 180);
+  testing::WriteText(dir / "runs.csv", "trajectory_id,x_m,y_m,block_id,ground_z_m\nv1,5,0,1," +
+                                           std::to_string(ground + 0.3) + "\nv2,5,1,1," +
+                                           std::to_string(ground - 2) + "\nv3,5,2,1,\n");
+  testing::WriteText(dir / "scene.toml", kRunScene);
+  const SceneFile s = LoadScene((dir / "scene.toml").string());
+  ASSERT_EQ(s.ground_mismatches.size(), 1u);
+  EXPECT_EQ(s.ground_mismatches[0].run, "v2");
+  EXPECT_NEAR(s.ground_mismatches[0].dem_z_m, ground, 1e-6);
+  EXPECT_NEAR(s.ground_mismatches[0].surveyed_z_m, ground - 2, 1e-5);
+  ASSERT_EQ(s.warnings.size(), 1u);
+  EXPECT_HAS(s.warnings[0], "1 of 3 runs start where the DEM departs from the surveyed ground");
+  EXPECT_HAS(s.warnings[0], "largest: run 'v2'");
+  testing::WriteText(dir / "scene.toml",
+                     Replace(kRunScene, "rocks = 3", "rocks = 3\nground_z_tolerance_m = 0.2"));
+  EXPECT_EQ(LoadScene((dir / "scene.toml").string()).ground_mismatches.size(), 2u);
+  EXPECT_HAS(ErrorOf(Replace(kRunScene, "rocks = 3", "rocks = 3\nground_z_tolerance_m = 0"), dir),
+             "release.ground_z_tolerance_m: 0 must be in (0, 1000] m");
+  testing::WriteText(dir / "runs.csv", "trajectory_id,x_m,y_m,block_id\nv1,5,0,1\n");
+  EXPECT_HAS(ErrorOf(Replace(kRunScene, "rocks = 3", "rocks = 3\nground_z_tolerance_m = 2"), dir),
+             "release.ground_z_tolerance_m: the run table has no ground_z_m column to compare");
+}
+
 // Reliability item 4: inputs that used to be accepted without a word and give wrong results.
 
 // A DEM in degrees would be read as metres: slopes of thousands of kilometres per cell.
