@@ -3,6 +3,9 @@
 #include <pcl/console/print.h>
 #include <pcl/point_types.h>
 #include <pcl/surface/convex_hull.h>
+// PCL's ConvexHull from its header implementation, on Qhull: Debian's libpcl_surface links VTK,
+// which every talus call would then load at start-up.
+#include <pcl/surface/impl/convex_hull.hpp>
 
 #include <Eigen/Geometry>
 #include <cstdint>

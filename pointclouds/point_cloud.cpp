@@ -1,10 +1,9 @@
 #include "pointclouds/point_cloud.hpp"
 
+#include <dlfcn.h>
 #include <pcl/PCLPointCloud2.h>
 #include <pcl/console/print.h>
 #include <pcl/filters/statistical_outlier_removal.h>
-#include <pcl/io/pcd_io.h>
-#include <pcl/io/ply_io.h>
 #include <pcl/point_types.h>
 #include <pcl/search/kdtree.h>
 
@@ -19,11 +18,13 @@
 #include <limits>
 #include <numeric>
 #include <sstream>
+#include <stdexcept>
 #include <unordered_map>
 
 #include "common/atomic_file.hpp"
 #include "common/error.hpp"
 #include "pointclouds/convex_hull.hpp"
+#include "pointclouds/pcl_files.hpp"
 
 namespace talus::pointclouds {
 namespace {
@@ -269,17 +270,30 @@ std::string HeaderProblem(const std::string& path, bool pcd) {
   return "";
 }
 
+// PCL's PCD and PLY readers: the module talus_pcl_files (pcl_files.hpp), loaded on first use.
+decltype(&TalusLoadPclFile) PclFileReader() {
+  static const auto reader = [] {
+    void* module = dlopen(TALUS_PCL_FILES_MODULE, RTLD_NOW | RTLD_LOCAL);
+    void* symbol = module ? dlsym(module, "TalusLoadPclFile") : nullptr;
+    if (!symbol)
+      throw std::runtime_error(std::string("cannot load PCL's PCD and PLY readers: ") + dlerror());
+    return reinterpret_cast<decltype(&TalusLoadPclFile)>(symbol);
+  }();
+  return reader;
+}
+
 // PCD and PLY through PCL, into a PCLPointCloud2 so that double-precision fields stay double.
 PointCloud ReadPclPoints(const std::string& path, bool pcd) {
   const char* format = pcd ? "PCD" : "PLY";
   const std::string problem = HeaderProblem(path, pcd);
   if (!problem.empty())
     throw InputError(path + ": not a readable " + format + " file (" + problem + ")");
+  const auto load = PclFileReader();
   pcl::PCLPointCloud2 blob;
   int status = -1;
   try {
     QuietPcl quiet;
-    status = pcd ? pcl::io::loadPCDFile(path, blob) : pcl::io::loadPLYFile(path, blob);
+    status = load(path.c_str(), pcd, &blob);
   } catch (const std::exception& e) {
     throw InputError(path + ": not a readable " + format + " file (" + e.what() + ")");
   }
