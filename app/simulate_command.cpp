@@ -94,10 +94,13 @@ int LoadForSimulate(const SimulateArgs& args, io::SceneFile* scene, std::pair<lo
         std::printf("--preset %s overrides the scene's %s\n", args.preset.c_str(), key.c_str());
     }
     args.ensemble.ApplyTo(scene->release);
-    if (args.self_check > 0 && !args.rock_range.empty())
-      throw InputError("--self-check: not with --rock-range (check the whole run, not a part)");
-    if (args.self_check > scene->release.total_rocks())
-      throw InputError("--self-check " + std::to_string(args.self_check) + ": the run has " +
+    // --self-check wins over the scene's [solver] self_check.
+    const std::string check_key = args.self_check > 0 ? "--self-check" : "[solver] self_check";
+    if (args.self_check > 0) scene->self_check = args.self_check;
+    if (scene->self_check > 0 && !args.rock_range.empty())
+      throw InputError(check_key + ": not with --rock-range (check the whole run, not a part)");
+    if (scene->self_check > scene->release.total_rocks())
+      throw InputError(check_key + " " + std::to_string(scene->self_check) + ": the run has " +
                        std::to_string(scene->release.total_rocks()) + " rocks");
     *range = {0, scene->release.total_rocks()};
     if (!args.rock_range.empty()) {
@@ -158,9 +161,9 @@ int RunSimulate(const SimulateArgs& args) {
     };
     // The self-check runs first: its subsample is small, and its report goes into summary.json.
     std::optional<ensemble::SelfCheckReport> self_check;
-    if (args.self_check > 0) {
+    if (scene.self_check > 0) {
       ensemble::SelfCheckOptions check;
-      check.rocks = args.self_check;
+      check.rocks = scene.self_check;
       check.threads = args.ensemble.threads;
       if (!scene.evaluation_lines.empty())
         check.evaluation_lines =

@@ -145,6 +145,12 @@ int SimulateOnRanks(const MpiSession& mpi, const SimulateArgs& args) {
         "--rock-range is for runs of one process (e.g. a job array); under mpirun the ranks "
         "share all rocks";
   }
+  if (code == kExitOk && scene.self_check > 0) {
+    code = kExitBadInput;
+    message =
+        "--self-check and [solver] self_check are for runs of one process; under mpirun, check "
+        "the step on one process first (talus simulate --self-check N)";
+  }
   if (const int failed = Agree(mpi, code, message, "talus simulate")) return failed;
   const std::string identity = EnsembleIdentity(args, scene);
   if (const std::string root_identity = BroadcastText(mpi, identity); identity != root_identity) {

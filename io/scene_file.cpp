@@ -140,7 +140,7 @@ double SolverValue(const Section& s, const SolverOptionInfo& f) {
 
 // The keys of [solver]: preset and every key of kSolverOptions.
 std::vector<std::string> SolverKeys() {
-  std::vector<std::string> keys = {"preset"};
+  std::vector<std::string> keys = {"preset", "self_check"};
   for (const SolverOptionInfo& f : kSolverOptions) keys.emplace_back(f.key);
   return keys;
 }
@@ -275,8 +275,13 @@ SceneFile LoadScene(const std::string& path) {
       Section(context, SubTable(context, root, "evaluation_lines"), "evaluation_lines",
               {"lines", "names", "file", "name_field"}),
       out);
-  LoadSolver(Section(context, SubTable(context, root, "solver"), "solver", SolverKeys()),
-             out.scene.options, out.solver_preset, out.solver_keys_given);
+  const Section solver(context, SubTable(context, root, "solver"), "solver", SolverKeys());
+  LoadSolver(solver, out.scene.options, out.solver_preset, out.solver_keys_given);
+  // A run's own check of its time step (talus simulate --self-check N): 0, or 2 .. the run's rocks
+  // (checked by the command, which knows the rocks after its --rocks).
+  out.self_check = solver.Integer("self_check", 0);
+  if (out.self_check != 0 && out.self_check < 2)
+    solver.Fail("self_check", std::to_string(out.self_check) + " must be 0 (none) or >= 2 rocks");
   LoadOutput(Section(context, SubTable(context, root, "output"), "output",
                      {"trajectories", "trajectory_interval_s", "rasters", "percentiles",
                       "raster_format", "quicklook", "report", "geopackage"}),

@@ -76,6 +76,9 @@ struct SceneFile {
   std::vector<std::string> inputs;  // the scene file and every data file it read
   std::string inputs_hash;          // FNV-1a 64 over the contents of `inputs`, hex
   SolverPreset solver_preset = SolverPreset::kDefault;  // [solver] preset, or --preset
+  // [solver] self_check: rocks rerun at half the step to measure the run's own step error
+  // (ensemble/self_check.hpp); 0: none. talus simulate --self-check N wins over it.
+  long self_check = 0;
   std::vector<std::string> solver_keys_given;           // the preset's knobs the scene sets itself
   // --preset given on the command line (UseSolverPreset): it wins over the scene's own keys;
   // solver_keys_overridden lists those whose values it changed, as "dt_s = 0.002 -> 0.001".

@@ -148,7 +148,7 @@ void LoadRuns(const Context& context, const Section& s, SceneFile& out) {
         " m (largest: run '" + worst->run + "', DEM " + FormatDouble(worst->dem_z_m, "%.2f") +
         " m, survey " + FormatDouble(worst->surveyed_z_m, "%.2f") +
         " m): they start on other terrain than the field's, and their scores measure the DEM as "
-        "much as the model (listed in scores.json, start_ground_mismatch)");
+        "much as the model (talus validate lists them: scores.json, start_ground_mismatch)");
   }
 }
 

@@ -338,6 +338,37 @@ TEST(SimulateCommand, SelfCheckIsPrintedAndWrittenToTheSummary) {
             2)
       << log;
   EXPECT_NE(log.find("--self-check 9: the run has"), std::string::npos) << log;
+  // The scene may ask for it ([solver] self_check); --self-check wins over it.
+  std::string asking = kScene;
+  asking.replace(asking.find("[solver]\n"), 9, "[solver]\nself_check = 3\n");
+  std::ofstream(dir / "asking.toml") << asking;
+  ASSERT_EQ(RunCommand(std::string(TALUS_BINARY) + " simulate " + (dir / "asking.toml").string() +
+                           " --out " + (dir / "asked").string() + " --rocks 2",
+                       &log),
+            0)
+      << log;
+  EXPECT_EQ(nlohmann::json::parse(Slurp(dir / "asked" / "summary.json"))["self_check"]["rocks"], 3);
+  ASSERT_EQ(RunCommand(std::string(TALUS_BINARY) + " simulate " + (dir / "asking.toml").string() +
+                           " --out " + (dir / "given").string() + " --rocks 2 --self-check 4",
+                       &log),
+            0)
+      << log;
+  EXPECT_EQ(nlohmann::json::parse(Slurp(dir / "given" / "summary.json"))["self_check"]["rocks"], 4);
+  EXPECT_EQ(RunCommand(std::string(TALUS_BINARY) + " simulate " + (dir / "asking.toml").string() +
+                           " --out " + (dir / "few").string() + " --rocks 1",
+                       &log),
+            2)
+      << log;
+  EXPECT_NE(log.find("[solver] self_check 3: the run has"), std::string::npos) << log;
+  asking.replace(asking.find("self_check = 3"), 14, "self_check = 1");
+  std::ofstream(dir / "asking.toml") << asking;
+  EXPECT_EQ(RunCommand(std::string(TALUS_BINARY) + " simulate " + (dir / "asking.toml").string() +
+                           " --out " + (dir / "one").string(),
+                       &log),
+            2)
+      << log;
+  EXPECT_NE(log.find("solver.self_check: 1 must be 0 (none) or >= 2 rocks"), std::string::npos)
+      << log;
 }
 
 // --rocks is checked like the scene's rocks: 2 releases x 2^63 - 1 rocks used to overflow to a
