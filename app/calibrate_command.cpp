@@ -329,6 +329,10 @@ void WriteOutputs(const CalibrateArgs& args, const Loaded& loaded,
   std::printf("Wrote %zu files to %s in %.1f s%s\n", outputs.size(), args.out.c_str(),
               run.wall_time_s,
               budget ? " (a budget ended a fit: checkpoint.json kept for --resume)" : "");
+  std::fflush(stdout);
+  for (const std::string& warning : calibration::CalibrationWarnings(run, objective))
+    std::fprintf(stderr, "talus calibrate: WARNING: %s\n", warning.c_str());
+  std::fflush(stderr);
 }
 
 int RunCalibrate(const CalibrateArgs& args, const Processes& processes) {

@@ -1,6 +1,7 @@
 #include "calibration/calibrate.hpp"
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <stdexcept>
 #include <utility>
@@ -263,6 +264,56 @@ CalibrationSummary Calibrate(const CalibrationProblem& problem, const Calibratio
   stages.CrossValidate();
   run.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return run;
+}
+
+std::vector<std::string> CalibrationWarnings(const CalibrationSummary& run,
+                                             const Objective& objective) {
+  std::vector<std::string> out;
+  const auto& coordinates = objective.parameters().coordinates();
+  const Eigen::VectorXd& u = run.fit.best.u;
+  for (std::size_t j = 0; j < coordinates.size(); ++j) {
+    const Coordinate& c = coordinates[j];
+    const bool flat = j < run.profiles.size() && !run.profiles[j].identified;
+    const bool singular = run.uncertainty && j < run.uncertainty->identified.size() &&
+                          !run.uncertainty->identified[j];
+    if (flat)
+      out.push_back(Format("%s is unidentified: over its whole range its profile changes the "
+                           "objective by %.3g, less than %.3g (3 x the noise): the observations "
+                           "do not constrain it, and its fitted value is where the fit left it",
+                           c.name.c_str(), run.profiles[j].range, run.profiles[j].threshold));
+    else if (singular)
+      out.push_back(c.name + " is unidentified by the covariance (J^T J is singular in it): the "
+                             "observations do not constrain it");
+    const auto jj = static_cast<Eigen::Index>(j);
+    if (jj < u.size() && (u[jj] <= 1e-3 || u[jj] >= 1 - 1e-3)) {
+      const bool low = u[jj] <= 1e-3;
+      out.push_back(Format("%s lies at the %s bound of its range (%g): the optimum may lie "
+                           "beyond it; widen the bounds where physics allows",
+                           c.name.c_str(), low ? "lower" : "upper", low ? c.lower : c.upper));
+    }
+  }
+  const double noise = run.roughness ? run.roughness->level() : 0;
+  for (const ParameterProfile& p : run.profiles)
+    for (std::size_t k = 0; k < p.f.size(); ++k)
+      if (p.f[k] < run.fit.best.value - noise) {
+        out.push_back(Format("the profile of %s found a lower objective (%.4g at %g) than the "
+                             "reported optimum (%.4g), by more than the noise level %.3g: the fit "
+                             "stopped short of the best point it could have found; refit from there "
+                             "or with more starts",
+                             p.name.c_str(), p.f[k], p.values[k], run.fit.best.value, noise));
+        break;
+      }
+  const auto worse = [&out](const std::vector<HeldOutKind>& kinds, const char* which) {
+    for (const HeldOutKind& k : kinds)
+      if (std::isfinite(k.fitted) && std::isfinite(k.reference) && k.fitted > k.reference)
+        out.push_back(Format("%s score %s worse with the fitted values than with the reference "
+                             "table (%.4g against %.4g %s): the fit does not carry over to runs "
+                             "it did not see",
+                             which, k.kind.c_str(), k.fitted, k.reference, k.unit.c_str()));
+  };
+  if (run.holdout) worse(run.holdout->kinds, "the held-out runs");
+  worse(run.cross_validated, "the cross-validated runs");
+  return out;
 }
 
 }  // namespace talus::calibration

@@ -141,6 +141,15 @@ struct CalibrationSummary {
   std::string FullReport() const;   // every stage's report
 };
 
+// What in a calibration's result deserves a warning, one sentence each, in this order: a
+// parameter the profiles or the covariance find unidentified; a fitted value at a bound of its
+// range (within 1e-3 of the range: the optimum may lie beyond); a profile point below the reported
+// optimum by more than the objective's noise level (the optimum is then not the best point
+// evaluated; within the noise it is not reported); a kind that the held-out runs, or the folds'
+// runs, score worse with the fitted values than with the reference table. `objective` is the fit's.
+std::vector<std::string> CalibrationWarnings(const CalibrationSummary& run,
+                                             const Objective& objective);
+
 // Runs the calibration. Throws what the objective and the callbacks throw,
 // std::invalid_argument for invalid options, and std::runtime_error when the fit (or a fold's)
 // has no usable solution.

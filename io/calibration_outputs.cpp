@@ -511,7 +511,11 @@ std::string CalibrationJson(const CalibrationFile& file, const Objective& object
               {"total_s", run.wall_time_s}}}};
   j["uncertainty"] = UncertaintyJson(run);
   j["not_scored"] = file.event.not_scored;  // observed values without a simulated counterpart
-  j["warnings"] = file.event.scene.warnings;  // the scene's, as printed
+  // The scene's and the result's (calibration::CalibrationWarnings), as printed.
+  std::vector<std::string> warnings = file.event.scene.warnings;
+  for (const std::string& w : calibration::CalibrationWarnings(run, objective))
+    warnings.push_back(w);
+  j["warnings"] = warnings;
   const ensemble::ReleaseSpec& all_runs = file.event.scene.release;
   // The fitted runs scored with the fitted values, per block: what the fit leaves in each block.
   j["fitted_runs_blocks"] = BlocksJson(run.after.observations, all_runs);

@@ -154,5 +154,59 @@ TEST(CalibrationProblem, RefusesAnUnknownHeldOutRunAndTooManyFolds) {
                InputError);
 }
 
+// Each warning of a result, from a summary made by hand (no rock runs): mu_min at its lower
+// bound with a flat profile, a profile point 0.5 below the optimum (noise 0.1), and held-out
+// run-outs and cross-validated rest positions scoring worse fitted than with the reference; a
+// profile point below the optimum by less than the noise, and kinds scoring better fitted, give
+// none.
+TEST(CalibrationWarnings, EachWeakOrCensoredResultIsSaid) {
+  const CalibrationProblem problem = MakeProblem();
+  CalibrationSummary run;
+  run.fit.best.u = Eigen::VectorXd::Constant(1, 0.0);
+  run.fit.best.value = 1.0;
+  ParameterProfile profile;
+  profile.name = "medium_hard.mu_min";
+  profile.u = {0, 0.5, 1};
+  profile.values = {kLower, 0.5, kUpper};
+  profile.f = {1.0, 0.5, 1.2};
+  profile.range = 0.7;
+  profile.threshold = 0.9;
+  profile.identified = false;
+  run.profiles = {profile};
+  run.roughness = RoughnessReport{};
+  run.roughness->noise = 0.1;
+  run.holdout = HeldOutScores{};
+  run.holdout->kinds = {{"runout", "m", 2, 2, 12.0, 10.0}, {"deposit", "m", 2, 2, 9.0, 10.0}};
+  run.cross_validated = {{"runout", "m", 6, 6, 9.0, 10.0}, {"deposit", "m", 6, 6, 14.0, 13.0}};
+  const std::vector<std::string> w = CalibrationWarnings(run, problem.objective());
+  ASSERT_EQ(w.size(), 5u);
+  EXPECT_EQ(w[0].rfind("medium_hard.mu_min is unidentified: over its whole range its profile "
+                       "changes the objective by 0.7, less than 0.9",
+                       0),
+            0u)
+      << w[0];
+  EXPECT_EQ(w[1].rfind("medium_hard.mu_min lies at the lower bound of its range (0.1)", 0), 0u)
+      << w[1];
+  EXPECT_EQ(w[2].rfind("the profile of medium_hard.mu_min found a lower objective (0.5 at 0.5) "
+                       "than the reported optimum (1)",
+                       0),
+            0u)
+      << w[2];
+  EXPECT_EQ(w[3].rfind("the held-out runs score runout worse with the fitted values than with "
+                       "the reference table (12 against 10 m)",
+                       0),
+            0u)
+      << w[3];
+  EXPECT_EQ(w[4].rfind("the cross-validated runs score deposit worse", 0), 0u) << w[4];
+
+  // Within the noise, inside the bounds, identified, better fitted: nothing to say.
+  run.fit.best.u[0] = 0.5;
+  run.profiles[0].identified = true;
+  run.profiles[0].f = {1.2, 0.95, 1.1};
+  run.holdout->kinds[0].fitted = 9.0;
+  run.cross_validated[1].fitted = 12.0;
+  EXPECT_TRUE(CalibrationWarnings(run, problem.objective()).empty());
+}
+
 }  // namespace
 }  // namespace talus::calibration
