@@ -110,6 +110,10 @@ std::string SummaryJson(const SceneFile& scene, const ensemble::EnsembleReport& 
   j["inputs"] = scene.inputs;
   j["inputs_hash_fnv1a64"] = scene.inputs_hash;
   j["terrain"] = scene.terrain_description;
+  // The coordinates of every position written (rocks.csv, evaluation lines, trajectories): the
+  // DEM's CRS as WKT, null for the plane or a DEM without one.
+  j["crs_wkt"] = scene.crs_wkt.empty() ? nlohmann::ordered_json(nullptr)
+                                       : nlohmann::ordered_json(scene.crs_wkt);
   j["rock"] = {{"shape", scene.rock_description},
                {"mass_kg", scene.scene.rock.mass_kg},
                {"volume_m3", scene.scene.rock.volume_m3},

@@ -46,6 +46,24 @@ TEST(SummaryJson, CarriesHashVersionCountsAndRate) {
   EXPECT_FALSE(j["ground"]["medium"].contains("drag_height_m"));  // no layer
   EXPECT_DOUBLE_EQ(j["trajectories_per_s"].get<double>(), 5.0);
   EXPECT_DOUBLE_EQ(j["wall_time_s"].get<double>(), 2.0);
+  EXPECT_TRUE(j["crs_wkt"].is_null());  // the plane has no CRS
+}
+
+// The DEM's CRS, as WKT, for the positions every output holds.
+TEST(SummaryJson, CarriesTheDemsCrs) {
+  const auto dir = testing::FreshDir("summary_crs");
+  const std::vector<std::vector<double>> flat(20, std::vector<double>(20, 1000.0));
+  testing::WriteGdalRaster(dir / "dem.tif", flat, {2600000, 10, 0, 1200200, 0, -10}, 2056,
+                           std::nullopt);
+  testing::WriteText(dir / "scene.toml",
+                     "[terrain]\ndem = \"dem.tif\"\n[rock]\nshape = { box = [1, 1, 1] "
+                     "}\n[release]\npoints = [[2600100, 1200100]]\n");
+  const SceneFile scene = LoadScene((dir / "scene.toml").string());
+  const auto j =
+      nlohmann::json::parse(SummaryJson(scene, ensemble::EnsembleReport{}, "9.9.9", {}));
+  ASSERT_TRUE(j["crs_wkt"].is_string());
+  EXPECT_EQ(j["crs_wkt"], scene.crs_wkt);
+  EXPECT_NE(j["crs_wkt"].get<std::string>().find("2056"), std::string::npos);
 }
 
 // "solver": every option of kSolverOptions in the table's order, then the preset, where it came
