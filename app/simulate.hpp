@@ -24,7 +24,9 @@ struct SimulateArgs {
   EnsembleArgs ensemble;   // --rocks (per release), --threads, --seed
   std::string rock_range;  // "A:B": write a partial result of rocks A .. B - 1
   std::string preset;      // --preset: fast, default, accurate; empty: the scene's
-  long self_check = 0;     // --self-check N: rerun N rocks at dt/2 and compare; 0: none
+  // --self-check N: rerun N rocks at dt/2 and compare; 0: none (over the scene's [solver]
+  // self_check); -1: not given (the scene's).
+  long self_check = -1;
 };
 
 // Loads the scene with the overrides of `args` and the rocks to run ([0, total), or --rock-range).

@@ -95,8 +95,8 @@ int LoadForSimulate(const SimulateArgs& args, io::SceneFile* scene, std::pair<lo
     }
     args.ensemble.ApplyTo(scene->release);
     // --self-check wins over the scene's [solver] self_check.
-    const std::string check_key = args.self_check > 0 ? "--self-check" : "[solver] self_check";
-    if (args.self_check > 0) scene->self_check = args.self_check;
+    const std::string check_key = args.self_check >= 0 ? "--self-check" : "[solver] self_check";
+    if (args.self_check >= 0) scene->self_check = args.self_check;
     if (scene->self_check > 0 && !args.rock_range.empty())
       throw InputError(check_key + ": not with --rock-range (check the whole run, not a part)");
     if (scene->self_check > scene->release.total_rocks())
@@ -210,8 +210,14 @@ Runner AddSimulateCommand(CLI::App& app) {
   cmd->add_option("--self-check", args->self_check,
                   "Rerun N rocks (every total/N-th) at half the time step and a 1e-7 m/s contact "
                   "solve, and report each headline statistic's difference with its standard error "
-                  "(console and summary.json)")
-      ->check(IntegerRange(2, std::numeric_limits<long>::max()));
+                  "(console and summary.json); 0: none, whatever the scene's [solver] self_check")
+      ->check(IntegerRange(0, std::numeric_limits<long>::max()))
+      ->check(CLI::Validator(
+          [](std::string& text) -> std::string {
+            // An integer >= 0 by now (IntegerRange).
+            return std::stoll(text) == 1 ? "must be 0 (none) or at least 2 rocks" : "";
+          },
+          "0 or >= 2"));
   cmd->add_option("--rock-range", args->rock_range,
                   "Run only rocks A .. B-1 (A:B) and write a partial result for talus merge");
   return [cmd, args]() { return *cmd ? RunSimulate(*args) : -1; };

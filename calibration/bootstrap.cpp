@@ -148,7 +148,8 @@ int RefitBudget(const BootstrapOptions& options, int refitted) {
 
 Eigen::VectorXd RefitFromOptimum(const std::function<double(const Eigen::VectorXd&)>& f,
                                  const std::vector<int>& free, const Eigen::VectorXd& origin,
-                                 const BootstrapOptions& options, int budget, bool* at_budget) {
+                                 const BootstrapOptions& options, int budget, bool* at_budget,
+                                 const Eigen::VectorXd* start) {
   const auto k = free.size();
   const std::vector<double> lower(k, 0.0), upper(k, 1.0);
   // Steps below half the lattice spacing would ask for the same point again.
@@ -165,7 +166,7 @@ Eigen::VectorXd RefitFromOptimum(const std::function<double(const Eigen::VectorX
   nlopt_set_ftol_rel(refit.opt, options.ftol_rel);
   nlopt_set_maxeval(refit.opt, budget);
   std::vector<double> x(k);
-  for (std::size_t q = 0; q < k; ++q) x[q] = origin[free[q]];
+  for (std::size_t q = 0; q < k; ++q) x[q] = (start ? *start : origin)[free[q]];
   double value = 0;
   const nlopt_result result = nlopt_optimize(refit.opt, x.data(), &value);
   nlopt_destroy(refit.opt);
@@ -190,6 +191,8 @@ bool BootstrapOptions::IsValid(std::string* why) const {
     msg << "bootstrap_resolution = " << resolution << " must be in [0, 0.25] (0: exact points)";
   else if (!(xtol_abs >= 0) || !(ftol_rel >= 0))
     msg << "bootstrap tolerances must be >= 0";
+  else if (!(start_spread >= 0 && start_spread <= 0.5))
+    msg << "bootstrap_start_spread = " << start_spread << " must be in [0, 0.5]";
   else if (!(level > 0 && level < 1))
     msg << "bootstrap_level = " << level << " must be in (0, 1)";
   if (msg.str().empty()) return true;
@@ -224,6 +227,7 @@ Bootstrap BootstrapOverRuns(const Objective& objective, const Eigen::VectorXd& u
   out.resamples = options.resamples;
   out.level = options.level;
   out.resolution = options.resolution;
+  out.start_spread = options.start_spread;
   out.seed = options.seed;
   out.u = u.cwiseMax(0.0).cwiseMin(1.0);
   for (const Coordinate& c : objective.parameters().coordinates()) out.names.push_back(c.name);
@@ -251,8 +255,19 @@ Bootstrap BootstrapOverRuns(const Objective& objective, const Eigen::VectorXd& u
             return s.feasible ? weights.dot(s.sums) + s.prior : s.value;
           };
       bool at_budget = false;
+      Eigen::VectorXd start = out.u;
+      if (options.start_spread > 0) {
+        // Uniform draws on [-1, 1) from 53 bits of a generator of the resample's own.
+        std::mt19937_64 draw(options.seed * 0x9E3779B97F4A7C15ULL + static_cast<std::uint64_t>(b));
+        for (int j : free)
+          start[j] = std::clamp(
+              OnLattice(out.u[j] + options.start_spread * (2 * double(draw() >> 11) * 0x1p-53 - 1),
+                        out.u[j], options.resolution),
+              0.0, 1.0);
+      }
       out.refits_unit.row(b) =
-          RefitFromOptimum(resampled, free, out.u, options, budget, &at_budget).transpose();
+          RefitFromOptimum(resampled, free, out.u, options, budget, &at_budget, &start)
+              .transpose();
       out.refits_at_budget += at_budget ? 1 : 0;
     }
   out.refits = Eigen::MatrixXd(options.resamples, n);
@@ -274,7 +289,9 @@ Bootstrap BootstrapOverRuns(const Objective& objective, const Eigen::VectorXd& u
   if (out.note.empty()) {
     std::ostringstream note;
     note << options.resamples << " resamples of " << out.groups << " runs, each refitted by BOBYQA"
-         << " from the optimum (at most " << budget << " evaluations";
+         << (options.start_spread > 0 ? " from a start within +- " : " from the optimum");
+    if (options.start_spread > 0) note << options.start_spread << " of each range of the optimum";
+    note << " (at most " << budget << " evaluations";
     if (options.resolution > 0)
       note << ", on a lattice of " << options.resolution << " of each range";
     note << ")";

@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "calibration/least_squares.hpp"
+#include "common/error.hpp"
 
 namespace talus::calibration {
 namespace {
@@ -65,7 +66,16 @@ class Pipeline {
                       const GroundTable* reference) const {
     // Every scoring runs the scene as the objective does (its contact-solve tolerance).
     std::vector<ensemble::Block> blocks;
-    if (objective.parameters().has_shapes()) blocks = objective.BlocksOf(u);
+    if (objective.parameters().has_shapes()) {
+      try {
+        blocks = objective.BlocksOf(u);
+      } catch (const InputError&) {
+        // Shapes that cannot be made (an infeasible start): nothing to score there.
+        HeldOutScores none;
+        for (const ensemble::ReleaseRun& r : runs.release.runs) none.runs.push_back(r.id);
+        return none;
+      }
+    }
     return ScoreRuns(objective_.scene(), runs, objective.GroundOf(u), reference,
                      objective_.options().threads, objective_.needs_episodes(),
                      objective_.options().run_ensemble,

@@ -212,8 +212,14 @@ Evaluation Objective::Run(const Eigen::VectorXd& u, const ensemble::ReleaseSpec&
   options.progress = options_.progress;
   fieldobs::AddRecordersFor(observations_, scene_.terrain, runs, options);
   fieldobs::EnsembleSamples samples(runs);
-  const ensemble::EnsembleReport report =
-      RunWith(options_.run_ensemble, scene, runs, options, &samples);
+  ensemble::EnsembleReport report;
+  try {
+    report = RunWith(options_.run_ensemble, scene, runs, options, &samples);
+  } catch (const InputError& error) {
+    // A rock whose own shape (shape_per_rock) the vector's knobs cannot make.
+    if (!parameters_.has_shapes()) throw;
+    return infeasible(error.what(), 0);
+  }
   e.rocks = report.rocks;
   e.failed_rocks = report.count(EndReason::kFailed);
   fieldobs::ValidationOptions validation;

@@ -274,6 +274,9 @@ void LoadBootstrap(const Section& s, CalibrationFile& out) {
         "must be in [0, 0.25] (a fraction of each range; 0: the points BOBYQA asks for)");
   b.level = s.Checked(
       "bootstrap_level", b.level, [](double v) { return v > 0 && v < 1; }, "must be in (0, 1)");
+  b.start_spread = s.Checked(
+      "bootstrap_start_spread", b.start_spread, [](double v) { return v >= 0 && v <= 0.5; },
+      "must be in [0, 0.5] (a fraction of each range; 0: every refit starts at the optimum)");
   b.seed = out.options.optimizer.seed;
   if (b.resamples > 0 && !out.options.uncertainty)
     s.Fail("bootstrap", "needs enabled = true (it is estimated with the covariance)");
@@ -298,7 +301,8 @@ void LoadUncertainty(const Context& context, const toml::table* table, Calibrati
   const Section s(
       context, table, "uncertainty",
       {"enabled", "fd_step", "min_reciprocal_condition_number", "weak_fraction", "bootstrap",
-       "bootstrap_evaluations", "bootstrap_resolution", "bootstrap_level", "seeds"});
+       "bootstrap_evaluations", "bootstrap_resolution", "bootstrap_level",
+       "bootstrap_start_spread", "seeds"});
   calibration::UncertaintyOptions& o = out.options.uncertainty_options;
   out.options.uncertainty = s.Bool("enabled", true);
   o.fd_step = s.Checked(

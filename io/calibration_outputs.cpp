@@ -10,6 +10,7 @@
 
 #include "common/format.hpp"
 #include "io/rocks_csv.hpp"
+#include "pointclouds/rock_source.hpp"
 #include "io/validation_outputs.hpp"
 
 namespace talus::io {
@@ -99,11 +100,12 @@ json BootstrapJson(const calibration::Bootstrap& b) {
   for (bool i : b.identified) identified.push_back(i);
   return {{"method",
            "bootstrap over runs: resamples of the runs with replacement, each refitted by "
-           "BOBYQA from the optimum"},
+           "BOBYQA from a start within start_spread_unit of the optimum"},
           {"resamples", b.resamples},
           {"runs", b.groups},
           {"seed", b.seed},
           {"resolution_unit", b.resolution},
+          {"start_spread_unit", b.start_spread},
           {"level", b.level},
           {"names", b.names},
           {"identified", identified},
@@ -386,6 +388,8 @@ std::string GroundTableToml(const CalibrationFile& file, const Objective& object
   std::string out = "# Ground table fitted by talus calibrate " + file.path +
                     " (docs/calibration.md).\n# Paste into a scene file, or append to one. A value "
                     "with a comment is not supported by the observations.\n";
+  if (objective.parameters().has_shapes())
+    out += "# Fitted jointly with block shapes: use it with the blocks of shape_table.toml.\n";
   for (int k : Touched(objective, fitted)) {
     const GroundCategory& c = fitted.category(k);
     out += "\n[ground." + TomlKey(c.name) + "]\ncode = " + std::to_string(c.code) + "\n";
@@ -408,32 +412,36 @@ std::string ShapeTableToml(const CalibrationFile& file, const Objective& objecti
   std::string out =
       "# Block shapes fitted by talus calibrate " + file.path +
       " (docs/calibration.md), jointly with\n# the ground table in ground_table.toml: use the "
-      "two together. Each block's fitted knobs replace\n# its own in the scene's [blocks] (a "
-      "block of the blocks file: move it to a [blocks.<id>]\n# table). A value with a comment "
-      "is not supported by the observations.\n";
+      "two together. Each [blocks.<id>] table is the\n# whole block with its fitted knobs: it "
+      "replaces the block in the scene's [blocks] (a block of\n# the blocks file: drop its row). "
+      "A value with a comment is not supported by the observations.\n";
   const auto& specs = objective.parameters().specs();
-  for (const ensemble::Block& block : run.fitted_blocks) {
-    std::string lines;
-    bool size = false;
-    for (const calibration::ParameterSpec& spec : specs) {
-      if (!spec.IsShape() || spec.block != block.id) continue;
-      if (spec.shape_field == calibration::ShapeField::kRoughness) {
-        lines += "roughness = " + G(block.knobs.roughness) +
-                 FittedValueNote(objective, run, spec.Name()) + "\n";
-      } else if (!size) {
-        size = true;
-        lines += "size_m = [" + G(block.knobs.size_m.x()) + ", " + G(block.knobs.size_m.y()) +
-                 ", " + G(block.knobs.size_m.z()) + "]\n";
-      }
+  const std::vector<pointclouds::RockSpec>& block_specs = file.event.scene.block_specs;
+  for (std::size_t b = 0; b < run.fitted_blocks.size() && b < block_specs.size(); ++b) {
+    const ensemble::Block& block = run.fitted_blocks[b];
+    const pointclouds::RockSpec& spec = block_specs[b];
+    std::string notes;  // of the fitted knobs
+    bool fitted = false;
+    for (const calibration::ParameterSpec& p : specs) {
+      if (!p.IsShape() || p.block != block.id) continue;
+      fitted = true;
+      const std::string note = FittedValueNote(objective, run, p.Name());
+      if (!note.empty()) notes += "# " + p.FieldName() + ":" + note.substr(3) + "\n";
     }
-    for (const calibration::ParameterSpec& spec : specs)
-      if (spec.IsShape() && spec.block == block.id &&
-          spec.shape_field != calibration::ShapeField::kRoughness) {
-        const std::string note = FittedValueNote(objective, run, spec.Name());
-        if (!note.empty()) lines += "# " + spec.FieldName() + ":" + note.substr(3) + "\n";
-      }
-    if (lines.empty()) continue;
-    out += "\n[blocks." + TomlKey(block.id) + "]\n" + lines;
+    if (!fitted) continue;
+    out += "\n[blocks." + TomlKey(block.id) + "]\n" + notes;
+    out += "shape = \"" + spec.builtin + "\"\n";
+    out += "size_m = [" + G(block.knobs.size_m.x()) + ", " + G(block.knobs.size_m.y()) + ", " +
+           G(block.knobs.size_m.z()) + "]\n";
+    if (spec.mass_kg)
+      out += "mass_kg = " + G(*spec.mass_kg) + "\n";
+    else
+      out += "# no mass: the density of [blocks] (" + G(spec.density_kg_m3) + " kg/m3) sets it\n";
+    if (spec.builtin == "rock") {
+      out += "roughness = " + G(block.knobs.roughness) + "\n";
+      out += "points = " + std::to_string(spec.points) + "\n";
+      out += "shape_seed = " + std::to_string(block.knobs.shape_seed) + "\n";
+    }
   }
   return out;
 }

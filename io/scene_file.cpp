@@ -303,7 +303,12 @@ SceneFile LoadScene(const std::string& path) {
       }
       ensemble::ShapeKnobs knobs = VariedKnobs(block->knobs, variation, seed);
       knobs.shape_seed = seed;
-      return block->make(knobs);
+      try {
+        return block->make(knobs);
+      } catch (const InputError& e) {
+        throw InputError("block '" + block->id + "', the shape of shape seed " +
+                         std::to_string(seed) + ": " + e.what());
+      }
     };
   }
   std::string why;

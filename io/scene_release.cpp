@@ -424,6 +424,9 @@ void LoadRelease(const Context& context, const Section& s, SceneFile& out) {
         s.Fail(key, "a run table gives each run's start velocities (columns vx_mps .. wz_radps)");
     LoadRuns(context, s, out);
   }
+  if (s.Has("ground_z_tolerance_m") && !s.Has("runs"))
+    s.Fail("ground_z_tolerance_m",
+           "compares a run table's ground_z_m with the DEM: only with runs = \"file.csv\"");
   if (s.Has("single_impacts")) {
     if (!r.releases.empty() || s.Has("runs"))
       s.Fail(

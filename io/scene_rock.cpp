@@ -201,8 +201,8 @@ ensemble::ShapeKnobs KnobsOf(const pointclouds::RockSpec& spec) {
 }
 
 // The block of `spec` with other knobs: a built-in's size, a rock's roughness and seed. The
-// mass, when given, stays, so the density follows the volume; a density or volume outside the
-// scene's bounds is an InputError.
+// mass, when given, stays, so the density follows the volume; a volume outside the scene's
+// bounds is an InputError, as when the block is loaded.
 ensemble::ShapeMaker MakerOf(const pointclouds::RockSpec& spec) {
   return [spec](const ensemble::ShapeKnobs& knobs) {
     pointclouds::RockSpec s = spec;
@@ -215,10 +215,6 @@ ensemble::ShapeMaker MakerOf(const pointclouds::RockSpec& spec) {
     if (std::string bad = OutsideBounds(shape.volume_m3, kMinVolume_m3, kMaxVolume_m3, "m3");
         !bad.empty())
       throw InputError("the volume " + bad);
-    if (std::string bad = OutsideBounds(shape.mass_kg / shape.volume_m3, kMinDensity_kg_m3,
-                                        kMaxDensity_kg_m3, "kg/m3");
-        !bad.empty())
-      throw InputError("the density (mass / volume) " + bad);
     return shape;
   };
 }

@@ -9,6 +9,7 @@
 
 #include <Eigen/Geometry>
 #include <cstdint>
+#include <mutex>
 #include <queue>
 #include <sstream>
 #include <unordered_map>
@@ -18,6 +19,31 @@
 
 namespace talus::pointclouds {
 namespace {
+
+// PCL's verbosity is one global: silenced while any thread computes a hull (rocks get their own
+// shapes in worker threads), and restored by the last one out, so that concurrent hulls cannot
+// leave it silenced, or restore it while another still runs.
+class QuietHullScope {
+ public:
+  QuietHullScope() {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    if (depth_++ == 0) {
+      previous_ = pcl::console::getVerbosityLevel();
+      pcl::console::setVerbosityLevel(pcl::console::L_ALWAYS);
+    }
+  }
+  ~QuietHullScope() {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    if (--depth_ == 0) pcl::console::setVerbosityLevel(previous_);
+  }
+  QuietHullScope(const QuietHullScope&) = delete;
+  QuietHullScope& operator=(const QuietHullScope&) = delete;
+
+ private:
+  static inline std::mutex mutex_;
+  static inline int depth_ = 0;
+  static inline pcl::console::VERBOSITY_LEVEL previous_ = pcl::console::L_INFO;
+};
 
 template <typename Distance>
 std::size_t Farthest(const std::vector<Eigen::Vector3d>& points, Distance distance, double* best) {
@@ -167,11 +193,9 @@ Polyhedron ComputeConvexHull(const std::vector<Eigen::Vector3d>& points_m,
   std::vector<pcl::Vertices> polygons;
   pcl::PointIndices hull_indices;
   {
-    const auto previous = pcl::console::getVerbosityLevel();
-    pcl::console::setVerbosityLevel(pcl::console::L_ALWAYS);
+    const QuietHullScope quiet;
     qhull.reconstruct(hull_points, polygons);
     qhull.getHullPointIndices(hull_indices);
-    pcl::console::setVerbosityLevel(previous);
   }
   if (polygons.empty() || hull_indices.indices.size() != hull_points.size())
     throw InputError(source + ": qhull could not compute the convex hull of " +

@@ -288,7 +288,13 @@ PointCloud ReadPclPoints(const std::string& path, bool pcd) {
   const std::string problem = HeaderProblem(path, pcd);
   if (!problem.empty())
     throw InputError(path + ": not a readable " + format + " file (" + problem + ")");
-  const auto load = PclFileReader();
+  decltype(&TalusLoadPclFile) load = nullptr;
+  try {
+    load = PclFileReader();
+  } catch (const std::runtime_error& e) {
+    throw std::runtime_error(path + ": " + e.what() + " (the module " TALUS_PCL_FILES_MODULE
+                             " of the build is needed to read PCD and PLY files)");
+  }
   pcl::PCLPointCloud2 blob;
   int status = -1;
   try {

@@ -301,17 +301,19 @@ enabled = false
   EXPECT_EQ(ground.find("roughness"), std::string::npos) << ground;
   const std::string shapes = Slurp(dir / "out" / "shape_table.toml");
   const double roughness = json["parameters"][1]["final"].get<double>();
-  EXPECT_NE(shapes.find("\n[blocks.round]\nroughness = "), std::string::npos) << shapes;
+  EXPECT_NE(shapes.find("\n[blocks.round]\nshape = \"rock\"\nsize_m = [0.4, 0.4, 0.3]\n"),
+            std::string::npos)
+      << shapes;
+  EXPECT_NE(shapes.find("\nroughness = "), std::string::npos) << shapes;
   EXPECT_EQ(shapes.find("[blocks.slab]"), std::string::npos) << shapes;
-  // The fitted scene: the ground table, and the block's fitted roughness in its own table.
-  Write(dir / "fitted_scene.toml",
-        scene + ground + R"([blocks]
-shape = "rock"
+  EXPECT_NE(ground.find("Fitted jointly with block shapes"), std::string::npos) << ground;
+  // The fitted scene: the ground table, the other block as it was, and the fitted block's whole
+  // table as written.
+  Write(dir / "fitted_scene.toml", scene + ground + R"([blocks]
 [blocks.slab]
 size_m = [0.5, 0.4, 0.2]
 shape = "box"
-)" + shapes.substr(shapes.find("[blocks.round]")) +
-            "size_m = [0.4, 0.4, 0.3]\n");
+)" + shapes.substr(shapes.find("[blocks.round]")));
   ASSERT_EQ(RunCommand(std::string(TALUS_BINARY) + " simulate " +
                            (dir / "fitted_scene.toml").string() + " --out " +
                            (dir / "sim").string() + " --rocks 2",

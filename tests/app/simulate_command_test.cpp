@@ -354,6 +354,17 @@ TEST(SimulateCommand, SelfCheckIsPrintedAndWrittenToTheSummary) {
             0)
       << log;
   EXPECT_EQ(nlohmann::json::parse(Slurp(dir / "given" / "summary.json"))["self_check"]["rocks"], 4);
+  ASSERT_EQ(RunCommand(std::string(TALUS_BINARY) + " simulate " + (dir / "asking.toml").string() +
+                           " --out " + (dir / "off").string() + " --rocks 2 --self-check 0",
+                       &log),
+            0)
+      << log;
+  EXPECT_FALSE(nlohmann::json::parse(Slurp(dir / "off" / "summary.json")).contains("self_check"));
+  EXPECT_EQ(RunCommand(std::string(TALUS_BINARY) + " simulate " + (dir / "asking.toml").string() +
+                           " --out " + (dir / "bad").string() + " --self-check 1",
+                       &log),
+            2)
+      << log;
   EXPECT_EQ(RunCommand(std::string(TALUS_BINARY) + " simulate " + (dir / "asking.toml").string() +
                            " --out " + (dir / "few").string() + " --rocks 1",
                        &log),

@@ -57,6 +57,11 @@ TEST(BootstrapOptions, DefaultsAreValidAndAbsurdValuesAreRefusedWithTheKey) {
   o.level = 1;
   EXPECT_FALSE(o.IsValid(&why));
   EXPECT_NE(why.find("bootstrap_level"), std::string::npos) << why;
+  o.level = 0.95;
+  o.start_spread = 0.6;
+  EXPECT_FALSE(o.IsValid(&why));
+  EXPECT_NE(why.find("bootstrap_start_spread = 0.6 must be in [0, 0.5]"), std::string::npos)
+      << why;
 }
 
 // The refits run one after the other and every evaluation is bit-identical for any thread count,
@@ -82,8 +87,13 @@ TEST(Bootstrap, IsBitIdenticalForAnyThreadCountAndWhateverIsKnown) {
   EXPECT_EQ(known.evaluations, fresh.evaluations - 1);
   EXPECT_EQ(known.refits, fresh.refits);
   EXPECT_EQ(known.standard_error, fresh.standard_error);
-  EXPECT_GT(fresh.cached, 0);  // BOBYQA's first points are the same for every resample
+  EXPECT_GT(fresh.cached, 0);  // refits share lattice points
   EXPECT_GT(fresh.standard_error[0], 0);
+  // The refits' starts are seeded: the same again, and others than from the optimum.
+  EXPECT_EQ(BootstrapOverRuns(one, u, options).refits, fresh.refits);
+  BootstrapOptions at_optimum = options;
+  at_optimum.start_spread = 0;
+  EXPECT_NE(BootstrapOverRuns(one, u, at_optimum).refits, fresh.refits);
 }
 
 // The synthetic run-outs of optimizer_test.cpp (24 runs x 5 rocks, mu_min true 0.50) under the
@@ -94,12 +104,12 @@ TEST(Bootstrap, IsBitIdenticalForAnyThreadCountAndWhateverIsKnown) {
 // factor 2 of the data's (testing::MeasuredDataError, an independent estimate from the run-outs'
 // spread and sensitivity), and its 95 % percentile interval must cover the truth. Measured:
 // fitted 0.581 in 12 evaluations; data's standard error 0.049 (within-run sd 1.49 m, d mean /
-// d mu_min -6.8 m); bootstrap 0.035 from 21 evaluations (635 answered from the cache), interval
-// [0.489, 0.581]; sandwich 0.020. With 3 rocks per run instead of 5 the fit stopped at 0.506 in a
+// d mu_min -6.8 m); bootstrap 0.037 from 35 evaluations (663 answered from the cache), interval
+// [0.477, 0.613] (refits from the optimum itself: 0.035, [0.489, 0.581]); sandwich 0.020. With 3 rocks per run instead of 5 the fit stopped at 0.506 in a
 // dip of the rough objective and the bootstrap stated 0.010 against the data's 0.028: its refits
 // stay in the dip they start from (docs/calibration.md, "Limits"). Seed refits after the
-// bootstrap (S = 5): measured, seeds' sd 0.014, combined standard error 0.040, interval
-// [0.482, 0.618].
+// bootstrap (S = 5): measured, seeds' sd 0.014, combined standard error 0.041, interval
+// [0.471, 0.630].
 TEST(Bootstrap, StatesTheDataErrorWhereTheSandwichUnderstatesIt) {
   constexpr double kTruth = 0.5;
   const testing::SyntheticRunouts p(24, 5, kTruth, 0.5, ViscousReading::kContactFriction);

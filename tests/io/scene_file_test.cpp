@@ -1277,13 +1277,19 @@ TEST(LoadScene, ShapeVariationPerRockKeepsTheMassAndBoundsTheAxes) {
       EXPECT_LE(std::abs(std::log(k.size_m[i] / size[i])), 4 * 0.2 / 3 + 1e-12);
       spread = std::max(spread, std::abs(std::log(k.size_m[i] / size[i])));
     }
+    // The rock's own shape is the block's made from these knobs with the rock's seed.
     const RockShape rock = s.release.shape_per_rock(&block, seed);
     EXPECT_NEAR(rock.mass_kg, 69, 1e-9);
-    const ensemble::ShapeKnobs again =
-        VariedKnobs(block.knobs, s.shape_variation, seed);
-    EXPECT_EQ(again.size_m, k.size_m);
+    ensemble::ShapeKnobs seeded = k;
+    seeded.shape_seed = seed;
+    const RockShape made = block.make(seeded);
+    ASSERT_EQ(rock.vertices_m.size(), made.vertices_m.size());
+    for (std::size_t v = 0; v < made.vertices_m.size(); ++v)
+      EXPECT_EQ(rock.vertices_m[v], made.vertices_m[v]);
   }
   EXPECT_GT(spread, 0.1);  // the draws do vary
+  EXPECT_NE(VariedKnobs(block.knobs, s.shape_variation, 1).size_m,
+            VariedKnobs(block.knobs, s.shape_variation, 2).size_m);
 }
 
 // A run table's surveyed ground height (ground_z_m) is compared with the DEM's at each start: the
@@ -1314,6 +1320,10 @@ TEST(LoadScene, StartsOffTheSurveyedGroundAreListedAndWarned) {
   testing::WriteText(dir / "runs.csv", "trajectory_id,x_m,y_m,block_id\nv1,5,0,1\n");
   EXPECT_HAS(ErrorOf(Replace(kRunScene, "rocks = 3", "rocks = 3\nground_z_tolerance_m = 2"), dir),
              "release.ground_z_tolerance_m: the run table has no ground_z_m column to compare");
+  EXPECT_HAS(ErrorOf("[terrain]\nplane = {}\n[rock]\nshape = { box = [1, 1, 1] }\n[release]\n"
+                     "points = [[10, 0]]\nground_z_tolerance_m = 2\n",
+                     dir),
+             "release.ground_z_tolerance_m: compares a run table's ground_z_m with the DEM");
 }
 
 // Reliability item 4: inputs that used to be accepted without a word and give wrong results.
