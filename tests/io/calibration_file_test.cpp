@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <string>
 
 #include "common/error.hpp"
@@ -13,6 +14,24 @@
 
 namespace talus::io {
 namespace {
+
+// In `dir` (with scene.toml and its four runs r1 .. r4): the observed run-outs, the event, and a
+// calibration file freeing medium_soft's mu_min, ending with `tail`; returns the calibration file.
+std::string WriteEventAndCalibration(const std::filesystem::path& dir, const std::string& tail) {
+  testing::WriteText(dir / "observed.csv",
+                     "trajectory_id,observed_runout_m\nr1,17\nr2,19\nr3,14\nr4,16\n");
+  testing::WriteText(dir / "event.toml",
+                     "scene = \"scene.toml\"\n[[observations]]\nkind = \"runout\"\n"
+                     "file = \"observed.csv\"\n");
+  testing::WriteText(dir / "cal.toml", R"(event = "event.toml"
+[[parameters]]
+category = "medium_soft"
+field = "mu_min"
+lower = 0.1
+upper = 0.9
+)" + tail);
+  return (dir / "cal.toml").string();
+}
 
 // A plane scene whose [solver] table is `solver`, four runs with observed run-outs, and a
 // calibration file of that event ending with `calibration_tail`; returns the calibration file.
@@ -32,19 +51,7 @@ max_time_s = 3
 )" + solver);
   testing::WriteText(dir / "runs.csv",
                      "trajectory_id,x_m,y_m,height_m\nr1,3,0,1\nr2,3,2,1\nr3,4,-2,1\nr4,4,3,1\n");
-  testing::WriteText(dir / "observed.csv",
-                     "trajectory_id,observed_runout_m\nr1,17\nr2,19\nr3,14\nr4,16\n");
-  testing::WriteText(dir / "event.toml",
-                     "scene = \"scene.toml\"\n[[observations]]\nkind = \"runout\"\n"
-                     "file = \"observed.csv\"\n");
-  testing::WriteText(dir / "cal.toml", R"(event = "event.toml"
-[[parameters]]
-category = "medium_soft"
-field = "mu_min"
-lower = 0.1
-upper = 0.9
-)" + calibration_tail);
-  return (dir / "cal.toml").string();
+  return WriteEventAndCalibration(dir, calibration_tail);
 }
 
 std::string ErrorOf(const std::string& path) {
@@ -140,20 +147,7 @@ max_time_s = 3
   testing::WriteText(dir / "runs.csv",
                      "trajectory_id,x_m,y_m,height_m,block_id\nr1,3,0,1,round\nr2,3,2,1,slab\n"
                      "r3,4,-2,1,round\nr4,4,3,1,slab\n");
-  testing::WriteText(dir / "observed.csv",
-                     "trajectory_id,observed_runout_m\nr1,17\nr2,19\nr3,14\nr4,16\n");
-  testing::WriteText(dir / "event.toml",
-                     "scene = \"scene.toml\"\n[[observations]]\nkind = \"runout\"\n"
-                     "file = \"observed.csv\"\n");
-  testing::WriteText(dir / "cal.toml", R"(event = "event.toml"
-[[parameters]]
-category = "medium_soft"
-field = "mu_min"
-lower = 0.1
-upper = 0.9
-[[parameters]]
-)" + parameter);
-  return (dir / "cal.toml").string();
+  return WriteEventAndCalibration(dir, "[[parameters]]\n" + parameter);
 }
 
 TEST(LoadCalibration, ShapeParametersNameABlockAndItsKnob) {
