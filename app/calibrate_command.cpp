@@ -53,31 +53,6 @@ const char* kCheckpoint = "checkpoint.json";
 // Seconds between two writes of the checkpoint during an optimisation.
 constexpr double kCheckpointEvery_s = 10;
 
-// The held-out runs of --holdout: K runs drawn by the optimiser's seed, or the listed ids.
-std::vector<std::string> HoldoutRuns(const std::string& text, const ensemble::ReleaseSpec& release,
-                                     std::uint64_t seed) {
-  if (text.empty()) return {};
-  if (release.runs.empty())
-    throw InputError("--holdout: the event's scene releases no runs ([release] runs)");
-  if (text.find_first_not_of("0123456789") == std::string::npos)
-    return calibration::PickRuns(release, std::stoi(text), seed);
-  std::vector<std::string> ids;
-  std::stringstream list(text);
-  for (std::string id; std::getline(list, id, ',');) {
-    id.erase(0, id.find_first_not_of(' '));
-    id.erase(id.find_last_not_of(' ') + 1);
-    bool known = false;
-    for (const ensemble::ReleaseRun& r : release.runs) known = known || r.id == id;
-    if (!known) throw InputError("--holdout: '" + id + "' is not a run of the event's scene");
-    if (std::find(ids.begin(), ids.end(), id) != ids.end())
-      throw InputError("--holdout: run '" + id + "' is listed twice");
-    ids.push_back(id);
-  }
-  if (ids.size() >= release.runs.size())
-    throw InputError("--holdout: every run is held out; nothing is left to fit");
-  return calibration::OtherRuns(release, calibration::OtherRuns(release, ids));  // release order
-}
-
 std::string Join(const std::vector<std::string>& items) {
   std::string out;
   for (const std::string& s : items) out += (out.empty() ? "" : ", ") + s;
@@ -143,20 +118,10 @@ int Load(const CalibrateArgs& args, const Processes& processes, Loaded* loaded,
     const io::EventFile& event = file.event;
     if (processes.root()) PrintSceneWarnings(event.scene, "calibrate");
     if (processes.root()) PrintNotScored(event.not_scored);
-    calibration::HeldOutChecks checks;
-    checks.seed = file.options.optimizer.seed;
-    checks.holdout = HoldoutRuns(args.holdout, event.scene.release, checks.seed);
-    if (args.folds > 0 && event.scene.release.runs.empty())
-      throw InputError("--folds: the event's scene releases no runs ([release] runs)");
-    checks.folds = args.folds;
-    if (event.reference == "table1")
-      checks.reference = io::ReferenceGround(event.scene.scene.ground, nullptr);
-    loaded->problem = std::make_unique<calibration::CalibrationProblem>(
-        event.scene.scene, event.scene.release, event.observations, file.parameters, objective,
-        checks);
+    loaded->problem = io::MakeCalibrationProblem(file, args.holdout, args.folds, objective);
     io::CalibrationCheckpoint& checkpoint = loaded->checkpoint;
     checkpoint.path_hash = file.path_hash;
-    checkpoint.holdout = checks.holdout;
+    checkpoint.holdout = loaded->problem->holdout();
     checkpoint.folds = args.folds;
     const std::string& path = loaded->checkpoint_path;
     const bool exists = fs::exists(path);

@@ -22,6 +22,7 @@
 #include "fieldobs/samples.hpp"
 #include "fieldobs/validation.hpp"
 #include "io/event_file.hpp"
+#include "io/validate_event.hpp"
 #include "io/validation_outputs.hpp"
 #include "talus/version.hpp"
 
@@ -60,44 +61,14 @@ int RunValidate(const ValidateArgs& args) {
     // Every output is staged and moved into --out only when all are complete.
     staging.emplace(args.out);
     const auto out = [&](const std::string& name) { return staging->path(name); };
-    ensemble::EnsembleOptions options;
+    io::EventValidationOptions options;
     options.threads = args.ensemble.threads;
-    options.episodes = event.needs_episodes;
     options.progress = [](long, long) { ThrowIfInterrupted(); };
-    // Trajectory segments and zones: what each rock gives for them.
-    fieldobs::AddRecordersFor(event.observations, event.scene.scene.terrain, release, options);
-    fieldobs::EnsembleSamples simulated(release);
-    io::ValidationRun run;
-    run.ensemble = ensemble::RunEnsemble(event.scene.scene, release, options, &simulated);
-    std::printf("Simulated: %s\n", run.ensemble.BriefReport().c_str());
-
-    // The reference parameter set: the same rocks again, when it differs from the scene's.
-    std::optional<fieldobs::EnsembleSamples> reference;
-    const fieldobs::EnsembleSamples* reference_samples = nullptr;
-    if (event.reference == "table1") {
-      bool differs = false;
-      GroundTable table = io::ReferenceGround(event.scene.scene.ground, &differs);
-      reference_samples = &simulated;
-      if (differs) {
-        Scene scene = event.scene.scene;
-        scene.ground = std::move(table);
-        reference.emplace(release);
-        const ensemble::EnsembleReport r =
-            ensemble::RunEnsemble(scene, release, options, &*reference);
-        std::printf("Reference (Table 1): %s\n", r.BriefReport().c_str());
-        reference_samples = &*reference;
-        run.reference_run = true;
-      }
-    }
-    fieldobs::ValidationOptions validation;
-    validation.seed = release.seed;
-    const fieldobs::ValidationReport report =
-        fieldobs::Validate(event.observations, simulated, reference_samples, validation);
-
-    run.version = kVersion;
-    run.rocks_per_run = release.rocks_per_release;
-    run.seed = release.seed;
-    run.threads = run.ensemble.threads;
+    options.say = [](const std::string& line) { std::printf("%s\n", line.c_str()); };
+    const io::EventValidation validation = io::ValidateEvent(event, options);
+    const fieldobs::ValidationReport& report = validation.report;
+    const fieldobs::EnsembleSamples& simulated = *validation.simulated;
+    io::ValidationRun run = validation.run;
     run.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     std::vector<std::string> outputs = {"observations.csv", "observed_vs_simulated.svg", "pit.svg"};
     io::WriteTextFile(out("observations.csv"), io::ObservationsCsv(report));

@@ -2,12 +2,14 @@
 
 #include <toml++/toml.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 
 #include "calibration/designs.hpp"
+#include "calibration/holdout.hpp"
 #include "common/closest_name.hpp"
 #include "common/error.hpp"
 #include "io/toml_section.hpp"
@@ -389,6 +391,46 @@ CalibrationFile LoadCalibration(const std::string& path) {
             << o.start_design << ' ' << o.seed << ' ' << o.fd_step;
   out.path_hash = Fnv1a(path_text.str());
   return out;
+}
+
+std::vector<std::string> HoldoutRuns(const std::string& holdout,
+                                     const ensemble::ReleaseSpec& release, std::uint64_t seed) {
+  if (holdout.empty()) return {};
+  if (release.runs.empty())
+    throw InputError("--holdout: the event's scene releases no runs ([release] runs)");
+  if (holdout.find_first_not_of("0123456789") == std::string::npos)
+    return calibration::PickRuns(release, std::stoi(holdout), seed);
+  std::vector<std::string> ids;
+  std::stringstream list(holdout);
+  for (std::string id; std::getline(list, id, ',');) {
+    id.erase(0, id.find_first_not_of(' '));
+    id.erase(id.find_last_not_of(' ') + 1);
+    bool known = false;
+    for (const ensemble::ReleaseRun& r : release.runs) known = known || r.id == id;
+    if (!known) throw InputError("--holdout: '" + id + "' is not a run of the event's scene");
+    if (std::find(ids.begin(), ids.end(), id) != ids.end())
+      throw InputError("--holdout: run '" + id + "' is listed twice");
+    ids.push_back(id);
+  }
+  if (ids.size() >= release.runs.size())
+    throw InputError("--holdout: every run is held out; nothing is left to fit");
+  return calibration::OtherRuns(release, calibration::OtherRuns(release, ids));  // release order
+}
+
+std::unique_ptr<calibration::CalibrationProblem> MakeCalibrationProblem(
+    const CalibrationFile& file, const std::string& holdout, int folds,
+    const calibration::ObjectiveOptions& objective) {
+  const EventFile& event = file.event;
+  calibration::HeldOutChecks checks;
+  checks.seed = file.options.optimizer.seed;
+  checks.holdout = HoldoutRuns(holdout, event.scene.release, checks.seed);
+  if (folds > 0 && event.scene.release.runs.empty())
+    throw InputError("--folds: the event's scene releases no runs ([release] runs)");
+  checks.folds = folds;
+  if (event.reference == "table1") checks.reference = ReferenceGround(event.scene.scene.ground, nullptr);
+  return std::make_unique<calibration::CalibrationProblem>(event.scene.scene, event.scene.release,
+                                                           event.observations, file.parameters,
+                                                           objective, checks);
 }
 
 }  // namespace talus::io

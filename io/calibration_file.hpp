@@ -5,6 +5,7 @@
 // its budget, and the roughness measurement.
 // Loading validates everything before any rock runs; errors are "<file>:<line>: <key>: <reason>".
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -38,5 +39,21 @@ struct CalibrationFile {
 
 // Throws InputError "<file>:<line>: <key>: <reason>".
 CalibrationFile LoadCalibration(const std::string& path);
+
+// The runs `holdout` holds out of the fit (talus calibrate --holdout): "" none, a number K (K runs
+// drawn with `seed`), or a comma-separated list of run ids (returned in release order). Throws
+// InputError "--holdout: <reason>".
+std::vector<std::string> HoldoutRuns(const std::string& holdout,
+                                     const ensemble::ReleaseSpec& release, std::uint64_t seed);
+
+// The calibration problem of a loaded file as talus calibrate poses it: the event's scene, runs
+// and observations, the file's parameters, `objective` (the file's objective options with the
+// caller's threads, progress and runner), the runs `holdout` holds out (HoldoutRuns, drawn with the
+// optimiser's seed), `folds` (0: no cross-validation) and the reference table of the event. Throws
+// InputError for --holdout and --folds that do not fit the event, and what CalibrationProblem
+// throws.
+std::unique_ptr<calibration::CalibrationProblem> MakeCalibrationProblem(
+    const CalibrationFile& file, const std::string& holdout, int folds,
+    const calibration::ObjectiveOptions& objective);
 
 }  // namespace talus::io

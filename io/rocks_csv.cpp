@@ -26,29 +26,51 @@ RocksCsvWriter::RocksCsvWriter(const std::string& path, const Scene& scene,
                                const ensemble::ReleaseSpec& release)
     : file_(path, Header()), scene_(scene), release_(release) {}
 
-void RocksCsvWriter::Write(const ensemble::RockOutcome& rock) {
+RockRow RockRowOf(const ensemble::RockOutcome& rock, const Scene& scene,
+                  const ensemble::ReleaseSpec& release) {
   const RockResult& r = rock.result;
   const Eigen::Vector3d& end = r.final_state.position_m;
-  const ensemble::ReleaseRun* run =
-      release_.runs.empty() ? nullptr : &release_.runs[static_cast<std::size_t>(rock.release)];
-  const std::string block =
-      run && run->block >= 0 ? release_.blocks[static_cast<std::size_t>(run->block)].id : "";
   const Eigen::Vector3d& start = rock.start.position_m;
-  // Travel angle (Fahrboeschung) of the centre of mass, release to end.
-  const double travel_angle_deg =
-      std::atan2(start.z() - end.z(), r.runout_m) * 180.0 / std::numbers::pi;
-  const std::string& end_ground =
-      scene_.ground.category(scene_.terrain.GroundAt(end.x(), end.y())).name;
+  const ensemble::ReleaseRun* run =
+      release.runs.empty() ? nullptr : &release.runs[static_cast<std::size_t>(rock.release)];
+  RockRow row;
+  row.rock = rock.rock;
+  row.release = rock.release;
+  row.run = release.ReleaseName(rock.release);
+  row.seed = release.seed;
+  row.end = ToString(r.end);
+  row.x_end = end.x();
+  row.y_end = end.y();
+  row.z_end = end.z();
+  row.runout_m = r.runout_m;
+  row.path_length_m = r.path_length_m;
+  row.travel_time_s = r.travel_time_s;
+  row.max_speed_m_s = r.max_speed_m_s;
+  row.max_kinetic_energy_j = r.max_kinetic_energy_j;
+  row.max_jump_height_m = r.max_jump_height_m;
+  row.max_angular_speed_rad_s = r.max_angular_speed_rad_s;
+  row.max_scar_m = r.max_scar_m;
+  if (run && run->block >= 0) row.block = release.blocks[static_cast<std::size_t>(run->block)].id;
+  row.mass_kg = rock.shape ? rock.shape->mass_kg : 0.0;
+  row.x_start = start.x();
+  row.y_start = start.y();
+  row.z_start = start.z();
+  row.travel_angle_deg = std::atan2(start.z() - end.z(), r.runout_m) * 180.0 / std::numbers::pi;
+  row.end_ground = scene.ground.category(scene.terrain.GroundAt(end.x(), end.y())).name;
+  return row;
+}
+
+void RocksCsvWriter::Write(const ensemble::RockOutcome& rock) {
+  const RockRow r = RockRowOf(rock, scene_, release_);
   std::fprintf(
       file_.get(),
       "%ld,%d,%s,%llu,%s,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,"
       "%s,%.10g,%.10g,%.10g,%.10g,%.10g,%s\n",
-      rock.rock, rock.release, CsvField(release_.ReleaseName(rock.release)).c_str(),
-      static_cast<unsigned long long>(release_.seed), ToString(r.end), end.x(), end.y(), end.z(),
-      r.runout_m, r.path_length_m, r.travel_time_s, r.max_speed_m_s, r.max_kinetic_energy_j,
-      r.max_jump_height_m, r.max_angular_speed_rad_s, r.max_scar_m, CsvField(block).c_str(),
-      rock.shape ? rock.shape->mass_kg : 0.0, start.x(), start.y(), start.z(), travel_angle_deg,
-      CsvField(end_ground).c_str());
+      r.rock, r.release, CsvField(r.run).c_str(), static_cast<unsigned long long>(r.seed), r.end,
+      r.x_end, r.y_end, r.z_end, r.runout_m, r.path_length_m, r.travel_time_s, r.max_speed_m_s,
+      r.max_kinetic_energy_j, r.max_jump_height_m, r.max_angular_speed_rad_s, r.max_scar_m,
+      CsvField(r.block).c_str(), r.mass_kg, r.x_start, r.y_start, r.z_start, r.travel_angle_deg,
+      CsvField(r.end_ground).c_str());
 }
 
 void RocksCsvWriter::Commit() { file_.Commit(); }

@@ -84,8 +84,12 @@ std::string Hex(std::uint64_t v) {
   return buffer;
 }
 
-std::string HashFiles(const std::vector<std::string>& files) {
+std::string HashFiles(const std::vector<std::string>& files, const std::string& before) {
   std::uint64_t h = 1469598103934665603ULL;
+  for (const char c : before) {
+    h ^= static_cast<unsigned char>(c);
+    h *= 1099511628211ULL;
+  }
   for (const std::string& f : files) {
     std::ifstream in(f, std::ios::binary);
     char buffer[65536];
@@ -228,9 +232,12 @@ ensemble::RasterRequest OutputSpec::Request(const GridGeometry& grid) const {
   return r;
 }
 
-SceneFile LoadScene(const std::string& path) {
+namespace {
+
+// The scene of a parsed scene file `path` (which need not exist when `text` holds its contents).
+SceneFile LoadSceneTable(const toml::table& root, const std::string& path,
+                         const std::string* text) {
   const Context context(path);
-  const toml::table root = ParseTomlFile(path, "scene file");
   const Section top(
       context, &root, "",
       {"terrain", "ground", "rock", "blocks", "release", "evaluation_lines", "solver", "output"});
@@ -242,7 +249,7 @@ SceneFile LoadScene(const std::string& path) {
 
   SceneFile out;
   out.path = path;
-  out.inputs.push_back(path);
+  if (!text) out.inputs.push_back(path);
   LoadGround(context, SubTable(context, root, "ground"), out.scene.ground);
   scene_tables::LoadTerrain(
       context,
@@ -313,8 +320,26 @@ SceneFile LoadScene(const std::string& path) {
   }
   std::string why;
   if (!out.scene.IsValid(&why)) throw InputError(path + ": " + why);
-  out.inputs_hash = HashFiles(out.inputs);
+  // A scene given as text: its text first, then the files it read.
+  out.inputs_hash = HashFiles(out.inputs, text ? *text : std::string());
   return out;
+}
+
+}  // namespace
+
+SceneFile LoadScene(const std::string& path) {
+  return LoadSceneTable(ParseTomlFile(path, "scene file"), path, nullptr);
+}
+
+SceneFile LoadSceneText(const std::string& text, const std::string& path) {
+  toml::table root;
+  try {
+    root = toml::parse(text, path);
+  } catch (const toml::parse_error& e) {
+    throw InputError(path + ":" + std::to_string(e.source().begin.line) +
+                     ": TOML syntax error: " + std::string(e.description()));
+  }
+  return LoadSceneTable(root, path, &text);
 }
 
 }  // namespace talus::io

@@ -91,6 +91,10 @@ struct SceneFile {
 
 // Loads and validates a scene. Throws talus::InputError with "<file>:<line>: <key>: <reason>".
 SceneFile LoadScene(const std::string& path);
+// The same for a scene given as TOML text (e.g. built from values in Python): `path` names it in
+// errors and relative paths in it are resolved from its folder; it need not exist. inputs lists
+// the files the scene read; inputs_hash covers the text and those files.
+SceneFile LoadSceneText(const std::string& text, const std::string& path);
 
 // Sets the solver's accuracy knobs to `preset` as talus simulate --preset asks: the preset wins
 // over the values the scene's [solver] gives itself (a check with "accurate" must run accurately),
