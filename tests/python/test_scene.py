@@ -162,3 +162,31 @@ def test_other_python_threads_run_while_rocks_run(small_ramp):
         counter.join()
     during = sum(begin < t < end for t in ticks)
     assert during >= 10, f"{during} ticks in {end - begin:.2f} s of simulation"
+
+
+def test_ctrl_c_stops_a_run(small_ramp):
+    """SIGINT during a long ensemble raises KeyboardInterrupt promptly, as Ctrl-C in a notebook."""
+    import os
+    import signal
+    import sys
+    script = f"""
+import sys, talus
+scene = talus.Scene.load({str(small_ramp)!r})
+scene.rocks = 100000
+print("running", flush=True)
+try:
+    scene.simulate(threads=1, rasters=False)
+except KeyboardInterrupt:
+    print("interrupted", flush=True)
+    sys.exit(3)
+"""
+    child = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True,
+                             env=dict(os.environ))
+    assert child.stdout.readline().strip() == "running"
+    time.sleep(1.0)
+    child.send_signal(signal.SIGINT)
+    try:
+        out, _ = child.communicate(timeout=30)
+    finally:
+        child.kill()
+    assert child.returncode == 3 and "interrupted" in out
