@@ -407,8 +407,7 @@ calibration::EnsembleRunner RanksRunner(const MpiSession& mpi) {
 int RunCalibrateOnProcesses(const CalibrateArgs& args) {
   if (LaunchedRanks() <= 1) return RunCalibrate(args, Processes{});
 #if !TALUS_HAVE_MPI
-  const char* rank = std::getenv("OMPI_COMM_WORLD_RANK");
-  if (!rank || std::atoi(rank) == 0)
+  if (LaunchedRank() == 0)
     std::cerr << "talus calibrate: started as " << LaunchedRanks()
               << " MPI processes, but this talus was built without MPI (configure with "
                  "-DTALUS_WITH_MPI=ON, or run one process)\n";

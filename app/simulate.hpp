@@ -50,6 +50,8 @@ void PrintNotScored(const std::vector<std::string>& not_scored);
 
 // How many processes an MPI launcher (mpirun, srun) started this one among; 1 without a launcher.
 int LaunchedRanks();
+// This process's rank as the launcher states it (Open MPI, PMI, PMIx); 0 when none does.
+int LaunchedRank();
 
 // talus simulate across the ranks of an MPI run: the rocks are divided among the ranks, each
 // writes a part (io/partial.hpp) and rank 0 merges them into --out, byte for byte the outputs of

@@ -39,11 +39,16 @@ int LaunchedRanks() {
   return n > 1 ? n : 1;
 }
 
+int LaunchedRank() {
+  for (const char* name : {"OMPI_COMM_WORLD_RANK", "PMI_RANK", "PMIX_RANK"})
+    if (const char* rank = std::getenv(name)) return std::atoi(rank);
+  return 0;
+}
+
 #if !TALUS_HAVE_MPI
 
 int RunSimulateOnRanks(const SimulateArgs&) {
-  const char* rank = std::getenv("OMPI_COMM_WORLD_RANK");
-  if (!rank || std::atoi(rank) == 0)
+  if (LaunchedRank() == 0)
     std::cerr << "talus simulate: started as " << LaunchedRanks()
               << " MPI processes, but this talus was built without MPI (configure with "
                  "-DTALUS_WITH_MPI=ON, or run one process)\n";
