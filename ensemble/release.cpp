@@ -1,5 +1,7 @@
 #include "ensemble/release.hpp"
 
+#include <boost/math/distributions/normal.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -183,6 +185,8 @@ bool ReleaseSpec::IsValid(std::string* why) const {
   if (releases.empty() && runs.empty()) return Fail(why, "no release point, line, polygon or run");
   if (!releases.empty() && !runs.empty())
     return Fail(why, "release geometries and runs cannot be combined");
+  if (std::string volume_why; !volume.IsValid(&volume_why))
+    return Fail(why, "volume." + volume_why);
   for (const Block& block : blocks) {
     std::string shape_why;
     if (!block.shape) {
@@ -360,6 +364,74 @@ std::uint64_t RockShapeSeed(std::uint64_t seed, long rock) {
   return z ^ (z >> 31);
 }
 
+const char* ToString(VolumeDistribution::Kind kind) {
+  switch (kind) {
+    case VolumeDistribution::Kind::kFixed: return "fixed";
+    case VolumeDistribution::Kind::kUniform: return "uniform";
+    case VolumeDistribution::Kind::kLogNormal: return "lognormal";
+    case VolumeDistribution::Kind::kPowerLaw: return "power_law";
+  }
+  return "?";
+}
+
+double VolumeDistribution::Quantile(double u) const {
+  switch (kind) {
+    case Kind::kFixed:
+      break;
+    case Kind::kUniform:
+      return min_m3 + u * (max_m3 - min_m3);
+    case Kind::kLogNormal: {
+      // Inverse CDF of the normal restricted to [ln min, ln max].
+      const boost::math::normal normal(std::log(median_m3), sigma);
+      const double lo = min_m3 > 0 ? boost::math::cdf(normal, std::log(min_m3)) : 0.0;
+      const double hi = std::isfinite(max_m3) ? boost::math::cdf(normal, std::log(max_m3)) : 1.0;
+      const double p = std::clamp(lo + u * (hi - lo), 1e-300, 1.0 - 1e-16);
+      return std::clamp(std::exp(boost::math::quantile(normal, p)), min_m3, max_m3);
+    }
+    case Kind::kPowerLaw: {
+      // P(V >= v) = (v^-b - max^-b) / (min^-b - max^-b) on [min, max].
+      const double a = std::pow(min_m3, -exponent), b = std::pow(max_m3, -exponent);
+      return std::clamp(std::pow(a - u * (a - b), -1.0 / exponent), min_m3, max_m3);
+    }
+  }
+  throw std::logic_error("VolumeDistribution::Quantile of a fixed volume");
+}
+
+bool VolumeDistribution::IsValid(std::string* why) const {
+  std::ostringstream msg;
+  const auto positive = [](double v) { return std::isfinite(v) && v > 0; };
+  switch (kind) {
+    case Kind::kFixed:
+      return true;
+    case Kind::kUniform:
+    case Kind::kPowerLaw:
+      if (!positive(min_m3)) msg << "min_m3 = " << min_m3 << " must be a number > 0";
+      else if (!positive(max_m3) || !(max_m3 > min_m3))
+        msg << "max_m3 = " << max_m3 << " must be a number > min_m3 = " << min_m3;
+      else if (kind == Kind::kPowerLaw && !(exponent > 0 && exponent <= 10))
+        msg << "exponent = " << exponent << " violates 0 < exponent <= 10";
+      break;
+    case Kind::kLogNormal:
+      if (!positive(median_m3)) msg << "median_m3 = " << median_m3 << " must be a number > 0";
+      else if (!(sigma > 0 && sigma <= 10)) msg << "sigma = " << sigma << " violates 0 < sigma <= 10";
+      else if (!(min_m3 >= 0) || !(max_m3 > min_m3) || std::isnan(max_m3))
+        msg << "min_m3 = " << min_m3 << ", max_m3 = " << max_m3
+            << " must satisfy 0 <= min_m3 < max_m3";
+      else if (!(median_m3 * std::exp(-8 * sigma) < max_m3 && median_m3 * std::exp(8 * sigma) > min_m3))
+        msg << "min_m3 = " << min_m3 << " .. max_m3 = " << max_m3
+            << " lies more than 8 sigma from median_m3 = " << median_m3;
+      break;
+  }
+  if (msg.str().empty()) return true;
+  if (why) *why = msg.str();
+  return false;
+}
+
+double RockVolume(const ReleaseSpec& spec, long rock) {
+  RockRandom random(RockShapeSeed(spec.seed, rock), kRockVolumeStream);
+  return spec.volume.Quantile(random.Uniform());
+}
+
 ReleasedRock Release(const Scene& scene, const ReleaseSpec& spec, long rock) {
   RockRandom random(spec.seed, static_cast<std::uint64_t>(rock));
   const int release = spec.ReleaseOf(rock);
@@ -378,6 +450,9 @@ ReleasedRock Release(const Scene& scene, const ReleaseSpec& spec, long rock) {
   } else {
     out.shape = std::shared_ptr<const RockShape>(std::shared_ptr<const RockShape>(), &scene.rock);
   }
+  if (spec.volume.kind != VolumeDistribution::Kind::kFixed)
+    out.shape = std::make_shared<const RockShape>(
+        ScaleRockShape(*out.shape, std::cbrt(RockVolume(spec, rock) / out.shape->volume_m3)));
 
   // Position: on the release geometry (where the terrain has a height, with clip_to_dem), or the
   // run's.

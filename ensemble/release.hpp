@@ -62,6 +62,31 @@ struct Block {
   ShapeMaker make;   // the same block with other knobs; empty: the shape is fixed
 };
 
+// The volumes of the rocks of a release (block sizes): each rock's shape is scaled at its density
+// to a volume drawn from its own stream (seed, rock), so that an ensemble is a population of sizes
+// as a rockfall inventory describes it. The quantile V(u) of u uniform on [0, 1):
+//  - fixed: every rock keeps its shape's volume (the default);
+//  - uniform on [min_m3, max_m3];
+//  - log-normal: ln V normal with median ln(median_m3) and standard deviation sigma, truncated to
+//    [min_m3, max_m3] (0 and infinity: not truncated);
+//  - power law: the cumulative frequency of inventories, N(>= V) proportional to V^-exponent,
+//    on [min_m3, max_m3] (a truncated Pareto distribution; e.g. Dussauge et al. 2003, JGR 108(B6),
+//    exponents 0.4-0.7 for rockfall volumes).
+struct VolumeDistribution {
+  enum class Kind { kFixed, kUniform, kLogNormal, kPowerLaw };
+  Kind kind = Kind::kFixed;
+  double min_m3 = 0, max_m3 = std::numeric_limits<double>::infinity();
+  double median_m3 = 0, sigma = 0;  // log-normal
+  double exponent = 0;              // power law, > 0
+  // The volume at cumulative probability u in [0, 1] (not for kFixed).
+  double Quantile(double u) const;
+  // False, naming the key and value, when a bound or parameter is out of range.
+  bool IsValid(std::string* why) const;
+};
+
+// "fixed", "uniform", "lognormal", "power_law".
+const char* ToString(VolumeDistribution::Kind kind);
+
 struct ReleaseSpec {
   static constexpr long kMaxTotalRocks = 1'000'000'000;  // rocks in one run, all releases together
 
@@ -92,6 +117,8 @@ struct ReleaseSpec {
   Eigen::Vector3d velocity_m_s = Eigen::Vector3d::Zero();            // world frame
   Eigen::Vector3d angular_velocity_rad_s = Eigen::Vector3d::Zero();  // world frame
   std::uint64_t seed = 1;
+  // The rocks' volumes (block sizes); fixed by default.
+  VolumeDistribution volume;
 
   // Number of release geometries or runs.
   long release_count() const {
@@ -167,5 +194,12 @@ ReleasedRock Release(const Scene& scene, const ReleaseSpec& spec, long rock);
 // The seed of rock `rock`'s own shape (see ReleaseSpec::shape_per_rock): SplitMix64 mixing of
 // (seed, rock), independent of the rock's orientation stream.
 std::uint64_t RockShapeSeed(std::uint64_t seed, long rock);
+
+// The stream of a rock's volume draw, RockRandom(RockShapeSeed(seed, rock), kRockVolumeStream):
+// independent of its orientation and of its shape's points.
+inline constexpr std::uint64_t kRockVolumeStream = 0x524f434b564f4c55;  // "ROCKVOLU"
+
+// The volume rock `rock` of `spec` is scaled to (spec.volume not fixed).
+double RockVolume(const ReleaseSpec& spec, long rock);
 
 }  // namespace talus::ensemble

@@ -5,6 +5,8 @@
 #include <cstdint>
 #include <cstdlib>
 #include <filesystem>
+#include <limits>
+#include <map>
 #include <string>
 #include <unordered_map>
 #include <utility>
@@ -413,6 +415,53 @@ std::vector<Eigen::Vector2d> PointList(const Section& s, const toml::node* node,
   return out;
 }
 
+// [release] volume = { distribution = "power_law", min_m3 = ..., max_m3 = ..., exponent = ... }
+// (ensemble::VolumeDistribution): block sizes for release geometries, not for runs, which have
+// their blocks.
+void LoadVolume(const Context& context, const Section& s, ensemble::ReleaseSpec& r) {
+  const toml::node* node = s.Node("volume");
+  if (!node) return;
+  if (!node->is_table())
+    s.Fail("volume", "expected an inline table { distribution = \"power_law\", min_m3 = ..., ... }");
+  if (!r.runs.empty())
+    s.Fail("volume", "block sizes are for release points, lines and polygons; a run table gives "
+                     "each run its block");
+  const Section v(context, node->as_table(), "release.volume",
+                  {"distribution", "min_m3", "max_m3", "median_m3", "sigma", "exponent"});
+  const std::string name = v.String("distribution", "");
+  using Kind = ensemble::VolumeDistribution::Kind;
+  ensemble::VolumeDistribution& d = r.volume;
+  const std::map<std::string, std::vector<std::string>> keys = {
+      {"fixed", {}},
+      {"uniform", {"min_m3", "max_m3"}},
+      {"lognormal", {"median_m3", "sigma", "min_m3", "max_m3"}},
+      {"power_law", {"min_m3", "max_m3", "exponent"}}};
+  const auto known = keys.find(name);
+  if (known == keys.end())
+    v.Fail("distribution", "'" + name + "' is not one of fixed, uniform, lognormal, power_law");
+  for (const char* key : {"min_m3", "max_m3", "median_m3", "sigma", "exponent"})
+    if (v.Has(key) && std::find(known->second.begin(), known->second.end(), key) == known->second.end())
+      v.Fail(key, "is not a parameter of the " + name + " distribution");
+  if (name == "fixed") return;
+  d.kind = name == "uniform" ? Kind::kUniform : name == "lognormal" ? Kind::kLogNormal : Kind::kPowerLaw;
+  const auto required = [&v](const char* key) {
+    if (!v.Has(key)) v.Fail(key, "missing");
+    return v.Number(key, 0);
+  };
+  if (d.kind == Kind::kLogNormal) {
+    d.median_m3 = required("median_m3");
+    d.sigma = required("sigma");
+    d.min_m3 = v.Number("min_m3", 0);
+    d.max_m3 = v.Number("max_m3", std::numeric_limits<double>::infinity());
+  } else {
+    d.min_m3 = required("min_m3");
+    d.max_m3 = required("max_m3");
+    if (d.kind == Kind::kPowerLaw) d.exponent = required("exponent");
+  }
+  std::string why;
+  if (!d.IsValid(&why)) v.FailCheck(why);
+}
+
 void LoadRelease(const Context& context, const Section& s, SceneFile& out) {
   ensemble::ReleaseSpec& r = out.release;
   const std::vector<std::string> origin = LoadReleaseGeometries(context, s, out);
@@ -452,6 +501,7 @@ void LoadRelease(const Context& context, const Section& s, SceneFile& out) {
   if (rocks < 1) s.Fail("rocks", std::to_string(rocks) + " must be >= 1");
   r.rocks_per_release = rocks;
   LoadReleaseStart(s, r);
+  LoadVolume(context, s, r);
 
   const std::vector<double> on_terrain = CheckReleasesOnTerrain(origin, out);
   if (count_key != "rocks") SetRocksByArea(s, count_key, origin, on_terrain, out);

@@ -1,5 +1,6 @@
 #include "io/summary.hpp"
 
+#include <cmath>
 #include <nlohmann/json.hpp>
 
 #include "ensemble/run_warnings.hpp"
@@ -145,6 +146,21 @@ std::string SummaryJson(const SceneFile& scene, const ensemble::EnsembleReport& 
     j["blocks"] = blocks;
   }
   j["shape_per_rock"] = static_cast<bool>(scene.release.shape_per_rock);
+  // Block sizes ([release] volume): the distribution each rock's volume is drawn from.
+  const ensemble::VolumeDistribution& volume = scene.release.volume;
+  nlohmann::ordered_json v = {{"distribution", ToString(volume.kind)}};
+  using Kind = ensemble::VolumeDistribution::Kind;
+  if (volume.kind == Kind::kLogNormal) {
+    v["median_m3"] = volume.median_m3;
+    v["sigma"] = volume.sigma;
+  }
+  if (volume.kind != Kind::kFixed) {
+    v["min_m3"] = volume.min_m3;
+    v["max_m3"] = std::isfinite(volume.max_m3) ? nlohmann::ordered_json(volume.max_m3)
+                                               : nlohmann::ordered_json(nullptr);
+  }
+  if (volume.kind == Kind::kPowerLaw) v["exponent"] = volume.exponent;
+  j["volume"] = v;
   if (scene.release.release_first_rock.empty()) {
     j["rocks_per_release"] = scene.release.rocks_per_release;
   } else {  // rocks_per_m2: each release its own number

@@ -105,4 +105,18 @@ bool RockShape::IsValid(std::string* why) const {
   return false;
 }
 
+RockShape ScaleRockShape(const RockShape& rock, double factor) {
+  RockShape out = rock;
+  for (Eigen::Vector3d& v : out.vertices_m) v *= factor;
+  const double cube = factor * factor * factor;
+  out.volume_m3 *= cube;
+  out.mass_kg *= cube;
+  out.inertia_kg_m2 *= cube * factor * factor;
+  out.bounding_radius_m *= factor;
+  out.thickness_m *= factor;
+  out.length_m *= factor;
+  out.centroid_input_m *= factor;
+  return out;
+}
+
 }  // namespace talus

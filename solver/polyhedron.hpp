@@ -62,4 +62,9 @@ struct RockShape {
 // Hull vertices that are not used by any triangle are dropped.
 RockShape MakeRockShape(const Polyhedron& hull, double density_kg_m3);
 
+// The same rock scaled by `factor` (> 0) in every length about its centre of mass, at the same
+// density: vertices and extents times factor, volume and mass times factor^3, principal moments
+// times factor^5; the principal frame and how it sits in the input frame are unchanged.
+RockShape ScaleRockShape(const RockShape& rock, double factor);
+
 }  // namespace talus

@@ -2,10 +2,13 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <vector>
 
+#include "ensemble/runner.hpp"
 #include "fixtures.hpp"
 
 namespace talus::ensemble {
@@ -212,6 +215,146 @@ TEST(Release, PointOffTerrainFindsNodataAlongLinesAndInsidePolygons) {
   const ReleaseGeometry elsewhere{ReleaseGeometry::Kind::kPolygon,
                                   {{{15, -8}, {20, -8}, {20, -2}, {15, -2}}}};
   EXPECT_FALSE(PointOffTerrain(terrain, elsewhere));
+}
+
+// Block sizes. ScaleRockShape against the shape built at the scaled size: a box of 1 x 2 x 3 m
+// scaled by 1.7 is the box of 1.7 x 3.4 x 5.1 m at the same density (mass x 1.7^3, moments x 1.7^5),
+// to rounding (1e-12 relative).
+TEST(BlockSizes, AScaledShapeIsTheShapeOfTheScaledSize) {
+  const RockShape rock = MakeRockShape(MakeBox(1, 2, 3), 2700);
+  const RockShape scaled = ScaleRockShape(rock, 1.7);
+  const RockShape built = MakeRockShape(MakeBox(1.7, 3.4, 5.1), 2700);
+  EXPECT_NEAR(scaled.mass_kg, built.mass_kg, 1e-12 * built.mass_kg);
+  EXPECT_NEAR(scaled.volume_m3, built.volume_m3, 1e-12 * built.volume_m3);
+  for (int k = 0; k < 3; ++k)
+    EXPECT_NEAR(scaled.inertia_kg_m2[k], built.inertia_kg_m2[k], 1e-12 * built.inertia_kg_m2[k]);
+  EXPECT_NEAR(scaled.length_m, built.length_m, 1e-12);
+  EXPECT_NEAR(scaled.bounding_radius_m, built.bounding_radius_m, 1e-12);
+  std::string why;
+  EXPECT_TRUE(scaled.IsValid(&why)) << why;
+}
+
+// The quantiles in closed form: uniform at u = 1/2 is the midpoint; the power law's exceedance
+// P(V >= Q(u)) = (Q^-b - max^-b) / (min^-b - max^-b) is 1 - u; the untruncated log-normal's median
+// is median_m3 and Q(Phi(1)) = median e^sigma (Phi(1) = 0.841344746068543); every truncated one
+// maps 0 and 1 to its bounds.
+TEST(BlockSizes, QuantilesAreTheDistributionsClosedForms) {
+  VolumeDistribution uniform{VolumeDistribution::Kind::kUniform, 0.5, 2.5};
+  EXPECT_DOUBLE_EQ(uniform.Quantile(0.5), 1.5);
+  VolumeDistribution power{VolumeDistribution::Kind::kPowerLaw, 0.1, 10};
+  power.exponent = 0.6;
+  const double a = std::pow(0.1, -0.6), b = std::pow(10.0, -0.6);
+  for (double u : {0.0, 0.1, 0.5, 0.9, 0.999}) {
+    const double v = power.Quantile(u);
+    EXPECT_NEAR((std::pow(v, -0.6) - b) / (a - b), 1 - u, 1e-12) << u;
+  }
+  EXPECT_DOUBLE_EQ(power.Quantile(0), 0.1);
+  EXPECT_NEAR(power.Quantile(1), 10, 1e-12);
+  VolumeDistribution log_normal{VolumeDistribution::Kind::kLogNormal};
+  log_normal.median_m3 = 2;
+  log_normal.sigma = 0.8;
+  EXPECT_NEAR(log_normal.Quantile(0.5), 2, 1e-12);
+  EXPECT_NEAR(log_normal.Quantile(0.841344746068543), 2 * std::exp(0.8), 1e-9);
+  log_normal.min_m3 = 0.5;
+  log_normal.max_m3 = 4;
+  EXPECT_NEAR(log_normal.Quantile(0), 0.5, 1e-12);
+  EXPECT_NEAR(log_normal.Quantile(1), 4, 1e-12);
+  std::string why;
+  for (const VolumeDistribution& d : {uniform, power, log_normal})
+    EXPECT_TRUE(d.IsValid(&why)) << why;
+}
+
+// The drawn volumes of 4000 rocks follow the distribution: the Kolmogorov-Smirnov distance of
+// their empirical CDF to the stated one stays below 1.95 / sqrt(n), the asymptotic critical value
+// at the 0.001 level (Massey 1951, JASA 46); and each rock's mass is its volume at the density.
+TEST(BlockSizes, RocksDrawTheirVolumesFromTheDistribution) {
+  Scene scene = testing::SmallPlane(30, 20, 10);
+  scene.rock = MakeRockShape(MakeBox(1, 1, 1), 2700);
+  const long n = 4000;
+  ReleaseSpec spec = testing::PointRelease({{5, 0}}, n);
+  spec.volume.kind = VolumeDistribution::Kind::kPowerLaw;
+  spec.volume.min_m3 = 0.05;
+  spec.volume.max_m3 = 5;
+  spec.volume.exponent = 0.5;
+  std::string why;
+  ASSERT_TRUE(spec.IsValid(&why)) << why;
+  std::vector<double> volumes;
+  for (long rock = 0; rock < n; ++rock) {
+    const ReleasedRock r = Release(scene, spec, rock);
+    const double v = RockVolume(spec, rock);
+    ASSERT_NEAR(r.shape->volume_m3, v, 1e-12 * v) << rock;
+    ASSERT_NEAR(r.shape->mass_kg, 2700 * v, 1e-9 * 2700 * v) << rock;
+    volumes.push_back(v);
+  }
+  std::sort(volumes.begin(), volumes.end());
+  const double a = std::pow(0.05, -0.5), b = std::pow(5.0, -0.5);
+  double distance = 0;
+  for (long k = 0; k < n; ++k) {
+    const double cdf = (a - std::pow(volumes[k], -0.5)) / (a - b);
+    distance = std::max({distance, std::abs(cdf - double(k) / n), std::abs(cdf - double(k + 1) / n)});
+  }
+  EXPECT_LT(distance, 1.95 / std::sqrt(double(n)));
+  // The rock's own stream: another seed, another volume.
+  ReleaseSpec other = spec;
+  other.seed = 2;
+  EXPECT_NE(RockVolume(other, 17), RockVolume(spec, 17));
+  // Orientations do not change with sizes: the volume has its own stream.
+  ReleaseSpec fixed = spec;
+  fixed.volume = {};
+  EXPECT_EQ(Release(scene, fixed, 17).start.orientation.coeffs(),
+            Release(scene, spec, 17).start.orientation.coeffs());
+}
+
+TEST(BlockSizes, BadDistributionsNameTheKey) {
+  std::string why;
+  VolumeDistribution d{VolumeDistribution::Kind::kUniform, 2, 1};
+  EXPECT_FALSE(d.IsValid(&why));
+  EXPECT_NE(why.find("max_m3"), std::string::npos) << why;
+  d = {VolumeDistribution::Kind::kPowerLaw, 0.1, 1};
+  d.exponent = 0;
+  EXPECT_FALSE(d.IsValid(&why));
+  EXPECT_NE(why.find("exponent"), std::string::npos) << why;
+  d = {VolumeDistribution::Kind::kLogNormal};
+  d.median_m3 = 1;
+  d.sigma = -1;
+  EXPECT_FALSE(d.IsValid(&why));
+  EXPECT_NE(why.find("sigma"), std::string::npos) << why;
+  d.sigma = 0.5;
+  d.min_m3 = 100;
+  d.max_m3 = 200;
+  EXPECT_FALSE(d.IsValid(&why));  // beyond 8 sigma of the median
+  ReleaseSpec spec = testing::PointRelease({{5, 0}}, 1);
+  spec.volume = {VolumeDistribution::Kind::kUniform, -1, 1};
+  EXPECT_FALSE(spec.IsValid(&why));
+  EXPECT_EQ(why.rfind("volume.min_m3", 0), 0u) << why;
+}
+
+// A population of sizes runs to the same bits on any number of threads, and the mixed masses are
+// what each rock ran with.
+TEST(BlockSizes, EnsemblesOfMixedSizesAreTheSameForAnyThreadCount) {
+  Scene scene = testing::SmallPlane(35, 15, 10);
+  ReleaseSpec spec = testing::PointRelease({{3, 0}}, 24);
+  spec.volume = {VolumeDistribution::Kind::kLogNormal};
+  spec.volume.median_m3 = 0.064;
+  spec.volume.sigma = 0.6;
+  struct Masses : RockSink {
+    std::vector<double> mass, runout;
+    void OnRock(const RockOutcome& o) override {
+      mass.push_back(o.shape->mass_kg);
+      runout.push_back(o.result.runout_m);
+    }
+  };
+  std::vector<Masses> runs(2);
+  for (int threads : {1, 2}) {
+    EnsembleOptions options;
+    options.threads = threads;
+    RunEnsemble(scene, spec, options, &runs[static_cast<std::size_t>(threads - 1)]);
+  }
+  EXPECT_EQ(runs[0].mass, runs[1].mass);
+  EXPECT_EQ(runs[0].runout, runs[1].runout);
+  for (long rock = 0; rock < 24; ++rock)
+    EXPECT_NEAR(runs[0].mass[static_cast<std::size_t>(rock)], 2700 * RockVolume(spec, rock),
+                1e-9 * runs[0].mass[static_cast<std::size_t>(rock)]);
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <string>
 
 #include "common/error.hpp"
@@ -90,6 +91,37 @@ TEST(SceneRelease, RunTableAndSingleImpactErrorsNameTheKey) {
   EXPECT_HAS(e, "release.single_impacts.file: missing");
   e = ErrorOf("points = [[5, 0]]\nsingle_impacts = { file = \"impacts.csv\" }\n");
   EXPECT_HAS(e, "release.single_impacts: a single-impact table cannot be combined with points");
+}
+
+// [release] volume: block sizes from a distribution, each parameter checked and named.
+TEST(SceneRelease, BlockSizeDistributionsLoadAndBadOnesNameTheKey) {
+  const SceneFile power = Load(
+      "points = [[5, 0]]\nvolume = { distribution = \"power_law\", min_m3 = 0.1, max_m3 = 10, "
+      "exponent = 0.6 }\n");
+  EXPECT_EQ(power.release.volume.kind, ensemble::VolumeDistribution::Kind::kPowerLaw);
+  EXPECT_EQ(power.release.volume.exponent, 0.6);
+  const SceneFile log_normal = Load(
+      "points = [[5, 0]]\nvolume = { distribution = \"lognormal\", median_m3 = 1, sigma = 0.7 }\n");
+  EXPECT_EQ(log_normal.release.volume.median_m3, 1);
+  EXPECT_TRUE(std::isinf(log_normal.release.volume.max_m3));
+  const std::string p = "points = [[5, 0]]\n";
+  EXPECT_HAS(ErrorOf(p + "volume = { distribution = \"pareto\", min_m3 = 1, max_m3 = 2 }\n"),
+             "scene.toml:9: release.volume.distribution: 'pareto' is not one of fixed, uniform");
+  EXPECT_HAS(ErrorOf(p + "volume = { distribution = \"uniform\", min_m3 = 1 }\n"),
+             "release.volume.max_m3: missing");
+  EXPECT_HAS(ErrorOf(p + "volume = { distribution = \"uniform\", min_m3 = 2, max_m3 = 1 }\n"),
+             "release.volume.max_m3");
+  EXPECT_HAS(ErrorOf(p + "volume = { distribution = \"uniform\", min_m3 = 1, max_m3 = 2, "
+                         "exponent = 1 }\n"),
+             "release.volume.exponent: is not a parameter of the uniform distribution");
+  EXPECT_HAS(ErrorOf(p + "volume = { distribution = \"power_law\", min_m3 = 0.1, max_m3 = 2, "
+                         "exponent = -1 }\n"),
+             "release.volume.exponent");
+  EXPECT_HAS(ErrorOf(p + "volume = 2.0\n"), "release.volume: expected an inline table");
+  EXPECT_HAS(ErrorOf("runs = \"runs.csv\"\nvolume = { distribution = \"uniform\", min_m3 = 1, "
+                     "max_m3 = 2 }\n",
+                     "trajectory_id,x_m,y_m\nr1,5,0\n"),
+             "release.volume: block sizes are for release points");
 }
 
 }  // namespace
