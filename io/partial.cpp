@@ -19,7 +19,8 @@ namespace talus::io {
 namespace {
 
 constexpr const char* kFormat = "talus partial result";
-constexpr int kFormatVersion = 2;  // 2: the files' sizes and checksums
+// 2: the files' sizes and checksums; 3: the ending "barrier".
+constexpr int kFormatVersion = 3;
 constexpr const char* kStateMagic = "talus partial state 1";
 
 std::string ReadWholeFile(const std::string& path) {
@@ -160,7 +161,7 @@ PartialInfo ReadPartialInfo(const std::string& dir) {
     p.end_rock = j.at("end_rock");
     p.trajectories = j.at("trajectories");
     p.counts.rocks = j.at("rocks");
-    p.counts.by_end = j.at("ends").get<std::array<long, 4>>();
+    p.counts.by_end = j.at("ends").get<decltype(p.counts.by_end)>();
     p.counts.raised = j.at("raised_at_release");
     p.counts.stayed_at_release = j.at("stayed_at_release");
     p.counts.steps = j.at("steps");
