@@ -25,7 +25,7 @@ constexpr int kFeaturesPerTransaction = 20000;
 // names as text, the rest (coordinates, distances, speeds, energies, masses) as reals.
 OGRFieldType FieldType(const std::string& column) {
   static const char* const integers[] = {"rock", "release", "seed", "crossings"};
-  static const char* const texts[] = {"run", "end", "block", "end_ground", "line"};
+  static const char* const texts[] = {"run", "end", "block", "end_ground", "end_barrier", "line"};
   for (const char* name : integers)
     if (column == name) return OFTInteger64;
   for (const char* name : texts)

@@ -24,7 +24,7 @@ std::string RocksCsv(int rocks) {
   for (int k = 0; k < rocks; ++k) {
     const std::string c = std::to_string(k);
     text += c + ",0,\"run, " + c + "\",7," + (k == 0 ? "rest" : "left_domain") + ",10" + c +
-            ",20" + c + ",30" + c + ",12.5,13,2,3.5,4000,0.5,6,0,,100,0,0,0,30,hard\n";
+            ",20" + c + ",30" + c + ",12.5,13,2,3.5,4000,0.5,6,0,,100,0,0,0,30,hard,\n";
   }
   return text;
 }

@@ -18,7 +18,7 @@ std::string RocksCsv(const std::vector<std::string>& runouts) {
   int rock = 0;
   for (const std::string& runout : runouts) {
     text += std::to_string(rock) + ",0,\"run, " + std::to_string(rock) +
-            "\",1,rest,0,0,0," + runout + ",1,2,3.5,4000,0.5,6,0,\"a \"\"block\"\"\",100,0,0,0,30,hard\n";
+            "\",1,rest,0,0,0," + runout + ",1,2,3.5,4000,0.5,6,0,\"a \"\"block\"\"\",100,0,0,0,30,hard,\n";
     ++rock;
   }
   return text;
