@@ -380,8 +380,8 @@ int RunCalibrate(const CalibrateArgs& args, const Processes& processes) {
 // Counts of an ensemble report as bytes, and back.
 std::string CountsBytes(const ensemble::EnsembleReport& r) {
   const std::array<long, 10> counts = {
-      r.rocks,       r.by_end[0], r.by_end[1],        r.by_end[2], r.by_end[3],
-      r.by_end[4],   r.raised,    r.stayed_at_release, r.steps,     r.unconverged_steps};
+      r.rocks,     r.by_end[0], r.by_end[1],         r.by_end[2], r.by_end[3],
+      r.by_end[4], r.raised,    r.stayed_at_release, r.steps,     r.unconverged_steps};
   return std::string(reinterpret_cast<const char*>(counts.data()), sizeof counts);
 }
 ensemble::EnsembleReport ReportOfCounts(const std::string& bytes) {

@@ -113,8 +113,8 @@ std::vector<std::string> WriteSummaryOutputs(const io::SceneFile& scene,
   // Barriers: summarised from the complete barriers.csv.
   std::vector<io::BarrierSummary> barriers;
   if (!scene.scene.barriers.empty()) {
-    barriers = io::SummarizeBarriers(staging.path("barriers.csv"), scene.scene.barriers,
-                                     report.rocks);
+    barriers =
+        io::SummarizeBarriers(staging.path("barriers.csv"), scene.scene.barriers, report.rocks);
     WriteFileAtomically(staging.path("barriers_summary.csv"), io::BarriersSummaryCsv(barriers));
     outputs.push_back("barriers_summary.csv");
   }
@@ -186,11 +186,21 @@ bool QuickLookSample(const ensemble::ReleaseSpec& release, long rock) {
 }
 
 std::vector<std::string> TalusOutputNames() {
-  std::vector<std::string> names = {
-      "rocks.csv",    "trajectories.h5",       "summary.json", "quicklook.png", "passages.tif",
-      "deposits.tif", "reach_probability.tif", "partial.json", "partial.bin",   "report.html",
-      "rocks.gpkg",     "evaluation_lines.csv", "evaluation_lines_summary.csv",
-      "barriers.csv",   "barriers_summary.csv"};
+  std::vector<std::string> names = {"rocks.csv",
+                                    "trajectories.h5",
+                                    "summary.json",
+                                    "quicklook.png",
+                                    "passages.tif",
+                                    "deposits.tif",
+                                    "reach_probability.tif",
+                                    "partial.json",
+                                    "partial.bin",
+                                    "report.html",
+                                    "rocks.gpkg",
+                                    "evaluation_lines.csv",
+                                    "evaluation_lines_summary.csv",
+                                    "barriers.csv",
+                                    "barriers_summary.csv"};
   for (const char* quantity : {"speed", "energy", "jump_height"}) {
     for (const char* statistic : {"max", "mean"})
       names.push_back(std::string(quantity) + "_" + statistic + ".tif");

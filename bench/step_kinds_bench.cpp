@@ -124,9 +124,9 @@ void PrintContactWork(const StepKinds& k) {
     t.steps = t.contact_steps;  // a group's steps are its solves
     PrintTally(names[g], t, k, solved.contact_steps, solved.sweeps);
   }
-  for (talus::EndReason end : {talus::EndReason::kRest, talus::EndReason::kLeftDomain,
-                               talus::EndReason::kMaxTime, talus::EndReason::kFailed,
-                               talus::EndReason::kBarrier}) {
+  for (talus::EndReason end :
+       {talus::EndReason::kRest, talus::EndReason::kLeftDomain, talus::EndReason::kMaxTime,
+        talus::EndReason::kFailed, talus::EndReason::kBarrier}) {
     const int e = static_cast<int>(end);
     if (k.rocks_by_end[e] == 0) continue;
     const std::string name = std::string("rocks ending ") + talus::ToString(end) + " (" +

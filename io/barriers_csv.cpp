@@ -139,7 +139,8 @@ std::string BarriersSummaryCsv(const std::vector<BarrierSummary>& summary) {
       out.append(",").append(std::to_string(n));
     out.append(",").append(Field(s.reach_probability));
     out.append(",").append(Field(s.passing_probability));
-    for (const CrossingStatistics* q : {&s.impact_energy_J, &s.passing_height_m, &s.passing_energy_J})
+    for (const CrossingStatistics* q :
+         {&s.impact_energy_J, &s.passing_height_m, &s.passing_energy_J})
       for (double v : q->values) out.append(",").append(Field(v));
     out.append("\n");
   }

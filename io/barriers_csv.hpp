@@ -42,11 +42,11 @@ struct BarrierSummary {
   std::string name;
   std::string type;  // ToString(BarrierType)
   double length_m = 0, height_m = 0, capacity_J = 0;
-  long rocks = 0;          // rocks of the run
-  long reached = 0;        // rocks that reached it (crossed its line)
-  long stopped = 0;        // ... and were stopped there
-  long overtopped = 0;     // ... and passed above it
-  long broke_through = 0;  // ... and broke through it with energy_J - capacity
+  long rocks = 0;                  // rocks of the run
+  long reached = 0;                // rocks that reached it (crossed its line)
+  long stopped = 0;                // ... and were stopped there
+  long overtopped = 0;             // ... and passed above it
+  long broke_through = 0;          // ... and broke through it with energy_J - capacity
   double reach_probability = 0;    // reached / rocks
   double passing_probability = 0;  // (overtopped + broke_through) / rocks
   // Over the rocks that reached it: kinetic energy at the crossing (before the barrier acted)

@@ -183,11 +183,11 @@ std::string WhatRanSection(const Json& summary) {
   html += WarningsSection(summary);
 
   html += "<h2>What ran</h2>\n";
-  html += KeyValueTable(
-      summary, {"ends", "raised_at_release", "stayed_at_release", "steps", "unconverged_steps",
-                "threads", "wall_time_s", "trajectories_per_s", "outputs", "blocks",
-                "talus_version", "inputs_hash_fnv1a64", "evaluation_lines", "barriers",
-                "warnings"});
+  html +=
+      KeyValueTable(summary, {"ends", "raised_at_release", "stayed_at_release", "steps",
+                              "unconverged_steps", "threads", "wall_time_s", "trajectories_per_s",
+                              "outputs", "blocks", "talus_version", "inputs_hash_fnv1a64",
+                              "evaluation_lines", "barriers", "warnings"});
   if (summary.contains("rock") && summary["rock"].is_object()) {
     html += "<h3>Rock</h3>\n";
     html += KeyValueTable(summary["rock"]);
@@ -383,8 +383,7 @@ std::string RunReportHtml(const RunReportInput& input) {
   const Json summary = Json::parse(input.summary_json);
   return WhatRanSection(summary) + EndingsSection(summary) + MapsSection(input) +
          DistributionsSection(input.rocks) + EvaluationLinesSection(summary) +
-         BarriersSection(summary) +
-         SettingsSection(summary);
+         BarriersSection(summary) + SettingsSection(summary);
 }
 
 }  // namespace talus::io

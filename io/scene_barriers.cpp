@@ -53,13 +53,13 @@ void LoadBarriers(const Context& context, const toml::node* node, SceneFile& out
     const Section s(context, tables->get(k)->as_table(), key,
                     {"name", "type", "line", "file", "name_field", "height_m", "capacity_kj"});
     Barrier b;
-    if (!s.Has("type"))
-      s.Fail("type", "missing: \"flexible_net\", \"rigid_wall\" or \"dam\"");
+    if (!s.Has("type")) s.Fail("type", "missing: \"flexible_net\", \"rigid_wall\" or \"dam\"");
     const std::string type = s.String("type", "");
     if (!ParseBarrierType(type, &b.type))
       s.Fail("type", "unknown barrier type '" + type +
                          "': expected \"flexible_net\", \"rigid_wall\" or \"dam\"");
-    if (!s.Has("height_m")) s.Fail("height_m", "missing: the barrier's height above the terrain (m)");
+    if (!s.Has("height_m"))
+      s.Fail("height_m", "missing: the barrier's height above the terrain (m)");
     b.height_m = s.Number("height_m", 0);
     if (!std::isfinite(b.height_m) || b.height_m < 0)
       s.Fail("height_m", TenDigits(b.height_m) + " m: the height must be >= 0 m");
@@ -118,11 +118,11 @@ void LoadBarriers(const Context& context, const toml::node* node, SceneFile& out
     Eigen::Vector2d off;
     if (FirstPointOffDem(out.scene.terrain, b.vertices_m, &off)) {
       const GridGeometry& g = out.scene.terrain.heights().grid;
-      throw InputError(origin[k] + ": the barrier '" + b.name + "' is off the DEM or on nodata at (" +
-                       TenDigits(off.x()) + ", " + TenDigits(off.y()) + "); the DEM covers x " +
-                       TenDigits(g.x0_m) + " .. " + TenDigits(g.x_max_m()) + ", y " +
-                       TenDigits(g.y0_m) + " .. " + TenDigits(g.y_max_m()) +
-                       ": every part of a barrier must lie on the DEM");
+      throw InputError(origin[k] + ": the barrier '" + b.name +
+                       "' is off the DEM or on nodata at (" + TenDigits(off.x()) + ", " +
+                       TenDigits(off.y()) + "); the DEM covers x " + TenDigits(g.x0_m) + " .. " +
+                       TenDigits(g.x_max_m()) + ", y " + TenDigits(g.y0_m) + " .. " +
+                       TenDigits(g.y_max_m()) + ": every part of a barrier must lie on the DEM");
     }
     for (std::size_t j = 0; j < k; ++j)
       if (barriers[j].name == b.name)

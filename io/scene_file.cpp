@@ -231,10 +231,9 @@ ensemble::RasterRequest OutputSpec::Request(const GridGeometry& grid) const {
 SceneFile LoadScene(const std::string& path) {
   const Context context(path);
   const toml::table root = ParseTomlFile(path, "scene file");
-  const Section top(
-      context, &root, "",
-      {"terrain", "ground", "rock", "blocks", "release", "evaluation_lines", "barriers", "solver",
-       "output"});
+  const Section top(context, &root, "",
+                    {"terrain", "ground", "rock", "blocks", "release", "evaluation_lines",
+                     "barriers", "solver", "output"});
   for (const char* required : {"terrain", "release"})
     if (!root.get(required))
       context.Fail(nullptr, required, std::string("missing table [") + required + "]");

@@ -83,10 +83,9 @@ nlohmann::ordered_json BarrierJson(const BarrierSummary& s) {
                               {"broke_through", s.broke_through},
                               {"reach_probability", s.reach_probability},
                               {"passing_probability", s.passing_probability}};
-  for (const auto& [key, statistics] :
-       {std::pair{"impact_energy_J", &s.impact_energy_J},
-        std::pair{"passing_height_m", &s.passing_height_m},
-        std::pair{"passing_energy_J", &s.passing_energy_J}}) {
+  for (const auto& [key, statistics] : {std::pair{"impact_energy_J", &s.impact_energy_J},
+                                        std::pair{"passing_height_m", &s.passing_height_m},
+                                        std::pair{"passing_energy_J", &s.passing_energy_J}}) {
     nlohmann::ordered_json q = nlohmann::ordered_json::object();
     for (std::size_t k = 0; k < CrossingStatistics::kNames.size(); ++k)
       q[CrossingStatistics::kNames[k]] = statistics->values[k];

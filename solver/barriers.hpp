@@ -83,11 +83,11 @@ struct BarrierEvent {
   int barrier = 0;  // index into Scene::barriers
   BarrierOutcome outcome = BarrierOutcome::kOvertopped;
   double t_s = 0;
-  Eigen::Vector3d position_m = Eigen::Vector3d::Zero();  // centre of mass at the crossing
-  double speed_m_s = 0;                                  // of the centre of mass, before
+  Eigen::Vector3d position_m = Eigen::Vector3d::Zero();        // centre of mass at the crossing
+  double speed_m_s = 0;                                        // of the centre of mass, before
   double translational_energy_J = 0, rotational_energy_J = 0;  // before the barrier acted
-  double passing_height_m = 0;  // PointOnStep::clearance_m
-  double com_height_m = 0;      // centre of mass above the terrain
+  double passing_height_m = 0;                                 // PointOnStep::clearance_m
+  double com_height_m = 0;                                     // centre of mass above the terrain
   // Kinetic energy after the barrier acted: unchanged when overtopped, 0 when stopped,
   // energy_J() - capacity when it broke through.
   double energy_after_J = 0;

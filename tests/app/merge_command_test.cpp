@@ -160,8 +160,8 @@ capacity_kj = 0.05
   const auto summary = nlohmann::json::parse(single.at("summary.json"));
   EXPECT_EQ(summary.at("barriers").size(), 2u);
   EXPECT_GT(summary.at("ends").at("barrier").get<int>(), 0);
-  for (const auto& split : std::vector<std::vector<std::string>>{{"3:10", "0:3"},
-                                                                 {"0:2", "2:7", "7:10"}}) {
+  for (const auto& split :
+       std::vector<std::vector<std::string>>{{"3:10", "0:3"}, {"0:2", "2:7", "7:10"}}) {
     std::vector<fs::path> parts;
     int k = 0;
     for (const std::string& range : split) parts.push_back(Part(range, 1 + (k++ % 2)));

@@ -144,8 +144,8 @@ TEST(RunEnsemble, BarriersAreBitIdenticalForAnyThreadCount) {
   EXPECT_GT(reports[0].count(EndReason::kBarrier), 0);
   float deposits = 0;
   for (float d : reports[0].rasters.front().values) deposits += d > 0 ? d : 0;
-  EXPECT_EQ(deposits, float(reports[0].count(EndReason::kRest) +
-                            reports[0].count(EndReason::kBarrier)));
+  EXPECT_EQ(deposits,
+            float(reports[0].count(EndReason::kRest) + reports[0].count(EndReason::kBarrier)));
   for (int k = 1; k < 3; ++k) {
     EXPECT_EQ(reports[k].by_end, reports[0].by_end);
     for (std::size_t r = 0; r < 10; ++r) {
@@ -156,7 +156,8 @@ TEST(RunEnsemble, BarriersAreBitIdenticalForAnyThreadCount) {
       ASSERT_EQ(a.barrier_events.size(), b.barrier_events.size());
       for (std::size_t e = 0; e < a.barrier_events.size(); ++e) {
         EXPECT_EQ(a.barrier_events[e].outcome, b.barrier_events[e].outcome);
-        EXPECT_TRUE(SameBits(a.barrier_events[e].energy_after_J, b.barrier_events[e].energy_after_J));
+        EXPECT_TRUE(
+            SameBits(a.barrier_events[e].energy_after_J, b.barrier_events[e].energy_after_J));
         EXPECT_TRUE(SameBits(a.barrier_events[e].position_m, b.barrier_events[e].position_m));
       }
     }

@@ -14,7 +14,8 @@
 namespace talus::io {
 namespace {
 
-// A 60 x 30 m plane (x 0 .. 60, y -15 .. 15, 1 m cells); its [[barriers]] table is on line 10, its keys from line 11.
+// A 60 x 30 m plane (x 0 .. 60, y -15 .. 15, 1 m cells); its [[barriers]] table is on line 10, its
+// keys from line 11.
 const std::string kScene = R"([terrain]
 plane = { slope_deg = 30, slope_length_m = 40, runout_m = 20, width_m = 30, cell_m = 1 }
 
@@ -48,10 +49,11 @@ std::string ErrorOf(const std::string& table) {
 
 TEST(SceneBarriers, KeysBecomeTheScenesBarriers) {
   const auto dir = testing::FreshDir("scene");
-  testing::WriteText(dir / "scene.toml", kScene + kNet + "capacity_kj = 500\n" +
-                                             "[[barriers]]\nname = \"wall\"\ntype = \"rigid_wall\"\n"
-                                             "line = [[40, -10], [42, 0], [40, 10]]\n"
-                                             "height_m = 0\ncapacity_kj = 2000.5\n");
+  testing::WriteText(dir / "scene.toml",
+                     kScene + kNet + "capacity_kj = 500\n" +
+                         "[[barriers]]\nname = \"wall\"\ntype = \"rigid_wall\"\n"
+                         "line = [[40, -10], [42, 0], [40, 10]]\n"
+                         "height_m = 0\ncapacity_kj = 2000.5\n");
   const SceneFile s = LoadScene((dir / "scene.toml").string());
   ASSERT_EQ(s.scene.barriers.size(), 2u);
   const Barrier& net = s.scene.barriers[0];
@@ -74,8 +76,9 @@ TEST(SceneBarriers, AVectorFileGivesOneBarrierPerLineFeature) {
  "geometry": {"type": "LineString", "coordinates": [[20, -10], [20, 10]]}},
 {"type": "Feature", "properties": {"name": "lower"},
  "geometry": {"type": "LineString", "coordinates": [[50, -10], [50, 10]]}}]})";
-  testing::WriteText(dir / "scene.toml", kScene + "file = \"nets.geojson\"\ntype = \"dam\"\n"
-                                                  "height_m = 6\ncapacity_kj = 50000\n");
+  testing::WriteText(dir / "scene.toml", kScene +
+                                             "file = \"nets.geojson\"\ntype = \"dam\"\n"
+                                             "height_m = 6\ncapacity_kj = 50000\n");
   const SceneFile s = LoadScene((dir / "scene.toml").string());
   ASSERT_EQ(s.scene.barriers.size(), 2u);
   EXPECT_EQ(s.scene.barriers[0].name, "upper");

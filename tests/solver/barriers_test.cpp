@@ -2,8 +2,8 @@
 // against closed forms: a cube sliding on flat ground with constant Coulomb friction mu and no
 // viscous term decelerates at mu g, so its kinetic energy after a distance d is
 // E(d) = E0 - mu m g d and it stops after E0 / (mu m g) (Coulomb's law; DESIGN.md section 2 with
-// mu_min = mu_max). A barrier at distance d that stops it leaves it at d; one it breaks through takes
-// its capacity C, so it stops C / (mu m g) short of where it would have stopped without the
+// mu_min = mu_max). A barrier at distance d that stops it leaves it at d; one it breaks through
+// takes its capacity C, so it stops C / (mu m g) short of where it would have stopped without the
 // barrier. A cube in free flight over a barrier lower than it passes unchanged, bit for bit.
 
 #include "solver/barriers.hpp"
@@ -170,9 +170,10 @@ TEST(Barriers, CubeFlyingAboveTheBarrierPassesBitForBitUnchanged) {
 }
 
 // Contacts never add energy; neither does a barrier. Random tumbling rocks down a 40 deg incline
-// through a 0.5 m net of 25 kJ (of the 12, some overtop it, some are stopped, most break through): the runs with and without it are the same step for step up to the
-// crossing (the same bits), and in the step that crosses, and in every event, the rock with the
-// barrier has no more kinetic energy than without it.
+// through a 0.5 m net of 25 kJ (of the 12, some overtop it, some are stopped, most break through):
+// the runs with and without it are the same step for step up to the crossing (the same bits), and
+// in the step that crosses, and in every event, the rock with the barrier has no more kinetic
+// energy than without it.
 TEST(Barriers, NoBarrierAddsEnergy) {
   Scene scene = scenes::Incline(40, MakeRockShape(MakeBox(0.8, 0.6, 0.4), kDensity),
                                 GroundParams{0.35, 2.0, 150, 2, 0.6});
