@@ -159,6 +159,8 @@ ResourceEstimate EstimateResources(const SceneFile& scene, int threads) {
     e.disk.push_back({"barriers.csv", rows * kBarriersCsvBytesPerRow, fewer});
     e.memory.push_back(
         {"barrier values behind the summary", rows * 3 * sizeof(double) * kVectorGrowth, fewer});
+    if (output.geopackage)
+      e.disk.push_back({"rocks.gpkg barrier_impacts", rows * kGeoPackageBytesPerRock, fewer});
   }
   if (output.geopackage)
     e.disk.push_back({"rocks.gpkg",
