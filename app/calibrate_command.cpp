@@ -344,21 +344,21 @@ int RunCalibrate(const CalibrateArgs& args, const Processes& processes) {
 
 // Counts of an ensemble report as bytes, and back.
 std::string CountsBytes(const ensemble::EnsembleReport& r) {
-  const std::array<long, 9> counts = {
-      r.rocks,  r.by_end[0],         r.by_end[1], r.by_end[2],        r.by_end[3],
-      r.raised, r.stayed_at_release, r.steps,     r.unconverged_steps};
+  const std::array<long, 10> counts = {
+      r.rocks,     r.by_end[0], r.by_end[1],         r.by_end[2], r.by_end[3],
+      r.by_end[4], r.raised,    r.stayed_at_release, r.steps,     r.unconverged_steps};
   return std::string(reinterpret_cast<const char*>(counts.data()), sizeof counts);
 }
 ensemble::EnsembleReport ReportOfCounts(const std::string& bytes) {
-  std::array<long, 9> c{};
+  std::array<long, 10> c{};
   std::memcpy(c.data(), bytes.data(), sizeof c);
   ensemble::EnsembleReport r;
   r.rocks = c[0];
-  r.by_end = {c[1], c[2], c[3], c[4]};
-  r.raised = c[5];
-  r.stayed_at_release = c[6];
-  r.steps = c[7];
-  r.unconverged_steps = c[8];
+  r.by_end = {c[1], c[2], c[3], c[4], c[5]};
+  r.raised = c[6];
+  r.stayed_at_release = c[7];
+  r.steps = c[8];
+  r.unconverged_steps = c[9];
   return r;
 }
 

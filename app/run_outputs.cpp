@@ -10,6 +10,7 @@
 
 #include "app/interrupt.hpp"
 #include "common/error.hpp"
+#include "io/barriers_csv.hpp"
 #include "io/evaluation_lines_csv.hpp"
 #include "io/geopackage.hpp"
 #include "io/quicklook.hpp"
@@ -25,18 +26,24 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// Streams each finished rock to rocks.csv, trajectories.h5 and evaluation_lines.csv.
-// Keeps the horizontal paths of the quick-look's sample rocks.
+// Streams each finished rock to rocks.csv, trajectories.h5, evaluation_lines.csv and
+// barriers.csv. Keeps the horizontal paths of the quick-look's sample rocks.
 class FileSink : public ensemble::RockSink {
  public:
   FileSink(io::RocksCsvWriter& csv, io::TrajectoryWriter* trajectories,
-           io::EvaluationLinesCsvWriter* lines, std::function<bool(long)> sample)
-      : csv_(csv), trajectories_(trajectories), lines_(lines), sample_(std::move(sample)) {}
+           io::EvaluationLinesCsvWriter* lines, io::BarriersCsvWriter* barriers,
+           std::function<bool(long)> sample)
+      : csv_(csv),
+        trajectories_(trajectories),
+        lines_(lines),
+        barriers_(barriers),
+        sample_(std::move(sample)) {}
   void OnRock(const ensemble::RockOutcome& rock) override {
     ThrowIfInterrupted();
     csv_.Write(rock);
     if (trajectories_) trajectories_->Write(rock);
     if (lines_) lines_->Write(rock);
+    if (barriers_) barriers_->Write(rock);
     if (sample_ && sample_(rock.rock)) {
       io::SamplePath& path = paths.emplace_back();
       path.rock = rock.rock;
@@ -50,6 +57,7 @@ class FileSink : public ensemble::RockSink {
   io::RocksCsvWriter& csv_;
   io::TrajectoryWriter* trajectories_;
   io::EvaluationLinesCsvWriter* lines_;
+  io::BarriersCsvWriter* barriers_;
   std::function<bool(long)> sample_;
 };
 
@@ -102,9 +110,19 @@ std::vector<std::string> WriteSummaryOutputs(const io::SceneFile& scene,
                         io::EvaluationLinesSummaryCsv(lines));
     outputs.push_back("evaluation_lines_summary.csv");
   }
+  // Barriers: summarised from the complete barriers.csv.
+  std::vector<io::BarrierSummary> barriers;
+  if (!scene.scene.barriers.empty()) {
+    barriers =
+        io::SummarizeBarriers(staging.path("barriers.csv"), scene.scene.barriers, report.rocks);
+    WriteFileAtomically(staging.path("barriers_summary.csv"), io::BarriersSummaryCsv(barriers));
+    outputs.push_back("barriers_summary.csv");
+  }
   std::vector<io::MapLine> map_lines;
   for (const ensemble::EvaluationLine& line : scene.evaluation_lines)
     map_lines.push_back({line.name, line.vertices_m});
+  for (const Barrier& barrier : scene.scene.barriers)
+    map_lines.push_back({barrier.name, barrier.vertices_m});
   std::vector<std::vector<Eigen::Vector2d>> xy;
   for (const io::SamplePath& p : paths) xy.push_back(p.xy_m);
   if (scene.output.quicklook) {
@@ -117,12 +135,13 @@ std::vector<std::string> WriteSummaryOutputs(const io::SceneFile& scene,
     io::WriteRocksGeoPackage(
         staging.path("rocks.gpkg"), staging.path("rocks.csv"),
         scene.output.trajectories ? staging.path("trajectories.h5") : std::string(), scene.crs_wkt,
-        scene.evaluation_lines.empty() ? std::string() : staging.path("evaluation_lines.csv"));
+        scene.evaluation_lines.empty() ? std::string() : staging.path("evaluation_lines.csv"),
+        scene.scene.barriers.empty() ? std::string() : staging.path("barriers.csv"));
     outputs.push_back("rocks.gpkg");
   }
   if (scene.output.report) outputs.push_back("report.html");
   const std::string summary =
-      io::SummaryJson(scene, report, kVersion, outputs, lines, self_check);
+      io::SummaryJson(scene, report, kVersion, outputs, lines, self_check, barriers);
   if (scene.output.report) {
     ThrowIfInterrupted();
     io::RunReportInput page;
@@ -168,10 +187,21 @@ bool QuickLookSample(const ensemble::ReleaseSpec& release, long rock) {
 }
 
 std::vector<std::string> TalusOutputNames() {
-  std::vector<std::string> names = {
-      "rocks.csv",    "trajectories.h5",       "summary.json", "quicklook.png", "passages.tif",
-      "deposits.tif", "reach_probability.tif", "partial.json", "partial.bin",   "report.html",
-      "rocks.gpkg",     "evaluation_lines.csv", "evaluation_lines_summary.csv"};
+  std::vector<std::string> names = {"rocks.csv",
+                                    "trajectories.h5",
+                                    "summary.json",
+                                    "quicklook.png",
+                                    "passages.tif",
+                                    "deposits.tif",
+                                    "reach_probability.tif",
+                                    "partial.json",
+                                    "partial.bin",
+                                    "report.html",
+                                    "rocks.gpkg",
+                                    "evaluation_lines.csv",
+                                    "evaluation_lines_summary.csv",
+                                    "barriers.csv",
+                                    "barriers_summary.csv"};
   for (const char* quantity : {"speed", "energy", "jump_height"}) {
     for (const char* statistic : {"max", "mean"})
       names.push_back(std::string(quantity) + "_" + statistic + ".tif");
@@ -217,12 +247,19 @@ std::vector<std::string> RunIntoStaging(const io::SceneFile& scene, int threads,
                                                            scene.evaluation_lines, scene.release);
     outputs.push_back("evaluation_lines.csv");
   }
-  FileSink sink(csv, trajectories.get(), lines.get(), options.sample_trajectories);
+  std::unique_ptr<io::BarriersCsvWriter> barriers;
+  if (!scene.scene.barriers.empty()) {
+    barriers = std::make_unique<io::BarriersCsvWriter>(staging.path("barriers.csv"),
+                                                       scene.scene.barriers, scene.release);
+    outputs.push_back("barriers.csv");
+  }
+  FileSink sink(csv, trajectories.get(), lines.get(), barriers.get(), options.sample_trajectories);
   *report = ensemble::RunEnsemble(scene.scene, scene.release, options, &sink);
   ThrowIfInterrupted();
   csv.Commit();
   if (trajectories) trajectories->Commit();
   if (lines) lines->Commit();
+  if (barriers) barriers->Commit();
   if (!part)
     return WriteSummaryOutputs(scene, *report, report->rasters, sink.paths, staging, outputs,
                                self_check);
@@ -274,6 +311,17 @@ std::vector<std::string> MergeIntoStaging(const io::SceneFile& scene,
     csv.close();
     if (!csv) throw std::runtime_error("cannot write " + staging.path("evaluation_lines.csv"));
     outputs.push_back("evaluation_lines.csv");
+  }
+  if (!scene.scene.barriers.empty()) {
+    std::ofstream csv(staging.path("barriers.csv"), std::ios::binary);
+    for (std::size_t k = 0; k < parts.size(); ++k) {
+      ThrowIfInterrupted();
+      AppendCsv((fs::path(parts[k].dir) / "barriers.csv").string(), k > 0,
+                io::BarriersCsvWriter::Header(), csv);
+    }
+    csv.close();
+    if (!csv) throw std::runtime_error("cannot write " + staging.path("barriers.csv"));
+    outputs.push_back("barriers.csv");
   }
   const ensemble::RasterRequest request = scene.output.Request(scene.scene.terrain.heights().grid);
   std::optional<ensemble::RasterAccumulator> rasters;

@@ -60,8 +60,8 @@ class StepKinds : public talus::StepObserver {
   }
   long steps = 0, contact = 0, clear = 0;
   std::array<Tally, kContactGroups> by_contacts{};
-  std::array<Tally, 4> by_end{};  // indexed by talus::EndReason
-  std::array<int, 4> rocks_by_end{};
+  std::array<Tally, talus::kEndReasons> by_end{};  // indexed by talus::EndReason
+  std::array<int, talus::kEndReasons> rocks_by_end{};
 
  private:
   Tally rock;
@@ -124,8 +124,9 @@ void PrintContactWork(const StepKinds& k) {
     t.steps = t.contact_steps;  // a group's steps are its solves
     PrintTally(names[g], t, k, solved.contact_steps, solved.sweeps);
   }
-  for (talus::EndReason end : {talus::EndReason::kRest, talus::EndReason::kLeftDomain,
-                               talus::EndReason::kMaxTime, talus::EndReason::kFailed}) {
+  for (talus::EndReason end :
+       {talus::EndReason::kRest, talus::EndReason::kLeftDomain, talus::EndReason::kMaxTime,
+        talus::EndReason::kFailed, talus::EndReason::kBarrier}) {
     const int e = static_cast<int>(end);
     if (k.rocks_by_end[e] == 0) continue;
     const std::string name = std::string("rocks ending ") + talus::ToString(end) + " (" +

@@ -8,21 +8,6 @@
 namespace talus::ensemble {
 namespace {
 
-// Where the step a -> b crosses the segment p -> q: the fraction along a -> b, or -1. The step is
-// half-open at its start (a rock that ends a step on the segment crossed it in that step, not in
-// the next one); the segment is closed, or half-open at q when `open_end`.
-double SegmentCrossing(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& p,
-                       const Eigen::Vector2d& q, bool open_end) {
-  const Eigen::Vector2d r = b - a, s = q - p;
-  const double denominator = r.x() * s.y() - r.y() * s.x();
-  if (denominator == 0) return -1;  // parallel (or a zero-length step or segment): no crossing
-  const Eigen::Vector2d d = p - a;
-  const double t = (d.x() * s.y() - d.y() * s.x()) / denominator;
-  const double u = (d.x() * r.y() - d.y() * r.x()) / denominator;
-  const bool on_segment = u >= 0 && (open_end ? u < 1 : u <= 1);
-  return t > 0 && t <= 1 && on_segment ? t : -1;
-}
-
 struct Box {
   Eigen::Vector2d lo, hi;
   bool Overlaps(const Box& o) const {
@@ -44,11 +29,6 @@ struct PreparedLines {
   std::shared_ptr<const std::vector<EvaluationLine>> lines;
   std::vector<Box> boxes;
 };
-
-double RotationalEnergy(const RockShape& shape, const RockState& s) {
-  const Eigen::Vector3d& w = s.angular_velocity_rad_s;
-  return 0.5 * w.dot(shape.inertia_kg_m2.cwiseProduct(w));
-}
 
 class EvaluationLineRecorder : public RockRecorder {
  public:
@@ -94,32 +74,16 @@ class EvaluationLineRecorder : public RockRecorder {
  private:
   // The crossing at fraction f of the step s0 -> s1 (ground_m: the terrain under s1).
   LineCrossing At(const RockState& s0, const RockState& s1, double ground_m, double f) const {
+    const PointOnStep p =
+        PointAlongStep(terrain_, *shape_, s0, previous_ground_m_, s1, ground_m, f);
     LineCrossing c;
-    c.t_s = s0.time_s + f * (s1.time_s - s0.time_s);
-    c.position_m = s0.position_m + f * (s1.position_m - s0.position_m);
-    const Eigen::Vector3d v = s0.velocity_m_s + f * (s1.velocity_m_s - s0.velocity_m_s);
-    c.speed_m_s = v.norm();
-    c.translational_energy_J = 0.5 * shape_->mass_kg * v.squaredNorm();
-    const double e0 = RotationalEnergy(*shape_, s0), e1 = RotationalEnergy(*shape_, s1);
-    c.rotational_energy_J = e0 + f * (e1 - e0);
-    double here_m = 0;
-    if (!terrain_.Height(c.position_m.x(), c.position_m.y(), &here_m)) {
-      // A nodata cell between two valid ends of the step: the terrain between them.
-      const double g0 = std::isnan(previous_ground_m_) ? ground_m : previous_ground_m_;
-      here_m = g0 + f * (ground_m - g0);
-    }
-    c.com_height_m = c.position_m.z() - here_m;
-    // Clearance: the lowest vertex above the terrain under it (under the centre of mass for a
-    // vertex off the DEM), in the orientation interpolated along the step.
-    const Eigen::Matrix3d rotation = s0.orientation.slerp(f, s1.orientation).toRotationMatrix();
-    double clearance = std::numeric_limits<double>::infinity();
-    for (const Eigen::Vector3d& vertex : shape_->vertices_m) {
-      const Eigen::Vector3d x = c.position_m + rotation * vertex;
-      double under_m = here_m;
-      terrain_.Height(x.x(), x.y(), &under_m);
-      clearance = std::min(clearance, x.z() - under_m);
-    }
-    c.bounce_height_m = std::max(0.0, clearance);
+    c.t_s = p.t_s;
+    c.position_m = p.position_m;
+    c.speed_m_s = p.velocity_m_s.norm();
+    c.translational_energy_J = 0.5 * shape_->mass_kg * p.velocity_m_s.squaredNorm();
+    c.rotational_energy_J = p.rotational_energy_J;
+    c.com_height_m = p.com_height_m;
+    c.bounce_height_m = p.clearance_m;
     return c;
   }
 
@@ -133,18 +97,6 @@ class EvaluationLineRecorder : public RockRecorder {
 };
 
 }  // namespace
-
-StepCrossing CrossPolyline(const Eigen::Vector2d& a, const Eigen::Vector2d& b,
-                           const std::vector<Eigen::Vector2d>& polyline) {
-  StepCrossing out;
-  for (std::size_t k = 1; k < polyline.size(); ++k) {
-    const double t = SegmentCrossing(a, b, polyline[k - 1], polyline[k], k + 1 < polyline.size());
-    if (t < 0) continue;
-    ++out.count;
-    if (out.fraction < 0 || t < out.fraction) out.fraction = t;
-  }
-  return out;
-}
 
 double EvaluationLine::length_m() const {
   double length = 0;

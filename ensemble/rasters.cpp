@@ -99,7 +99,8 @@ void FootprintRecorder::Finish(RockOutcome& outcome) {
   outcome.footprint = std::move(footprint_);
   footprint_ = Footprint{};
   const RockResult& result = outcome.result;
-  if (result.end == EndReason::kRest)
+  // At rest where it ended: on the ground, or held by a barrier at its line.
+  if (result.end == EndReason::kRest || result.end == EndReason::kBarrier)
     outcome.footprint.deposit_cell =
         CellOf(result.final_state.position_m.x(), result.final_state.position_m.y());
 }

@@ -64,6 +64,9 @@ std::string EnsembleReport::BriefReport() const {
       rocks, wall_time_s, threads, trajectories_per_s(), count(EndReason::kRest),
       count(EndReason::kLeftDomain), count(EndReason::kMaxTime), count(EndReason::kFailed), raised,
       stayed_at_release);
+  // Only a scene with barriers can have rocks stopped by one.
+  if (const long n = count(EndReason::kBarrier); n > 0)
+    return std::string(line) + "; " + std::to_string(n) + " stopped by barriers";
   return line;
 }
 

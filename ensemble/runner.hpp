@@ -57,7 +57,7 @@ class RockSink {
 
 struct EnsembleReport {
   long rocks = 0;
-  std::array<long, 4> by_end{};  // indexed by EndReason
+  std::array<long, kEndReasons> by_end{};  // indexed by EndReason
   long raised = 0;               // rocks whose start had to be raised above the terrain
   // Rocks whose centre of mass never got further from its start than the rock's length
   // (RockResult::StayedAtRelease): held at release by the ground model, e.g. a slab landing flat

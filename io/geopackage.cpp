@@ -21,11 +21,12 @@ namespace {
 
 constexpr int kFeaturesPerTransaction = 20000;
 
-// The field type of a rocks.csv or evaluation_lines.csv column: counts and indices as integers,
-// names as text, the rest (coordinates, distances, speeds, energies, masses) as reals.
+// The field type of a rocks.csv, evaluation_lines.csv or barriers.csv column: counts and indices
+// as integers, names as text, the rest (coordinates, distances, speeds, energies, masses) as reals.
 OGRFieldType FieldType(const std::string& column) {
   static const char* const integers[] = {"rock", "release", "seed", "crossings"};
-  static const char* const texts[] = {"run", "end", "block", "end_ground", "line"};
+  static const char* const texts[] = {"run",  "end",     "block", "end_ground", "end_barrier",
+                                      "line", "barrier", "type",  "outcome"};
   for (const char* name : integers)
     if (column == name) return OFTInteger64;
   for (const char* name : texts)
@@ -147,7 +148,8 @@ void PointLayer(Writer& out, const char* name, const std::string& csv, const cha
 
 void WriteRocksGeoPackage(const std::string& path, const std::string& rocks_csv,
                           const std::string& trajectories_h5, const std::string& crs_wkt,
-                          const std::string& evaluation_lines_csv) {
+                          const std::string& evaluation_lines_csv,
+                          const std::string& barriers_csv) {
   const FixedGpkgDate fixed_date;
   AtomicFile file(path);
   Writer out(path, file.temp_path(), crs_wkt);
@@ -155,6 +157,8 @@ void WriteRocksGeoPackage(const std::string& path, const std::string& rocks_csv,
   PointLayer(out, "end_points", rocks_csv, "x_end", "y_end", "z_end");
   if (!evaluation_lines_csv.empty())
     PointLayer(out, "evaluation_crossings", evaluation_lines_csv, "x_m", "y_m", "z_m");
+  if (!barriers_csv.empty())
+    PointLayer(out, "barrier_impacts", barriers_csv, "x_m", "y_m", "z_m");
 
   std::vector<std::string> fields;
   if (!trajectories_h5.empty()) {

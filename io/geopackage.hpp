@@ -13,11 +13,13 @@
 namespace talus::io {
 
 // Writes the GeoPackage atomically. `trajectories_h5` empty: no `paths` layer;
-// `evaluation_lines_csv` empty: no `evaluation_crossings` layer. `crs_wkt` empty: local
+// `evaluation_lines_csv` empty: no `evaluation_crossings` layer; `barriers_csv` empty: no
+// `barrier_impacts` layer (a point per row of barriers.csv). `crs_wkt` empty: local
 // coordinates in metres (the analytic plane), an engineering CRS. Throws std::runtime_error naming
 // the file and the reason, and InputError for a CSV file it cannot read.
 void WriteRocksGeoPackage(const std::string& path, const std::string& rocks_csv,
                           const std::string& trajectories_h5, const std::string& crs_wkt,
-                          const std::string& evaluation_lines_csv = "");
+                          const std::string& evaluation_lines_csv = "",
+                          const std::string& barriers_csv = "");
 
 }  // namespace talus::io

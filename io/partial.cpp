@@ -12,6 +12,7 @@
 #include "common/csv_table.hpp"
 #include "common/error.hpp"
 #include "common/fnv1a.hpp"
+#include "io/barriers_csv.hpp"
 #include "io/evaluation_lines_csv.hpp"
 #include "io/rocks_csv.hpp"
 
@@ -19,7 +20,9 @@ namespace talus::io {
 namespace {
 
 constexpr const char* kFormat = "talus partial result";
-constexpr int kFormatVersion = 2;  // 2: the files' sizes and checksums
+// 2: the files' sizes and checksums; 3: the ending "barrier", rocks.csv's end_barrier column and
+// barriers.csv.
+constexpr int kFormatVersion = 3;
 constexpr const char* kStateMagic = "talus partial state 1";
 
 std::string ReadWholeFile(const std::string& path) {
@@ -160,7 +163,7 @@ PartialInfo ReadPartialInfo(const std::string& dir) {
     p.end_rock = j.at("end_rock");
     p.trajectories = j.at("trajectories");
     p.counts.rocks = j.at("rocks");
-    p.counts.by_end = j.at("ends").get<std::array<long, 4>>();
+    p.counts.by_end = j.at("ends").get<decltype(p.counts.by_end)>();
     p.counts.raised = j.at("raised_at_release");
     p.counts.stayed_at_release = j.at("stayed_at_release");
     p.counts.steps = j.at("steps");
@@ -204,8 +207,8 @@ void CheckPartFiles(const PartialInfo& part) {
                        " bytes with " + want.fnv1a64 +
                        ": changed or damaged since the part was run");
   }
-  // The rows: rocks.csv has each rock of the part once, in order; evaluation_lines.csv only rocks
-  // of the part, in order.
+  // The rows: rocks.csv has each rock of the part once, in order; evaluation_lines.csv and
+  // barriers.csv only rocks of the part, in order.
   const std::string range = "the part holds rocks " + Range(part.first_rock, part.end_rock);
   const std::string rocks_csv = (std::filesystem::path(part.dir) / "rocks.csv").string();
   long next = part.first_rock;
@@ -219,10 +222,13 @@ void CheckPartFiles(const PartialInfo& part) {
   if (next != part.end_rock)
     throw InputError(rocks_csv + ": no row of rock " + std::to_string(next) + " or later (" +
                      range + ")");
-  if (part.files.count("evaluation_lines.csv")) {
+  for (const auto& [name, header] :
+       {std::pair{"evaluation_lines.csv", EvaluationLinesCsvWriter::Header()},
+        std::pair{"barriers.csv", BarriersCsvWriter::Header()}}) {
+    if (!part.files.count(name)) continue;
     long last = part.first_rock;
-    CheckRockColumn((std::filesystem::path(part.dir) / "evaluation_lines.csv").string(),
-                    EvaluationLinesCsvWriter::Header(), [&](long rock) -> std::string {
+    CheckRockColumn((std::filesystem::path(part.dir) / name).string(), header,
+                    [&](long rock) -> std::string {
                       if (rock < last || rock >= part.end_rock)
                         return "rock " + std::to_string(rock) +
                                " out of order or not of the part (" + range + ")";

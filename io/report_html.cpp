@@ -183,10 +183,11 @@ std::string WhatRanSection(const Json& summary) {
   html += WarningsSection(summary);
 
   html += "<h2>What ran</h2>\n";
-  html += KeyValueTable(
-      summary, {"ends", "raised_at_release", "stayed_at_release", "steps", "unconverged_steps",
-                "threads", "wall_time_s", "trajectories_per_s", "outputs", "blocks",
-                "talus_version", "inputs_hash_fnv1a64", "evaluation_lines", "warnings"});
+  html +=
+      KeyValueTable(summary, {"ends", "raised_at_release", "stayed_at_release", "steps",
+                              "unconverged_steps", "threads", "wall_time_s", "trajectories_per_s",
+                              "outputs", "blocks", "talus_version", "inputs_hash_fnv1a64",
+                              "evaluation_lines", "barriers", "warnings"});
   if (summary.contains("rock") && summary["rock"].is_object()) {
     html += "<h3>Rock</h3>\n";
     html += KeyValueTable(summary["rock"]);
@@ -310,6 +311,52 @@ std::string EvaluationLinesSection(const Json& summary) {
   return html;
 }
 
+// "Barriers": what each barrier did to the rocks that reached it, and the energies and heights
+// there ("" without barriers).
+std::string BarriersSection(const Json& summary) {
+  if (!summary.contains("barriers") || !summary["barriers"].is_array()) return "";
+  const Json& barriers = summary["barriers"];
+  const auto number = [](const Json& v) {
+    return v.is_number() ? v.get<double>() : std::numeric_limits<double>::quiet_NaN();
+  };
+  std::string html =
+      "<h2>Barriers</h2>\n<table>\n<tr><th>barrier</th><th>type</th><th>height (m)</th>"
+      "<th>capacity (kJ)</th><th>rocks</th><th>reached</th><th>stopped</th><th>overtopped</th>"
+      "<th>broke through</th><th>passing probability</th></tr>\n";
+  for (const Json& b : barriers)
+    Add(html, "<tr><th>", Cell(b["name"]), "</th><td>", Cell(b["type"]), "</td><td>",
+        Cell(b["height_m"]), "</td><td>", Number(1e-3 * number(b["capacity_J"]), "%.0f"),
+        "</td><td>", Cell(b["rocks"]), "</td><td>", Cell(b["reached"]), "</td><td>",
+        Cell(b["stopped"]), "</td><td>", Cell(b["overtopped"]), "</td><td>",
+        Cell(b["broke_through"]), "</td><td>",
+        Number(100 * number(b["passing_probability"]), "%.1f"), " %</td></tr>\n");
+  html += "</table>\n";
+  const std::pair<const char*, const char*> quantities[] = {
+      {"impact_energy_J", "kinetic energy at the barrier (kJ)"},
+      {"passing_height_m", "passing height (m)"},
+      {"passing_energy_J", "kinetic energy of the rocks that passed, after it (kJ)"}};
+  for (const Json& b : barriers) {
+    Add(html, "<h3>", Cell(b["name"]),
+        "</h3>\n<table>\n<tr><th></th><th>mean</th>"
+        "<th>median</th><th>90 %</th><th>95 %</th><th>99 %</th><th>largest</th></tr>\n");
+    for (const auto& [key, label] : quantities) {
+      Add(html, "<tr><th>", label, "</th>");
+      const double scale = std::string(key) == "passing_height_m" ? 1.0 : 1e-3;
+      for (const char* statistic : {"mean", "p50", "p90", "p95", "p99", "max"})
+        Add(html, "<td>", Number(scale * number(b[key][statistic])), "</td>");
+      html += "</tr>\n";
+    }
+    html += "</table>\n";
+  }
+  html +=
+      "<p class=\"note\">Over the rocks that reached each barrier (barriers.csv), at the first "
+      "crossing of its line by the centre of mass: a rock whose lowest point passed higher than "
+      "the barrier overtopped it; one with at most the capacity's kinetic energy was stopped; "
+      "the others broke through with their energy less the capacity (docs/model.md, "
+      "\"Barriers\"). Percentiles are nearest-rank.</p>\n";
+  return html;
+}
+
 // The ground table, the solver options and the files, as summary.json has them; the page's end.
 std::string SettingsSection(const Json& summary) {
   std::string html;
@@ -336,7 +383,7 @@ std::string RunReportHtml(const RunReportInput& input) {
   const Json summary = Json::parse(input.summary_json);
   return WhatRanSection(summary) + EndingsSection(summary) + MapsSection(input) +
          DistributionsSection(input.rocks) + EvaluationLinesSection(summary) +
-         SettingsSection(summary);
+         BarriersSection(summary) + SettingsSection(summary);
 }
 
 }  // namespace talus::io

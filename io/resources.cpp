@@ -30,6 +30,9 @@ constexpr double kTrajectoryBytesPerSample = 84;
 constexpr double kRocksCsvBytesPerRow = 150;
 // A row of evaluation_lines.csv (cases/tirol, two lines: 260 rows, 35 934 bytes, 138 per row).
 constexpr double kEvaluationLinesCsvBytesPerRow = 150;
+// A row of barriers.csv (cases/tirol/scene_net.toml, 1000 rocks: 371 rows, 60 640 bytes, 163 per
+// row; 180 with longer names).
+constexpr double kBarriersCsvBytesPerRow = 180;
 // rocks.gpkg: an end point with its fields and spatial index; a path's vertex (x, y, z) and per
 // path its row and index (1000 rocks on a plane: 2.26 MB, 1.46 MB of it path geometry, 61 vertices
 // each).
@@ -148,6 +151,16 @@ ResourceEstimate EstimateResources(const SceneFile& scene, int threads) {
                         rows * 4 * sizeof(double) * kVectorGrowth, fewer});
     if (output.geopackage)
       e.disk.push_back({"rocks.gpkg evaluation_crossings", rows * kGeoPackageBytesPerRock, fewer});
+  }
+  if (!scene.scene.barriers.empty()) {
+    // At most a row per rock and barrier; the summary holds three numbers per row.
+    const double rows = rocks * double(scene.scene.barriers.size());
+    const char* fewer = "fewer rocks (--rocks) or fewer barriers";
+    e.disk.push_back({"barriers.csv", rows * kBarriersCsvBytesPerRow, fewer});
+    e.memory.push_back(
+        {"barrier values behind the summary", rows * 3 * sizeof(double) * kVectorGrowth, fewer});
+    if (output.geopackage)
+      e.disk.push_back({"rocks.gpkg barrier_impacts", rows * kGeoPackageBytesPerRock, fewer});
   }
   if (output.geopackage)
     e.disk.push_back({"rocks.gpkg",

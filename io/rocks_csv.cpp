@@ -19,7 +19,7 @@ std::string CsvField(const std::string& text) {
 const char* RocksCsvWriter::Header() {
   return "rock,release,run,seed,end,x_end,y_end,z_end,runout_m,path_length_m,travel_time_s,"
          "max_speed_m_s,max_kinetic_energy_j,max_jump_height_m,max_angular_speed_rad_s,max_scar_m,"
-         "block,mass_kg,x_start,y_start,z_start,travel_angle_deg,end_ground";
+         "block,mass_kg,x_start,y_start,z_start,travel_angle_deg,end_ground,end_barrier";
 }
 
 RocksCsvWriter::RocksCsvWriter(const std::string& path, const Scene& scene,
@@ -57,6 +57,9 @@ RockRow RockRowOf(const ensemble::RockOutcome& rock, const Scene& scene,
   row.z_start = start.z();
   row.travel_angle_deg = std::atan2(start.z() - end.z(), r.runout_m) * 180.0 / std::numbers::pi;
   row.end_ground = scene.ground.category(scene.terrain.GroundAt(end.x(), end.y())).name;
+  // The barrier that stopped it (the last it met), empty for every other ending.
+  if (r.end == EndReason::kBarrier && !r.barrier_events.empty())
+    row.end_barrier = scene.barriers[static_cast<std::size_t>(r.barrier_events.back().barrier)].name;
   return row;
 }
 
@@ -65,12 +68,12 @@ void RocksCsvWriter::Write(const ensemble::RockOutcome& rock) {
   std::fprintf(
       file_.get(),
       "%ld,%d,%s,%llu,%s,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,"
-      "%s,%.10g,%.10g,%.10g,%.10g,%.10g,%s\n",
+      "%s,%.10g,%.10g,%.10g,%.10g,%.10g,%s,%s\n",
       r.rock, r.release, CsvField(r.run).c_str(), static_cast<unsigned long long>(r.seed), r.end,
       r.x_end, r.y_end, r.z_end, r.runout_m, r.path_length_m, r.travel_time_s, r.max_speed_m_s,
       r.max_kinetic_energy_j, r.max_jump_height_m, r.max_angular_speed_rad_s, r.max_scar_m,
       CsvField(r.block).c_str(), r.mass_kg, r.x_start, r.y_start, r.z_start, r.travel_angle_deg,
-      CsvField(r.end_ground).c_str());
+      CsvField(r.end_ground).c_str(), CsvField(r.end_barrier).c_str());
 }
 
 void RocksCsvWriter::Commit() { file_.Commit(); }

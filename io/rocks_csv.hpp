@@ -31,6 +31,7 @@ struct RockRow {
   double x_start = 0, y_start = 0, z_start = 0;
   double travel_angle_deg = 0;  // of the centre of mass, release to end (Fahrboeschung)
   std::string end_ground;       // the ground category where it ended
+  std::string end_barrier;      // the barrier that stopped it (ending "barrier"); "" otherwise
 };
 
 // The row of `rock`; `scene` and `release` are those it ran with.

@@ -238,9 +238,9 @@ namespace {
 SceneFile LoadSceneTable(const toml::table& root, const std::string& path,
                          const std::string* text) {
   const Context context(path);
-  const Section top(
-      context, &root, "",
-      {"terrain", "ground", "rock", "blocks", "release", "evaluation_lines", "solver", "output"});
+  const Section top(context, &root, "",
+                    {"terrain", "ground", "rock", "blocks", "release", "evaluation_lines",
+                     "barriers", "solver", "output"});
   for (const char* required : {"terrain", "release"})
     if (!root.get(required))
       context.Fail(nullptr, required, std::string("missing table [") + required + "]");
@@ -282,6 +282,7 @@ SceneFile LoadSceneTable(const toml::table& root, const std::string& path,
       Section(context, SubTable(context, root, "evaluation_lines"), "evaluation_lines",
               {"lines", "names", "file", "name_field"}),
       out);
+  scene_tables::LoadBarriers(context, root.get("barriers"), out);
   const Section solver(context, SubTable(context, root, "solver"), "solver", SolverKeys());
   LoadSolver(solver, out.scene.options, out.solver_preset, out.solver_keys_given);
   // A run's own check of its time step (talus simulate --self-check N): 0, or 2 .. the run's rocks

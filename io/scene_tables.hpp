@@ -2,7 +2,8 @@
 // The tables of a scene file (docs/scenes.md), each read by its own function: the driver
 // (LoadScene), [ground], [solver] and [output] in scene_file.cpp; [terrain] in scene_terrain.cpp;
 // [rock] and [blocks] in scene_rock.cpp; [release], with run tables and single-impact tables, in
-// scene_release.cpp; [evaluation_lines] in scene_evaluation_lines.cpp. Also the bounds of
+// scene_release.cpp; [evaluation_lines] in scene_evaluation_lines.cpp; [[barriers]] in
+// scene_barriers.cpp. Also the bounds of
 // plausible input and the messages they share. Internal to io/: include it from .cpp files only
 // (it brings in toml++).
 
@@ -59,5 +60,8 @@ void LoadBlocks(const Context& context, const toml::table* table, SceneFile& out
 void LoadRelease(const Context& context, const Section& s, SceneFile& out);
 // [evaluation_lines]: the lines where crossing rocks are recorded (nothing without the table).
 void LoadEvaluationLines(const Context& context, const Section& s, SceneFile& out);
+// [[barriers]]: the barriers that act on the rocks, into out.scene.barriers (nothing when `node`,
+// the scene's "barriers", is null).
+void LoadBarriers(const Context& context, const toml::node* node, SceneFile& out);
 
 }  // namespace talus::io::scene_tables

@@ -70,6 +70,31 @@ nlohmann::ordered_json EvaluationLineJson(const EvaluationLineSummary& s) {
   return j;
 }
 
+// One barrier's summary (barriers_summary.csv's numbers; NaN, no rock counted, is null).
+nlohmann::ordered_json BarrierJson(const BarrierSummary& s) {
+  nlohmann::ordered_json j = {{"name", s.name},
+                              {"type", s.type},
+                              {"length_m", s.length_m},
+                              {"height_m", s.height_m},
+                              {"capacity_J", s.capacity_J},
+                              {"rocks", s.rocks},
+                              {"reached", s.reached},
+                              {"stopped", s.stopped},
+                              {"overtopped", s.overtopped},
+                              {"broke_through", s.broke_through},
+                              {"reach_probability", s.reach_probability},
+                              {"passing_probability", s.passing_probability}};
+  for (const auto& [key, statistics] : {std::pair{"impact_energy_J", &s.impact_energy_J},
+                                        std::pair{"passing_height_m", &s.passing_height_m},
+                                        std::pair{"passing_energy_J", &s.passing_energy_J}}) {
+    nlohmann::ordered_json q = nlohmann::ordered_json::object();
+    for (std::size_t k = 0; k < CrossingStatistics::kNames.size(); ++k)
+      q[CrossingStatistics::kNames[k]] = statistics->values[k];
+    j[key] = q;
+  }
+  return j;
+}
+
 }  // namespace
 
 std::string GroundTableJson(const GroundTable& table) { return GroundJson(table).dump(); }
@@ -104,7 +129,8 @@ nlohmann::ordered_json SelfCheckJson(const ensemble::SelfCheckReport& r) {
 std::string SummaryJson(const SceneFile& scene, const ensemble::EnsembleReport& report,
                         const std::string& version, const std::vector<std::string>& outputs,
                         const std::vector<EvaluationLineSummary>& evaluation_lines,
-                        const ensemble::SelfCheckReport* self_check) {
+                        const ensemble::SelfCheckReport* self_check,
+                        const std::vector<BarrierSummary>& barriers) {
   nlohmann::ordered_json j;
   j["talus_version"] = version;
   j["scene"] = scene.path;
@@ -174,6 +200,7 @@ std::string SummaryJson(const SceneFile& scene, const ensemble::EnsembleReport& 
                {"left_domain", report.count(EndReason::kLeftDomain)},
                {"max_time", report.count(EndReason::kMaxTime)},
                {"failed", report.count(EndReason::kFailed)}};
+  if (!scene.scene.barriers.empty()) j["ends"]["barrier"] = report.count(EndReason::kBarrier);
   j["raised_at_release"] = report.raised;
   // Rocks that never moved further than their own length from the start (held by the ground).
   j["stayed_at_release"] = report.stayed_at_release;
@@ -195,6 +222,11 @@ std::string SummaryJson(const SceneFile& scene, const ensemble::EnsembleReport& 
     nlohmann::ordered_json lines = nlohmann::ordered_json::array();
     for (const EvaluationLineSummary& s : evaluation_lines) lines.push_back(EvaluationLineJson(s));
     j["evaluation_lines"] = lines;
+  }
+  if (!scene.scene.barriers.empty()) {
+    nlohmann::ordered_json list = nlohmann::ordered_json::array();
+    for (const BarrierSummary& s : barriers) list.push_back(BarrierJson(s));
+    j["barriers"] = list;
   }
   if (self_check) j["self_check"] = SelfCheckJson(*self_check);
   j["threads"] = report.threads;

@@ -7,6 +7,7 @@
 
 #include "ensemble/runner.hpp"
 #include "ensemble/self_check.hpp"
+#include "io/barriers_csv.hpp"
 #include "io/evaluation_lines_csv.hpp"
 #include "io/scene_file.hpp"
 
@@ -14,11 +15,13 @@ namespace talus::io {
 
 // The summary as JSON text; `outputs` lists the files written next to it. `evaluation_lines`, the
 // per-line summary of a scene with evaluation lines, goes under "evaluation_lines"; a self-check's
-// report (talus simulate --self-check) under "self_check".
+// report (talus simulate --self-check) under "self_check"; `barriers`, the per-barrier summary of
+// a scene with barriers, under "barriers" (and the ending "barrier" joins "ends").
 std::string SummaryJson(const SceneFile& scene, const ensemble::EnsembleReport& report,
                         const std::string& version, const std::vector<std::string>& outputs,
                         const std::vector<EvaluationLineSummary>& evaluation_lines = {},
-                        const ensemble::SelfCheckReport* self_check = nullptr);
+                        const ensemble::SelfCheckReport* self_check = nullptr,
+                        const std::vector<BarrierSummary>& barriers = {});
 
 // The ground table as used, as summary.json's "ground" holds it, on one line (compact JSON).
 std::string GroundTableJson(const GroundTable& table);

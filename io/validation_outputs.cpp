@@ -60,6 +60,8 @@ std::string ScoresJson(const EventFile& event, const fieldobs::ValidationReport&
                {"left_domain", run.ensemble.count(EndReason::kLeftDomain)},
                {"max_time", run.ensemble.count(EndReason::kMaxTime)},
                {"failed", run.ensemble.count(EndReason::kFailed)}};
+  if (!event.scene.scene.barriers.empty())
+    j["ends"]["barrier"] = run.ensemble.count(EndReason::kBarrier);
   j["observations"] = report.observations.size();
   j["observations_scored"] = report.observations_scored;
   j["not_scored"] = event.not_scored;  // observed values without a simulated counterpart

@@ -200,8 +200,10 @@ class CollectingSink : public ensemble::RockSink {
   void OnRock(const ensemble::RockOutcome& outcome) override {
     rows.push_back(io::RockRowOf(outcome, file_.scene, file_.release));
     if (trajectories_) samples.push_back(outcome.trajectory);
+    for (const BarrierEvent& e : outcome.result.barrier_events) barriers.emplace_back(outcome.rock, e);
   }
   std::vector<io::RockRow> rows;
+  std::vector<std::pair<long, BarrierEvent>> barriers;  // (rock, event) in rock order
   std::vector<std::vector<ensemble::TrajectorySample>> samples;
 
  private:
@@ -214,7 +216,7 @@ py::dict RowsDict(const std::vector<io::RockRow>& rows) {
   const auto n = static_cast<py::ssize_t>(rows.size());
   py::array_t<std::int64_t> rock(n), release(n);
   py::array_t<std::uint64_t> seed(n);
-  std::vector<std::string> run, end, block, end_ground;
+  std::vector<std::string> run, end, block, end_ground, end_barrier;
   struct Column {
     const char* name;
     double io::RockRow::*member;
@@ -248,6 +250,7 @@ py::dict RowsDict(const std::vector<io::RockRow>& rows) {
     end.push_back(r.end);
     block.push_back(r.block);
     end_ground.push_back(r.end_ground);
+    end_barrier.push_back(r.end_barrier);
     for (std::size_t c = 0; c < std::size(kColumns); ++c)
       columns[c].mutable_at(i) = r.*(kColumns[c].member);
   }
@@ -262,14 +265,47 @@ py::dict RowsDict(const std::vector<io::RockRow>& rows) {
   d["block"] = StringArray(block);
   for (std::size_t c = 11; c < std::size(kColumns); ++c) d[kColumns[c].name] = columns[c];
   d["end_ground"] = StringArray(end_ground);
+  d["end_barrier"] = StringArray(end_barrier);
+  return d;
+}
+
+// What each rock did at each barrier it reached, as barriers.csv lists it: one entry per (rock,
+// barrier) in rock order.
+py::dict BarriersDict(const io::SceneFile& file,
+                      const std::vector<std::pair<long, BarrierEvent>>& events) {
+  const auto n = static_cast<py::ssize_t>(events.size());
+  py::array_t<std::int64_t> rock(n);
+  py::array_t<double> t(n), speed(n), energy(n), after(n), height(n);
+  py::array_t<double> position({n, py::ssize_t{3}});
+  std::vector<std::string> barrier, outcome;
+  for (py::ssize_t i = 0; i < n; ++i) {
+    const auto& [r, e] = events[static_cast<std::size_t>(i)];
+    rock.mutable_at(i) = r;
+    barrier.push_back(file.scene.barriers[static_cast<std::size_t>(e.barrier)].name);
+    outcome.push_back(ToString(e.outcome));
+    t.mutable_at(i) = e.t_s;
+    for (py::ssize_t k = 0; k < 3; ++k) position.mutable_at(i, k) = e.position_m[k];
+    speed.mutable_at(i) = e.speed_m_s;
+    energy.mutable_at(i) = e.energy_J();
+    after.mutable_at(i) = e.energy_after_J;
+    height.mutable_at(i) = e.passing_height_m;
+  }
+  py::dict d;
+  d["rock"] = rock;
+  d["barrier"] = StringArray(barrier);
+  d["outcome"] = StringArray(outcome);
+  d["t_s"] = t;
+  d["position_m"] = position;
+  d["speed_m_s"] = speed;
+  d["energy_J"] = energy;
+  d["energy_after_J"] = after;
+  d["passing_height_m"] = height;
   return d;
 }
 
 py::dict CountsDict(const ensemble::EnsembleReport& r) {
   py::dict ends;
-  for (const EndReason end :
-       {EndReason::kRest, EndReason::kLeftDomain, EndReason::kMaxTime, EndReason::kFailed})
-    ends[ToString(end)] = r.count(end);
+  for (int k = 0; k < kEndReasons; ++k) ends[ToString(static_cast<EndReason>(k))] = r.by_end[k];
   py::dict d;
   d["rocks"] = r.rocks;
   d["ends"] = ends;
@@ -346,6 +382,7 @@ py::dict Simulate(const io::SceneFile& file, int threads, const py::object& rock
   out["rocks"] = RowsDict(sink.rows);
   out["counts"] = CountsDict(report);
   out["warnings"] = ensemble::RunWarnings(report, file.scene.options);
+  if (!file.scene.barriers.empty()) out["barriers"] = BarriersDict(file, sink.barriers);
   py::dict raster_dict = RastersDict(file, report.rasters);
   out["rasters"] = raster_dict;
   out["geotransform"] = GeoTransform(file);
@@ -452,7 +489,8 @@ void BindScene(py::module_& m) {
            "Runs the ensemble (or the rocks of a slice) as talus simulate does, with the GIL "
            "released. Returns {'rocks': per-rock arrays under rocks.csv's column names, "
            "'counts', 'warnings', 'rasters': {name: {'values': float32 (ny, nx) north-up, unit, "
-           "...}}, 'geotransform', 'crs_wkt', 'nodata'} and, with trajectories=True, "
+           "...}}, 'geotransform', 'crs_wkt', 'nodata'}, with barriers 'barriers' (one entry per "
+           "rock and barrier it reached, as barriers.csv) and, with trajectories=True, "
            "'trajectories': one dict of arrays per rock.")
       .def("run_rock", &RunRock, py::arg("rock") = 0, py::arg("threads") = 1,
            py::arg("trajectory_interval_s") = 0.0,

@@ -37,6 +37,9 @@ class FlightStepper {
                      StepWorkspace& workspace, StageTimes* times);
 
   long flight_steps() const { return flight_steps_; }  // steps taken as FlightStep
+  // Something other than a step changed the rock's velocity (a barrier): the current window no
+  // longer holds; look for a new one before the next step.
+  void Restart() { left_ = wait_ = 0; }
 
  private:
   bool windows_;

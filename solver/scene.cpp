@@ -12,6 +12,8 @@ bool Scene::IsValid(std::string* why) const {
   if (!ground.IsValid(&reason)) return fail("ground");
   if (!rock.IsValid(&reason)) return fail("rock");
   if (!options.IsValid(&reason)) return fail("solver");
+  for (const Barrier& barrier : barriers)
+    if (!barrier.IsValid(&reason)) return fail("barrier '" + barrier.name + "'");
   if (terrain.default_ground() < 0 || terrain.default_ground() >= ground.size()) {
     reason =
         "default ground index " + std::to_string(terrain.default_ground()) + " is not in the table";

@@ -1,8 +1,11 @@
 #pragma once
-// The immutable scene a simulation reads: terrain, ground table, rock and solver options.
+// The immutable scene a simulation reads: terrain, ground table, rock, solver options and the
+// barriers that act on the rocks.
 
 #include <string>
+#include <vector>
 
+#include "solver/barriers.hpp"
 #include "solver/ground.hpp"
 #include "solver/options.hpp"
 #include "solver/polyhedron.hpp"
@@ -15,8 +18,10 @@ struct Scene {
   GroundTable ground = GroundTable::BuiltIn();
   RockShape rock;
   SolverOptions options;
+  // Barriers the rocks meet (solver/barriers.hpp); none: no barrier work at all.
+  std::vector<Barrier> barriers;
 
-  // Checks every part and that the terrain's ground indices exist in the table.
+  // Checks every part (each barrier too) and that the terrain's ground indices exist in the table.
   bool IsValid(std::string* why) const;
 };
 

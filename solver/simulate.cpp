@@ -19,6 +19,8 @@ const char* ToString(EndReason reason) {
       return "max_time";
     case EndReason::kFailed:
       return "failed";
+    case EndReason::kBarrier:
+      return "barrier";
   }
   return "unknown";
 }
@@ -94,8 +96,13 @@ RockResult SimulateRock(const Scene& scene, const RockShape& rock, const RockSta
 
   const double end_time = start.time_s + opt.max_time_s;
   FlightStepper stepper(workspace.flight_windows);
+  // With barriers: the state and the terrain under it at the beginning of the step.
+  const bool barriers = !scene.barriers.empty();
+  RockState before;
+  double before_ground_m = ground.height_m;
   while (true) {
     const Eigen::Vector3d previous = state.position_m;
+    if (barriers) before = state;
     [[maybe_unused]] const double previous_time_s = state.time_s;  // for the assertion
     const StepReport step =
         stepper.Advance(scene, rock, state, workspace.step, workspace.stage_times);
@@ -112,6 +119,21 @@ RockResult SimulateRock(const Scene& scene, const RockShape& rock, const RockSta
         "a step left a finite state with a non-unit quaternion, a negative scar or a wrong time");
     if (!scene.terrain.Sample(state.position_m.x(), state.position_m.y(), &ground))
       return finish(EndReason::kLeftDomain);
+    // Barriers the step crossed: the rock overtops them, breaks through them with less energy or
+    // is stopped by one, at the crossing point (solver/barriers.hpp).
+    bool stopped = false;
+    if (barriers) {
+      const BarrierAction action =
+          MeetBarriers(scene.barriers, scene.terrain, rock, before, before_ground_m, &state,
+                       ground.height_m, &result.barrier_events);
+      if (action.acted) stepper.Restart();
+      stopped = action.stopped;
+      if (stopped) {
+        TerrainSample here;
+        if (scene.terrain.Sample(state.position_m.x(), state.position_m.y(), &here)) ground = here;
+      }
+      before_ground_m = ground.height_m;
+    }
 
     result.path_length_m += (state.position_m - previous).head<2>().norm();
     record(ground);
@@ -121,6 +143,7 @@ RockResult SimulateRock(const Scene& scene, const RockShape& rock, const RockSta
       if (!step.converged) ++result.unconverged_steps;
     }
     if (observer) observer->OnStep(state, step, ground);
+    if (stopped) return finish(EndReason::kBarrier);
 
     // Rest: slow and in contact for the hold time.
     const bool slow = state.velocity_m_s.norm() <= opt.rest_speed_m_s &&

@@ -2,7 +2,9 @@
 // Running one rock from release to its end, with the statistics a hazard engineer reads.
 
 #include <string>
+#include <vector>
 
+#include "solver/barriers.hpp"
 #include "solver/contact.hpp"
 #include "solver/scene.hpp"
 #include "solver/state.hpp"
@@ -10,8 +12,12 @@
 
 namespace talus {
 
-enum class EndReason { kRest, kLeftDomain, kMaxTime, kFailed };
-const char* ToString(EndReason reason);  // "rest", "left_domain", "max_time", "failed"
+// kBarrier: stopped by a barrier (RockResult::barrier_events' last event says which), at rest at
+// the crossing point.
+enum class EndReason { kRest, kLeftDomain, kMaxTime, kFailed, kBarrier };
+inline constexpr int kEndReasons = 5;
+// "rest", "left_domain", "max_time", "failed", "barrier"
+const char* ToString(EndReason reason);
 
 // What happened to one rock: its ending, final state and the extremes along its path.
 struct RockResult {
@@ -34,6 +40,9 @@ struct RockResult {
   long solver_iterations = 0;  // Gauss-Seidel sweeps, summed over steps
   long unconverged_steps = 0;  // steps whose contact solve hit max_iterations
   long flight_steps = 0;       // steps taken in flight windows, without contact detection
+  // The scene's barriers the rock met, in the order it met them (empty without barriers). A rock
+  // that ends as kBarrier was stopped by the barrier of the last event.
+  std::vector<BarrierEvent> barrier_events;
 
   // True when the centre of mass never got further from its start than the rock's length.
   bool StayedAtRelease(const RockShape& rock) const { return max_displacement_m <= rock.length_m; }

@@ -134,6 +134,46 @@ raster_format = "cog"
   for (const auto& [name, bytes] : single) EXPECT_TRUE(merged.at(name) == bytes) << name;
 }
 
+// Barriers: a net that stops some rocks and is broken through by others, and a wall behind it that
+// stops one. barriers.csv, barriers_summary.csv, rocks.csv's end_barrier and summary.json's
+// "barriers" merge to the single run's bytes (threads 1 and 2 in the parts, 2 in the single run).
+TEST_F(MergeCommand, BarriersMergeToTheSingleRunsBytes) {
+  talus::app::testing::Write(scene_, talus::app::testing::SmallSlopeScene(5, "", R"([[barriers]]
+name = "net, upper"
+type = "flexible_net"
+line = [[5, -6], [5, 6]]
+height_m = 0.4
+capacity_kj = 0.12
+[[barriers]]
+name = "wall"
+type = "rigid_wall"
+line = [[6, -6], [6, 0], [6, 6]]
+height_m = 1
+capacity_kj = 0.05
+)"));
+  std::string log;
+  const auto single = SingleRun();
+  const std::string& rows = single.at("barriers.csv");
+  EXPECT_NE(rows.find(",stopped,"), std::string::npos) << rows;
+  EXPECT_NE(rows.find(",broke_through,"), std::string::npos) << rows;
+  EXPECT_NE(single.at("rocks.csv").find(",barrier,"), std::string::npos);
+  const auto summary = nlohmann::json::parse(single.at("summary.json"));
+  EXPECT_EQ(summary.at("barriers").size(), 2u);
+  EXPECT_GT(summary.at("ends").at("barrier").get<int>(), 0);
+  for (const auto& split :
+       std::vector<std::vector<std::string>>{{"3:10", "0:3"}, {"0:2", "2:7", "7:10"}}) {
+    std::vector<fs::path> parts;
+    int k = 0;
+    for (const std::string& range : split) parts.push_back(Part(range, 1 + (k++ % 2)));
+    const std::string out = "merged-" + std::to_string(split.size());
+    ASSERT_EQ(Merge(parts, &log, out), 0) << log;
+    const auto merged = OutputsWithoutTimings(dir_ / out);
+    ASSERT_EQ(merged.size(), single.size());
+    for (const auto& [name, bytes] : single)
+      EXPECT_TRUE(merged.at(name) == bytes) << name << " differs for a split into " << split.size();
+  }
+}
+
 TEST_F(MergeCommand, OverlappingPartsAreRefused) {
   std::string log;
   EXPECT_EQ(Merge({Part("0:6"), Part("4:10")}, &log), 2);

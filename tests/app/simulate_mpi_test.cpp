@@ -65,6 +65,35 @@ TEST(SimulateMpi, RanksTimesThreadsGiveTheOneProcessBytes) {
   }
 }
 
+// cases/tirol with its 500 kJ net (scene_net.toml): barriers.csv, rocks.csv's endings and the
+// summary's barriers are the one-process bytes for 1 and 2 threads and 2 and 3 ranks.
+TEST(SimulateMpi, BarriersGiveTheOneProcessBytesForAnyRanksAndThreads) {
+  const fs::path dir = FreshDir("barriers");
+  std::string log;
+  const std::string args = " simulate " + std::string(TALUS_SOURCE_DIR) +
+                           "/cases/tirol/scene_net.toml --rocks 12 --out ";
+  ASSERT_EQ(RunCommand(Talus() + args + (dir / "single").string() + " --threads 1", &log), 0)
+      << log;
+  const auto single = OutputsWithoutTimings(dir / "single");
+  ASSERT_NE(single.at("barriers.csv").find(",stopped,"), std::string::npos);
+  ASSERT_NE(single.at("barriers.csv").find(",broke_through,"), std::string::npos);
+  ASSERT_EQ(RunCommand(Talus() + args + (dir / "threads").string() + " --threads 2", &log), 0)
+      << log;
+  EXPECT_TRUE(OutputsWithoutTimings(dir / "threads") == single) << "2 threads differ";
+  for (int ranks : {2, 3}) {
+    const std::string name = "mpi-" + std::to_string(ranks);
+    ASSERT_EQ(RunCommand(MpiRun("-n " + std::to_string(ranks) + " " + Talus()) + args +
+                             (dir / name).string() + " --threads 1",
+                         &log),
+              0)
+        << log;
+    const auto merged = OutputsWithoutTimings(dir / name);
+    ASSERT_EQ(merged.size(), single.size()) << name;
+    for (const auto& [file, bytes] : single)
+      EXPECT_TRUE(merged.at(file) == bytes) << file << " differs for " << name;
+  }
+}
+
 // Rank 1 is given a scene file that does not exist: every rank stops before any work, rank 0 says
 // which rank failed and why, once, and nothing is written.
 TEST(SimulateMpi, ABadInputOnOneRankEndsTheRunWithOneMessage) {

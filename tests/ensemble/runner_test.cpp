@@ -122,6 +122,48 @@ TEST(RunEnsemble, BitIdenticalForAnyThreadCount) {
   EXPECT_EQ(reports[0].rasters.size(), 12u);  // 3 x 3 statistics, passages, deposits, reach
 }
 
+// Barriers act inside each rock's run, so their events and the rocks they stop are bit-identical
+// for 1, 2 and 3 threads too; the stopped rocks are counted by their ending and as deposits.
+TEST(RunEnsemble, BarriersAreBitIdenticalForAnyThreadCount) {
+  Scene scene = testing::SmallPlane(35, 25, 10);
+  scene.options.max_time_s = 4;
+  scene.barriers = {{"net", BarrierType::kFlexibleNet, {{5, -8}, {5, 8}}, 0.4, 120},
+                    {"wall", BarrierType::kRigidWall, {{6, -8}, {6, 8}}, 1, 50}};
+  ReleaseSpec release = testing::PointRelease({{3, 0}, {4, 2}}, 5);
+  EnsembleOptions options;
+  options.rasters = {scene.terrain.heights().grid, false, false, false, false, true, false};
+  std::vector<Collect> runs(3);
+  std::vector<EnsembleReport> reports;
+  for (int threads = 1; threads <= 3; ++threads) {
+    options.threads = threads;
+    reports.push_back(RunEnsemble(scene, release, options, &runs[threads - 1]));
+  }
+  long events = 0;
+  for (const RockOutcome& a : runs[0].rocks) events += long(a.result.barrier_events.size());
+  EXPECT_GT(events, 3);
+  EXPECT_GT(reports[0].count(EndReason::kBarrier), 0);
+  float deposits = 0;
+  for (float d : reports[0].rasters.front().values) deposits += d > 0 ? d : 0;
+  EXPECT_EQ(deposits,
+            float(reports[0].count(EndReason::kRest) + reports[0].count(EndReason::kBarrier)));
+  for (int k = 1; k < 3; ++k) {
+    EXPECT_EQ(reports[k].by_end, reports[0].by_end);
+    for (std::size_t r = 0; r < 10; ++r) {
+      const RockResult& a = runs[0].rocks[r].result;
+      const RockResult& b = runs[k].rocks[r].result;
+      EXPECT_EQ(a.end, b.end);
+      EXPECT_TRUE(SameBits(a.final_state.position_m, b.final_state.position_m));
+      ASSERT_EQ(a.barrier_events.size(), b.barrier_events.size());
+      for (std::size_t e = 0; e < a.barrier_events.size(); ++e) {
+        EXPECT_EQ(a.barrier_events[e].outcome, b.barrier_events[e].outcome);
+        EXPECT_TRUE(
+            SameBits(a.barrier_events[e].energy_after_J, b.barrier_events[e].energy_after_J));
+        EXPECT_TRUE(SameBits(a.barrier_events[e].position_m, b.barrier_events[e].position_m));
+      }
+    }
+  }
+}
+
 // Trajectories speak the user's conventions: the quaternion rotates the shape as given, the
 // angular velocity is in the world frame, and samples come every interval.
 TEST(RunEnsemble, TrajectoriesUseTheShapeAsGivenAndTheWorldFrame) {

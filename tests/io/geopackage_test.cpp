@@ -9,6 +9,7 @@
 #include <iterator>
 
 #include "common/error.hpp"
+#include "io/barriers_csv.hpp"
 #include "io/evaluation_lines_csv.hpp"
 #include "io/rocks_csv.hpp"
 #include "io/trajectory_file.hpp"
@@ -24,7 +25,7 @@ std::string RocksCsv(int rocks) {
   for (int k = 0; k < rocks; ++k) {
     const std::string c = std::to_string(k);
     text += c + ",0,\"run, " + c + "\",7," + (k == 0 ? "rest" : "left_domain") + ",10" + c +
-            ",20" + c + ",30" + c + ",12.5,13,2,3.5,4000,0.5,6,0,,100,0,0,0,30,hard\n";
+            ",20" + c + ",30" + c + ",12.5,13,2,3.5,4000,0.5,6,0,,100,0,0,0,30,hard,\n";
   }
   return text;
 }
@@ -165,6 +166,34 @@ TEST(RocksGeoPackage, EvaluationCrossingsArePointsWithEveryColumn) {
   WriteRocksGeoPackage(path, (dir / "rocks.csv").string(), "", "");
   Dataset plain(path);
   EXPECT_EQ(plain.d->GetLayerByName("evaluation_crossings"), nullptr);
+}
+
+// Barriers: one 3-D point per row of barriers.csv at the crossing, every column a field.
+TEST(RocksGeoPackage, BarrierImpactsArePointsWithEveryColumn) {
+  const auto dir = testing::FreshDir("barrier_impacts");
+  testing::WriteText(dir / "rocks.csv", RocksCsv(3));
+  testing::WriteText(dir / "barriers.csv",
+                     std::string(BarriersCsvWriter::Header()) +
+                         "\nnet,flexible_net,1,0,\"run, 1\",stopped,2.5,11,22,33,4,1000,250,1250,"
+                         "0.5,0.9,0\n");
+  const std::string path = (dir / "rocks.gpkg").string();
+  WriteRocksGeoPackage(path, (dir / "rocks.csv").string(), "", "", "",
+                       (dir / "barriers.csv").string());
+  RegisterGdal();
+  Dataset gpkg(path);
+  ASSERT_NE(gpkg.d, nullptr);
+  OGRLayer* impacts = gpkg.d->GetLayerByName("barrier_impacts");
+  ASSERT_NE(impacts, nullptr);
+  EXPECT_EQ(impacts->GetFeatureCount(), 1);
+  EXPECT_EQ(impacts->GetLayerDefn()->GetFieldCount(), 17);
+  impacts->ResetReading();
+  const std::unique_ptr<OGRFeature> first(impacts->GetNextFeature());
+  ASSERT_NE(first, nullptr);
+  EXPECT_STREQ(first->GetFieldAsString("outcome"), "stopped");
+  EXPECT_EQ(first->GetFieldAsInteger64("rock"), 1);
+  EXPECT_DOUBLE_EQ(first->GetFieldAsDouble("energy_J"), 1250);
+  EXPECT_DOUBLE_EQ(first->GetGeometryRef()->toPoint()->getZ(), 33);
+  EXPECT_EQ(gpkg.d->GetLayerByName("evaluation_crossings"), nullptr);
 }
 
 }  // namespace

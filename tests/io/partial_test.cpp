@@ -102,7 +102,7 @@ std::string MakePart(const std::string& name, long first, long end,
   {
     std::ofstream csv(dir / "rocks.csv");
     csv << RocksCsvWriter::Header() << "\n";
-    for (long rock = first; rock < end; ++rock) csv << rock << std::string(22, ',') << "\n";
+    for (long rock = first; rock < end; ++rock) csv << rock << std::string(23, ',') << "\n";
     std::ofstream(dir / "partial.bin", std::ios::binary) << std::string("state \x01\x02\x03", 9);
   }
   if (edit) edit(dir);
@@ -172,7 +172,7 @@ TEST(CheckPartFiles, RowsOutsideThePartsRangeAreRefusedNamingTheLine) {
       std::ofstream csv(dir / "rocks.csv");
       csv << RocksCsvWriter::Header() << "\n";
       for (long rock = first; rock < end; ++rock)
-        if (rock != skip) csv << rock << std::string(22, ',') << "\n";
+        if (rock != skip) csv << rock << std::string(23, ',') << "\n";
     };
   };
   EXPECT_NE(FilesMessage(MakePart("dup", 5, 10, rewrite(0, 5, -1)))

@@ -18,7 +18,7 @@ std::string RocksCsv(const std::vector<std::string>& runouts) {
   int rock = 0;
   for (const std::string& runout : runouts) {
     text += std::to_string(rock) + ",0,\"run, " + std::to_string(rock) +
-            "\",1,rest,0,0,0," + runout + ",1,2,3.5,4000,0.5,6,0,\"a \"\"block\"\"\",100,0,0,0,30,hard\n";
+            "\",1,rest,0,0,0," + runout + ",1,2,3.5,4000,0.5,6,0,\"a \"\"block\"\"\",100,0,0,0,30,hard,\n";
     ++rock;
   }
   return text;
@@ -103,6 +103,31 @@ TEST(ReportHtml, ShowsTheEvaluationLinesSummary) {
   EXPECT_EQ(html.find("<th>evaluation_lines</th>"), std::string::npos);  // not as raw JSON
   input.summary_json = R"({"rocks": 4})";
   EXPECT_EQ(RunReportHtml(input).find("Evaluation lines"), std::string::npos);
+}
+
+TEST(ReportHtml, ShowsTheBarriersSummary) {
+  RunReportInput input;
+  input.summary_json = R"({"rocks": 10, "barriers": [{"name": "net <B>", "type": "flexible_net",
+      "length_m": 50, "height_m": 4, "capacity_J": 500000, "rocks": 10, "reached": 6,
+      "stopped": 3, "overtopped": 1, "broke_through": 2, "reach_probability": 0.6,
+      "passing_probability": 0.3,
+      "impact_energy_J": {"mean": 600000, "p50": 400000, "p90": 1200000, "p95": 1200000,
+                          "p99": 1200000, "max": 1200000},
+      "passing_height_m": {"mean": 1, "p50": 0.5, "p90": 5, "p95": 5, "p99": 5, "max": 5},
+      "passing_energy_J": {"mean": null, "p50": null, "p90": null, "p95": null, "p99": null,
+                           "max": null}}]})";
+  const std::string html = RunReportHtml(input);
+  EXPECT_NE(html.find("<h2>Barriers</h2>"), std::string::npos);
+  EXPECT_NE(html.find("<tr><th>net &lt;B&gt;</th><td>flexible_net</td><td>4</td><td>500</td>"
+                      "<td>10</td><td>6</td><td>3</td><td>1</td><td>2</td><td>30.0 %</td>"),
+            std::string::npos)
+      << html;
+  EXPECT_NE(html.find("<th>kinetic energy at the barrier (kJ)</th><td>600</td><td>400</td>"),
+            std::string::npos)
+      << html;
+  EXPECT_EQ(html.find("<th>barriers</th>"), std::string::npos);  // not as raw JSON
+  input.summary_json = R"({"rocks": 4})";
+  EXPECT_EQ(RunReportHtml(input).find("Barriers"), std::string::npos);
 }
 
 }  // namespace

@@ -46,12 +46,12 @@ TEST(RocksCsvWriter, OneRowPerRockWithTheContractColumns) {
       header,
       "rock,release,run,seed,end,x_end,y_end,z_end,runout_m,path_length_m,travel_time_s,"
       "max_speed_m_s,max_kinetic_energy_j,max_jump_height_m,max_angular_speed_rad_s,max_scar_m,"
-      "block,mass_kg,x_start,y_start,z_start,travel_angle_deg,end_ground");
+      "block,mass_kg,x_start,y_start,z_start,travel_angle_deg,end_ground,end_barrier");
   std::getline(in, row);
   // The run's id, its block's id quoted because it holds a comma; start, the travel angle
   // atan(9 m drop / 5 m runout) = 60.94539590 deg, and the ground where it ended.
   EXPECT_EQ(row,
-            "0,1,v002,7,rest,3,4,1,5,0,0,12.5,0,0,0,0,\"plate, thin\",0,0,0,10,60.9453959,medium");
+            "0,1,v002,7,rest,3,4,1,5,0,0,12.5,0,0,0,0,\"plate, thin\",0,0,0,10,60.9453959,medium,");
   int rows = 1;
   while (std::getline(in, row)) ++rows;
   EXPECT_EQ(rows, 3);

@@ -190,3 +190,26 @@ except KeyboardInterrupt:
     finally:
         child.kill()
     assert child.returncode == 3 and "interrupted" in out
+
+
+def test_barrier_results_are_the_programs(tmp_path):
+    """What rocks did at the tirol case's 500 kJ net: barriers.csv's rows, from Python."""
+    scene_path = SOURCE / "cases" / "tirol" / "scene_net.toml"
+    out = tmp_path / "out"
+    run_talus("simulate", scene_path, "--out", out, "--rocks", "30", "--threads", "2")
+    scene = talus.Scene.load(scene_path)
+    scene.rocks = 30
+    result = scene.simulate(threads=2, rasters=False)
+    with open(out / "barriers.csv") as f:
+        rows = list(csv.DictReader(f))
+    barriers = result["barriers"]
+    assert len(rows) == len(barriers["rock"]) > 0
+    for i, row in enumerate(rows):
+        assert row["barrier"] == barriers["barrier"][i]
+        assert row["outcome"] == barriers["outcome"][i]
+        assert int(row["rock"]) == barriers["rock"][i]
+        for name in ("energy_J", "energy_after_J", "passing_height_m", "t_s", "speed_m_s"):
+            assert f"{barriers[name][i]:.10g}" == row[name], name
+    stopped = result["rocks"]["end"] == "barrier"
+    assert list(result["rocks"]["end_barrier"][stopped]) == ["lower net"] * int(stopped.sum())
+    assert result["counts"]["ends"]["barrier"] == int(stopped.sum())
