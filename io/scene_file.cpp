@@ -275,7 +275,7 @@ SceneFile LoadSceneTable(const toml::table& root, const std::string& path,
                "block_column", "ground_z_tolerance_m", "height_m", "height_reference", "rocks",
                "rocks_per_m2",
                "rocks_per_cell", "clip_to_dem", "orientation", "velocity_m_s",
-               "angular_velocity_rad_s", "seed", "volume"}),
+               "angular_velocity_rad_s", "seed", "volume", "source"}),
       out);
   scene_tables::LoadEvaluationLines(
       context,

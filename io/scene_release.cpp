@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <limits>
 #include <map>
+#include <numbers>
 #include <string>
 #include <unordered_map>
 #include <utility>
@@ -24,6 +25,9 @@ namespace {
 
 namespace fs = std::filesystem;
 using ensemble::ReleaseGeometry;
+
+// The most source cells one [release] source may give (each is a release polygon).
+constexpr long kMaxSourceCells = 10'000'000;
 
 // The block a row of a run table names in its column `block_column` (the index into [blocks]), or
 // -1 for the scene's [rock] when the cell is empty.
@@ -221,6 +225,72 @@ void LoadSingleImpacts(const Context& context, const Section& release, SceneFile
   out.release.height_reference = ensemble::ReleaseSpec::HeightReference::kLowestPoint;
 }
 
+// [release] source = { raster = "sources.tif", slope_min_deg = ... }: source cells, each a
+// release polygon (Rockyfor3D's source raster, a slope threshold for screening). The cells of the
+// raster whose value is > 0 (not nodata), or without a raster every DEM cell (a square around its
+// node, as the rasters Talus writes), clipped to the DEM's outermost nodes; with slope_min_deg only those
+// where the terrain's slope at the cell's centre is at least that.
+void LoadSourceCells(const Context& context, const Section& s, SceneFile& out,
+                     std::vector<std::string>& origin) {
+  const toml::node* node = s.Node("source");
+  if (!node->is_table())
+    s.Fail("source", "expected an inline table { raster = \"sources.tif\" } or { slope_min_deg = ... }");
+  const Section v(context, node->as_table(), "release.source", {"raster", "slope_min_deg"});
+  if (!v.Has("raster") && !v.Has("slope_min_deg"))
+    v.Fail("raster", "missing: give raster = \"file\", slope_min_deg = ..., or both");
+  const double slope_min = v.Checked(
+      "slope_min_deg", 0, [](double x) { return x >= 0 && x < 90; }, "0 <= slope_min_deg < 90");
+  const Terrain& terrain = out.scene.terrain;
+  const GridGeometry& dem = terrain.heights().grid;
+  const std::string where = context.Where(s.Node("source")) + ": " + s.Key("source");
+  // The cells: the raster's, or the DEM's.
+  GridGeometry grid = dem;
+  std::vector<double> values;
+  std::string path;
+  if (v.Has("raster")) {
+    path = context.Resolve(v.String("raster", ""));
+    std::string reprojected_from;
+    Raster raster = ReadRasterIn(path, out.crs_wkt,
+                                 context.Where(v.Node("raster")) + ": " + v.Key("raster"),
+                                 &reprojected_from);
+    out.inputs.push_back(path);
+    grid = raster.grid;
+    values = std::move(raster.values);
+  }
+  // The terrain has heights between the DEM's outermost nodes: edge cells are cut there.
+  const double xmin = dem.x0_m, xmax = dem.x_max_m(), ymin = dem.y0_m, ymax = dem.y_max_m();
+  long cells = 0;
+  for (int j = 0; j < grid.ny; ++j)
+    for (int i = 0; i < grid.nx; ++i) {
+      const std::size_t k = static_cast<std::size_t>(j) * grid.nx + i;
+      if (!values.empty() && !(values[k] > 0)) continue;  // 0, negative or nodata: not a source
+      const double x = grid.x0_m + i * grid.dx_m, y = grid.y0_m + j * grid.dy_m;
+      const double x0 = std::max(x - 0.5 * grid.dx_m, xmin), x1 = std::min(x + 0.5 * grid.dx_m, xmax);
+      const double y0 = std::max(y - 0.5 * grid.dy_m, ymin), y1 = std::min(y + 0.5 * grid.dy_m, ymax);
+      if (!(x1 > x0 && y1 > y0)) continue;  // off the DEM's extent
+      if (v.Has("slope_min_deg")) {
+        TerrainSample sample;
+        if (!terrain.Sample(0.5 * (x0 + x1), 0.5 * (y0 + y1), &sample)) continue;
+        const double slope_deg = std::acos(std::clamp(sample.normal.z(), -1.0, 1.0)) * 180 / std::numbers::pi;
+        if (slope_deg < slope_min) continue;
+      }
+      if (++cells > kMaxSourceCells)
+        v.Fail(v.Has("raster") ? "raster" : "slope_min_deg",
+               "more than " + std::to_string(kMaxSourceCells) +
+                   " source cells: coarsen the source raster or raise slope_min_deg");
+      out.release.releases.push_back(
+          {ReleaseGeometry::Kind::kPolygon, {{{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}}}});
+      origin.push_back(where + " (" + (path.empty() ? std::string("DEM") : path) + " cell " +
+                       std::to_string(i) + ", " + std::to_string(j) + " from the south-west)");
+    }
+  if (cells == 0)
+    v.Fail(v.Has("raster") ? "raster" : "slope_min_deg",
+           "no source cell: " +
+               std::string(v.Has("raster") ? "the raster has no cell > 0 on the DEM" : "") +
+               std::string(v.Has("raster") && v.Has("slope_min_deg") ? " at that slope" : "") +
+               std::string(!v.Has("raster") ? "no DEM cell is that steep" : ""));
+}
+
 // [release] points, lines, polygons and a vector file (with layer and where) into
 // out.release.releases; returns where each came from, for errors: "<file>:<line>: <key>[k]".
 std::vector<std::string> LoadReleaseGeometries(const Context& context, const Section& s,
@@ -270,6 +340,7 @@ std::vector<std::string> LoadReleaseGeometries(const Context& context, const Sec
   for (const char* key : {"layer", "where"})
     if (s.Has(key) && !s.Has("file"))
       s.Fail(key, "chooses features of a vector file: give file = \"...\" as well");
+  if (s.Has("source")) LoadSourceCells(context, s, out, origin);
   return origin;
 }
 
@@ -497,6 +568,8 @@ void LoadRelease(const Context& context, const Section& s, SceneFile& out) {
                "give one of rocks, rocks_per_m2 and rocks_per_cell, not " + count_key + " as well");
       count_key = key;
     }
+  if (s.Has("source") && count_key != "rocks")
+    s.Fail(count_key, "each source cell releases `rocks` rocks; give rocks with source");
   const long rocks = s.Integer("rocks", 1);
   if (rocks < 1) s.Fail("rocks", std::to_string(rocks) + " must be >= 1");
   r.rocks_per_release = rocks;

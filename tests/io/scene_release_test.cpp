@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include "common/error.hpp"
 #include "io/scene_file.hpp"
@@ -122,6 +123,73 @@ TEST(SceneRelease, BlockSizeDistributionsLoadAndBadOnesNameTheKey) {
                      "max_m3 = 2 }\n",
                      "trajectory_id,x_m,y_m\nr1,5,0\n"),
              "release.volume: block sizes are for release points");
+}
+
+// [release] source by slope: the plane rises at 30 deg for x in 0 .. 40 m and is flat to 60 m (1 m
+// cells, y -15 .. 15). A cell is the square around a DEM node, cut at the outermost nodes; with
+// slope_min_deg = 20 the cells of nodes x = 0 .. 39 are sources, 31 rows each; the node at the kink
+// (x = 40) touches both faces and may count either way.
+TEST(SceneRelease, SourceCellsBySlopeAreTheSteepCells) {
+  const SceneFile scene = Load("source = { slope_min_deg = 20 }\nrocks = 3\n");
+  const auto& releases = scene.release.releases;
+  EXPECT_TRUE(releases.size() == 40 * 31 || releases.size() == 41 * 31) << releases.size();
+  for (const auto& release : releases) {
+    ASSERT_EQ(release.kind, ensemble::ReleaseGeometry::Kind::kPolygon);
+    for (const Eigen::Vector2d& p : release.rings[0]) {
+      EXPECT_LE(p.x(), 40.5);
+      EXPECT_GE(p.x(), 0);
+      EXPECT_LE(std::abs(p.y()), 15);
+    }
+  }
+  EXPECT_EQ(scene.release.total_rocks(), 3 * static_cast<long>(releases.size()));
+  EXPECT_HAS(ErrorOf("source = { slope_min_deg = 45 }\n"),
+             "release.source.slope_min_deg: no source cell: no DEM cell is that steep");
+  EXPECT_HAS(ErrorOf("source = { slope_min_deg = 95 }\n"), "release.source.slope_min_deg");
+  EXPECT_HAS(ErrorOf("source = 3\n"), "release.source: expected an inline table");
+  EXPECT_HAS(ErrorOf("source = { }\n"), "release.source.raster: missing");
+  EXPECT_HAS(ErrorOf("source = { slope_min_deg = 20 }\nrocks_per_m2 = 0.1\n"),
+             "release.rocks_per_m2: each source cell releases `rocks` rocks");
+}
+
+// [release] source by raster: the cells > 0 of a raster on the DEM's grid (here 61 x 31 cells of
+// 1 m centred on the DEM's nodes) are sources; 0, negative and nodata cells are not; with a slope
+// threshold as well, only the steep ones.
+TEST(SceneRelease, SourceCellsFromARasterAreItsPositiveCells) {
+  const auto dir = testing::FreshDir("sources");
+  std::vector<std::vector<double>> rows(31, std::vector<double>(61, 0.0));
+  // Row 0 is the north edge (y = 15); cell (i, j) from the south-west is rows[30 - j][i].
+  rows[30 - 15][10] = 1;    // on the slope
+  rows[30 - 15][11] = 2.5;  // any positive value
+  rows[30 - 16][10] = -1;   // not a source
+  rows[30 - 16][11] = -9999;  // nodata
+  rows[30 - 15][50] = 1;    // on the flat
+  testing::WriteGdalRaster(dir / "sources.tif", rows, {-0.5, 1, 0, 15.5, 0, -1}, 0, -9999.0);
+  testing::WriteText(dir / "scene.toml",
+                     kHead + "source = { raster = \"sources.tif\" }\nrocks = 2\n");
+  const SceneFile all = LoadScene((dir / "scene.toml").string());
+  ASSERT_EQ(all.release.releases.size(), 3u);
+  const auto centre = [](const ensemble::ReleaseGeometry& g) {
+    Eigen::Vector2d c = Eigen::Vector2d::Zero();
+    for (const Eigen::Vector2d& p : g.rings[0]) c += p / 4;
+    return c;
+  };
+  EXPECT_TRUE(centre(all.release.releases[0]).isApprox(Eigen::Vector2d(10, 0)));
+  EXPECT_TRUE(centre(all.release.releases[1]).isApprox(Eigen::Vector2d(11, 0)));
+  EXPECT_TRUE(centre(all.release.releases[2]).isApprox(Eigen::Vector2d(50, 0)));
+  EXPECT_EQ(all.release.total_rocks(), 6);
+  testing::WriteText(dir / "steep.toml",
+                     kHead + "source = { raster = \"sources.tif\", slope_min_deg = 20 }\n");
+  EXPECT_EQ(LoadScene((dir / "steep.toml").string()).release.releases.size(), 2u);
+  // A raster whose positive cells all lie off the DEM gives no source.
+  testing::WriteGdalRaster(dir / "off.tif", {{1, 1}, {1, 1}}, {500, 1, 0, 500, 0, -1}, 0,
+                           std::nullopt);
+  testing::WriteText(dir / "off.toml", kHead + "source = { raster = \"off.tif\" }\n");
+  try {
+    LoadScene((dir / "off.toml").string());
+    ADD_FAILURE() << "a raster off the DEM was accepted";
+  } catch (const InputError& e) {
+    EXPECT_HAS(e.what(), "release.source.raster: no source cell: the raster has no cell > 0 on the DEM");
+  }
 }
 
 }  // namespace
