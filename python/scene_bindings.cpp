@@ -201,7 +201,10 @@ class CollectingSink : public ensemble::RockSink {
     rows.push_back(io::RockRowOf(outcome, file_.scene, file_.release));
     if (trajectories_) samples.push_back(outcome.trajectory);
     for (const BarrierEvent& e : outcome.result.barrier_events) barriers.emplace_back(outcome.rock, e);
+    for (const ensemble::LineCrossing& c : outcome.line_crossings)
+      crossings.emplace_back(outcome.rock, c);
   }
+  std::vector<std::pair<long, ensemble::LineCrossing>> crossings;  // (rock, crossing) in rock order
   std::vector<io::RockRow> rows;
   std::vector<std::pair<long, BarrierEvent>> barriers;  // (rock, event) in rock order
   std::vector<std::vector<ensemble::TrajectorySample>> samples;
@@ -303,6 +306,44 @@ py::dict BarriersDict(const io::SceneFile& file,
   return d;
 }
 
+// Each rock's first crossing of each evaluation line, as evaluation_lines.csv lists them: one entry
+// per (rock, line crossed) in rock order, lines in order within a rock.
+py::dict CrossingsDict(const io::SceneFile& file,
+                       const std::vector<std::pair<long, ensemble::LineCrossing>>& crossings) {
+  const auto n = static_cast<py::ssize_t>(crossings.size());
+  py::array_t<std::int64_t> rock(n), count(n);
+  py::array_t<double> t(n), speed(n), translational(n), rotational(n), energy(n), com(n), bounce(n);
+  py::array_t<double> position({n, py::ssize_t{3}});
+  std::vector<std::string> line;
+  for (py::ssize_t i = 0; i < n; ++i) {
+    const auto& [r, c] = crossings[static_cast<std::size_t>(i)];
+    rock.mutable_at(i) = r;
+    line.push_back(file.evaluation_lines[static_cast<std::size_t>(c.line)].name);
+    t.mutable_at(i) = c.t_s;
+    for (py::ssize_t k = 0; k < 3; ++k) position.mutable_at(i, k) = c.position_m[k];
+    speed.mutable_at(i) = c.speed_m_s;
+    translational.mutable_at(i) = c.translational_energy_J;
+    rotational.mutable_at(i) = c.rotational_energy_J;
+    energy.mutable_at(i) = c.energy_J();
+    com.mutable_at(i) = c.com_height_m;
+    bounce.mutable_at(i) = c.bounce_height_m;
+    count.mutable_at(i) = c.crossings;
+  }
+  py::dict d;
+  d["line"] = StringArray(line);
+  d["rock"] = rock;
+  d["t_s"] = t;
+  d["position_m"] = position;
+  d["speed_m_s"] = speed;
+  d["translational_energy_J"] = translational;
+  d["rotational_energy_J"] = rotational;
+  d["energy_J"] = energy;
+  d["com_height_m"] = com;
+  d["bounce_height_m"] = bounce;
+  d["crossings"] = count;
+  return d;
+}
+
 py::dict CountsDict(const ensemble::EnsembleReport& r) {
   py::dict ends;
   for (int k = 0; k < kEndReasons; ++k) ends[ToString(static_cast<EndReason>(k))] = r.by_end[k];
@@ -383,6 +424,7 @@ py::dict Simulate(const io::SceneFile& file, int threads, const py::object& rock
   out["counts"] = CountsDict(report);
   out["warnings"] = ensemble::RunWarnings(report, file.scene.options);
   if (!file.scene.barriers.empty()) out["barriers"] = BarriersDict(file, sink.barriers);
+  if (!file.evaluation_lines.empty()) out["lines"] = CrossingsDict(file, sink.crossings);
   py::dict raster_dict = RastersDict(file, report.rasters);
   out["rasters"] = raster_dict;
   out["geotransform"] = GeoTransform(file);
@@ -489,8 +531,10 @@ void BindScene(py::module_& m) {
            "Runs the ensemble (or the rocks of a slice) as talus simulate does, with the GIL "
            "released. Returns {'rocks': per-rock arrays under rocks.csv's column names, "
            "'counts', 'warnings', 'rasters': {name: {'values': float32 (ny, nx) north-up, unit, "
-           "...}}, 'geotransform', 'crs_wkt', 'nodata'}, with barriers 'barriers' (one entry per "
-           "rock and barrier it reached, as barriers.csv) and, with trajectories=True, "
+           "...}}, 'geotransform', 'crs_wkt', 'nodata'}, with evaluation lines 'lines' (each "
+           "rock's first crossing of each line, as evaluation_lines.csv), with barriers "
+           "'barriers' (one entry per rock and barrier it reached, as barriers.csv) and, with "
+           "trajectories=True, "
            "'trajectories': one dict of arrays per rock.")
       .def("run_rock", &RunRock, py::arg("rock") = 0, py::arg("threads") = 1,
            py::arg("trajectory_interval_s") = 0.0,

@@ -192,8 +192,9 @@ except KeyboardInterrupt:
     assert child.returncode == 3 and "interrupted" in out
 
 
-def test_barrier_results_are_the_programs(tmp_path):
-    """What rocks did at the tirol case's 500 kJ net: barriers.csv's rows, from Python."""
+def test_barrier_and_line_results_are_the_programs(tmp_path):
+    """What rocks did at the tirol case's 500 kJ net and its evaluation lines: barriers.csv's and
+    evaluation_lines.csv's rows, from Python."""
     scene_path = SOURCE / "cases" / "tirol" / "scene_net.toml"
     out = tmp_path / "out"
     run_talus("simulate", scene_path, "--out", out, "--rocks", "30", "--threads", "2")
@@ -210,6 +211,17 @@ def test_barrier_results_are_the_programs(tmp_path):
         assert int(row["rock"]) == barriers["rock"][i]
         for name in ("energy_J", "energy_after_J", "passing_height_m", "t_s", "speed_m_s"):
             assert f"{barriers[name][i]:.10g}" == row[name], name
+    # The evaluation lines' crossings: evaluation_lines.csv's rows.
+    with open(out / "evaluation_lines.csv") as f:
+        rows = list(csv.DictReader(f))
+    lines = result["lines"]
+    assert len(rows) == len(lines["rock"]) > 0
+    for i, row in enumerate(rows):
+        assert row["line"] == lines["line"][i] and int(row["rock"]) == lines["rock"][i]
+        assert int(row["crossings"]) == lines["crossings"][i]
+        for name in ("t_s", "speed_m_s", "energy_J", "bounce_height_m", "com_height_m"):
+            assert f"{lines[name][i]:.10g}" == row[name], name
+        assert f"{lines['position_m'][i][0]:.10g}" == row["x_m"]
     stopped = result["rocks"]["end"] == "barrier"
     assert list(result["rocks"]["end_barrier"][stopped]) == ["lower net"] * int(stopped.sum())
     assert result["counts"]["ends"]["barrier"] == int(stopped.sum())
