@@ -96,8 +96,14 @@ std::vector<std::string> WriteSummaryOutputs(const io::SceneFile& scene,
                                        {"TALUS_ROCKS", std::to_string(report.rocks)},
                                        {"TALUS_SEED", std::to_string(scene.release.seed)},
                                        {"TALUS_GROUND", ground}}};
-    io::WriteGeoTiff(staging.path(layer.name + ".tif"), dem, scene.crs_wkt, layer.values, true,
-                     ensemble::RasterLayer::kNoData, metadata, scene.output.raster_format);
+    // Counts as Int32 (exact for any number of rocks, classified as integers by GIS), the
+    // others as Float32.
+    if (!layer.counts.empty())
+      io::WriteGeoTiff(staging.path(layer.name + ".tif"), dem, scene.crs_wkt, layer.counts, true,
+                       ensemble::RasterLayer::kNoData, metadata, scene.output.raster_format);
+    else
+      io::WriteGeoTiff(staging.path(layer.name + ".tif"), dem, scene.crs_wkt, layer.values, true,
+                       ensemble::RasterLayer::kNoData, metadata, scene.output.raster_format);
     outputs.push_back(layer.name + ".tif");
   }
   ThrowIfInterrupted();

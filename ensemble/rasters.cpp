@@ -227,11 +227,13 @@ std::vector<RasterLayer> RasterAccumulator::Finish(const Heightfield& dem) const
     out.push_back(layer(ToString(RasterKind::kPassages), "count", "count",
                         "passages, rocks that passed the cell", 0));
     std::copy(passages_.begin(), passages_.end(), out.back().values.begin());
+    out.back().counts.assign(passages_.begin(), passages_.end());
   }
   if (request_.deposits) {
     out.push_back(layer(ToString(RasterKind::kDeposits), "count", "count",
                         "deposits, rocks at rest in the cell", 0));
     std::copy(deposits_.begin(), deposits_.end(), out.back().values.begin());
+    out.back().counts.assign(deposits_.begin(), deposits_.end());
   }
   if (request_.reach_probability) {
     out.push_back(layer(ToString(RasterKind::kReachProbability), "fraction", "1",
@@ -243,7 +245,10 @@ std::vector<RasterLayer> RasterAccumulator::Finish(const Heightfield& dem) const
   // No value where the DEM has none.
   for (std::size_t c = 0; c < cells; ++c)
     if (std::isnan(dem.z_m[c]))
-      for (RasterLayer& l : out) l.values[c] = RasterLayer::kNoData;
+      for (RasterLayer& l : out) {
+        l.values[c] = RasterLayer::kNoData;
+        if (!l.counts.empty()) l.counts[c] = static_cast<std::int32_t>(RasterLayer::kNoData);
+      }
   return out;
 }
 

@@ -4,6 +4,7 @@
 // are summarised per cell so that the rasters do not depend on the number of threads, ranks or
 // partial runs.
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -85,6 +86,9 @@ struct RasterLayer {
   std::string quantity = {};   // speed, energy, jump_height, passages, deposits, reach_probability
   std::string statistic = {};  // max, mean, p<NN>, count (passages, deposits), fraction (reach)
   std::string description = {};  // e.g. "energy, 95th percentile over passing rocks"
+  // The counts of a count layer (passages, deposits) exactly, kNoData where the DEM has no height;
+  // empty for the others. `values` holds them too, as float (exact up to 2^24).
+  std::vector<std::int32_t> counts = {};
   static constexpr float kNoData = -9999.0f;
 };
 

@@ -8,12 +8,14 @@
 
 #include <algorithm>
 #include <array>
+#include <cstdint>
 #include <cmath>
 #include <filesystem>
 #include <memory>
 #include <mutex>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 
 #include "common/atomic_file.hpp"
 #include "common/error.hpp"
@@ -257,9 +259,14 @@ std::vector<int> RasterisePolygons(
   return out;
 }
 
-void WriteGeoTiff(const std::string& path, const GridGeometry& grid, const std::string& crs_wkt,
-                  const std::vector<float>& values, bool has_nodata, double nodata,
-                  const RasterMetadata& metadata, RasterFormat format) {
+namespace {
+
+// WriteGeoTiff for cells of type T (float: Float32, std::int32_t: Int32), row j from the south.
+template <class T>
+void WriteGeoTiffOf(const std::string& path, const GridGeometry& grid, const std::string& crs_wkt,
+                    const std::vector<T>& values, bool has_nodata, double nodata,
+                    const RasterMetadata& metadata, RasterFormat format) {
+  constexpr GDALDataType kType = std::is_same_v<T, float> ? GDT_Float32 : GDT_Int32;
   RegisterGdal();
   const bool cog = format == RasterFormat::kCog;
   GDALDriver* driver = GetGDALDriverManager()->GetDriverByName(cog ? "COG" : "GTiff");
@@ -270,8 +277,8 @@ void WriteGeoTiff(const std::string& path, const GridGeometry& grid, const std::
   {
     // The COG driver only copies a finished dataset: it is built in memory first.
     const char* gtiff_options[] = {"COMPRESS=DEFLATE", "TILED=YES", nullptr};
-    Dataset dataset(cog ? memory->Create("", grid.nx, grid.ny, 1, GDT_Float32, nullptr)
-                        : driver->Create(file.temp_path().c_str(), grid.nx, grid.ny, 1, GDT_Float32,
+    Dataset dataset(cog ? memory->Create("", grid.nx, grid.ny, 1, kType, nullptr)
+                        : driver->Create(file.temp_path().c_str(), grid.nx, grid.ny, 1, kType,
                                          const_cast<char**>(gtiff_options)));
     if (!dataset) throw std::runtime_error("cannot create " + path + ": " + CPLGetLastErrorMsg());
     std::array<double, 6> gt = GeoTransformOf(grid);
@@ -287,13 +294,13 @@ void WriteGeoTiff(const std::string& path, const GridGeometry& grid, const std::
     if (has_nodata) band->SetNoDataValue(nodata);
     band->SetDescription(metadata.description.c_str());
     if (!metadata.unit.empty()) band->SetUnitType(metadata.unit.c_str());
-    std::vector<float> rows(values.size());
+    std::vector<T> rows(values.size());
     for (int j = 0; j < grid.ny; ++j) {
       const int r = grid.ny - 1 - j;
       std::copy_n(values.begin() + static_cast<long>(j) * grid.nx, grid.nx,
                   rows.begin() + static_cast<long>(r) * grid.nx);
     }
-    if (band->RasterIO(GF_Write, 0, 0, grid.nx, grid.ny, rows.data(), grid.nx, grid.ny, GDT_Float32,
+    if (band->RasterIO(GF_Write, 0, 0, grid.nx, grid.ny, rows.data(), grid.nx, grid.ny, kType,
                        0, 0) != CE_None)
       throw std::runtime_error("cannot write " + path + ": " + CPLGetLastErrorMsg());
     if (cog) {
@@ -313,6 +320,20 @@ void WriteGeoTiff(const std::string& path, const GridGeometry& grid, const std::
   if (CPLGetLastErrorType() >= CE_Failure)
     throw std::runtime_error("cannot write " + path + ": " + CPLGetLastErrorMsg());
   file.Commit();
+}
+
+}  // namespace
+
+void WriteGeoTiff(const std::string& path, const GridGeometry& grid, const std::string& crs_wkt,
+                  const std::vector<float>& values, bool has_nodata, double nodata,
+                  const RasterMetadata& metadata, RasterFormat format) {
+  WriteGeoTiffOf(path, grid, crs_wkt, values, has_nodata, nodata, metadata, format);
+}
+
+void WriteGeoTiff(const std::string& path, const GridGeometry& grid, const std::string& crs_wkt,
+                  const std::vector<std::int32_t>& values, bool has_nodata, double nodata,
+                  const RasterMetadata& metadata, RasterFormat format) {
+  WriteGeoTiffOf(path, grid, crs_wkt, values, has_nodata, nodata, metadata, format);
 }
 
 }  // namespace talus::io

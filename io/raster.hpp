@@ -4,6 +4,7 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <cstdint>
 #include <string>
 #include <utility>
 #include <vector>
@@ -69,11 +70,14 @@ struct RasterMetadata {
   std::vector<std::pair<std::string, std::string>> items = {};
 };
 
-// Writes a one-band Float32 GeoTIFF (deflate-compressed, tiled) on `grid` with `crs_wkt` (may be
+// Writes a one-band Float32 (or, for counts, Int32) GeoTIFF (deflate-compressed, tiled) on `grid` with `crs_wkt` (may be
 // empty), atomically, in `format`. `nodata` is set when has_nodata. The same arguments give the
 // same bytes (nothing depends on the time or the machine).
 void WriteGeoTiff(const std::string& path, const GridGeometry& grid, const std::string& crs_wkt,
                   const std::vector<float>& values, bool has_nodata, double nodata,
+                  const RasterMetadata& metadata, RasterFormat format = RasterFormat::kGeoTiff);
+void WriteGeoTiff(const std::string& path, const GridGeometry& grid, const std::string& crs_wkt,
+                  const std::vector<std::int32_t>& values, bool has_nodata, double nodata,
                   const RasterMetadata& metadata, RasterFormat format = RasterFormat::kGeoTiff);
 
 // Rasterises polygons onto the nodes of `grid` (GDAL's rasteriser): a node takes burn[k] of the

@@ -359,19 +359,27 @@ py::dict CountsDict(const ensemble::EnsembleReport& r) {
   return d;
 }
 
-// The rasters as the GeoTIFFs of talus simulate hold them: north-up rows (ny, nx) of float32,
-// RasterLayer::kNoData where no rock passed, with the grid's GDAL geotransform and CRS.
+// The rasters as the GeoTIFFs of talus simulate hold them: north-up rows (ny, nx) of float32 (int32
+// for counts), RasterLayer::kNoData where no rock passed, with the grid's GDAL geotransform and CRS.
 py::dict RastersDict(const io::SceneFile& file, const std::vector<ensemble::RasterLayer>& layers) {
   const GridGeometry& grid = file.scene.terrain.heights().grid;
   py::dict out;
-  for (const ensemble::RasterLayer& layer : layers) {
-    py::array_t<float> values({static_cast<py::ssize_t>(grid.ny), static_cast<py::ssize_t>(grid.nx)});
-    auto v = values.mutable_unchecked<2>();
+  const auto north_up = [&grid](const auto& cells) {
+    using T = typename std::decay_t<decltype(cells)>::value_type;
+    py::array_t<T> values({static_cast<py::ssize_t>(grid.ny), static_cast<py::ssize_t>(grid.nx)});
+    auto v = values.template mutable_unchecked<2>();
     for (int j = 0; j < grid.ny; ++j)
       for (int i = 0; i < grid.nx; ++i)
-        v(grid.ny - 1 - j, i) = layer.values[static_cast<std::size_t>(j) * grid.nx + i];
+        v(grid.ny - 1 - j, i) = cells[static_cast<std::size_t>(j) * grid.nx + i];
+    return values;
+  };
+  for (const ensemble::RasterLayer& layer : layers) {
     py::dict d;
-    d["values"] = values;
+    // Counts as int32, as the GeoTIFF holds them.
+    if (!layer.counts.empty())
+      d["values"] = north_up(layer.counts);
+    else
+      d["values"] = north_up(layer.values);
     d["unit"] = layer.unit;
     d["quantity"] = layer.quantity;
     d["statistic"] = layer.statistic;

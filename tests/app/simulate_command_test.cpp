@@ -231,6 +231,8 @@ report = false
     int has_nodata = 0;
     EXPECT_EQ(band->GetNoDataValue(&has_nodata), -9999.0) << name;
     EXPECT_TRUE(has_nodata) << name;
+    // Counts are Int32 (exact, integer classes in GIS), the others Float32.
+    EXPECT_EQ(band->GetRasterDataType(), statistic == "count" ? GDT_Int32 : GDT_Float32) << name;
     std::vector<float> v(30 * 12);
     ASSERT_EQ(band->RasterIO(GF_Read, 0, 0, 30, 12, v.data(), 30, 12, GDT_Float32, 0, 0), CE_None);
     GDALClose(d);

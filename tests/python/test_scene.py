@@ -102,13 +102,14 @@ def test_ensemble_is_the_programs_to_the_bit(small_ramp, tmp_path):
             assert np.array_equal(h5["samples/contact"][span].reshape(-1) == 1,
                                   trajectory["contact"])
 
-    # The rasters: the GeoTIFFs' float32 values and geotransform.
+    # The rasters: the GeoTIFFs' values (float32; int32 counts) and geotransform.
     assert result["rasters"], "the scene asks for rasters"
     for name, layer in result["rasters"].items():
         raw = tmp_path / (name + ".bin")
         subprocess.run(["gdal_translate", "-q", "-of", "ENVI", out / (name + ".tif"), raw],
                        check=True)
-        stored = np.fromfile(raw, dtype=np.float32).reshape(layer["values"].shape)
+        stored = np.fromfile(raw, dtype=layer["values"].dtype).reshape(layer["values"].shape)
+        assert layer["values"].dtype == (np.int32 if layer["unit"] == "count" else np.float32)
         assert np.array_equal(stored, layer["values"]), name
         info = subprocess.run(["gdalinfo", "-json", out / (name + ".tif")], check=True,
                               capture_output=True, text=True).stdout
