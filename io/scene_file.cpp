@@ -9,6 +9,7 @@
 #include "common/format.hpp"
 #include "common/closest_name.hpp"
 #include "common/error.hpp"
+#include "common/fnv1a.hpp"
 #include "io/scene_tables.hpp"
 #include "io/toml_section.hpp"
 
@@ -85,20 +86,12 @@ std::string Hex(std::uint64_t v) {
 }
 
 std::string HashFiles(const std::vector<std::string>& files, const std::string& before) {
-  std::uint64_t h = 1469598103934665603ULL;
-  for (const char c : before) {
-    h ^= static_cast<unsigned char>(c);
-    h *= 1099511628211ULL;
-  }
+  std::uint64_t h = Fnv1a64(before);
   for (const std::string& f : files) {
     std::ifstream in(f, std::ios::binary);
     char buffer[65536];
-    while (in.read(buffer, sizeof buffer) || in.gcount() > 0) {
-      for (std::streamsize k = 0; k < in.gcount(); ++k) {
-        h ^= static_cast<unsigned char>(buffer[k]);
-        h *= 1099511628211ULL;
-      }
-    }
+    while (in.read(buffer, sizeof buffer) || in.gcount() > 0)
+      h = Fnv1a64(std::string_view(buffer, static_cast<std::size_t>(in.gcount())), h);
   }
   return Hex(h);
 }
