@@ -1,5 +1,7 @@
 #include "calibration/seeds.hpp"
 
+#include <boost/math/distributions/normal.hpp>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -14,16 +16,8 @@
 namespace talus::calibration {
 namespace {
 
-// The standard normal quantile at p in (0, 1), by bisection on the distribution function (to
-// 1e-12; an interval's width needs far less).
-double NormalQuantile(double p) {
-  double lo = -40, hi = 40;
-  while (hi - lo > 1e-12) {
-    const double mid = (lo + hi) / 2;
-    (0.5 * std::erfc(-mid / std::sqrt(2.0)) < p ? lo : hi) = mid;
-  }
-  return (lo + hi) / 2;
-}
+// The standard normal quantile at p in (0, 1) (Boost.Math).
+double NormalQuantile(double p) { return boost::math::quantile(boost::math::normal(), p); }
 
 // One seed's refit: its objective, each lattice point evaluated once.
 Eigen::VectorXd RefitWithSeed(const Objective& objective, std::uint64_t seed,

@@ -1,5 +1,7 @@
 #include "ensemble/self_check.hpp"
 
+#include <boost/math/distributions/normal.hpp>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -97,15 +99,10 @@ SelfCheckStatistic Compare(const std::string& name, const std::string& unit,
   return s;
 }
 
-// z with P(|Z| > z) = p for a standard normal Z: erfc(z / sqrt 2) = p, by bisection (erfc falls
-// monotonically; 60 halvings of [0, 40] reach double precision).
+// z with P(|Z| > z) = p for a standard normal Z: the quantile at 1 - p/2 (Boost.Math, from the
+// upper tail so that a small p keeps its digits).
 double TwoSidedNormalQuantile(double p) {
-  double lo = 0, hi = 40;
-  for (int k = 0; k < 60; ++k) {
-    const double mid = 0.5 * (lo + hi);
-    (std::erfc(mid / std::sqrt(2.0)) > p ? lo : hi) = mid;
-  }
-  return 0.5 * (lo + hi);
+  return boost::math::quantile(boost::math::complement(boost::math::normal(), p / 2));
 }
 
 Statistic Percentile(double p) {
