@@ -142,7 +142,8 @@ std::vector<std::string> WriteSummaryOutputs(const io::SceneFile& scene,
         staging.path("rocks.gpkg"), staging.path("rocks.csv"),
         scene.output.trajectories ? staging.path("trajectories.h5") : std::string(), scene.crs_wkt,
         scene.evaluation_lines.empty() ? std::string() : staging.path("evaluation_lines.csv"),
-        scene.scene.barriers.empty() ? std::string() : staging.path("barriers.csv"));
+        scene.scene.barriers.empty() ? std::string() : staging.path("barriers.csv"),
+        io::GeoPackageScene{&scene.release, &scene.evaluation_lines, &scene.scene.barriers});
     outputs.push_back("rocks.gpkg");
   }
   if (scene.output.report) outputs.push_back("report.html");

@@ -8,6 +8,8 @@
 #include <algorithm>
 #include <memory>
 #include <stdexcept>
+#include <string>
+#include <tuple>
 #include <vector>
 
 #include "common/atomic_file.hpp"
@@ -144,12 +146,107 @@ void PointLayer(Writer& out, const char* name, const std::string& csv, const cha
   out.Flush();
 }
 
+// A 2-D ring or polyline as OGR geometry.
+template <class Curve>
+void SetVertices(Curve& curve, const std::vector<Eigen::Vector2d>& vertices) {
+  curve.setNumPoints(static_cast<int>(vertices.size()));
+  for (std::size_t k = 0; k < vertices.size(); ++k)
+    curve.setPoint(static_cast<int>(k), vertices[k].x(), vertices[k].y());
+}
+
+// The scene's releases, evaluation lines and barriers (GeoPackageScene).
+void SceneLayers(Writer& out, const GeoPackageScene& scene) {
+  if (scene.release) {
+    using Kind = ensemble::ReleaseGeometry::Kind;
+    const ensemble::ReleaseSpec& r = *scene.release;
+    for (const auto& [kind, name, type] :
+         {std::tuple{Kind::kPoint, "release_points", wkbPoint},
+          std::tuple{Kind::kLine, "release_lines", wkbLineString},
+          std::tuple{Kind::kPolygon, "release_polygons", wkbPolygon}}) {
+      const bool runs = kind == Kind::kPoint && !r.runs.empty();
+      const bool any = runs || std::any_of(r.releases.begin(), r.releases.end(),
+                                           [k = kind](const auto& g) { return g.kind == k; });
+      if (!any) continue;
+      OGRLayer* layer = out.Layer(name, type);
+      out.Field(layer, "release", OFTInteger64);
+      out.Field(layer, "name", OFTString);
+      out.Field(layer, "rocks", OFTInteger64);
+      const long count = r.release_count();
+      for (long k = 0; k < count; ++k) {
+        OGRFeature feature(layer->GetLayerDefn());
+        feature.SetField(0, static_cast<GIntBig>(k));
+        feature.SetField(1, r.ReleaseName(static_cast<int>(k)).c_str());
+        feature.SetField(2, static_cast<GIntBig>(r.RocksOf(static_cast<int>(k))));
+        if (runs) {
+          const Eigen::Vector2d& p = r.runs[static_cast<std::size_t>(k)].xy_m;
+          OGRPoint point(p.x(), p.y());
+          feature.SetGeometry(&point);
+        } else {
+          const ensemble::ReleaseGeometry& g = r.releases[static_cast<std::size_t>(k)];
+          if (g.kind != kind) continue;
+          if (kind == Kind::kPoint) {
+            OGRPoint point(g.rings[0][0].x(), g.rings[0][0].y());
+            feature.SetGeometry(&point);
+          } else if (kind == Kind::kLine) {
+            OGRLineString line;
+            SetVertices(line, g.rings[0]);
+            feature.SetGeometry(&line);
+          } else {
+            OGRPolygon polygon;
+            for (const std::vector<Eigen::Vector2d>& ring : g.rings) {
+              OGRLinearRing closed;
+              SetVertices(closed, ring);
+              closed.closeRings();
+              polygon.addRing(&closed);
+            }
+            feature.SetGeometry(&polygon);
+          }
+        }
+        out.Add(layer, feature);
+      }
+      out.Flush();
+    }
+  }
+  if (scene.evaluation_lines && !scene.evaluation_lines->empty()) {
+    OGRLayer* layer = out.Layer("evaluation_lines", wkbLineString);
+    out.Field(layer, "name", OFTString);
+    for (const ensemble::EvaluationLine& l : *scene.evaluation_lines) {
+      OGRFeature feature(layer->GetLayerDefn());
+      feature.SetField(0, l.name.c_str());
+      OGRLineString line;
+      SetVertices(line, l.vertices_m);
+      feature.SetGeometry(&line);
+      out.Add(layer, feature);
+    }
+    out.Flush();
+  }
+  if (scene.barriers && !scene.barriers->empty()) {
+    OGRLayer* layer = out.Layer("barriers", wkbLineString);
+    out.Field(layer, "name", OFTString);
+    out.Field(layer, "type", OFTString);
+    out.Field(layer, "height_m", OFTReal);
+    out.Field(layer, "capacity_kj", OFTReal);
+    for (const Barrier& b : *scene.barriers) {
+      OGRFeature feature(layer->GetLayerDefn());
+      feature.SetField(0, b.name.c_str());
+      feature.SetField(1, ToString(b.type));
+      feature.SetField(2, b.height_m);
+      feature.SetField(3, b.capacity_J / 1000);
+      OGRLineString line;
+      SetVertices(line, b.vertices_m);
+      feature.SetGeometry(&line);
+      out.Add(layer, feature);
+    }
+    out.Flush();
+  }
+}
+
 }  // namespace
 
 void WriteRocksGeoPackage(const std::string& path, const std::string& rocks_csv,
                           const std::string& trajectories_h5, const std::string& crs_wkt,
                           const std::string& evaluation_lines_csv,
-                          const std::string& barriers_csv) {
+                          const std::string& barriers_csv, const GeoPackageScene& scene) {
   const FixedGpkgDate fixed_date;
   AtomicFile file(path);
   Writer out(path, file.temp_path(), crs_wkt);
@@ -159,6 +256,8 @@ void WriteRocksGeoPackage(const std::string& path, const std::string& rocks_csv,
     PointLayer(out, "evaluation_crossings", evaluation_lines_csv, "x_m", "y_m", "z_m");
   if (!barriers_csv.empty())
     PointLayer(out, "barrier_impacts", barriers_csv, "x_m", "y_m", "z_m");
+
+  SceneLayers(out, scene);
 
   std::vector<std::string> fields;
   if (!trajectories_h5.empty()) {

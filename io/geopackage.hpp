@@ -4,13 +4,29 @@
 // and, when trajectories.h5 was written, `paths` (one 3-D line per rock through its trajectory
 // samples, with the rock, its run and how it ended), and with evaluation lines
 // `evaluation_crossings` (one 3-D point per row of evaluation_lines.csv, at the first crossing of
-// the centre of mass, with every column as a field). Built from rocks.csv and trajectories.h5 after
+// the centre of mass, with every column as a field), and the scene's releases, evaluation lines and
+// barriers (GeoPackageScene). Built from rocks.csv and trajectories.h5 after
 // they are complete, so a run split into parts gives the same file; the GeoPackage's timestamps are
 // fixed (2000-01-01T00:00:00Z), so the same rocks give the same bytes.
 
 #include <string>
+#include <vector>
+
+#include "ensemble/evaluation_lines.hpp"
+#include "ensemble/release.hpp"
+#include "solver/barriers.hpp"
 
 namespace talus::io {
+
+// What the scene puts on the map beside the rocks: its releases (layers `release_points`,
+// `release_lines`, `release_polygons` with the release's index and name; a run table's runs as
+// points), its evaluation lines (`evaluation_lines`, with their names) and barriers (`barriers`,
+// with name, type, height_m and capacity_kj). Layers without features are not written.
+struct GeoPackageScene {
+  const ensemble::ReleaseSpec* release = nullptr;
+  const std::vector<ensemble::EvaluationLine>* evaluation_lines = nullptr;
+  const std::vector<Barrier>* barriers = nullptr;
+};
 
 // Writes the GeoPackage atomically. `trajectories_h5` empty: no `paths` layer;
 // `evaluation_lines_csv` empty: no `evaluation_crossings` layer; `barriers_csv` empty: no
@@ -20,6 +36,7 @@ namespace talus::io {
 void WriteRocksGeoPackage(const std::string& path, const std::string& rocks_csv,
                           const std::string& trajectories_h5, const std::string& crs_wkt,
                           const std::string& evaluation_lines_csv = "",
-                          const std::string& barriers_csv = "");
+                          const std::string& barriers_csv = "",
+                          const GeoPackageScene& scene = {});
 
 }  // namespace talus::io

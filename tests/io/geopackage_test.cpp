@@ -7,6 +7,9 @@
 #include <algorithm>
 #include <fstream>
 #include <iterator>
+#include <memory>
+#include <tuple>
+#include <vector>
 
 #include "common/error.hpp"
 #include "io/barriers_csv.hpp"
@@ -194,6 +197,73 @@ TEST(RocksGeoPackage, BarrierImpactsArePointsWithEveryColumn) {
   EXPECT_DOUBLE_EQ(first->GetFieldAsDouble("energy_J"), 1250);
   EXPECT_DOUBLE_EQ(first->GetGeometryRef()->toPoint()->getZ(), 33);
   EXPECT_EQ(gpkg.d->GetLayerByName("evaluation_crossings"), nullptr);
+}
+
+// The scene on the map: a point, a line and a polygon with a hole as release layers (index, name,
+// rocks), the evaluation lines and the barriers with their attributes, at the coordinates given.
+TEST(RocksGeoPackage, ReleasesEvaluationLinesAndBarriersAreLayers) {
+  const auto dir = testing::FreshDir("scene_layers");
+  testing::WriteText(dir / "rocks.csv", RocksCsv(2));
+  ensemble::ReleaseSpec release;
+  using Kind = ensemble::ReleaseGeometry::Kind;
+  release.releases.push_back({Kind::kPoint, {{{1, 2}}}});
+  release.releases.push_back({Kind::kLine, {{{0, 0}, {10, 0}, {10, 5}}}});
+  release.releases.push_back(
+      {Kind::kPolygon, {{{0, 0}, {8, 0}, {8, 8}, {0, 8}}, {{2, 2}, {4, 2}, {4, 4}, {2, 4}}}});
+  release.SetRocksPerRelease(3);
+  const std::vector<ensemble::EvaluationLine> lines = {{"upper", {{0, 20}, {30, 20}}}};
+  Barrier net;
+  net.name = "net";
+  net.vertices_m = {{0, 30}, {15, 31}};
+  net.height_m = 4;
+  net.capacity_J = 5e5;
+  const std::vector<Barrier> barriers = {net};
+  const std::string path = (dir / "scene.gpkg").string();
+  WriteRocksGeoPackage(path, (dir / "rocks.csv").string(), "", "", "", "",
+                       GeoPackageScene{&release, &lines, &barriers});
+  Dataset gpkg(path);
+  ASSERT_NE(gpkg.d, nullptr);
+  for (const char* name : {"release_points", "release_lines", "release_polygons"}) {
+    OGRLayer* layer = gpkg.d->GetLayerByName(name);
+    ASSERT_NE(layer, nullptr) << name;
+    EXPECT_EQ(layer->GetFeatureCount(), 1) << name;
+  }
+  OGRLayer* polygons = gpkg.d->GetLayerByName("release_polygons");
+  std::unique_ptr<OGRFeature> polygon(polygons->GetNextFeature());
+  EXPECT_EQ(polygon->GetFieldAsInteger64("release"), 2);
+  EXPECT_EQ(polygon->GetFieldAsInteger64("rocks"), 3);
+  const auto* shape = polygon->GetGeometryRef()->toPolygon();
+  EXPECT_EQ(shape->getNumInteriorRings(), 1);
+  EXPECT_DOUBLE_EQ(shape->get_Area(), 64 - 4);
+  std::unique_ptr<OGRFeature> line(gpkg.d->GetLayerByName("release_lines")->GetNextFeature());
+  EXPECT_DOUBLE_EQ(line->GetGeometryRef()->toLineString()->get_Length(), 15);
+  std::unique_ptr<OGRFeature> upper(gpkg.d->GetLayerByName("evaluation_lines")->GetNextFeature());
+  EXPECT_STREQ(upper->GetFieldAsString("name"), "upper");
+  std::unique_ptr<OGRFeature> b(gpkg.d->GetLayerByName("barriers")->GetNextFeature());
+  EXPECT_STREQ(b->GetFieldAsString("name"), "net");
+  EXPECT_STREQ(b->GetFieldAsString("type"), "flexible_net");
+  EXPECT_EQ(b->GetFieldAsDouble("height_m"), 4);
+  EXPECT_EQ(b->GetFieldAsDouble("capacity_kj"), 500);
+  // A run table's runs are points; no layer for kinds the scene does not have.
+  ensemble::ReleaseSpec runs;
+  for (const auto& [id, x, y] : {std::tuple{"r1", 5.0, 6.0}, std::tuple{"r2", 7.0, 8.0}}) {
+    ensemble::ReleaseRun run;
+    run.id = id;
+    run.xy_m = {x, y};
+    runs.runs.push_back(run);
+  }
+  const std::string path2 = (dir / "runs.gpkg").string();
+  WriteRocksGeoPackage(path2, (dir / "rocks.csv").string(), "", "", "", "",
+                       GeoPackageScene{&runs, nullptr, nullptr});
+  Dataset runs_gpkg(path2);
+  OGRLayer* points = runs_gpkg.d->GetLayerByName("release_points");
+  ASSERT_NE(points, nullptr);
+  EXPECT_EQ(points->GetFeatureCount(), 2);
+  std::unique_ptr<OGRFeature> second(points->GetFeature(2));
+  ASSERT_NE(second, nullptr);
+  EXPECT_STREQ(second->GetFieldAsString("name"), "r2");
+  EXPECT_EQ(runs_gpkg.d->GetLayerByName("release_polygons"), nullptr);
+  EXPECT_EQ(runs_gpkg.d->GetLayerByName("barriers"), nullptr);
 }
 
 }  // namespace
