@@ -285,8 +285,8 @@ SceneFile LoadSceneTable(const toml::table& root, const std::string& path,
   scene_tables::LoadBarriers(context, root.get("barriers"), out);
   scene_tables::LoadForest(context,
                            Section(context, SubTable(context, root, "forest"), "forest",
-                                   {"trees", "stands", "stem_height_m", "friction",
-                                    "energy_coefficient_j", "energy_exponent", "seed"}),
+                                   {"trees", "dbh_field", "stands", "stands_file", "stem_height_m",
+                                    "friction", "energy_coefficient_j", "energy_exponent", "seed"}),
                            root.get("forest") != nullptr, out);
   const Section solver(context, SubTable(context, root, "solver"), "solver", SolverKeys());
   LoadSolver(solver, out.scene.options, out.solver_preset, out.solver_keys_given);

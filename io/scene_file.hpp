@@ -95,7 +95,8 @@ struct SceneFile {
   bool has_forest = false;
   std::string trees_file;  // [forest] trees, resolved; "" without
   long trees_from_file = 0;
-  std::vector<ForestStand> stands;
+  std::string stands_file;          // [forest] stands_file, resolved; "" without
+  std::vector<ForestStand> stands;  // inline stands first, then those of stands_file
   std::uint64_t forest_seed = 0;
 };
 

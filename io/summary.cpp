@@ -243,6 +243,7 @@ std::string SummaryJson(const SceneFile& scene, const ensemble::EnsembleReport& 
                         {"dbh_cm", s.dbh_cm},
                         {"dbh_sd_cm", s.dbh_sd_cm},
                         {"trees", s.trees}});
+    f["stands_file"] = scene.stands_file;
     f["stands"] = stands;
     f["seed"] = scene.forest_seed;
     f["stem_height_m"] = model.stem_height_m;
@@ -251,13 +252,11 @@ std::string SummaryJson(const SceneFile& scene, const ensemble::EnsembleReport& 
                             {"exponent", model.energy_exponent},
                             {"law", "E_max = coefficient * DBH[cm]^exponent"}};
     if (trees)
-      f["impacts"] = {{"rock_stem_pairs", trees->rows},
-                      {"impacts", trees->impacts},
-                      {"rocks_hitting", trees->rocks_hitting},
-                      {"rocks_breaking", trees->rocks_breaking},
-                      {"breakages", trees->breakages},
-                      {"stems_hit", trees->stems_hit},
-                      {"absorbed_J", trees->absorbed_J}};
+      f["impacts"] = {
+          {"rock_stem_pairs", trees->rows},        {"impacts", trees->impacts},
+          {"rocks_hitting", trees->rocks_hitting}, {"rocks_breaking", trees->rocks_breaking},
+          {"breakages", trees->breakages},         {"stems_hit", trees->stems_hit},
+          {"absorbed_J", trees->absorbed_J}};
     j["forest"] = f;
   }
   if (self_check) j["self_check"] = SelfCheckJson(*self_check);

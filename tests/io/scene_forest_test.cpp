@@ -89,7 +89,8 @@ TEST(SceneForest, StandsDrawTheSameTreesAtEveryLoadFromTheForestSeed) {
   EXPECT_DOUBLE_EQ(a.stands[0].area_m2, 400);
   double sum = 0, squares = 0;
   for (const Stem& s : stems) {
-    EXPECT_TRUE(s.position_m.x() >= 20 && s.position_m.x() <= 40 && std::abs(s.position_m.y()) <= 10);
+    EXPECT_TRUE(s.position_m.x() >= 20 && s.position_m.x() <= 40 &&
+                std::abs(s.position_m.y()) <= 10);
     sum += 100 * s.dbh_m;
     squares += 1e4 * s.dbh_m * s.dbh_m;
   }
@@ -150,6 +151,94 @@ TEST(SceneForest, ARunHitsTheSameStemsForAnyNumberOfThreads) {
   EXPECT_GT(hits, 0) << "the rocks run into the stand";
 }
 
+// A point vector file of trees (GeoJSON here; any file GDAL/OGR reads): each point with the DBH of
+// its dbh_field attribute. A GeoJSON without a "crs" member on the plane (no CRS) is taken as
+// local coordinates.
+TEST(SceneForest, APointVectorFileOfTreesWithItsDbhField) {
+  const auto dir = testing::FreshDir("scene");
+  testing::WriteText(dir / "trees.geojson", R"({"type": "FeatureCollection", "features": [
+{"type": "Feature", "properties": {"d": 25.5}, "geometry": {"type": "Point", "coordinates": [30, 1]}},
+{"type": "Feature", "properties": {"d": 40}, "geometry": {"type": "Point", "coordinates": [33, -2]}}]})");
+  testing::WriteText(dir / "scene.toml",
+                     kScene + "[forest]\ntrees = \"trees.geojson\"\ndbh_field = \"d\"\n");
+  const SceneFile s = LoadScene((dir / "scene.toml").string());
+  ASSERT_EQ(s.scene.forest.stems().size(), 2u);
+  EXPECT_EQ(s.scene.forest.stems()[1].position_m, Eigen::Vector2d(33, -2));
+  EXPECT_DOUBLE_EQ(s.scene.forest.stems()[0].dbh_m, 0.255);
+  // Without the field, and with a DBH out of bounds: errors naming the file and the feature.
+  testing::WriteText(dir / "scene.toml", kScene + "[forest]\ntrees = \"trees.geojson\"\n");
+  try {
+    LoadScene((dir / "scene.toml").string());
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_HAS(e.what(), "forest.trees (");
+    EXPECT_HAS(e.what(), "trees.geojson, feature 0): no field 'dbh_cm'");
+  }
+}
+
+// A file in another CRS is reprojected to the DEM's (cases/tirol's EPSG:31287 from WGS 84), to
+// the same place as a release point of that file; a file with a CRS is refused in a scene without
+// one.
+TEST(SceneForest, ATreeFileInAnotherCrsIsReprojectedOrRefused) {
+  const auto dir = testing::FreshDir("scene");
+  // (256500, 379700) in EPSG:31287, by gdaltransform.
+  testing::WriteText(dir / "trees.geojson", R"({"type": "FeatureCollection",
+"crs": {"type": "name", "properties": {"name": "urn:ogc:def:crs:OGC:1.3:CRS84"}}, "features": [
+{"type": "Feature", "properties": {"dbh_cm": 30}, "geometry": {"type": "Point", "coordinates": [11.4343407630182, 47.3010011178257]}}]})");
+  const std::string tirol = std::string(TALUS_SOURCE_DIR) + "/cases/tirol/";
+  testing::WriteText(dir / "scene.toml",
+                     "[terrain]\ndem = \"" + tirol +
+                         "dem.tif\"\n[rock]\n"
+                         "shape = { box = [1, 1, 1] }\n[release]\nfile = \"trees.geojson\"\n"
+                         "[forest]\ntrees = \"trees.geojson\"\n");
+  const SceneFile s = LoadScene((dir / "scene.toml").string());
+  ASSERT_EQ(s.scene.forest.stems().size(), 1u);
+  const Eigen::Vector2d tree = s.scene.forest.stems()[0].position_m;
+  EXPECT_NEAR(tree.x(), 256500, 0.01);  // 1 cm: gdaltransform's printed digits
+  EXPECT_NEAR(tree.y(), 379700, 0.01);
+  EXPECT_EQ(tree, s.release.releases.at(0).rings.at(0).at(0));
+  testing::WriteText(dir / "local.geojson", R"({"type": "FeatureCollection",
+"crs": {"type": "name", "properties": {"name": "urn:ogc:def:crs:EPSG::31287"}}, "features": [
+{"type": "Feature", "properties": {"dbh_cm": 30}, "geometry": {"type": "Point", "coordinates": [30, 0]}}]})");
+  testing::WriteText(dir / "scene.toml", kScene + "[forest]\ntrees = \"local.geojson\"\n");
+  try {
+    LoadScene((dir / "scene.toml").string());
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_HAS(e.what(), "has a CRS but the DEM has none, so the trees cannot be placed");
+  }
+}
+
+// stands_file: the polygons of a vector file with stems_per_ha, dbh_cm (and dbh_sd_cm), drawn as
+// inline stands are, after them; a hole is left empty.
+TEST(SceneForest, StandsFromAVectorFileOfPolygons) {
+  const auto dir = testing::FreshDir("scene");
+  testing::WriteText(dir / "stands.geojson", R"({"type": "FeatureCollection", "features": [
+{"type": "Feature", "properties": {"stems_per_ha": 3000, "dbh_cm": 20},
+ "geometry": {"type": "Polygon", "coordinates": [[[20, -10], [40, -10], [40, 10], [20, 10], [20, -10]],
+                                                 [[25, -5], [35, -5], [35, 5], [25, 5], [25, -5]]]}}]})");
+  testing::WriteText(dir / "scene.toml", kScene + "[forest]\nstands_file = \"stands.geojson\"\n");
+  const SceneFile s = LoadScene((dir / "scene.toml").string());
+  ASSERT_EQ(s.stands.size(), 1u);
+  EXPECT_DOUBLE_EQ(s.stands[0].area_m2, 300);  // 400 less the 100 m^2 hole
+  // Poisson with mean 3000/ha * 0.03 ha = 90: within 4 sigma (38).
+  EXPECT_NEAR(static_cast<double>(s.scene.forest.stems().size()), 90, 4 * std::sqrt(90.0));
+  for (const Stem& stem : s.scene.forest.stems()) {
+    EXPECT_FALSE(std::abs(stem.position_m.x() - 30) < 5 && std::abs(stem.position_m.y()) < 5)
+        << "a tree in the hole";
+    EXPECT_DOUBLE_EQ(stem.dbh_m, 0.2);
+  }
+  testing::WriteText(dir / "stands.geojson", R"({"type": "FeatureCollection", "features": [
+{"type": "Feature", "properties": {"stems_per_ha": 0, "dbh_cm": 20},
+ "geometry": {"type": "Polygon", "coordinates": [[[20, -10], [40, -10], [40, 10], [20, -10]]]}}]})");
+  try {
+    LoadScene((dir / "scene.toml").string());
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_HAS(e.what(), "stands.geojson, feature 0): stems_per_ha: 0 must be > 0");
+  }
+}
+
 TEST(SceneForest, BadInputIsAnErrorNamingFileLineAndKey) {
   EXPECT_HAS(ErrorOf("[forest]\nstem_height_m = 10\n"), "forest.trees: a [forest] needs trees");
   EXPECT_HAS(ErrorOf("[forest]\ntrees = \"trees.csv\"\n", "x_m,y_m,dbh_cm\n30,0,-5\n"),
@@ -162,7 +251,8 @@ TEST(SceneForest, BadInputIsAnErrorNamingFileLineAndKey) {
   EXPECT_HAS(ErrorOf(stand + "stems_per_ha = 0, dbh_cm = 30 }]\n"),
              "scene.toml:13: forest.stands[0].stems_per_ha: 0 must be > 0 and <= 10000");
   EXPECT_HAS(ErrorOf(stand + "stems_per_ha = 1e6, dbh_cm = 30 }]\n"), "stems_per_ha: 1000000");
-  EXPECT_HAS(ErrorOf(stand + "stems_per_ha = 400, dbh_cm = -30 }]\n"), "dbh_cm: -30 cm must be > 0");
+  EXPECT_HAS(ErrorOf(stand + "stems_per_ha = 400, dbh_cm = -30 }]\n"),
+             "dbh_cm: -30 cm must be > 0");
   EXPECT_HAS(ErrorOf(stand + "stems_per_ha = 400, dbh_cm = 30, dbh_sd_cm = 40 }]\n"),
              "dbh_sd_cm: 40 cm must be >= 0 and <= dbh_cm");
   EXPECT_HAS(ErrorOf(stand + "stems_per_ha = 400 }]\n"), "forest.stands[0].dbh_cm: missing");
