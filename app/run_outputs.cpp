@@ -147,9 +147,8 @@ std::vector<std::string> WriteSummaryOutputs(const io::SceneFile& scene,
     outputs.push_back("rocks.gpkg");
   }
   if (scene.output.report) outputs.push_back("report.html");
-  const std::string summary =
-      io::SummaryJson(scene, report, kVersion, outputs, lines, self_check, barriers,
-                      trees ? &*trees : nullptr);
+  const std::string summary = io::SummaryJson(scene, report, kVersion, outputs, lines, self_check,
+                                              barriers, trees ? &*trees : nullptr);
   if (scene.output.report) {
     ThrowIfInterrupted();
     io::RunReportInput page;

@@ -108,8 +108,9 @@ void FootprintRecorder::Finish(RockOutcome& outcome) {
   if (request_.tree_hits)
     for (const StemHit& h : result.stem_hits) {
       const int cell = CellOf(h.stem_m.x(), h.stem_m.y());
-      if (cell >= 0) outcome.footprint.tree_hit_cells.insert(
-          outcome.footprint.tree_hit_cells.end(), static_cast<std::size_t>(h.impacts), cell);
+      if (cell >= 0)
+        outcome.footprint.tree_hit_cells.insert(outcome.footprint.tree_hit_cells.end(),
+                                                static_cast<std::size_t>(h.impacts), cell);
     }
 }
 
@@ -265,10 +266,9 @@ std::vector<RasterLayer> RasterAccumulator::Finish(const Heightfield& dem) const
 }
 
 std::size_t RasterAccumulator::MemoryBytes() const {
-  std::size_t bytes =
-      sizeof(int) * (passages_.capacity() + deposits_.capacity() + tree_hits_.capacity() +
-                     slot_.capacity()) +
-      sizeof(ValueSummary) * summaries_.capacity();
+  std::size_t bytes = sizeof(int) * (passages_.capacity() + deposits_.capacity() +
+                                     tree_hits_.capacity() + slot_.capacity()) +
+                      sizeof(ValueSummary) * summaries_.capacity();
   for (const ValueSummary& s : summaries_) bytes += 8 * s.bins();
   return bytes;
 }

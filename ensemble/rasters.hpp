@@ -55,8 +55,7 @@ struct RasterRequest {
   bool Wants(RasterKind kind) const;
 
   bool any() const {
-    return speed || energy || jump_height || passages || deposits || reach_probability ||
-           tree_hits;
+    return speed || energy || jump_height || passages || deposits || reach_probability || tree_hits;
   }
   bool needs_passes() const {
     return speed || energy || jump_height || passages || reach_probability;
@@ -112,8 +111,8 @@ class RasterAccumulator {
   // Adds the rocks of `other`, which must have the same request.
   void Merge(const RasterAccumulator& other);
   // The rasters, in the order speed, energy, jump height (each max, mean, then the percentiles
-  // ascending), passages, deposits, reach probability, tree hits; `dem` is the DEM on the request's grid,
-  // whose nodata cells (NaN) are nodata in every raster.
+  // ascending), passages, deposits, reach probability, tree hits; `dem` is the DEM on the request's
+  // grid, whose nodata cells (NaN) are nodata in every raster.
   std::vector<RasterLayer> Finish(const Heightfield& dem) const;
   long rocks() const { return rocks_; }
   const RasterRequest& request() const { return request_; }

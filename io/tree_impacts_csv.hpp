@@ -36,13 +36,13 @@ class TreeImpactsCsvWriter {
 
 // What the stems did over a run, from a complete tree_impacts.csv.
 struct TreeImpactSummary {
-  long rows = 0;              // (rock, stem) pairs
-  long impacts = 0;           // contact episodes, summed
-  long rocks_hitting = 0;     // rocks that touched at least one stem
-  long rocks_breaking = 0;    // rocks that broke at least one stem
-  long breakages = 0;         // (rock, stem) pairs where the rock broke the stem
-  long stems_hit = 0;         // distinct stems touched by any rock
-  double absorbed_J = 0;      // energy taken by the stems, summed over rows
+  long rows = 0;            // (rock, stem) pairs
+  long impacts = 0;         // contact episodes, summed
+  long rocks_hitting = 0;   // rocks that touched at least one stem
+  long rocks_breaking = 0;  // rocks that broke at least one stem
+  long breakages = 0;       // (rock, stem) pairs where the rock broke the stem
+  long stems_hit = 0;       // distinct stems touched by any rock
+  double absorbed_J = 0;    // energy taken by the stems, summed over rows
 };
 // Throws InputError naming the file and line when a row is malformed.
 TreeImpactSummary SummarizeTreeImpacts(const std::string& csv_path);

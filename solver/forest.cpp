@@ -68,7 +68,9 @@ double PolygonDistance(const std::vector<Eigen::Vector2d>& polygon, const Eigen:
 
 Eigen::Vector2d ProjectOnDisk(const Eigen::Vector2d& p, double radius) {
   const double norm = p.norm();
-  return norm <= radius ? p : (radius > 0 ? Eigen::Vector2d(p * (radius / norm)) : Eigen::Vector2d::Zero());
+  return norm <= radius
+             ? p
+             : (radius > 0 ? Eigen::Vector2d(p * (radius / norm)) : Eigen::Vector2d::Zero());
 }
 
 }  // namespace
@@ -156,8 +158,7 @@ Eigen::Vector3d PlasticFrictionalImpulse(const RockShape& rock, const Eigen::Mat
       Eigen::Matrix3d::Identity() / rock.mass_kg -
       cross_a * rotation * inv_inertia.asDiagonal() * rotation.transpose() * cross_a;
   const Eigen::Matrix3d g = directions.transpose() * mobility * directions;
-  const Eigen::Vector3d gamma =
-      directions.transpose() * (*velocity + (rotation * *omega).cross(a));
+  const Eigen::Vector3d gamma = directions.transpose() * (*velocity + (rotation * *omega).cross(a));
 
   // Sticking: the point stops entirely, when the percussion that does so lies in the cone.
   Eigen::Vector3d p = -g.partialPivLu().solve(gamma);
@@ -212,8 +213,8 @@ bool MeetStems(const Forest& forest, const RockShape& rock, RockState* state,
     const double top_m = stem.ground_m + model.stem_height_m;
     if ((stem.position_m - centre).norm() > rock.bounding_radius_m + radius) return;
     if (lowest_possible_m > top_m) return;
-    auto record = std::find_if(hits->begin(), hits->end(),
-                               [k](const StemHit& h) { return h.stem == k; });
+    auto record =
+        std::find_if(hits->begin(), hits->end(), [k](const StemHit& h) { return h.stem == k; });
     if (record != hits->end() && record->broken) return;  // gone for this rock
     if (!hull_ready) {
       rotation = state->orientation.toRotationMatrix();
@@ -235,8 +236,8 @@ bool MeetStems(const Forest& forest, const RockShape& rock, RockState* state,
     if (distance >= radius) return;
     overlapping.push_back(k);
     // Normal: horizontal, from the stem into the rock.
-    Eigen::Vector2d n2 = distance >= 0 ? Eigen::Vector2d(q - stem.position_m)
-                                       : Eigen::Vector2d(stem.position_m - q);
+    Eigen::Vector2d n2 =
+        distance >= 0 ? Eigen::Vector2d(q - stem.position_m) : Eigen::Vector2d(stem.position_m - q);
     if (!(n2.norm() > 0)) n2 = centre - stem.position_m;
     if (!(n2.norm() > 0)) return;
     n2.normalize();
@@ -246,16 +247,14 @@ bool MeetStems(const Forest& forest, const RockShape& rock, RockState* state,
     directions.col(2) = Eigen::Vector3d::UnitZ();
     // Where it acts: the hull's nearest point in plan view, at the height of the centre of mass
     // within the part of the rock that the stem spans.
-    const double z_c = std::clamp(state->position_m.z(), std::max(stem.ground_m, z_min),
-                                  std::min(top_m, z_max));
-    const Eigen::Vector3d lever =
-        Eigen::Vector3d(q.x(), q.y(), z_c) - state->position_m;
+    const double z_c =
+        std::clamp(state->position_m.z(), std::max(stem.ground_m, z_min), std::min(top_m, z_max));
+    const Eigen::Vector3d lever = Eigen::Vector3d(q.x(), q.y(), z_c) - state->position_m;
     const Eigen::Vector3d omega_world = rotation * state->angular_velocity_rad_s;
     const double approach = directions.col(0).dot(state->velocity_m_s + omega_world.cross(lever));
     if (!(approach < 0)) return;  // separating or sliding past
 
-    const double energy_J =
-        KineticEnergy(rock, state->velocity_m_s, state->angular_velocity_rad_s);
+    const double energy_J = KineticEnergy(rock, state->velocity_m_s, state->angular_velocity_rad_s);
     Eigen::Vector3d v = state->velocity_m_s, w = state->angular_velocity_rad_s;
     PlasticFrictionalImpulse(rock, rotation, lever, directions, model.friction, &v, &w);
     const double taken_J = std::max(0.0, energy_J - KineticEnergy(rock, v, w));
@@ -278,7 +277,8 @@ bool MeetStems(const Forest& forest, const RockShape& rock, RockState* state,
       record->absorbed_J += taken_J;
     } else {
       // It breaks: the rock keeps its directions with its energy less what the stem had left.
-      const double scale = energy_J > 0 ? std::sqrt(std::max(0.0, energy_J - left_J) / energy_J) : 0.0;
+      const double scale =
+          energy_J > 0 ? std::sqrt(std::max(0.0, energy_J - left_J) / energy_J) : 0.0;
       state->velocity_m_s *= scale;
       state->angular_velocity_rad_s *= scale;
       record->absorbed_J = forest.capacity_J(k);
@@ -288,8 +288,8 @@ bool MeetStems(const Forest& forest, const RockShape& rock, RockState* state,
   });
   // Episodes: a stem the hull no longer overlaps is free for a new impact.
   for (StemHit& h : *hits)
-    h.touching = !h.broken && std::find(overlapping.begin(), overlapping.end(), h.stem) !=
-                                  overlapping.end();
+    h.touching =
+        !h.broken && std::find(overlapping.begin(), overlapping.end(), h.stem) != overlapping.end();
   return acted;
 }
 

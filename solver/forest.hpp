@@ -34,7 +34,7 @@ struct ForestModel {
 // One tree.
 struct Stem {
   Eigen::Vector2d position_m = Eigen::Vector2d::Zero();  // axis, map coordinates (m)
-  double dbh_m = 0;     // stem diameter (m), > 0
+  double dbh_m = 0;                                      // stem diameter (m), > 0
   double ground_m = 0;  // terrain height at the axis (m): the stem's foot
 };
 
@@ -58,11 +58,15 @@ class Forest {
   template <class F>
   void ForEachNear(const Eigen::Vector2d& centre, double reach, F&& f) const {
     if (stems_.empty()) return;
-    const double u0 = (centre.x() - reach - x0_m_) / cell_m_, u1 = (centre.x() + reach - x0_m_) / cell_m_;
-    const double v0 = (centre.y() - reach - y0_m_) / cell_m_, v1 = (centre.y() + reach - y0_m_) / cell_m_;
+    const double u0 = (centre.x() - reach - x0_m_) / cell_m_,
+                 u1 = (centre.x() + reach - x0_m_) / cell_m_;
+    const double v0 = (centre.y() - reach - y0_m_) / cell_m_,
+                 v1 = (centre.y() + reach - y0_m_) / cell_m_;
     if (!(u1 >= 0 && u0 < nx_ && v1 >= 0 && v0 < ny_)) return;
-    const int i0 = u0 < 0 ? 0 : static_cast<int>(u0), i1 = u1 >= nx_ ? nx_ - 1 : static_cast<int>(u1);
-    const int j0 = v0 < 0 ? 0 : static_cast<int>(v0), j1 = v1 >= ny_ ? ny_ - 1 : static_cast<int>(v1);
+    const int i0 = u0 < 0 ? 0 : static_cast<int>(u0),
+              i1 = u1 >= nx_ ? nx_ - 1 : static_cast<int>(u1);
+    const int j0 = v0 < 0 ? 0 : static_cast<int>(v0),
+              j1 = v1 >= ny_ ? ny_ - 1 : static_cast<int>(v1);
     for (int j = j0; j <= j1; ++j)
       for (int i = i0; i <= i1; ++i) {
         const std::size_t cell = static_cast<std::size_t>(j) * nx_ + i;
@@ -86,10 +90,10 @@ class Forest {
 
 // What a rock did to one stem over its run (one record per stem it touched).
 struct StemHit {
-  int stem = 0;       // index into Forest::stems()
+  int stem = 0;                                      // index into Forest::stems()
   Eigen::Vector2d stem_m = Eigen::Vector2d::Zero();  // the stem's axis (map coordinates, m)
-  int impacts = 0;    // contact episodes (a rock leaning on a stem for many steps is one)
-  double t_s = 0;     // time of the first impact
+  int impacts = 0;  // contact episodes (a rock leaning on a stem for many steps is one)
+  double t_s = 0;   // time of the first impact
   Eigen::Vector3d position_m = Eigen::Vector3d::Zero();  // centre of mass at the first impact
   double energy_J = 0;    // kinetic energy just before the first impact
   double absorbed_J = 0;  // energy the stem took from this rock, <= its breaking energy

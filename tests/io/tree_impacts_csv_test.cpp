@@ -45,11 +45,10 @@ TEST(TreeImpactsCsv, RowsPerRockAndStemAndTheirSummary) {
   std::ifstream in(path);
   std::stringstream text;
   text << in.rdbuf();
-  EXPECT_EQ(text.str(),
-            std::string(TreeImpactsCsvWriter::Header()) + "\n" +
-                "0,0,0,0,10,20,30,2,1.5,0,0,0,5000,1000,0\n"
-                "1,0,0,0,12,20,20,1,1.5,0,0,0,5000,3000,1\n"
-                "0,2,0,0,10,20,30,1,1.5,0,0,0,5000,3000,1\n");
+  EXPECT_EQ(text.str(), std::string(TreeImpactsCsvWriter::Header()) + "\n" +
+                            "0,0,0,0,10,20,30,2,1.5,0,0,0,5000,1000,0\n"
+                            "1,0,0,0,12,20,20,1,1.5,0,0,0,5000,3000,1\n"
+                            "0,2,0,0,10,20,30,1,1.5,0,0,0,5000,3000,1\n");
   const TreeImpactSummary s = SummarizeTreeImpacts(path);
   EXPECT_EQ(s.rows, 3);
   EXPECT_EQ(s.impacts, 4);
