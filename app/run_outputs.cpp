@@ -19,6 +19,7 @@
 #include "io/rocks_csv.hpp"
 #include "io/summary.hpp"
 #include "io/trajectory_file.hpp"
+#include "io/tree_impacts_csv.hpp"
 #include "talus/version.hpp"
 
 namespace talus::app {
@@ -26,17 +27,18 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// Streams each finished rock to rocks.csv, trajectories.h5, evaluation_lines.csv and
-// barriers.csv. Keeps the horizontal paths of the quick-look's sample rocks.
+// Streams each finished rock to rocks.csv, trajectories.h5, evaluation_lines.csv, barriers.csv
+// and tree_impacts.csv. Keeps the horizontal paths of the quick-look's sample rocks.
 class FileSink : public ensemble::RockSink {
  public:
   FileSink(io::RocksCsvWriter& csv, io::TrajectoryWriter* trajectories,
            io::EvaluationLinesCsvWriter* lines, io::BarriersCsvWriter* barriers,
-           std::function<bool(long)> sample)
+           io::TreeImpactsCsvWriter* trees, std::function<bool(long)> sample)
       : csv_(csv),
         trajectories_(trajectories),
         lines_(lines),
         barriers_(barriers),
+        trees_(trees),
         sample_(std::move(sample)) {}
   void OnRock(const ensemble::RockOutcome& rock) override {
     ThrowIfInterrupted();
@@ -44,6 +46,7 @@ class FileSink : public ensemble::RockSink {
     if (trajectories_) trajectories_->Write(rock);
     if (lines_) lines_->Write(rock);
     if (barriers_) barriers_->Write(rock);
+    if (trees_) trees_->Write(rock);
     if (sample_ && sample_(rock.rock)) {
       io::SamplePath& path = paths.emplace_back();
       path.rock = rock.rock;
@@ -58,6 +61,7 @@ class FileSink : public ensemble::RockSink {
   io::TrajectoryWriter* trajectories_;
   io::EvaluationLinesCsvWriter* lines_;
   io::BarriersCsvWriter* barriers_;
+  io::TreeImpactsCsvWriter* trees_;
   std::function<bool(long)> sample_;
 };
 
@@ -124,6 +128,9 @@ std::vector<std::string> WriteSummaryOutputs(const io::SceneFile& scene,
     WriteFileAtomically(staging.path("barriers_summary.csv"), io::BarriersSummaryCsv(barriers));
     outputs.push_back("barriers_summary.csv");
   }
+  // Forest: summarised from the complete tree_impacts.csv.
+  std::optional<io::TreeImpactSummary> trees;
+  if (scene.has_forest) trees = io::SummarizeTreeImpacts(staging.path("tree_impacts.csv"));
   std::vector<io::MapLine> map_lines;
   for (const ensemble::EvaluationLine& line : scene.evaluation_lines)
     map_lines.push_back({line.name, line.vertices_m});
@@ -147,8 +154,8 @@ std::vector<std::string> WriteSummaryOutputs(const io::SceneFile& scene,
     outputs.push_back("rocks.gpkg");
   }
   if (scene.output.report) outputs.push_back("report.html");
-  const std::string summary =
-      io::SummaryJson(scene, report, kVersion, outputs, lines, self_check, barriers);
+  const std::string summary = io::SummaryJson(scene, report, kVersion, outputs, lines, self_check,
+                                              barriers, trees ? &*trees : nullptr);
   if (scene.output.report) {
     ThrowIfInterrupted();
     io::RunReportInput page;
@@ -208,7 +215,9 @@ std::vector<std::string> TalusOutputNames() {
                                     "evaluation_lines.csv",
                                     "evaluation_lines_summary.csv",
                                     "barriers.csv",
-                                    "barriers_summary.csv"};
+                                    "barriers_summary.csv",
+                                    "tree_impacts.csv",
+                                    "tree_hits.tif"};
   for (const char* quantity : {"speed", "energy", "jump_height"}) {
     for (const char* statistic : {"max", "mean"})
       names.push_back(std::string(quantity) + "_" + statistic + ".tif");
@@ -260,13 +269,21 @@ std::vector<std::string> RunIntoStaging(const io::SceneFile& scene, int threads,
                                                        scene.scene.barriers, scene.release);
     outputs.push_back("barriers.csv");
   }
-  FileSink sink(csv, trajectories.get(), lines.get(), barriers.get(), options.sample_trajectories);
+  std::unique_ptr<io::TreeImpactsCsvWriter> trees;
+  if (scene.has_forest) {
+    trees = std::make_unique<io::TreeImpactsCsvWriter>(staging.path("tree_impacts.csv"),
+                                                       scene.scene.forest, scene.release);
+    outputs.push_back("tree_impacts.csv");
+  }
+  FileSink sink(csv, trajectories.get(), lines.get(), barriers.get(), trees.get(),
+                options.sample_trajectories);
   *report = ensemble::RunEnsemble(scene.scene, scene.release, options, &sink);
   ThrowIfInterrupted();
   csv.Commit();
   if (trajectories) trajectories->Commit();
   if (lines) lines->Commit();
   if (barriers) barriers->Commit();
+  if (trees) trees->Commit();
   if (!part)
     return WriteSummaryOutputs(scene, *report, report->rasters, sink.paths, staging, outputs,
                                self_check);
@@ -329,6 +346,17 @@ std::vector<std::string> MergeIntoStaging(const io::SceneFile& scene,
     csv.close();
     if (!csv) throw std::runtime_error("cannot write " + staging.path("barriers.csv"));
     outputs.push_back("barriers.csv");
+  }
+  if (scene.has_forest) {
+    std::ofstream csv(staging.path("tree_impacts.csv"), std::ios::binary);
+    for (std::size_t k = 0; k < parts.size(); ++k) {
+      ThrowIfInterrupted();
+      AppendCsv((fs::path(parts[k].dir) / "tree_impacts.csv").string(), k > 0,
+                io::TreeImpactsCsvWriter::Header(), csv);
+    }
+    csv.close();
+    if (!csv) throw std::runtime_error("cannot write " + staging.path("tree_impacts.csv"));
+    outputs.push_back("tree_impacts.csv");
   }
   const ensemble::RasterRequest request = scene.output.Request(scene.scene.terrain.heights().grid);
   std::optional<ensemble::RasterAccumulator> rasters;

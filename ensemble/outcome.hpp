@@ -30,6 +30,7 @@ struct Footprint {
   std::vector<int> cells;                                 // j * nx + i
   std::vector<float> speed_m_s, energy_j, jump_height_m;  // parallel to cells, when requested
   int deposit_cell = -1;  // cell of the rest position, -1 when the rock did not come to rest there
+  std::vector<int> tree_hit_cells;  // the cell of the stem of each impact on a stem (tree_hits)
 };
 
 // What one rock did at one evaluation line (ensemble/evaluation_lines.hpp): the first crossing of

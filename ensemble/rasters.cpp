@@ -10,12 +10,13 @@ namespace talus::ensemble {
 
 namespace {
 
-constexpr std::array<const char*, 6> kRasterKinds = {"speed",    "energy",   "jump_height",
-                                                     "passages", "deposits", "reach_probability"};
+constexpr std::array<const char*, 7> kRasterKinds = {
+    "speed", "energy", "jump_height", "passages", "deposits", "reach_probability", "tree_hits"};
 // RasterRequest's flag of each kind, in RasterKind's order.
-constexpr std::array<bool RasterRequest::*, 6> kRasterFlags = {
+constexpr std::array<bool RasterRequest::*, 7> kRasterFlags = {
     &RasterRequest::speed,    &RasterRequest::energy,   &RasterRequest::jump_height,
-    &RasterRequest::passages, &RasterRequest::deposits, &RasterRequest::reach_probability};
+    &RasterRequest::passages, &RasterRequest::deposits, &RasterRequest::reach_probability,
+    &RasterRequest::tree_hits};
 
 }  // namespace
 
@@ -103,12 +104,21 @@ void FootprintRecorder::Finish(RockOutcome& outcome) {
   if (result.end == EndReason::kRest || result.end == EndReason::kBarrier)
     outcome.footprint.deposit_cell =
         CellOf(result.final_state.position_m.x(), result.final_state.position_m.y());
+  // Impacts on stems, in the cell of each stem.
+  if (request_.tree_hits)
+    for (const StemHit& h : result.stem_hits) {
+      const int cell = CellOf(h.stem_m.x(), h.stem_m.y());
+      if (cell >= 0)
+        outcome.footprint.tree_hit_cells.insert(outcome.footprint.tree_hit_cells.end(),
+                                                static_cast<std::size_t>(h.impacts), cell);
+    }
 }
 
 RasterAccumulator::RasterAccumulator(const RasterRequest& request) : request_(request) {
   const auto cells = static_cast<std::size_t>(request.grid.nx) * request.grid.ny;
   if (request.passages || request.reach_probability) passages_.assign(cells, 0);
   if (request.deposits) deposits_.assign(cells, 0);
+  if (request.tree_hits) tree_hits_.assign(cells, 0);
   if (quantities() > 0) slot_.assign(cells, -1);
 }
 
@@ -138,6 +148,8 @@ void RasterAccumulator::Add(const Footprint& footprint) {
   }
   if (!deposits_.empty() && footprint.deposit_cell >= 0)
     ++deposits_[static_cast<std::size_t>(footprint.deposit_cell)];
+  if (!tree_hits_.empty())
+    for (int cell : footprint.tree_hit_cells) ++tree_hits_[static_cast<std::size_t>(cell)];
 }
 
 void RasterAccumulator::Merge(const RasterAccumulator& other) {
@@ -145,6 +157,7 @@ void RasterAccumulator::Merge(const RasterAccumulator& other) {
   rocks_ += other.rocks_;
   for (std::size_t c = 0; c < passages_.size(); ++c) passages_[c] += other.passages_[c];
   for (std::size_t c = 0; c < deposits_.size(); ++c) deposits_[c] += other.deposits_[c];
+  for (std::size_t c = 0; c < tree_hits_.size(); ++c) tree_hits_[c] += other.tree_hits_[c];
   for (std::size_t c = 0; c < other.slot_.size(); ++c) {
     if (other.slot_[c] < 0) continue;
     ValueSummary* mine = Summaries(static_cast<int>(c));
@@ -242,6 +255,12 @@ std::vector<RasterLayer> RasterAccumulator::Finish(const Heightfield& dem) const
       out.back().values[c] =
           rocks_ ? static_cast<float>(double(passages_[c]) / double(rocks_)) : 0.0f;
   }
+  if (request_.tree_hits) {
+    out.push_back(layer(ToString(RasterKind::kTreeHits), "count", "count",
+                        "tree hits, impacts of rocks on the stems standing in the cell", 0));
+    std::copy(tree_hits_.begin(), tree_hits_.end(), out.back().values.begin());
+    out.back().counts.assign(tree_hits_.begin(), tree_hits_.end());
+  }
   // No value where the DEM has none.
   for (std::size_t c = 0; c < cells; ++c)
     if (std::isnan(dem.z_m[c]))
@@ -253,9 +272,9 @@ std::vector<RasterLayer> RasterAccumulator::Finish(const Heightfield& dem) const
 }
 
 std::size_t RasterAccumulator::MemoryBytes() const {
-  std::size_t bytes =
-      sizeof(int) * (passages_.capacity() + deposits_.capacity() + slot_.capacity()) +
-      sizeof(ValueSummary) * summaries_.capacity();
+  std::size_t bytes = sizeof(int) * (passages_.capacity() + deposits_.capacity() +
+                                     tree_hits_.capacity() + slot_.capacity()) +
+                      sizeof(ValueSummary) * summaries_.capacity();
   for (const ValueSummary& s : summaries_) bytes += 8 * s.bins();
   return bytes;
 }
@@ -263,7 +282,7 @@ std::size_t RasterAccumulator::MemoryBytes() const {
 namespace {
 
 // Format of RasterAccumulator::Serialize; a change of layout changes the number.
-constexpr std::uint32_t kStateFormat = 2;
+constexpr std::uint32_t kStateFormat = 3;
 
 std::string PercentileList(const std::vector<std::int32_t>& percentiles) {
   std::string text;
@@ -313,6 +332,7 @@ void RasterAccumulator::Serialize(ByteWriter& out) const {
   out.Put<std::int64_t>(rocks_);
   PutCounts(out, passages_);
   PutCounts(out, deposits_);
+  PutCounts(out, tree_hits_);
   std::vector<std::int32_t> passed;  // in cell order, so that the bytes do not depend on the order
   for (std::size_t c = 0; c < slot_.size(); ++c)
     if (slot_[c] >= 0) passed.push_back(static_cast<std::int32_t>(c));
@@ -341,11 +361,13 @@ RasterAccumulator RasterAccumulator::Deserialize(const RasterRequest& request, B
   RasterAccumulator acc(request);
   acc.rocks_ = static_cast<long>(in.Get<std::int64_t>());
   std::vector<int> passages(static_cast<std::size_t>(grid.nx) * grid.ny, 0);
-  std::vector<int> deposits(passages.size(), 0);
+  std::vector<int> deposits(passages.size(), 0), tree_hits(passages.size(), 0);
   GetCounts(in, passages);
   GetCounts(in, deposits);
+  GetCounts(in, tree_hits);
   if (!acc.passages_.empty()) acc.passages_ = std::move(passages);
   if (!acc.deposits_.empty()) acc.deposits_ = std::move(deposits);
+  if (!acc.tree_hits_.empty()) acc.tree_hits_ = std::move(tree_hits);
   const auto passed = in.GetVector<std::int32_t>();
   if (!passed.empty() && acc.slot_.empty()) in.Fail();
   for (std::int32_t c : passed) {

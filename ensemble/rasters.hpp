@@ -20,8 +20,17 @@ namespace talus::ensemble {
 
 // The rasters a scene's [output] rasters may name, in the order of RasterRequest's flags. The first
 // three are statistics rasters (<name>_max, _mean, _p<NN>), the others one raster each.
-enum class RasterKind { kSpeed, kEnergy, kJumpHeight, kPassages, kDeposits, kReachProbability };
-// "speed", "energy", "jump_height", "passages", "deposits", "reach_probability": the scene's
+enum class RasterKind {
+  kSpeed,
+  kEnergy,
+  kJumpHeight,
+  kPassages,
+  kDeposits,
+  kReachProbability,
+  kTreeHits
+};
+// "speed", "energy", "jump_height", "passages", "deposits", "reach_probability", "tree_hits": the
+// scene's
 // [output] rasters, summary.json's raster_output and the rasters' file names read this one list.
 extern const EnumNames kRasterKindNames;
 const char* ToString(RasterKind kind);
@@ -37,6 +46,7 @@ struct RasterRequest {
   bool passages = false;           // rocks that passed the cell
   bool deposits = false;           // rocks that came to rest in the cell
   bool reach_probability = false;  // fraction of all rocks that passed the cell
+  bool tree_hits = false;          // impacts on the stems of the cell (scenes with a [forest])
   // The percentiles (percent, ascending, each 1 .. 99) of the *_p<NN> rasters of speed, energy
   // and jump height.
   std::vector<int> percentiles = {95};
@@ -46,7 +56,7 @@ struct RasterRequest {
   bool Wants(RasterKind kind) const;
 
   bool any() const {
-    return speed || energy || jump_height || passages || deposits || reach_probability;
+    return speed || energy || jump_height || passages || deposits || reach_probability || tree_hits;
   }
   bool needs_passes() const {
     return speed || energy || jump_height || passages || reach_probability;
@@ -105,8 +115,8 @@ class RasterAccumulator {
   // Adds the rocks of `other`, which must have the same request.
   void Merge(const RasterAccumulator& other);
   // The rasters, in the order speed, energy, jump height (each max, mean, then the percentiles
-  // ascending), passages, deposits, reach probability; `dem` is the DEM on the request's grid,
-  // whose nodata cells (NaN) are nodata in every raster.
+  // ascending), passages, deposits, reach probability, tree hits; `dem` is the DEM on the request's
+  // grid, whose nodata cells (NaN) are nodata in every raster.
   std::vector<RasterLayer> Finish(const Heightfield& dem) const;
   long rocks() const { return rocks_; }
   const RasterRequest& request() const { return request_; }
@@ -126,7 +136,7 @@ class RasterAccumulator {
 
   RasterRequest request_;
   long rocks_ = 0;
-  std::vector<int> passages_, deposits_;
+  std::vector<int> passages_, deposits_, tree_hits_;
   std::vector<int> slot_;  // per cell: index of its first summary in summaries_, or -1
   std::vector<ValueSummary> summaries_;  // per passed cell: speed, energy, jump height as requested
 };

@@ -15,6 +15,7 @@
 #include "io/barriers_csv.hpp"
 #include "io/evaluation_lines_csv.hpp"
 #include "io/rocks_csv.hpp"
+#include "io/tree_impacts_csv.hpp"
 
 namespace talus::io {
 namespace {
@@ -224,7 +225,8 @@ void CheckPartFiles(const PartialInfo& part) {
                      range + ")");
   for (const auto& [name, header] :
        {std::pair{"evaluation_lines.csv", EvaluationLinesCsvWriter::Header()},
-        std::pair{"barriers.csv", BarriersCsvWriter::Header()}}) {
+        std::pair{"barriers.csv", BarriersCsvWriter::Header()},
+        std::pair{"tree_impacts.csv", TreeImpactsCsvWriter::Header()}}) {
     if (!part.files.count(name)) continue;
     long last = part.first_rock;
     CheckRockColumn((std::filesystem::path(part.dir) / name).string(), header,

@@ -33,6 +33,10 @@ constexpr double kEvaluationLinesCsvBytesPerRow = 150;
 // A row of barriers.csv (cases/tirol/scene_net.toml, 1000 rocks: 371 rows, 60 640 bytes, 163 per
 // row; 180 with longer names).
 constexpr double kBarriersCsvBytesPerRow = 180;
+// tree_impacts.csv (cases/tirol/scene_forest.toml, 1000 rocks through a 30 ha stand of 400
+// stems/ha: 16040 rows, 1 906 765 bytes, 119 per row; 16 rows per rock).
+constexpr double kTreeImpactsCsvBytesPerRow = 130;
+constexpr double kTreeImpactRowsPerRock = 20;
 // rocks.gpkg: an end point with its fields and spatial index; a path's vertex (x, y, z) and per
 // path its row and index (1000 rocks on a plane: 2.26 MB, 1.46 MB of it path geometry, 61 vertices
 // each).
@@ -161,6 +165,19 @@ ResourceEstimate EstimateResources(const SceneFile& scene, int threads) {
         {"barrier values behind the summary", rows * 3 * sizeof(double) * kVectorGrowth, fewer});
     if (output.geopackage)
       e.disk.push_back({"rocks.gpkg barrier_impacts", rows * kGeoPackageBytesPerRock, fewer});
+  }
+  if (scene.has_forest) {
+    // Rows per rock: the stems it touches, which depends on the forest; tirol's dense stand as
+    // the estimate. The summary reads the file back in rows of a few numbers.
+    const double rows = rocks * kTreeImpactRowsPerRock;
+    const char* fewer = "fewer rocks (--rocks)";
+    e.disk.push_back({"tree_impacts.csv", rows * kTreeImpactsCsvBytesPerRow, fewer});
+    e.memory.push_back(
+        {"tree impacts behind the summary", rows * kTreeImpactsCsvBytesPerRow * 4, fewer});
+    // The stems (position, DBH, foot, capacity) and their look-up grid's index.
+    const double stems = double(scene.scene.forest.stems().size());
+    e.memory.push_back({"forest", stems * (sizeof(Stem) + sizeof(double) + 2 * sizeof(int)),
+                        "a sparser or smaller [forest]"});
   }
   if (output.geopackage)
     e.disk.push_back({"rocks.gpkg",

@@ -233,7 +233,7 @@ SceneFile LoadSceneTable(const toml::table& root, const std::string& path,
   const Context context(path);
   const Section top(context, &root, "",
                     {"terrain", "ground", "rock", "blocks", "release", "evaluation_lines",
-                     "barriers", "solver", "output"});
+                     "barriers", "forest", "solver", "output"});
   for (const char* required : {"terrain", "release"})
     if (!root.get(required))
       context.Fail(nullptr, required, std::string("missing table [") + required + "]");
@@ -276,6 +276,11 @@ SceneFile LoadSceneTable(const toml::table& root, const std::string& path,
               {"lines", "names", "file", "name_field"}),
       out);
   scene_tables::LoadBarriers(context, root.get("barriers"), out);
+  scene_tables::LoadForest(context,
+                           Section(context, SubTable(context, root, "forest"), "forest",
+                                   {"trees", "dbh_field", "stands", "stands_file", "stem_height_m",
+                                    "friction", "energy_coefficient_j", "energy_exponent", "seed"}),
+                           root.get("forest") != nullptr, out);
   const Section solver(context, SubTable(context, root, "solver"), "solver", SolverKeys());
   LoadSolver(solver, out.scene.options, out.solver_preset, out.solver_keys_given);
   // A run's own check of its time step (talus simulate --self-check N): 0, or 2 .. the run's rocks
@@ -283,10 +288,13 @@ SceneFile LoadSceneTable(const toml::table& root, const std::string& path,
   out.self_check = solver.Integer("self_check", 0);
   if (out.self_check != 0 && out.self_check < 2)
     solver.Fail("self_check", std::to_string(out.self_check) + " must be 0 (none) or >= 2 rocks");
-  LoadOutput(Section(context, SubTable(context, root, "output"), "output",
-                     {"trajectories", "trajectory_interval_s", "rasters", "percentiles",
-                      "raster_format", "quicklook", "report", "geopackage"}),
-             out.output);
+  const Section output(context, SubTable(context, root, "output"), "output",
+                       {"trajectories", "trajectory_interval_s", "rasters", "percentiles",
+                        "raster_format", "quicklook", "report", "geopackage"});
+  LoadOutput(output, out.output);
+  if (!out.has_forest && std::count(out.output.rasters.begin(), out.output.rasters.end(),
+                                    ensemble::RasterKind::kTreeHits) > 0)
+    output.Fail("rasters", "tree_hits counts the impacts on stems: the scene has no [forest]");
   if (!out.release.blocks.empty() && out.release.runs.empty())
     context.Fail(root.get("blocks"), "blocks",
                  "blocks are for the runs of a run table ([release] runs = \"file.csv\")");

@@ -87,6 +87,17 @@ struct SceneFile {
   // Inputs that load but look wrong (e.g. a few points dominating the rock's hull), each naming
   // the file, line and key: printed by talus simulate and listed in summary.json.
   std::vector<std::string> warnings;
+  // [forest]: where its trees came from (scene.forest holds them); empty without the table.
+  struct ForestStand {
+    double area_m2 = 0, stems_per_ha = 0, dbh_cm = 0, dbh_sd_cm = 0;
+    long trees = 0;  // drawn
+  };
+  bool has_forest = false;
+  std::string trees_file;  // [forest] trees, resolved; "" without
+  long trees_from_file = 0;
+  std::string stands_file;          // [forest] stands_file, resolved; "" without
+  std::vector<ForestStand> stands;  // inline stands first, then those of stands_file
+  std::uint64_t forest_seed = 0;
 };
 
 // Loads and validates a scene. Throws talus::InputError with "<file>:<line>: <key>: <reason>".

@@ -3,7 +3,7 @@
 // (LoadScene), [ground], [solver] and [output] in scene_file.cpp; [terrain] in scene_terrain.cpp;
 // [rock] and [blocks] in scene_rock.cpp; [release], with run tables and single-impact tables, in
 // scene_release.cpp; [evaluation_lines] in scene_evaluation_lines.cpp; [[barriers]] in
-// scene_barriers.cpp. Also the bounds of
+// scene_barriers.cpp; [forest] in scene_forest.cpp. Also the bounds of
 // plausible input and the messages they share. Internal to io/: include it from .cpp files only
 // (it brings in toml++).
 
@@ -63,5 +63,9 @@ void LoadEvaluationLines(const Context& context, const Section& s, SceneFile& ou
 // [[barriers]]: the barriers that act on the rocks, into out.scene.barriers (nothing when `node`,
 // the scene's "barriers", is null).
 void LoadBarriers(const Context& context, const toml::node* node, SceneFile& out);
+// [forest]: explicit trees (a tree list and/or stands drawn from the seed), into
+// out.scene.forest (nothing when the scene has no [forest], `given` false). After [release],
+// whose seed is the forest's default.
+void LoadForest(const Context& context, const Section& s, bool given, SceneFile& out);
 
 }  // namespace talus::io::scene_tables

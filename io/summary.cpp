@@ -130,7 +130,8 @@ std::string SummaryJson(const SceneFile& scene, const ensemble::EnsembleReport& 
                         const std::string& version, const std::vector<std::string>& outputs,
                         const std::vector<EvaluationLineSummary>& evaluation_lines,
                         const ensemble::SelfCheckReport* self_check,
-                        const std::vector<BarrierSummary>& barriers) {
+                        const std::vector<BarrierSummary>& barriers,
+                        const TreeImpactSummary* trees) {
   nlohmann::ordered_json j;
   j["talus_version"] = version;
   j["scene"] = scene.path;
@@ -227,6 +228,36 @@ std::string SummaryJson(const SceneFile& scene, const ensemble::EnsembleReport& 
     nlohmann::ordered_json list = nlohmann::ordered_json::array();
     for (const BarrierSummary& s : barriers) list.push_back(BarrierJson(s));
     j["barriers"] = list;
+  }
+  if (scene.has_forest) {
+    const Forest& forest = scene.scene.forest;
+    const ForestModel& model = forest.model();
+    nlohmann::ordered_json f;
+    f["trees"] = forest.stems().size();
+    f["trees_file"] = scene.trees_file;
+    f["trees_from_file"] = scene.trees_from_file;
+    nlohmann::ordered_json stands = nlohmann::ordered_json::array();
+    for (const SceneFile::ForestStand& s : scene.stands)
+      stands.push_back({{"area_m2", s.area_m2},
+                        {"stems_per_ha", s.stems_per_ha},
+                        {"dbh_cm", s.dbh_cm},
+                        {"dbh_sd_cm", s.dbh_sd_cm},
+                        {"trees", s.trees}});
+    f["stands_file"] = scene.stands_file;
+    f["stands"] = stands;
+    f["seed"] = scene.forest_seed;
+    f["stem_height_m"] = model.stem_height_m;
+    f["friction"] = model.friction;
+    f["breaking_energy"] = {{"coefficient_J", model.energy_coefficient_J},
+                            {"exponent", model.energy_exponent},
+                            {"law", "E_max = coefficient * DBH[cm]^exponent"}};
+    if (trees)
+      f["impacts"] = {
+          {"rock_stem_pairs", trees->rows},        {"impacts", trees->impacts},
+          {"rocks_hitting", trees->rocks_hitting}, {"rocks_breaking", trees->rocks_breaking},
+          {"breakages", trees->breakages},         {"stems_hit", trees->stems_hit},
+          {"absorbed_J", trees->absorbed_J}};
+    j["forest"] = f;
   }
   if (self_check) j["self_check"] = SelfCheckJson(*self_check);
   j["threads"] = report.threads;

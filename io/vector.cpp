@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <functional>
 #include <memory>
+#include <optional>
 
 #include "common/error.hpp"
 #include "io/raster.hpp"
@@ -291,6 +292,70 @@ std::vector<fieldobs::DepositObservation> ReadDepositPoints(const std::string& p
                    out.push_back(d);
                  });
   if (out.empty()) throw InputError(what + ": " + path + " has no point");
+  return out;
+}
+
+std::vector<TreePoint> ReadTreePoints(const std::string& path, const std::string& target_crs_wkt,
+                                      const std::string& dbh_field, const std::string& what) {
+  std::vector<TreePoint> out;
+  ForEachFeature(path, target_crs_wkt, what, "trees", nullptr,
+                 [&](OGRFeature& feature, const OGRGeometry& geometry, const std::string& where) {
+                   if (wkbFlatten(geometry.getGeometryType()) != wkbPoint)
+                     throw InputError(where + ": a tree must be a point, not a " +
+                                      std::string(geometry.getGeometryName()));
+                   const auto& p = *geometry.toPoint();
+                   TreePoint t;
+                   t.xy_m = Eigen::Vector2d(p.getX(), p.getY());
+                   if (!t.xy_m.allFinite()) throw InputError(where + ": non-finite coordinates");
+                   const int field = feature.GetFieldIndex(dbh_field.c_str());
+                   if (field < 0)
+                     throw InputError(where + ": no field '" + dbh_field +
+                                      "' (the stem diameter at breast height, cm)");
+                   if (!feature.IsFieldSetAndNotNull(field))
+                     throw InputError(where + ": " + dbh_field + " is empty");
+                   t.dbh_cm = feature.GetFieldAsDouble(field);
+                   t.where = where;
+                   out.push_back(t);
+                 });
+  if (out.empty()) throw InputError(what + ": " + path + " has no point");
+  return out;
+}
+
+std::vector<StandPolygon> ReadStandPolygons(const std::string& path,
+                                            const std::string& target_crs_wkt,
+                                            const std::string& what) {
+  std::vector<StandPolygon> out;
+  ForEachFeature(path, target_crs_wkt, what, "stands", nullptr,
+                 [&](OGRFeature& feature, const OGRGeometry& geometry, const std::string& where) {
+                   StandPolygon stand;
+                   stand.where = where;
+                   const auto number = [&](const char* field,
+                                           bool required) -> std::optional<double> {
+                     const int index = feature.GetFieldIndex(field);
+                     if (index < 0 || !feature.IsFieldSetAndNotNull(index)) {
+                       if (required)
+                         throw InputError(where + ": no value in field '" + field + "'");
+                       return std::nullopt;
+                     }
+                     const OGRFieldType type = feature.GetFieldDefnRef(index)->GetType();
+                     if (type != OFTInteger && type != OFTInteger64 && type != OFTReal)
+                       throw InputError(where + ": field '" + field + "' is not a number");
+                     return feature.GetFieldAsDouble(index);
+                   };
+                   stand.stems_per_ha = *number("stems_per_ha", true);
+                   stand.dbh_cm = *number("dbh_cm", true);
+                   stand.dbh_sd_cm = number("dbh_sd_cm", false).value_or(0.0);
+                   std::vector<ReleaseGeometry> parts;
+                   Collect(geometry, where, parts);
+                   for (ReleaseGeometry& part : parts) {
+                     if (part.kind != ReleaseGeometry::Kind::kPolygon)
+                       throw InputError(where + ": a stand must be a polygon, not a " +
+                                        std::string(geometry.getGeometryName()));
+                     stand.rings = std::move(part.rings);
+                     out.push_back(stand);
+                   }
+                 });
+  if (out.empty()) throw InputError(what + ": " + path + " has no polygon");
   return out;
 }
 

@@ -1,11 +1,12 @@
 #pragma once
 // The immutable scene a simulation reads: terrain, ground table, rock, solver options and the
-// barriers that act on the rocks.
+// barriers and the trees that act on the rocks.
 
 #include <string>
 #include <vector>
 
 #include "solver/barriers.hpp"
+#include "solver/forest.hpp"
 #include "solver/ground.hpp"
 #include "solver/options.hpp"
 #include "solver/polyhedron.hpp"
@@ -20,6 +21,8 @@ struct Scene {
   SolverOptions options;
   // Barriers the rocks meet (solver/barriers.hpp); none: no barrier work at all.
   std::vector<Barrier> barriers;
+  // Trees whose stems the rocks hit (solver/forest.hpp); none: no forest work at all.
+  Forest forest;
 
   // Checks every part (each barrier too) and that the terrain's ground indices exist in the table.
   bool IsValid(std::string* why) const;

@@ -98,6 +98,7 @@ RockResult SimulateRock(const Scene& scene, const RockShape& rock, const RockSta
   FlightStepper stepper(workspace.flight_windows);
   // With barriers: the state and the terrain under it at the beginning of the step.
   const bool barriers = !scene.barriers.empty();
+  const bool forest = !scene.forest.empty();
   RockState before;
   double before_ground_m = ground.height_m;
   while (true) {
@@ -134,6 +135,10 @@ RockResult SimulateRock(const Scene& scene, const RockShape& rock, const RockSta
       }
       before_ground_m = ground.height_m;
     }
+    // Stems the rock's hull now overlaps and moves into: a plastic, frictional impact each, or
+    // the stem breaks (solver/forest.hpp).
+    if (forest && !stopped && MeetStems(scene.forest, rock, &state, &result.stem_hits))
+      stepper.Restart();
 
     result.path_length_m += (state.position_m - previous).head<2>().norm();
     record(ground);

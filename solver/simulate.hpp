@@ -43,6 +43,8 @@ struct RockResult {
   // The scene's barriers the rock met, in the order it met them (empty without barriers). A rock
   // that ends as kBarrier was stopped by the barrier of the last event.
   std::vector<BarrierEvent> barrier_events;
+  // The scene's stems the rock touched, in the order it first hit them (empty without a forest).
+  std::vector<StemHit> stem_hits;
 
   // True when the centre of mass never got further from its start than the rock's length.
   bool StayedAtRelease(const RockShape& rock) const { return max_displacement_m <= rock.length_m; }

@@ -134,6 +134,28 @@ raster_format = "cog"
   for (const auto& [name, bytes] : single) EXPECT_TRUE(merged.at(name) == bytes) << name;
 }
 
+// A forest: tree_impacts.csv, tree_hits.tif and summary.json's "forest" merge to the single run's
+// bytes (the stand's trees are drawn alike in every part).
+TEST_F(MergeCommand, AForestMergesToTheSingleRunsBytes) {
+  talus::app::testing::Write(
+      scene_, talus::app::testing::SmallSlopeScene(10, "rasters = [\"tree_hits\"]\n", R"([forest]
+stands = [{ polygon = [[5, -5], [16, -5], [16, 5], [5, 5]], stems_per_ha = 4000, dbh_cm = 8, dbh_sd_cm = 2 }]
+)"));
+  std::string log;
+  const auto single = SingleRun();
+  const std::string& rows = single.at("tree_impacts.csv");
+  EXPECT_GT(std::count(rows.begin(), rows.end(), '\n'), 1) << rows;
+  ASSERT_EQ(single.count("tree_hits.tif"), 1u);
+  const auto summary = nlohmann::json::parse(single.at("summary.json"));
+  EXPECT_GT(summary.at("forest").at("trees").get<int>(), 0);
+  EXPECT_GT(summary.at("forest").at("impacts").at("rocks_hitting").get<int>(), 0);
+  std::vector<fs::path> parts = {Part("7:20"), Part("0:7", 2)};  // 10 rocks at each release
+  ASSERT_EQ(Merge(parts, &log), 0) << log;
+  const auto merged = OutputsWithoutTimings(dir_ / "merged");
+  ASSERT_EQ(merged.size(), single.size());
+  for (const auto& [name, bytes] : single) EXPECT_TRUE(merged.at(name) == bytes) << name;
+}
+
 // Barriers: a net that stops some rocks and is broken through by others, and a wall behind it that
 // stops one. barriers.csv, barriers_summary.csv, rocks.csv's end_barrier and summary.json's
 // "barriers" merge to the single run's bytes (threads 1 and 2 in the parts, 2 in the single run).

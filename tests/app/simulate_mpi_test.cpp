@@ -94,6 +94,32 @@ TEST(SimulateMpi, BarriersGiveTheOneProcessBytesForAnyRanksAndThreads) {
   }
 }
 
+// cases/tirol with its forest (scene_forest.toml): the stands' trees are drawn on every rank from
+// the same seed, so tree_impacts.csv, tree_hits.tif and the summary's forest are the one-process
+// bytes for 2 threads and 2 ranks.
+TEST(SimulateMpi, AForestGivesTheOneProcessBytesForAnyRanksAndThreads) {
+  const fs::path dir = FreshDir("forest");
+  std::string log;
+  const std::string args = " simulate " + std::string(TALUS_SOURCE_DIR) +
+                           "/cases/tirol/scene_forest.toml --rocks 8 --out ";
+  ASSERT_EQ(RunCommand(Talus() + args + (dir / "single").string() + " --threads 1", &log), 0)
+      << log;
+  const auto single = OutputsWithoutTimings(dir / "single");
+  ASSERT_NE(single.at("tree_impacts.csv").find(",1\n"), std::string::npos) << "a stem broke";
+  ASSERT_EQ(single.count("tree_hits.tif"), 1u);
+  ASSERT_EQ(RunCommand(Talus() + args + (dir / "threads").string() + " --threads 2", &log), 0)
+      << log;
+  EXPECT_TRUE(OutputsWithoutTimings(dir / "threads") == single) << "2 threads differ";
+  ASSERT_EQ(
+      RunCommand(MpiRun("-n 2 " + Talus()) + args + (dir / "mpi").string() + " --threads 1", &log),
+      0)
+      << log;
+  const auto merged = OutputsWithoutTimings(dir / "mpi");
+  ASSERT_EQ(merged.size(), single.size());
+  for (const auto& [file, bytes] : single)
+    EXPECT_TRUE(merged.at(file) == bytes) << file << " differs for 2 ranks";
+}
+
 // Rank 1 is given a scene file that does not exist: every rank stops before any work, rank 0 says
 // which rank failed and why, once, and nothing is written.
 TEST(SimulateMpi, ABadInputOnOneRankEndsTheRunWithOneMessage) {

@@ -300,7 +300,7 @@ TEST(Rasters, LayersAreNamedAndDescribedInOrder) {
 // and its own flag of the request.
 TEST(RasterRequest, EveryKindHasItsNameAndItsOwnFlag) {
   EXPECT_EQ(kRasterKindNames.List(),
-            "speed, energy, jump_height, passages, deposits, reach_probability");
+            "speed, energy, jump_height, passages, deposits, reach_probability, tree_hits");
   for (int k = 0; k < kRasterKindNames.size(); ++k) {
     const auto kind = static_cast<RasterKind>(k);
     EXPECT_STREQ(ToString(kind), kRasterKindNames.Name(k));

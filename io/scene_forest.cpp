@@ -1,0 +1,283 @@
+#include <toml++/toml.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "common/csv_table.hpp"
+#include "common/error.hpp"
+#include "io/scene_tables.hpp"
+#include "io/vector.hpp"
+#include "solver/random.hpp"
+
+namespace talus::io::scene_tables {
+namespace {
+
+// Bounds of plausible forests (docs/scenes.md): beyond them a value is a typo or a wrong unit.
+constexpr double kMaxDbh_cm = 300;        // the largest trees of the Alps are ~ 2 m
+constexpr double kMaxStemsPerHa = 10000;  // one stem per m^2
+constexpr double kMaxStemHeight_m = 100;
+constexpr double kMaxFriction = 10;
+constexpr long kMaxTrees = 10'000'000;  // 24 bytes each
+constexpr double kMinDrawnDbh_cm = 1;   // a normal draw below it is set to it
+// The forest's own random streams: the stand index mixed with this, so that they never coincide
+// with a rock's (seed, rock) stream.
+constexpr std::uint64_t kForestStream = 0x666f72657374ULL;  // "forest"
+
+double Area(const std::vector<Eigen::Vector2d>& ring) {
+  double twice = 0;
+  for (std::size_t i = 0; i < ring.size(); ++i) {
+    const Eigen::Vector2d& a = ring[i];
+    const Eigen::Vector2d& b = ring[(i + 1) % ring.size()];
+    twice += a.x() * b.y() - a.y() * b.x();
+  }
+  return 0.5 * std::abs(twice);
+}
+
+// Even-odd rule.
+bool Inside(const std::vector<Eigen::Vector2d>& ring, const Eigen::Vector2d& p) {
+  bool in = false;
+  for (std::size_t i = 0, j = ring.size() - 1; i < ring.size(); j = i++) {
+    const Eigen::Vector2d &a = ring[i], &b = ring[j];
+    if ((a.y() > p.y()) != (b.y() > p.y()) &&
+        p.x() < (b.x() - a.x()) * (p.y() - a.y()) / (b.y() - a.y()) + a.x())
+      in = !in;
+  }
+  return in;
+}
+
+// The terrain's height under a tree, or an error naming `where` and the DEM's extent.
+double FootOf(const Terrain& terrain, const Eigen::Vector2d& p, const std::string& where) {
+  double z = 0;
+  if (terrain.Height(p.x(), p.y(), &z)) return z;
+  const GridGeometry& g = terrain.heights().grid;
+  throw InputError(where + ": the tree at (" + TenDigits(p.x()) + ", " + TenDigits(p.y()) +
+                   ") is off the DEM or on nodata; the DEM covers x " + TenDigits(g.x0_m) + " .. " +
+                   TenDigits(g.x_max_m()) + ", y " + TenDigits(g.y0_m) + " .. " +
+                   TenDigits(g.y_max_m()) +
+                   ": trees are in the DEM's coordinates (a file in another CRS must be "
+                   "reprojected first)");
+}
+
+bool IsCsv(const std::string& path) {
+  if (path.size() < 4) return false;
+  std::string ext = path.substr(path.size() - 4);
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return std::tolower(c); });
+  return ext == ".csv";
+}
+
+std::string DbhBounds(double dbh_cm) {
+  return TenDigits(dbh_cm) + " cm must be > 0 and <= " + TenDigits(kMaxDbh_cm) + " cm";
+}
+
+// trees = "file": a CSV file, one tree per row with columns x_m, y_m (the DEM's coordinates) and
+// dbh_cm; or any point vector file GDAL reads, reprojected to the DEM's CRS, its DBH (cm) in the
+// attribute dbh_field.
+void ReadTrees(const Context& context, const Section& s, const Terrain& terrain,
+               const std::string& crs_wkt, std::vector<Stem>* stems, SceneFile& out) {
+  const std::string path = context.Resolve(s.String("trees", ""));
+  const std::string key = context.Where(s.Node("trees")) + ": " + s.Key("trees");
+  const std::size_t first = stems->size();
+  if (IsCsv(path)) {
+    if (s.Has("dbh_field"))
+      s.Fail("dbh_field",
+             "a CSV tree list has its DBH in the column dbh_cm; dbh_field names the "
+             "attribute of a vector file");
+    CsvTable table = [&] {
+      try {
+        return CsvTable::Read(path);
+      } catch (const InputError& e) {
+        throw InputError(key + ": " + e.what());
+      }
+    }();
+    table.Require({"x_m", "y_m", "dbh_cm"});
+    if (table.rows() == 0) throw InputError(key + ": " + path + " has no trees (no rows)");
+    if (table.rows() > kMaxTrees)
+      throw InputError(key + ": " + path + " has " + std::to_string(table.rows()) +
+                       " trees, more than " + std::to_string(kMaxTrees));
+    for (int row = 0; row < table.rows(); ++row) {
+      Stem stem;
+      stem.position_m = {table.Number(row, "x_m"), table.Number(row, "y_m")};
+      const double dbh_cm = table.Number(row, "dbh_cm");
+      if (!(dbh_cm > 0 && dbh_cm <= kMaxDbh_cm))
+        throw InputError(table.Where(row, "dbh_cm") + ": " + DbhBounds(dbh_cm));
+      stem.dbh_m = dbh_cm / 100;
+      stem.ground_m = FootOf(terrain, stem.position_m, table.Where(row, "x_m"));
+      stems->push_back(stem);
+    }
+  } else {
+    const std::string field = s.String("dbh_field", "dbh_cm");
+    for (const TreePoint& t : ReadTreePoints(path, crs_wkt, field, key)) {
+      if (!(std::isfinite(t.dbh_cm) && t.dbh_cm > 0 && t.dbh_cm <= kMaxDbh_cm))
+        throw InputError(t.where + ": " + field + " = " + DbhBounds(t.dbh_cm));
+      if (static_cast<long>(stems->size() - first) >= kMaxTrees)
+        throw InputError(key + ": " + path + " has more than " + std::to_string(kMaxTrees) +
+                         " trees");
+      stems->push_back(Stem{t.xy_m, t.dbh_cm / 100, FootOf(terrain, t.xy_m, t.where)});
+    }
+  }
+  out.inputs.push_back(path);
+  out.trees_file = path;
+  out.trees_from_file = static_cast<long>(stems->size() - first);
+}
+
+// What is wrong with a stand's numbers, as {key, reason}; {"", ""} when nothing.
+std::pair<std::string, std::string> StandProblem(const SceneFile::ForestStand& stand) {
+  if (!(stand.stems_per_ha > 0 && stand.stems_per_ha <= kMaxStemsPerHa))
+    return {"stems_per_ha", TenDigits(stand.stems_per_ha) + " must be > 0 and <= " +
+                                TenDigits(kMaxStemsPerHa) + " stems per hectare"};
+  if (!(stand.dbh_cm > 0 && stand.dbh_cm <= kMaxDbh_cm)) return {"dbh_cm", DbhBounds(stand.dbh_cm)};
+  if (!(stand.dbh_sd_cm >= 0 && stand.dbh_sd_cm <= stand.dbh_cm))
+    return {"dbh_sd_cm", TenDigits(stand.dbh_sd_cm) + " cm must be >= 0 and <= dbh_cm"};
+  if (!(stand.area_m2 > 0)) return {"polygon", "the polygon has zero area"};
+  const double mean = stand.stems_per_ha / 1e4 * stand.area_m2;
+  if (mean > kMaxTrees)
+    return {"stems_per_ha", "the stand would have about " + TenDigits(mean) + " trees, more than " +
+                                std::to_string(kMaxTrees)};
+  return {"", ""};
+}
+
+// Area of a polygon with holes: the outer ring's less the holes'.
+double AreaOf(const std::vector<std::vector<Eigen::Vector2d>>& rings) {
+  double area = 0;
+  for (std::size_t r = 0; r < rings.size(); ++r) area += (r == 0 ? 1 : -1) * Area(rings[r]);
+  return area;
+}
+
+// Even-odd over all rings (holes excluded).
+bool InsideRings(const std::vector<std::vector<Eigen::Vector2d>>& rings, const Eigen::Vector2d& p) {
+  bool in = false;
+  for (const auto& ring : rings)
+    if (Inside(ring, p)) in = !in;
+  return in;
+}
+
+// A stand's trees: a homogeneous Poisson process in the polygon -- the count Poisson with mean
+// density * area, counted as the arrivals of a unit-rate process before that mean; each tree
+// uniform in the polygon (rejection from its bounding box) -- with a normal DBH (mean, spread),
+// clamped to kMinDrawnDbh_cm .. kMaxDbh_cm. From its own stream (seed, kForestStream + stream).
+void DrawStand(const std::vector<std::vector<Eigen::Vector2d>>& rings, std::uint64_t seed,
+               std::uint64_t stream, const Terrain& terrain, const std::string& where,
+               SceneFile::ForestStand* stand, std::vector<Stem>* stems) {
+  RockRandom random(seed, kForestStream + stream);
+  const double mean = stand->stems_per_ha / 1e4 * stand->area_m2;
+  long count = 0;
+  for (double t = -std::log1p(-random.Uniform()); t <= mean; t -= std::log1p(-random.Uniform()))
+    ++count;
+  Eigen::Vector2d lo = rings.front().front(), hi = lo;
+  for (const Eigen::Vector2d& p : rings.front()) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  for (long n = 0; n < count; ++n) {
+    Stem stem;
+    do {
+      stem.position_m =
+          lo + Eigen::Vector2d(random.Uniform(), random.Uniform()).cwiseProduct(hi - lo);
+    } while (!InsideRings(rings, stem.position_m));
+    double dbh_cm = stand->dbh_cm;
+    if (stand->dbh_sd_cm > 0) {  // Box-Muller
+      const double u = 1 - random.Uniform(), v = random.Uniform();
+      dbh_cm += stand->dbh_sd_cm * std::sqrt(-2 * std::log(u)) * std::cos(2 * M_PI * v);
+    }
+    stem.dbh_m = std::clamp(dbh_cm, kMinDrawnDbh_cm, kMaxDbh_cm) / 100;
+    stem.ground_m = FootOf(terrain, stem.position_m, where);
+    stems->push_back(stem);
+  }
+  stand->trees = count;
+}
+
+// stands = [{ polygon = [[x, y], ...], stems_per_ha, dbh_cm, dbh_sd_cm }] (or [[forest.stands]]
+// tables), then the polygons of stands_file; stand k draws from stream k.
+void DrawStands(const Context& context, const Section& forest, const Terrain& terrain,
+                const std::string& crs_wkt, std::uint64_t seed, std::vector<Stem>* stems,
+                SceneFile& out) {
+  std::uint64_t stream = 0;
+  if (forest.Has("stands")) {
+    const toml::array* list = forest.Node("stands")->as_array();
+    if (!list || list->empty() || !list->is_array_of_tables())
+      forest.Fail("stands",
+                  "expected a list of tables { polygon = [[x, y], ...], "
+                  "stems_per_ha = ..., dbh_cm = ... }");
+    for (std::size_t k = 0; k < list->size(); ++k) {
+      const Section s(context, list->get(k)->as_table(), "forest.stands[" + std::to_string(k) + "]",
+                      {"polygon", "stems_per_ha", "dbh_cm", "dbh_sd_cm"});
+      for (const char* required : {"polygon", "stems_per_ha", "dbh_cm"})
+        if (!s.Has(required)) s.Fail(required, "missing");
+      SceneFile::ForestStand stand;
+      stand.stems_per_ha = s.Number("stems_per_ha", 0);
+      stand.dbh_cm = s.Number("dbh_cm", 0);
+      stand.dbh_sd_cm = s.Number("dbh_sd_cm", 0);
+      const std::vector<std::vector<Eigen::Vector2d>> rings = {
+          PointList(s, s.Node("polygon"), s.Key("polygon"))};
+      if (rings.front().size() < 3) s.Fail("polygon", "a stand needs at least 3 points");
+      stand.area_m2 = AreaOf(rings);
+      if (const auto [key, why] = StandProblem(stand); !key.empty()) s.Fail(key, why);
+      const std::string where = context.Where(s.Node("polygon")) + ": " + s.Key("polygon");
+      DrawStand(rings, seed, stream++, terrain, where, &stand, stems);
+      out.stands.push_back(stand);
+    }
+  }
+  if (forest.Has("stands_file")) {
+    const std::string path = context.Resolve(forest.String("stands_file", ""));
+    const std::string key =
+        context.Where(forest.Node("stands_file")) + ": " + forest.Key("stands_file");
+    for (const StandPolygon& polygon : ReadStandPolygons(path, crs_wkt, key)) {
+      SceneFile::ForestStand stand;
+      stand.stems_per_ha = polygon.stems_per_ha;
+      stand.dbh_cm = polygon.dbh_cm;
+      stand.dbh_sd_cm = polygon.dbh_sd_cm;
+      if (polygon.rings.empty() || polygon.rings.front().size() < 3)
+        throw InputError(polygon.where + ": a stand needs at least 3 points");
+      stand.area_m2 = AreaOf(polygon.rings);
+      if (const auto [field, why] = StandProblem(stand); !field.empty())
+        throw InputError(polygon.where + ": " + field + ": " + why);
+      DrawStand(polygon.rings, seed, stream++, terrain, polygon.where, &stand, stems);
+      out.stands.push_back(stand);
+    }
+    out.inputs.push_back(path);
+    out.stands_file = path;
+  }
+}
+
+}  // namespace
+
+void LoadForest(const Context& context, const Section& s, bool given, SceneFile& out) {
+  if (!given) return;
+  if (!s.Has("trees") && !s.Has("stands") && !s.Has("stands_file"))
+    s.Fail("trees",
+           "a [forest] needs trees = \"trees.csv\", stands = [{ polygon = ..., "
+           "stems_per_ha = ..., dbh_cm = ... }] or stands_file = \"stands.gpkg\" (or "
+           "several)");
+  ForestModel model;
+  model.stem_height_m = s.Number("stem_height_m", model.stem_height_m);
+  RequireWithin(s, "stem_height_m", model.stem_height_m, 0, kMaxStemHeight_m, "m");
+  model.friction = s.Number("friction", model.friction);
+  RequireWithin(s, "friction", model.friction, 0, kMaxFriction, "");
+  model.energy_coefficient_J = s.Number("energy_coefficient_j", model.energy_coefficient_J);
+  model.energy_exponent = s.Number("energy_exponent", model.energy_exponent);
+  RequireWithin(s, "energy_exponent", model.energy_exponent, 0, 5, "");
+  std::string why;
+  if (!model.IsValid(&why)) s.FailCheck(why);
+  const long seed = s.Integer("seed", static_cast<long>(out.release.seed));
+  if (seed < 0) s.Fail("seed", std::to_string(seed) + " must be >= 0");
+  out.forest_seed = static_cast<std::uint64_t>(seed);
+
+  std::vector<Stem> stems;
+  if (s.Has("trees")) ReadTrees(context, s, out.scene.terrain, out.crs_wkt, &stems, out);
+  DrawStands(context, s, out.scene.terrain, out.crs_wkt, out.forest_seed, &stems, out);
+  if (static_cast<long>(stems.size()) > kMaxTrees)
+    s.Fail("stands",
+           std::to_string(stems.size()) + " trees, more than " + std::to_string(kMaxTrees));
+  if (stems.empty())
+    out.warnings.push_back(context.Where(s.Node(s.Has("stands") ? "stands" : "stands_file")) +
+                           ": forest: the stands drew no tree (too small or too sparse)");
+  out.has_forest = true;
+  out.scene.forest = Forest(std::move(stems), model);
+}
+
+}  // namespace talus::io::scene_tables

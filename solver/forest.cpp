@@ -1,0 +1,296 @@
+#include "solver/forest.hpp"
+
+#include <Eigen/Geometry>
+#include <Eigen/LU>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+namespace talus {
+namespace {
+
+std::string Number(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.10g", v);
+  return text;
+}
+
+double KineticEnergy(const RockShape& rock, const Eigen::Vector3d& v, const Eigen::Vector3d& w) {
+  return 0.5 * rock.mass_kg * v.squaredNorm() + 0.5 * w.dot(rock.inertia_kg_m2.cwiseProduct(w));
+}
+
+double Cross(const Eigen::Vector2d& o, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+  return (a.x() - o.x()) * (b.y() - o.y()) - (a.y() - o.y()) * (b.x() - o.x());
+}
+
+// The convex hull of `points` in the plane, counter-clockwise, without collinear points
+// (Andrew's monotone chain). Overwrites `points`' order.
+void PlanHull(std::vector<Eigen::Vector2d>& points, std::vector<Eigen::Vector2d>* hull) {
+  std::sort(points.begin(), points.end(), [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+    return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y());
+  });
+  hull->assign(2 * points.size(), Eigen::Vector2d::Zero());
+  std::size_t k = 0;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    while (k >= 2 && Cross((*hull)[k - 2], (*hull)[k - 1], points[i]) <= 0) --k;
+    (*hull)[k++] = points[i];
+  }
+  for (std::size_t i = points.size() - 1, t = k + 1; i-- > 0;) {
+    while (k >= t && Cross((*hull)[k - 2], (*hull)[k - 1], points[i]) <= 0) --k;
+    (*hull)[k++] = points[i];
+  }
+  hull->resize(k > 1 ? k - 1 : k);
+}
+
+// Where the stem's axis c lies relative to the convex polygon: the nearest point q of its
+// boundary and the signed distance (negative inside).
+double PolygonDistance(const std::vector<Eigen::Vector2d>& polygon, const Eigen::Vector2d& c,
+                       Eigen::Vector2d* nearest) {
+  bool inside = polygon.size() >= 3;
+  double best = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < polygon.size(); ++i) {
+    const Eigen::Vector2d& a = polygon[i];
+    const Eigen::Vector2d& b = polygon[(i + 1) % polygon.size()];
+    if (Cross(a, b, c) < 0) inside = false;
+    const Eigen::Vector2d ab = b - a;
+    const double length2 = ab.squaredNorm();
+    const double t = length2 > 0 ? std::clamp((c - a).dot(ab) / length2, 0.0, 1.0) : 0.0;
+    const Eigen::Vector2d q = a + t * ab;
+    const double d = (c - q).norm();
+    if (d < best) {
+      best = d;
+      *nearest = q;
+    }
+  }
+  return inside ? -best : best;
+}
+
+Eigen::Vector2d ProjectOnDisk(const Eigen::Vector2d& p, double radius) {
+  const double norm = p.norm();
+  return norm <= radius
+             ? p
+             : (radius > 0 ? Eigen::Vector2d(p * (radius / norm)) : Eigen::Vector2d::Zero());
+}
+
+}  // namespace
+
+double ForestModel::BreakingEnergy_J(double dbh_m) const {
+  return energy_coefficient_J * std::pow(100 * dbh_m, energy_exponent);
+}
+
+bool ForestModel::IsValid(std::string* why) const {
+  auto fail = [&](const std::string& what) {
+    if (why) *why = what;
+    return false;
+  };
+  if (!(std::isfinite(stem_height_m) && stem_height_m > 0))
+    return fail("stem_height_m = " + Number(stem_height_m) + " must be finite and > 0 m");
+  if (!(std::isfinite(friction) && friction >= 0))
+    return fail("friction = " + Number(friction) + " must be finite and >= 0");
+  if (!(std::isfinite(energy_coefficient_J) && energy_coefficient_J > 0))
+    return fail("energy_coefficient_j = " + Number(energy_coefficient_J) +
+                " must be finite and > 0 J");
+  if (!(std::isfinite(energy_exponent) && energy_exponent > 0))
+    return fail("energy_exponent = " + Number(energy_exponent) + " must be finite and > 0");
+  return true;
+}
+
+Forest::Forest(std::vector<Stem> stems, const ForestModel& model)
+    : stems_(std::move(stems)), model_(model) {
+  if (stems_.empty()) return;
+  double x1 = stems_.front().position_m.x(), y1 = stems_.front().position_m.y();
+  x0_m_ = x1;
+  y0_m_ = y1;
+  for (const Stem& s : stems_) {
+    capacity_J_.push_back(model_.BreakingEnergy_J(s.dbh_m));
+    max_radius_m_ = std::max(max_radius_m_, 0.5 * s.dbh_m);
+    x0_m_ = std::min(x0_m_, s.position_m.x());
+    y0_m_ = std::min(y0_m_, s.position_m.y());
+    x1 = std::max(x1, s.position_m.x());
+    y1 = std::max(y1, s.position_m.y());
+  }
+  nx_ = static_cast<int>((x1 - x0_m_) / cell_m_) + 1;
+  ny_ = static_cast<int>((y1 - y0_m_) / cell_m_) + 1;
+  const std::size_t cells = static_cast<std::size_t>(nx_) * static_cast<std::size_t>(ny_);
+  std::vector<int> cell_of(stems_.size());
+  cell_start_.assign(cells + 1, 0);
+  for (std::size_t k = 0; k < stems_.size(); ++k) {
+    const int i = std::min(nx_ - 1, static_cast<int>((stems_[k].position_m.x() - x0_m_) / cell_m_));
+    const int j = std::min(ny_ - 1, static_cast<int>((stems_[k].position_m.y() - y0_m_) / cell_m_));
+    cell_of[k] = j * nx_ + i;
+    ++cell_start_[static_cast<std::size_t>(cell_of[k]) + 1];
+  }
+  for (std::size_t c = 0; c < cells; ++c) cell_start_[c + 1] += cell_start_[c];
+  order_.assign(stems_.size(), 0);
+  std::vector<int> fill(cell_start_.begin(), cell_start_.end() - 1);
+  for (std::size_t k = 0; k < stems_.size(); ++k)
+    order_[static_cast<std::size_t>(fill[static_cast<std::size_t>(cell_of[k])]++)] =
+        static_cast<int>(k);
+}
+
+bool Forest::IsValid(std::string* why) const {
+  if (!model_.IsValid(why)) return false;
+  for (std::size_t k = 0; k < stems_.size(); ++k) {
+    const Stem& s = stems_[k];
+    if (!(s.position_m.allFinite() && std::isfinite(s.ground_m))) {
+      if (why) *why = "tree " + std::to_string(k) + ": position or foot not finite";
+      return false;
+    }
+    if (!(std::isfinite(s.dbh_m) && s.dbh_m > 0)) {
+      if (why) *why = "tree " + std::to_string(k) + ": dbh = " + Number(s.dbh_m) + " m must be > 0";
+      return false;
+    }
+  }
+  return true;
+}
+
+Eigen::Vector3d PlasticFrictionalImpulse(const RockShape& rock, const Eigen::Matrix3d& rotation,
+                                         const Eigen::Vector3d& lever_m,
+                                         const Eigen::Matrix3d& directions, double mu,
+                                         Eigen::Vector3d* velocity, Eigen::Vector3d* omega) {
+  const Eigen::Vector3d& a = lever_m;
+  const Eigen::Vector3d inv_inertia = rock.inertia_kg_m2.cwiseInverse();
+  Eigen::Matrix3d cross_a;
+  cross_a << 0, -a.z(), a.y(), a.z(), 0, -a.x(), -a.y(), a.x(), 0;
+  // K: the point's velocity change per unit percussion there (world); G in the contact frame.
+  const Eigen::Matrix3d mobility =
+      Eigen::Matrix3d::Identity() / rock.mass_kg -
+      cross_a * rotation * inv_inertia.asDiagonal() * rotation.transpose() * cross_a;
+  const Eigen::Matrix3d g = directions.transpose() * mobility * directions;
+  const Eigen::Vector3d gamma = directions.transpose() * (*velocity + (rotation * *omega).cross(a));
+
+  // Sticking: the point stops entirely, when the percussion that does so lies in the cone.
+  Eigen::Vector3d p = -g.partialPivLu().solve(gamma);
+  auto in_cone = [&](const Eigen::Vector3d& q) {
+    return q.x() >= 0 && q.tail<2>().norm() <= mu * q.x() * (1 + 1e-12);
+  };
+  if (!in_cone(p)) {
+    // Sliding: Gauss-Seidel of the proximal-point laws (normal then tangential), which for a
+    // single contact converges to the point where the normal velocity is 0 and the tangential
+    // percussion opposes the slip on the disk's rim.
+    p.setZero();
+    const double r_t = 1.0 / std::max(g(1, 1), g(2, 2));
+    for (int sweep = 0; sweep < 2000; ++sweep) {
+      const Eigen::Vector3d before = p;
+      Eigen::Vector3d end = gamma + g * p;
+      p.x() = std::max(0.0, p.x() - end.x() / g(0, 0));
+      end = gamma + g * p;
+      p.tail<2>() = ProjectOnDisk(p.tail<2>() - r_t * end.tail<2>(), mu * p.x());
+      if ((p - before).norm() <= 1e-14 * p.norm()) break;
+    }
+  }
+  // Never add energy, and take the normal velocity to 0: else the frictionless plastic impulse.
+  const double gained_J = p.dot(gamma) + 0.5 * p.dot(g * p);
+  const double end_normal = (gamma + g * p).x();
+  const double scale = std::abs(gamma.x());
+  if (!(gained_J <= 0 && std::abs(end_normal) <= 1e-9 * (1 + scale) && p.allFinite()))
+    p = Eigen::Vector3d(-gamma.x() / g(0, 0), 0, 0);
+  const Eigen::Vector3d percussion = directions * p;
+  *velocity += percussion / rock.mass_kg;
+  *omega += inv_inertia.cwiseProduct(rotation.transpose() * a.cross(percussion));
+  return percussion;
+}
+
+bool MeetStems(const Forest& forest, const RockShape& rock, RockState* state,
+               std::vector<StemHit>* hits) {
+  const Eigen::Vector2d centre = state->position_m.head<2>();
+  const double reach = rock.bounding_radius_m + forest.max_radius_m();
+  const double lowest_possible_m = state->position_m.z() - rock.bounding_radius_m;
+  const ForestModel& model = forest.model();
+  // The rock's hull in world coordinates and its plan view, made when a stem is near.
+  thread_local std::vector<Eigen::Vector2d> plan, polygon;
+  thread_local std::vector<int> overlapping;
+  bool hull_ready = false;
+  double z_min = 0, z_max = 0;
+  Eigen::Matrix3d rotation;
+  overlapping.clear();
+  bool acted = false;
+
+  forest.ForEachNear(centre, reach, [&](int k) {
+    const Stem& stem = forest.stems()[static_cast<std::size_t>(k)];
+    const double radius = 0.5 * stem.dbh_m;
+    const double top_m = stem.ground_m + model.stem_height_m;
+    if ((stem.position_m - centre).norm() > rock.bounding_radius_m + radius) return;
+    if (lowest_possible_m > top_m) return;
+    auto record =
+        std::find_if(hits->begin(), hits->end(), [k](const StemHit& h) { return h.stem == k; });
+    if (record != hits->end() && record->broken) return;  // gone for this rock
+    if (!hull_ready) {
+      rotation = state->orientation.toRotationMatrix();
+      plan.clear();
+      z_min = std::numeric_limits<double>::infinity();
+      z_max = -z_min;
+      for (const Eigen::Vector3d& b : rock.vertices_m) {
+        const Eigen::Vector3d x = rotation * b;  // from the centre of mass
+        plan.push_back(state->position_m.head<2>() + x.head<2>());
+        z_min = std::min(z_min, state->position_m.z() + x.z());
+        z_max = std::max(z_max, state->position_m.z() + x.z());
+      }
+      PlanHull(plan, &polygon);
+      hull_ready = true;
+    }
+    if (z_min > top_m || z_max < stem.ground_m) return;
+    Eigen::Vector2d q;
+    const double distance = PolygonDistance(polygon, stem.position_m, &q);
+    if (distance >= radius) return;
+    overlapping.push_back(k);
+    // Normal: horizontal, from the stem into the rock.
+    Eigen::Vector2d n2 =
+        distance >= 0 ? Eigen::Vector2d(q - stem.position_m) : Eigen::Vector2d(stem.position_m - q);
+    if (!(n2.norm() > 0)) n2 = centre - stem.position_m;
+    if (!(n2.norm() > 0)) return;
+    n2.normalize();
+    Eigen::Matrix3d directions;
+    directions.col(0) = Eigen::Vector3d(n2.x(), n2.y(), 0);
+    directions.col(1) = Eigen::Vector3d(-n2.y(), n2.x(), 0);
+    directions.col(2) = Eigen::Vector3d::UnitZ();
+    // Where it acts: the hull's nearest point in plan view, at the height of the centre of mass
+    // within the part of the rock that the stem spans.
+    const double z_c =
+        std::clamp(state->position_m.z(), std::max(stem.ground_m, z_min), std::min(top_m, z_max));
+    const Eigen::Vector3d lever = Eigen::Vector3d(q.x(), q.y(), z_c) - state->position_m;
+    const Eigen::Vector3d omega_world = rotation * state->angular_velocity_rad_s;
+    const double approach = directions.col(0).dot(state->velocity_m_s + omega_world.cross(lever));
+    if (!(approach < 0)) return;  // separating or sliding past
+
+    const double energy_J = KineticEnergy(rock, state->velocity_m_s, state->angular_velocity_rad_s);
+    Eigen::Vector3d v = state->velocity_m_s, w = state->angular_velocity_rad_s;
+    PlasticFrictionalImpulse(rock, rotation, lever, directions, model.friction, &v, &w);
+    const double taken_J = std::max(0.0, energy_J - KineticEnergy(rock, v, w));
+    if (record == hits->end()) {
+      StemHit& h = hits->emplace_back();
+      h.stem = k;
+      h.stem_m = stem.position_m;
+      h.t_s = state->time_s;
+      h.position_m = state->position_m;
+      h.energy_J = energy_J;
+      record = hits->end() - 1;
+    }
+    if (!record->touching) ++record->impacts;
+    record->touching = true;
+    const double left_J = forest.capacity_J(k) - record->absorbed_J;
+    if (taken_J <= left_J) {
+      // The stem holds: the plastic impact.
+      state->velocity_m_s = v;
+      state->angular_velocity_rad_s = w;
+      record->absorbed_J += taken_J;
+    } else {
+      // It breaks: the rock keeps its directions with its energy less what the stem had left.
+      const double scale =
+          energy_J > 0 ? std::sqrt(std::max(0.0, energy_J - left_J) / energy_J) : 0.0;
+      state->velocity_m_s *= scale;
+      state->angular_velocity_rad_s *= scale;
+      record->absorbed_J = forest.capacity_J(k);
+      record->broken = true;
+    }
+    acted = true;
+  });
+  // Episodes: a stem the hull no longer overlaps is free for a new impact.
+  for (StemHit& h : *hits)
+    h.touching =
+        !h.broken && std::find(overlapping.begin(), overlapping.end(), h.stem) != overlapping.end();
+  return acted;
+}
+
+}  // namespace talus

@@ -1,0 +1,122 @@
+#pragma once
+// Forest: explicit trees whose stems the rocks hit (docs/model.md, "Forest"). Each stem is a
+// vertical cylinder of diameter DBH standing on the terrain up to a stated height. After every
+// step a rock whose hull overlaps a stem (in plan view, below the stem's top) and moves into it
+// gets one impulsive contact with it: fully plastic along the horizontal normal, Coulomb friction
+// on the stem's surface. The stem absorbs what that impact dissipates up to its breaking energy
+// E_max(DBH); an impact that would take more breaks it, the rock loses the stem's remaining
+// energy (its velocities scaled, directions kept, as for barriers) and that stem is gone for the
+// rest of this rock, not for the other rocks. A scene without trees does no forest work.
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "solver/polyhedron.hpp"
+#include "solver/state.hpp"
+
+namespace talus {
+
+// The mechanics shared by all stems of a scene.
+struct ForestModel {
+  double stem_height_m = 10;  // stems reach this high above the terrain at their axis (m), > 0
+  double friction = 0.5;      // Coulomb coefficient between rock and stem, >= 0
+  // Breaking energy E_max = coefficient * DBH[cm]^exponent (J); defaults: Dorren & Berger 2006
+  // as docs/model.md "Forest" states (and what of it could be checked).
+  double energy_coefficient_J = 38.7;
+  double energy_exponent = 2.31;
+
+  double BreakingEnergy_J(double dbh_m) const;
+  // Checks the fields; *why names the field, the value and the bound.
+  bool IsValid(std::string* why) const;
+};
+
+// One tree.
+struct Stem {
+  Eigen::Vector2d position_m = Eigen::Vector2d::Zero();  // axis, map coordinates (m)
+  double dbh_m = 0;                                      // stem diameter (m), > 0
+  double ground_m = 0;  // terrain height at the axis (m): the stem's foot
+};
+
+// The trees of a scene and a uniform grid of them for cheap look-ups.
+class Forest {
+ public:
+  Forest() = default;
+  // Requires model.IsValid() and finite stems of positive DBH.
+  Forest(std::vector<Stem> stems, const ForestModel& model);
+
+  bool empty() const { return stems_.empty(); }
+  const std::vector<Stem>& stems() const { return stems_; }
+  const ForestModel& model() const { return model_; }
+  double capacity_J(int stem) const { return capacity_J_[static_cast<std::size_t>(stem)]; }
+  double max_radius_m() const { return max_radius_m_; }
+  bool IsValid(std::string* why) const;
+
+  // Calls f(stem index) for every stem whose axis may lie within `reach` (m) of `centre` in plan
+  // view (a superset: those in the grid cells the square of half-width reach touches), in
+  // ascending cell order, each once.
+  template <class F>
+  void ForEachNear(const Eigen::Vector2d& centre, double reach, F&& f) const {
+    if (stems_.empty()) return;
+    const double u0 = (centre.x() - reach - x0_m_) / cell_m_,
+                 u1 = (centre.x() + reach - x0_m_) / cell_m_;
+    const double v0 = (centre.y() - reach - y0_m_) / cell_m_,
+                 v1 = (centre.y() + reach - y0_m_) / cell_m_;
+    if (!(u1 >= 0 && u0 < nx_ && v1 >= 0 && v0 < ny_)) return;
+    const int i0 = u0 < 0 ? 0 : static_cast<int>(u0),
+              i1 = u1 >= nx_ ? nx_ - 1 : static_cast<int>(u1);
+    const int j0 = v0 < 0 ? 0 : static_cast<int>(v0),
+              j1 = v1 >= ny_ ? ny_ - 1 : static_cast<int>(v1);
+    for (int j = j0; j <= j1; ++j)
+      for (int i = i0; i <= i1; ++i) {
+        const std::size_t cell = static_cast<std::size_t>(j) * nx_ + i;
+        for (int k = cell_start_[cell]; k < cell_start_[cell + 1]; ++k)
+          f(order_[static_cast<std::size_t>(k)]);
+      }
+  }
+
+  static constexpr double kCell_m = 5;  // grid cell of the look-up (m)
+
+ private:
+  std::vector<Stem> stems_;
+  ForestModel model_;
+  std::vector<double> capacity_J_;  // per stem, model_.BreakingEnergy_J(dbh)
+  double max_radius_m_ = 0;
+  double x0_m_ = 0, y0_m_ = 0, cell_m_ = kCell_m;
+  int nx_ = 0, ny_ = 0;
+  std::vector<int> cell_start_;  // nx * ny + 1 offsets into order_
+  std::vector<int> order_;       // stem indices sorted by cell
+};
+
+// What a rock did to one stem over its run (one record per stem it touched).
+struct StemHit {
+  int stem = 0;                                      // index into Forest::stems()
+  Eigen::Vector2d stem_m = Eigen::Vector2d::Zero();  // the stem's axis (map coordinates, m)
+  int impacts = 0;  // contact episodes (a rock leaning on a stem for many steps is one)
+  double t_s = 0;   // time of the first impact
+  Eigen::Vector3d position_m = Eigen::Vector3d::Zero();  // centre of mass at the first impact
+  double energy_J = 0;    // kinetic energy just before the first impact
+  double absorbed_J = 0;  // energy the stem took from this rock, <= its breaking energy
+  bool broken = false;    // this rock broke it (it is gone for the rest of the rock's run)
+  bool touching = false;  // in contact in the last step (bookkeeping of episodes)
+};
+
+// The stems the rock at *state (at a step's end) overlaps and moves into, each met as the header
+// says. Stems broken earlier by this rock (in `hits`) are gone. Updates *state's velocities and
+// `hits`; returns true when a stem changed the rock's velocity.
+bool MeetStems(const Forest& forest, const RockShape& rock, RockState* state,
+               std::vector<StemHit>* hits);
+
+// The impulsive plastic, frictional contact of a rock with a fixed point: the percussion P
+// (world) that the point `lever_m` (world, from the centre of mass) of the rock gets, in the
+// contact frame `directions` (world columns n, t1, t2; n the contact normal, pointing into the
+// rock), such that the point's normal velocity ends at 0 (from < 0) and its tangential percussion
+// lies in Coulomb's disk mu P_N (sticking when it can). Never adds kinetic energy: when the local
+// iteration does not meet the laws to round-off it falls back to the frictionless plastic impulse.
+// Applies P to `velocity` and `omega` (body frame). Returns the percussion (world).
+Eigen::Vector3d PlasticFrictionalImpulse(const RockShape& rock, const Eigen::Matrix3d& rotation,
+                                         const Eigen::Vector3d& lever_m,
+                                         const Eigen::Matrix3d& directions, double mu,
+                                         Eigen::Vector3d* velocity, Eigen::Vector3d* omega);
+
+}  // namespace talus

@@ -1,0 +1,270 @@
+// [forest] of a scene file (io/scene_forest.cpp) through io::LoadScene: a tree list becomes
+// Scene::forest's stems (DBH cm -> m, foot on the terrain), stands draw the same trees at every
+// load from the forest's seed (a Poisson process: the count within its spread), a run gives the
+// same impacts for any number of threads, and bad input is an error naming the file, line and key
+// before any rock runs.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <mutex>
+#include <string>
+
+#include "common/error.hpp"
+#include "ensemble/runner.hpp"
+#include "io/scene_file.hpp"
+#include "test_files.hpp"
+
+namespace talus::io {
+namespace {
+
+// A 60 x 30 m plane (x 0 .. 60, y -15 .. 15, 1 m cells, 30 deg falling along +x).
+const std::string kScene = R"([terrain]
+plane = { slope_deg = 30, slope_length_m = 40, runout_m = 20, width_m = 30, cell_m = 1 }
+
+[rock]
+shape = { box = [0.5, 0.4, 0.3] }
+
+[release]
+points = [[5, 0]]
+rocks = 8
+seed = 4
+
+)";
+
+#define EXPECT_HAS(text, part) EXPECT_NE(std::string(text).find(part), std::string::npos) << (text)
+
+SceneFile Load(const std::string& table, const std::string& trees_csv = "",
+               const std::string& scene = kScene) {
+  const auto dir = testing::FreshDir("scene");
+  if (!trees_csv.empty()) testing::WriteText(dir / "trees.csv", trees_csv);
+  testing::WriteText(dir / "scene.toml", scene + table);
+  return LoadScene((dir / "scene.toml").string());
+}
+
+std::string ErrorOf(const std::string& table, const std::string& trees_csv = "") {
+  try {
+    Load(table, trees_csv);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+const std::string kStand =
+    "[forest]\nstands = [{ polygon = [[20, -10], [40, -10], [40, 10], [20, 10]], "
+    "stems_per_ha = 5000, dbh_cm = 30, dbh_sd_cm = 5 }]\n";
+
+TEST(SceneForest, ATreeListBecomesTheStems) {
+  const SceneFile s = Load("[forest]\ntrees = \"trees.csv\"\nstem_height_m = 8\n",
+                           "x_m,y_m,dbh_cm\n30,0,30\n35.5,-2,12\n");
+  ASSERT_EQ(s.scene.forest.stems().size(), 2u);
+  const Stem& a = s.scene.forest.stems()[0];
+  EXPECT_EQ(a.position_m, Eigen::Vector2d(30, 0));
+  EXPECT_DOUBLE_EQ(a.dbh_m, 0.30);
+  double ground = 0;
+  ASSERT_TRUE(s.scene.terrain.Height(30, 0, &ground));
+  EXPECT_EQ(a.ground_m, ground);
+  EXPECT_EQ(s.scene.forest.model().stem_height_m, 8);
+  EXPECT_TRUE(s.has_forest);
+  EXPECT_EQ(s.trees_from_file, 2);
+  EXPECT_EQ(s.inputs.back(), s.trees_file);
+  // Without a [forest]: no trees, no forest work.
+  EXPECT_TRUE(Load("").scene.forest.empty());
+}
+
+TEST(SceneForest, StandsDrawTheSameTreesAtEveryLoadFromTheForestSeed) {
+  const SceneFile a = Load(kStand), b = Load(kStand);
+  const std::vector<Stem>& stems = a.scene.forest.stems();
+  ASSERT_EQ(stems.size(), b.scene.forest.stems().size());
+  for (std::size_t k = 0; k < stems.size(); ++k) {
+    EXPECT_EQ(stems[k].position_m, b.scene.forest.stems()[k].position_m);
+    EXPECT_EQ(stems[k].dbh_m, b.scene.forest.stems()[k].dbh_m);
+  }
+  // Poisson: mean 5000/ha * 0.04 ha = 200, standard deviation sqrt(200) = 14.1; 4 sigma.
+  EXPECT_NEAR(static_cast<double>(stems.size()), 200, 4 * std::sqrt(200.0));
+  ASSERT_EQ(a.stands.size(), 1u);
+  EXPECT_EQ(a.stands[0].trees, static_cast<long>(stems.size()));
+  EXPECT_DOUBLE_EQ(a.stands[0].area_m2, 400);
+  double sum = 0, squares = 0;
+  for (const Stem& s : stems) {
+    EXPECT_TRUE(s.position_m.x() >= 20 && s.position_m.x() <= 40 &&
+                std::abs(s.position_m.y()) <= 10);
+    sum += 100 * s.dbh_m;
+    squares += 1e4 * s.dbh_m * s.dbh_m;
+  }
+  const double n = static_cast<double>(stems.size());
+  const double mean = sum / n, sd = std::sqrt(squares / n - mean * mean);
+  // The sample mean of ~200 normal DBHs (sd 5 cm) within 4 standard errors (1.4 cm); the sample
+  // spread within 25 %.
+  EXPECT_NEAR(mean, 30, 1.5);
+  EXPECT_NEAR(sd, 5, 1.25);
+  // The default seed is the release's; another seed draws another forest.
+  EXPECT_EQ(a.forest_seed, 4u);
+  const SceneFile c = Load(kStand + "seed = 5\n");
+  EXPECT_NE(c.scene.forest.stems().front().position_m, stems.front().position_m);
+}
+
+// Collects each rock's outcome, in rock order.
+class Collect : public ensemble::RockSink {
+ public:
+  void OnRock(const ensemble::RockOutcome& outcome) override {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    rocks.push_back(outcome);
+  }
+  std::vector<ensemble::RockOutcome> rocks;
+
+ private:
+  std::mutex mutex_;
+};
+
+TEST(SceneForest, ARunHitsTheSameStemsForAnyNumberOfThreads) {
+  // Thrown down the slope at 6 m/s in random orientations, so that they reach the stand.
+  std::string scene = kScene;
+  scene.replace(scene.find("seed = 4\n"), 9,
+                "seed = 4\nvelocity_m_s = [6, 0, 0]\norientation = \"random\"\n");
+  const SceneFile s = Load(kStand, "", scene);
+  std::vector<std::vector<ensemble::RockOutcome>> runs;
+  for (int threads : {1, 2}) {
+    ensemble::EnsembleOptions options;
+    options.threads = threads;
+    Collect sink;
+    ensemble::RunEnsemble(s.scene, s.release, options, &sink);
+    std::sort(sink.rocks.begin(), sink.rocks.end(),
+              [](const auto& a, const auto& b) { return a.rock < b.rock; });
+    runs.push_back(sink.rocks);
+  }
+  ASSERT_EQ(runs[0].size(), runs[1].size());
+  long hits = 0;
+  for (std::size_t k = 0; k < runs[0].size(); ++k) {
+    const RockResult &a = runs[0][k].result, &b = runs[1][k].result;
+    EXPECT_EQ(a.final_state.position_m, b.final_state.position_m) << "rock " << k;
+    ASSERT_EQ(a.stem_hits.size(), b.stem_hits.size()) << "rock " << k;
+    for (std::size_t h = 0; h < a.stem_hits.size(); ++h) {
+      EXPECT_EQ(a.stem_hits[h].stem, b.stem_hits[h].stem);
+      EXPECT_EQ(a.stem_hits[h].absorbed_J, b.stem_hits[h].absorbed_J);
+      EXPECT_EQ(a.stem_hits[h].broken, b.stem_hits[h].broken);
+    }
+    hits += static_cast<long>(a.stem_hits.size());
+  }
+  EXPECT_GT(hits, 0) << "the rocks run into the stand";
+}
+
+// A point vector file of trees (GeoJSON here; any file GDAL/OGR reads): each point with the DBH of
+// its dbh_field attribute. A GeoJSON without a "crs" member on the plane (no CRS) is taken as
+// local coordinates.
+TEST(SceneForest, APointVectorFileOfTreesWithItsDbhField) {
+  const auto dir = testing::FreshDir("scene");
+  testing::WriteText(dir / "trees.geojson", R"({"type": "FeatureCollection", "features": [
+{"type": "Feature", "properties": {"d": 25.5}, "geometry": {"type": "Point", "coordinates": [30, 1]}},
+{"type": "Feature", "properties": {"d": 40}, "geometry": {"type": "Point", "coordinates": [33, -2]}}]})");
+  testing::WriteText(dir / "scene.toml",
+                     kScene + "[forest]\ntrees = \"trees.geojson\"\ndbh_field = \"d\"\n");
+  const SceneFile s = LoadScene((dir / "scene.toml").string());
+  ASSERT_EQ(s.scene.forest.stems().size(), 2u);
+  EXPECT_EQ(s.scene.forest.stems()[1].position_m, Eigen::Vector2d(33, -2));
+  EXPECT_DOUBLE_EQ(s.scene.forest.stems()[0].dbh_m, 0.255);
+  // Without the field, and with a DBH out of bounds: errors naming the file and the feature.
+  testing::WriteText(dir / "scene.toml", kScene + "[forest]\ntrees = \"trees.geojson\"\n");
+  try {
+    LoadScene((dir / "scene.toml").string());
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_HAS(e.what(), "forest.trees (");
+    EXPECT_HAS(e.what(), "trees.geojson, feature 0): no field 'dbh_cm'");
+  }
+}
+
+// A file in another CRS is reprojected to the DEM's (cases/tirol's EPSG:31287 from WGS 84), to
+// the same place as a release point of that file; a file with a CRS is refused in a scene without
+// one.
+TEST(SceneForest, ATreeFileInAnotherCrsIsReprojectedOrRefused) {
+  const auto dir = testing::FreshDir("scene");
+  // (256500, 379700) in EPSG:31287, by gdaltransform.
+  testing::WriteText(dir / "trees.geojson", R"({"type": "FeatureCollection",
+"crs": {"type": "name", "properties": {"name": "urn:ogc:def:crs:OGC:1.3:CRS84"}}, "features": [
+{"type": "Feature", "properties": {"dbh_cm": 30}, "geometry": {"type": "Point", "coordinates": [11.4343407630182, 47.3010011178257]}}]})");
+  const std::string tirol = std::string(TALUS_SOURCE_DIR) + "/cases/tirol/";
+  testing::WriteText(dir / "scene.toml",
+                     "[terrain]\ndem = \"" + tirol +
+                         "dem.tif\"\n[rock]\n"
+                         "shape = { box = [1, 1, 1] }\n[release]\nfile = \"trees.geojson\"\n"
+                         "[forest]\ntrees = \"trees.geojson\"\n");
+  const SceneFile s = LoadScene((dir / "scene.toml").string());
+  ASSERT_EQ(s.scene.forest.stems().size(), 1u);
+  const Eigen::Vector2d tree = s.scene.forest.stems()[0].position_m;
+  EXPECT_NEAR(tree.x(), 256500, 0.01);  // 1 cm: gdaltransform's printed digits
+  EXPECT_NEAR(tree.y(), 379700, 0.01);
+  EXPECT_EQ(tree, s.release.releases.at(0).rings.at(0).at(0));
+  testing::WriteText(dir / "local.geojson", R"({"type": "FeatureCollection",
+"crs": {"type": "name", "properties": {"name": "urn:ogc:def:crs:EPSG::31287"}}, "features": [
+{"type": "Feature", "properties": {"dbh_cm": 30}, "geometry": {"type": "Point", "coordinates": [30, 0]}}]})");
+  testing::WriteText(dir / "scene.toml", kScene + "[forest]\ntrees = \"local.geojson\"\n");
+  try {
+    LoadScene((dir / "scene.toml").string());
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_HAS(e.what(), "has a CRS but the DEM has none, so the trees cannot be placed");
+  }
+}
+
+// stands_file: the polygons of a vector file with stems_per_ha, dbh_cm (and dbh_sd_cm), drawn as
+// inline stands are, after them; a hole is left empty.
+TEST(SceneForest, StandsFromAVectorFileOfPolygons) {
+  const auto dir = testing::FreshDir("scene");
+  testing::WriteText(dir / "stands.geojson", R"({"type": "FeatureCollection", "features": [
+{"type": "Feature", "properties": {"stems_per_ha": 3000, "dbh_cm": 20},
+ "geometry": {"type": "Polygon", "coordinates": [[[20, -10], [40, -10], [40, 10], [20, 10], [20, -10]],
+                                                 [[25, -5], [35, -5], [35, 5], [25, 5], [25, -5]]]}}]})");
+  testing::WriteText(dir / "scene.toml", kScene + "[forest]\nstands_file = \"stands.geojson\"\n");
+  const SceneFile s = LoadScene((dir / "scene.toml").string());
+  ASSERT_EQ(s.stands.size(), 1u);
+  EXPECT_DOUBLE_EQ(s.stands[0].area_m2, 300);  // 400 less the 100 m^2 hole
+  // Poisson with mean 3000/ha * 0.03 ha = 90: within 4 sigma (38).
+  EXPECT_NEAR(static_cast<double>(s.scene.forest.stems().size()), 90, 4 * std::sqrt(90.0));
+  for (const Stem& stem : s.scene.forest.stems()) {
+    EXPECT_FALSE(std::abs(stem.position_m.x() - 30) < 5 && std::abs(stem.position_m.y()) < 5)
+        << "a tree in the hole";
+    EXPECT_DOUBLE_EQ(stem.dbh_m, 0.2);
+  }
+  testing::WriteText(dir / "stands.geojson", R"({"type": "FeatureCollection", "features": [
+{"type": "Feature", "properties": {"stems_per_ha": 0, "dbh_cm": 20},
+ "geometry": {"type": "Polygon", "coordinates": [[[20, -10], [40, -10], [40, 10], [20, -10]]]}}]})");
+  try {
+    LoadScene((dir / "scene.toml").string());
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_HAS(e.what(), "stands.geojson, feature 0): stems_per_ha: 0 must be > 0");
+  }
+}
+
+TEST(SceneForest, BadInputIsAnErrorNamingFileLineAndKey) {
+  EXPECT_HAS(ErrorOf("[forest]\nstem_height_m = 10\n"), "forest.trees: a [forest] needs trees");
+  EXPECT_HAS(ErrorOf("[forest]\ntrees = \"trees.csv\"\n", "x_m,y_m,dbh_cm\n30,0,-5\n"),
+             "trees.csv:2: column 'dbh_cm': -5 cm must be > 0");
+  EXPECT_HAS(ErrorOf("[forest]\ntrees = \"trees.csv\"\n", "x_m,y_m,dbh\n30,0,5\n"), "dbh_cm");
+  EXPECT_HAS(ErrorOf("[forest]\ntrees = \"trees.csv\"\n", "x_m,y_m,dbh_cm\n30,0,30\n600000,0,30\n"),
+             "trees.csv:3: column 'x_m': the tree at (600000, 0) is off the DEM");
+  EXPECT_HAS(ErrorOf("[forest]\ntrees = \"missing.csv\"\n"), "scene.toml:13: forest.trees:");
+  const std::string stand = "[forest]\nstands = [{ polygon = [[20, -10], [40, -10], [40, 10]], ";
+  EXPECT_HAS(ErrorOf(stand + "stems_per_ha = 0, dbh_cm = 30 }]\n"),
+             "scene.toml:13: forest.stands[0].stems_per_ha: 0 must be > 0 and <= 10000");
+  EXPECT_HAS(ErrorOf(stand + "stems_per_ha = 1e6, dbh_cm = 30 }]\n"), "stems_per_ha: 1000000");
+  EXPECT_HAS(ErrorOf(stand + "stems_per_ha = 400, dbh_cm = -30 }]\n"),
+             "dbh_cm: -30 cm must be > 0");
+  EXPECT_HAS(ErrorOf(stand + "stems_per_ha = 400, dbh_cm = 30, dbh_sd_cm = 40 }]\n"),
+             "dbh_sd_cm: 40 cm must be >= 0 and <= dbh_cm");
+  EXPECT_HAS(ErrorOf(stand + "stems_per_ha = 400 }]\n"), "forest.stands[0].dbh_cm: missing");
+  EXPECT_HAS(ErrorOf("[forest]\nstands = [{ polygon = [[50, -10], [90, -10], [90, 10]], "
+                     "stems_per_ha = 400, dbh_cm = 30 }]\n"),
+             "is off the DEM or on nodata");
+  EXPECT_HAS(ErrorOf(kStand + "friction = -0.5\n"), "forest.friction: -0.5 is outside 0 .. 10");
+  EXPECT_HAS(ErrorOf(kStand + "stem_height_m = 0\n"), "forest.stem_height_m: stem_height_m = 0");
+  EXPECT_HAS(ErrorOf(kStand + "dbh = 3\n"), "forest.dbh: unknown key");
+  EXPECT_HAS(ErrorOf("[output]\nrasters = [\"tree_hits\"]\n"),
+             "output.rasters: tree_hits counts the impacts on stems: the scene has no [forest]");
+}
+
+}  // namespace
+}  // namespace talus::io

@@ -1,0 +1,281 @@
+// Trees acting on a rock (solver/forest.hpp, docs/model.md "Forest"), against closed forms.
+// A rigid body whose point a (from the centre of mass) gets a percussion P changes its velocity
+// by P / m and its angular velocity by Theta^-1 (a x P) (Newton-Euler for impulses). For a cube
+// of side s hitting a stem head-on with the centre of a face, a = (s/2) n: the normal percussion
+// has no lever, so the plastic impact takes the normal velocity v_N entirely (P_N = m v_N).
+// The tangential percussion P_T at a changes the point's tangential velocity by
+// P_T (1/m + (s/2)^2 / Theta), Theta = m s^2 / 6: it sticks when that stops the point with
+// |P_T| <= mu P_N, and else slides with |P_T| = mu P_N, which takes mu v_N from the centre of
+// mass's tangential velocity (Coulomb's law during a plastic impact). A stem that breaks leaves
+// the rock E - E_max with its directions (the model's rule, as for barriers). On flat ground with
+// constant Coulomb friction mu a sliding cube's energy after a distance d is E0 - mu m g d.
+
+#include "solver/forest.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "scenes/scenes.hpp"
+#include "solver/random.hpp"
+#include "solver/shapes.hpp"
+#include "solver/simulate.hpp"
+
+namespace talus {
+namespace {
+
+constexpr double kG = 9.81, kMu = 0.5, kSide_m = 1, kDensity = 2700;
+
+RockShape Cube() { return MakeRockShape(MakeBox(kSide_m, kSide_m, kSide_m), kDensity); }
+
+// The cube's principal frame is the box's (its vertices at +-s/2 on every axis): the closed forms
+// below assume the faces are normal to x, y and z at identity orientation.
+bool AxisAligned(const RockShape& rock) {
+  for (const Eigen::Vector3d& v : rock.vertices_m)
+    if ((v.cwiseAbs() - Eigen::Vector3d::Constant(0.5 * kSide_m)).norm() > 1e-9) return false;
+  return true;
+}
+
+// One stem of diameter dbh at (x, y) on ground at height 0.
+Forest OneStem(double x, double y, double dbh_m, double friction = kMu) {
+  ForestModel model;
+  model.friction = friction;
+  return Forest({Stem{{x, y}, dbh_m, 0}}, model);
+}
+
+// The cube at the origin (centre of mass 0.5 m up) moving with v; a stem of 30 cm whose surface
+// is 1 cm inside the cube's face x = 0.5.
+struct HeadOn {
+  RockShape rock = Cube();
+  Forest forest = OneStem(0.5 * kSide_m + 0.15 - 0.01, 0, 0.3);
+  RockState State(const Eigen::Vector3d& v) const {
+    RockState s;
+    s.position_m = {0, 0, 0.5 * kSide_m};
+    s.velocity_m_s = v;
+    return s;
+  }
+};
+
+TEST(Forest, DefaultsAreValidAndTheBreakingEnergyIsTheStatedPowerLaw) {
+  const ForestModel model;
+  std::string why;
+  EXPECT_TRUE(model.IsValid(&why)) << why;
+  // E_max = 38.7 DBH[cm]^2.31 J: 30 cm -> 38.7 * 30^2.31 = 99.96 kJ.
+  EXPECT_NEAR(model.BreakingEnergy_J(0.30), 38.7 * std::pow(30.0, 2.31), 1e-9);
+  EXPECT_NEAR(model.BreakingEnergy_J(0.30), 99960, 10);
+  ForestModel bad;
+  bad.stem_height_m = 0;
+  EXPECT_FALSE(bad.IsValid(&why));
+  EXPECT_NE(why.find("stem_height_m = 0"), std::string::npos) << why;
+  bad = ForestModel{};
+  bad.friction = -1;
+  EXPECT_FALSE(bad.IsValid(&why));
+  EXPECT_NE(why.find("friction = -1"), std::string::npos) << why;
+  const Forest negative({Stem{{0, 0}, -0.2, 0}}, ForestModel{});
+  EXPECT_FALSE(negative.IsValid(&why));
+  EXPECT_NE(why.find("dbh"), std::string::npos) << why;
+}
+
+TEST(Forest, TheGridFindsEveryStemWithinReach) {
+  // Against a brute-force search over 2000 random stems on 200 m x 100 m.
+  std::vector<Stem> stems;
+  RockRandom random(3, 0);
+  for (int k = 0; k < 2000; ++k)
+    stems.push_back(Stem{{200 * random.Uniform() - 50, 100 * random.Uniform()}, 0.3, 0});
+  const Forest forest(stems, ForestModel{});
+  for (int q = 0; q < 200; ++q) {
+    const Eigen::Vector2d c(260 * random.Uniform() - 80, 140 * random.Uniform() - 20);
+    const double reach = 4 * random.Uniform();
+    std::vector<int> found;
+    forest.ForEachNear(c, reach, [&](int k) { found.push_back(k); });
+    for (std::size_t k = 0; k < stems.size(); ++k) {
+      if ((stems[k].position_m - c).norm() > reach) continue;
+      EXPECT_NE(std::find(found.begin(), found.end(), static_cast<int>(k)), found.end())
+          << "stem " << k << " missed from query " << q;
+    }
+    std::vector<int> sorted = found;
+    std::sort(sorted.begin(), sorted.end());
+    EXPECT_EQ(std::adjacent_find(sorted.begin(), sorted.end()), sorted.end()) << "a stem twice";
+  }
+}
+
+TEST(Forest, HeadOnBelowTheBreakingEnergyTheStemTakesTheNormalVelocity) {
+  const HeadOn h;
+  ASSERT_TRUE(AxisAligned(h.rock));
+  RockState s = h.State({5, 0, 0});  // 33.75 kJ < E_max(30 cm) = 99.96 kJ
+  const double e0 = KineticEnergy(h.rock, s);
+  std::vector<StemHit> hits;
+  EXPECT_TRUE(MeetStems(h.forest, h.rock, &s, &hits));
+  // Plastic: nothing left along the normal, and no lever, so no spin: 1e-12 m/s (round-off of
+  // the 3x3 solve).
+  EXPECT_NEAR(s.velocity_m_s.norm(), 0, 1e-12);
+  EXPECT_NEAR(s.angular_velocity_rad_s.norm(), 0, 1e-12);
+  ASSERT_EQ(hits.size(), 1u);
+  EXPECT_EQ(hits[0].impacts, 1);
+  EXPECT_FALSE(hits[0].broken);
+  EXPECT_NEAR(hits[0].absorbed_J, e0, 1e-9 * e0);
+  EXPECT_EQ(hits[0].energy_J, e0);
+  // Still overlapping, at rest: the same episode, nothing more to take.
+  EXPECT_FALSE(MeetStems(h.forest, h.rock, &s, &hits));
+  EXPECT_EQ(hits[0].impacts, 1);
+}
+
+TEST(Forest, HeadOnAboveTheBreakingEnergyTheStemBreaksAndTakesItsEnergy) {
+  const HeadOn h;
+  RockState s = h.State({10, 0, 0});  // 135 kJ > 99.96 kJ
+  const double e0 = KineticEnergy(h.rock, s);
+  const double e_max = h.forest.capacity_J(0);
+  std::vector<StemHit> hits;
+  EXPECT_TRUE(MeetStems(h.forest, h.rock, &s, &hits));
+  ASSERT_EQ(hits.size(), 1u);
+  EXPECT_TRUE(hits[0].broken);
+  EXPECT_EQ(hits[0].absorbed_J, e_max);
+  // E - E_max, to round-off, along +x.
+  EXPECT_NEAR(KineticEnergy(h.rock, s), e0 - e_max, 1e-9 * e0);
+  EXPECT_NEAR(s.velocity_m_s.x(), std::sqrt(2 * (e0 - e_max) / h.rock.mass_kg), 1e-9);
+  EXPECT_EQ(s.velocity_m_s.y(), 0);
+  // Gone for this rock: the next overlap does nothing.
+  const RockState after = s;
+  EXPECT_FALSE(MeetStems(h.forest, h.rock, &s, &hits));
+  EXPECT_EQ(s.velocity_m_s, after.velocity_m_s);
+  // Not for another rock.
+  std::vector<StemHit> other;
+  RockState t = h.State({1, 0, 0});
+  EXPECT_TRUE(MeetStems(h.forest, h.rock, &t, &other));
+}
+
+TEST(Forest, ObliqueImpactSticksOrSlidesByCoulomb) {
+  const HeadOn h;
+  const double m = h.rock.mass_kg, theta = m * kSide_m * kSide_m / 6, arm = 0.5 * kSide_m;
+  const double v_n = 4, v_t = 3;
+  for (const double mu : {0.5, 0.2}) {
+    const Forest forest = OneStem(0.5 * kSide_m + 0.15 - 0.01, 0, 0.3, mu);
+    RockState s = h.State({v_n, v_t, 0});
+    std::vector<StemHit> hits;
+    ASSERT_TRUE(MeetStems(forest, h.rock, &s, &hits));
+    // Sticking percussion: the point's tangential velocity to 0 through 1/m + arm^2/Theta.
+    const double stick = v_t / (1 / m + arm * arm / theta);
+    const double p_t = std::min(stick, mu * m * v_n);  // mu = 0.5 sticks, 0.2 slides
+    EXPECT_NEAR(s.velocity_m_s.x(), 0, 1e-12);
+    // 1e-9: the sliding case's local iteration stops at 1e-14 relative change.
+    EXPECT_NEAR(s.velocity_m_s.y(), v_t - p_t / m, 1e-9) << "mu " << mu;
+    EXPECT_NEAR(s.velocity_m_s.z(), 0, 1e-12);
+    // The percussion -p_t y at arm x turns the cube about -z: arm p_t / Theta.
+    const Eigen::Vector3d w = s.orientation * s.angular_velocity_rad_s;
+    EXPECT_NEAR(w.z(), -arm * p_t / theta, 1e-9) << "mu " << mu;
+    if (mu == 0.5) {
+      EXPECT_NEAR(s.velocity_m_s.y() + w.z() * arm, 0, 1e-9);  // stuck
+    }
+  }
+}
+
+TEST(Forest, NoImpactAddsEnergy) {
+  // Random shapes' orientations, velocities, spins, stem sizes and friction coefficients, the
+  // EOTA221 block overlapping a stem: the impact never adds kinetic energy (1e-12 relative:
+  // round-off).
+  const RockShape rock = scenes::Eota221();
+  int acted = 0;
+  for (int k = 0; k < 2000; ++k) {
+    RockRandom random(11, static_cast<std::uint64_t>(k));
+    const double dbh = 0.05 + 0.6 * random.Uniform();
+    const double angle = 2 * M_PI * random.Uniform();
+    const double distance = rock.bounding_radius_m * random.Uniform();
+    ForestModel model;
+    model.friction = 1.5 * random.Uniform();
+    model.energy_coefficient_J = random.Uniform() < 0.5 ? 38.7 : 1e-3;  // hold or break
+    const Forest forest({Stem{{distance * std::cos(angle), distance * std::sin(angle)}, dbh, -2}},
+                        model);
+    RockState s;
+    s.orientation = random.Orientation();
+    for (int i = 0; i < 3; ++i) {
+      s.velocity_m_s[i] = 20 * (random.Uniform() - 0.5);
+      s.angular_velocity_rad_s[i] = 10 * (random.Uniform() - 0.5);
+    }
+    const double e0 = KineticEnergy(rock, s);
+    std::vector<StemHit> hits;
+    if (MeetStems(forest, rock, &s, &hits)) ++acted;
+    EXPECT_LE(KineticEnergy(rock, s), e0 * (1 + 1e-12)) << "case " << k;
+    for (const StemHit& h : hits) EXPECT_LE(h.absorbed_J, forest.capacity_J(0) * (1 + 1e-12));
+  }
+  EXPECT_GT(acted, 500);  // the draws do exercise impacts
+}
+
+// The sliding cube of the barrier tests: flat ground of constant friction, 1 m cube at x = 20
+// sliding along +x at 10 m/s.
+Scene SlidingScene() {
+  Scene scene = scenes::Incline(0, Cube(), GroundParams{kMu, kMu, 150, 2, 0});
+  scene.options.tolerance_m_s = 1e-9;
+  scene.options.max_iterations = 1000;
+  scene.options.max_time_s = 10;
+  return scene;
+}
+
+RockState SlidingStart(const Scene& scene) {
+  RockState s;
+  s.position_m = {20, 0, 0.5 * kSide_m};
+  s.velocity_m_s = {10, 0, 0};
+  RaiseAboveTerrain(scene, s);
+  return s;
+}
+
+TEST(Forest, SlidingCubeIsStoppedByAStemBelowItsBreakingEnergy) {
+  Scene scene = SlidingScene();
+  const double m = scene.rock.mass_kg;
+  constexpr double kDbh = 0.4, kStemX = 25.7;  // E_max(40 cm) = 195 kJ
+  scene.forest = OneStem(kStemX, 0, kDbh);
+  SimulationWorkspace ws;
+  const RockResult r = SimulateRock(scene, SlidingStart(scene), ws);
+  ASSERT_EQ(r.end, EndReason::kRest);
+  ASSERT_EQ(r.stem_hits.size(), 1u);
+  const StemHit& hit = r.stem_hits[0];
+  EXPECT_FALSE(hit.broken);
+  EXPECT_EQ(hit.impacts, 1);
+  // It rests with its face against the stem: the overlap found after a step is at most that
+  // step's travel v dt = 0.02 m.
+  const double contact_x = kStemX - 0.5 * kDbh - 0.5 * kSide_m;
+  EXPECT_NEAR(r.final_state.position_m.x(), contact_x, 0.02);
+  EXPECT_LE(r.final_state.position_m.x(), contact_x + 1e-12 + 0.02);
+  // Energy at impact: E0 - mu m g d (closed form) with d to the contact, within the friction
+  // work over the same 0.02 m of detection lag (mu m g 0.02 = 265 J); the stem took all of it.
+  const double expected = 0.5 * m * 100 - kMu * m * kG * (contact_x - 20);
+  EXPECT_NEAR(hit.energy_J, expected, kMu * m * kG * 0.02);
+  EXPECT_NEAR(hit.absorbed_J, hit.energy_J, 1e-6 * hit.energy_J);
+}
+
+TEST(Forest, SlidingCubeBreaksAStemAboveItsBreakingEnergyAndStopsShorter) {
+  Scene scene = SlidingScene();
+  const double m = scene.rock.mass_kg;
+  constexpr double kDbh = 0.2;  // E_max(20 cm) = 38.7 * 20^2.31 = 39.0 kJ < 62 kJ at the stem
+  SimulationWorkspace ws;
+  const RockResult free = SimulateRock(scene, SlidingStart(scene), ws);
+  scene.forest = OneStem(26, 0, kDbh);
+  const RockResult r = SimulateRock(scene, SlidingStart(scene), ws);
+  ASSERT_EQ(r.end, EndReason::kRest);
+  ASSERT_EQ(r.stem_hits.size(), 1u);
+  EXPECT_TRUE(r.stem_hits[0].broken);
+  const double e_max = scene.forest.capacity_J(0);
+  EXPECT_EQ(r.stem_hits[0].absorbed_J, e_max);
+  // Closed form: losing E_max on the way it stops E_max / (mu m g) = 2.95 m short of the free
+  // run. Each run's rest carries the scheme's stopping error (1e-5 m, barrier tests) and the
+  // cube's pitching under friction: 1e-3 m.
+  EXPECT_NEAR(free.runout_m - r.runout_m, e_max / (kMu * m * kG), 1e-3);
+}
+
+TEST(Forest, ARockAboveTheStemsTopPassesBitForBitUnchanged) {
+  Scene scene = SlidingScene();
+  RockState s;
+  s.position_m = {20, 0, 15};
+  s.velocity_m_s = {10, 0, 0};
+  SimulationWorkspace ws;
+  scene.options.max_time_s = 0.5;
+  const RockResult free = SimulateRock(scene, s, ws);
+  scene.forest = OneStem(23, 0, 0.5);  // 10 m stems; the cube's lowest vertex stays above 13.2 m
+  const RockResult r = SimulateRock(scene, s, ws);
+  EXPECT_TRUE(r.stem_hits.empty());
+  EXPECT_EQ(r.final_state.position_m, free.final_state.position_m);
+  EXPECT_EQ(r.final_state.velocity_m_s, free.final_state.velocity_m_s);
+}
+
+}  // namespace
+}  // namespace talus
