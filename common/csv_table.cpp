@@ -275,4 +275,17 @@ bool CsvReader::Next(std::vector<std::string>* fields) {
   return true;
 }
 
+double CsvFieldNumber(const std::string& text, const std::string& where, const std::string& column) {
+  std::size_t used = 0;
+  double v = 0;
+  try {
+    v = std::stod(text, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (text.empty() || used != text.size())
+    throw InputError(where + ": column '" + column + "': '" + text + "' is not a number");
+  return v;
+}
+
 }  // namespace talus

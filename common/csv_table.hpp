@@ -84,4 +84,8 @@ class CsvReader {
   int line_ = 0, next_line_ = 1;
 };
 
+// The number a whole CSV field holds (std::stod's syntax), or InputError
+// "<where>: column '<column>': '<text>' is not a number" (where: "file:line").
+double CsvFieldNumber(const std::string& text, const std::string& where, const std::string& column);
+
 }  // namespace talus

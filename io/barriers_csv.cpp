@@ -18,20 +18,6 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // "%.10g", or an empty field for NaN (no rock counted).
 std::string Field(double v) { return FormatOrMissing(v, "%.10g", ""); }
 
-// The number in `text`, or an InputError naming the file, line and column.
-double NumberIn(const std::string& text, const std::string& where, const std::string& column) {
-  std::size_t used = 0;
-  double v = kNaN;
-  try {
-    v = std::stod(text, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  if (text.empty() || used != text.size())
-    throw InputError(where + ": column '" + column + "': '" + text + "' is not a number");
-  return v;
-}
-
 }  // namespace
 
 const char* BarriersCsvWriter::Header() {
@@ -85,7 +71,7 @@ std::vector<BarrierSummary> SummarizeBarriers(const std::string& csv_path,
     BarrierSummary& s = out[at->second];
     std::array<double, 3> v{};
     for (std::size_t q = 0; q < 3; ++q)
-      v[q] = NumberIn(fields[columns[q]], where, in.header()[columns[q]]);
+      v[q] = CsvFieldNumber(fields[columns[q]], where, in.header()[columns[q]]);
     const std::string& outcome = fields[outcome_column];
     ++s.reached;
     if (outcome == ToString(BarrierOutcome::kStopped)) {

@@ -75,20 +75,10 @@ std::vector<EvaluationLineSummary> SummarizeEvaluationLines(
     if (at == index.end())
       throw InputError(csv_path + ":" + std::to_string(in.line()) + ": column 'line': '" +
                        fields[line_column] + "' is not an evaluation line of the scene");
-    for (std::size_t q = 0; q < 4; ++q) {
-      const std::string& text = fields[columns[q]];
-      std::size_t used = 0;
-      double v = kNaN;
-      try {
-        v = std::stod(text, &used);
-      } catch (const std::exception&) {
-        used = 0;
-      }
-      if (text.empty() || used != text.size())
-        throw InputError(csv_path + ":" + std::to_string(in.line()) + ": column '" +
-                         in.header()[columns[q]] + "': '" + text + "' is not a number");
-      values[at->second][q].push_back(v);
-    }
+    for (std::size_t q = 0; q < 4; ++q)
+      values[at->second][q].push_back(
+          CsvFieldNumber(fields[columns[q]], csv_path + ":" + std::to_string(in.line()),
+                         in.header()[columns[q]]));
   }
 
   std::vector<EvaluationLineSummary> out;
