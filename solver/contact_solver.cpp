@@ -247,17 +247,18 @@ struct SweepSetting {
 // Per-contact Jacobians, step lengths and warm start: each contact's Delassus block and prox
 // steps, its velocity bias (restitution and gap) and viscous mass, and the previous step's
 // percussion (re-expressed in this frame, made admissible) applied to the velocities.
-void PrepareContacts(const Scene& scene, const RockShape& rock, const Eigen::Matrix3d& rotation,
-                     const EffectiveInertia& inertia, const Eigen::Vector3d& v_begin,
-                     const Eigen::Vector3d& omega_begin, Eigen::Vector3d& velocity_m_s,
-                     Eigen::Vector3d& omega_rad_s, StepWorkspace& workspace) {
+void PrepareContacts(const Scene& scene, const RockShape& rock, double dt_s,
+                     const Eigen::Matrix3d& rotation, const EffectiveInertia& inertia,
+                     const Eigen::Vector3d& v_begin, const Eigen::Vector3d& omega_begin,
+                     Eigen::Vector3d& velocity_m_s, Eigen::Vector3d& omega_rad_s,
+                     StepWorkspace& workspace) {
   const SolverOptions& opt = scene.options;
   const Eigen::Vector3d inv_inertia = rock.inertia_kg_m2.cwiseInverse() / inertia.inertia_scale;
   const Eigen::Vector3d restitution(opt.normal_restitution, opt.tangential_restitution,
                                     opt.tangential_restitution);
   const bool with_restitution = opt.normal_restitution != 0 || opt.tangential_restitution != 0;
   const double inv_mass = 1.0 / inertia.mass_kg;
-  const double inv_dt = 1.0 / opt.dt_s;
+  const double inv_dt = 1.0 / dt_s;
   const bool viscous_friction = opt.viscous == ViscousReading::kContactFriction;
   for (Contact& c : workspace.contacts) {
     const Eigen::Vector3d& b = c.lever_m;
@@ -280,11 +281,11 @@ void PrepareContacts(const Scene& scene, const RockShape& rock, const Eigen::Mat
     if (with_restitution) {
       const Eigen::Vector3d gamma_begin =
           c.directions.transpose() * v_begin + c.arms.transpose() * omega_begin;
-      if (c.gap_m == 0 || c.gap_m + opt.dt_s * gamma_begin.x() < 0)
+      if (c.gap_m == 0 || c.gap_m + dt_s * gamma_begin.x() < 0)
         c.velocity_bias = restitution.cwiseProduct(gamma_begin);
     }
     c.viscous_kg =
-        viscous_friction ? scene.ground.params(c.ground).nu_1_s * opt.dt_s * rock.mass_kg : 0.0;
+        viscous_friction ? scene.ground.params(c.ground).nu_1_s * dt_s * rock.mass_kg : 0.0;
     c.percussion.setZero();
     if (workspace.last_closed[c.vertex] && !c.corner) {
       // Previous step's percussion, re-expressed in this frame and made admissible.
@@ -370,15 +371,15 @@ void RememberPercussions(StepWorkspace& workspace, ContactSolveReport& report) {
 
 }  // namespace
 
-ContactSolveReport SolveContacts(const Scene& scene, const RockShape& rock,
+ContactSolveReport SolveContacts(const Scene& scene, const RockShape& rock, double dt_s,
                                  const Eigen::Matrix3d& rotation, const EffectiveInertia& inertia,
                                  const Eigen::Vector3d& v_begin, const Eigen::Vector3d& omega_begin,
                                  Eigen::Vector3d& velocity_m_s, Eigen::Vector3d& omega_rad_s,
                                  StepWorkspace& workspace) {
   ContactSolveReport report;
   const SolverOptions& opt = scene.options;
-  PrepareContacts(scene, rock, rotation, inertia, v_begin, omega_begin, velocity_m_s, omega_rad_s,
-                  workspace);
+  PrepareContacts(scene, rock, dt_s, rotation, inertia, v_begin, omega_begin, velocity_m_s,
+                  omega_rad_s, workspace);
 
   // Gauss-Seidel over the contacts until a sweep changes no contact velocity by more than the
   // tolerance, or max_iterations sweeps.

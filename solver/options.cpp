@@ -73,7 +73,7 @@ constexpr Bounds Choices(const std::array<const char*, N>& /*names*/) {
 }  // namespace
 
 // In the order of summary.json's "solver".
-constinit const std::array<SolverOptionInfo, 16> kSolverOptions = {{
+constinit const std::array<SolverOptionInfo, 17> kSolverOptions = {{
     {.key = "dt_s",
      .type = Type::kNumber,
      .member = MemberOf<&O::dt_s>(),
@@ -155,6 +155,13 @@ constinit const std::array<SolverOptionInfo, 16> kSolverOptions = {{
      .valid = Choices(kPredictedLevers),
      .choices = &kPredictedLeverNames,
      .doc = "where a predicted contact's percussion acts (below)"},
+    {.key = "impact_substeps",
+     .type = Type::kInteger,
+     .member = MemberOf<&O::impact_substeps>(),
+     .unit = "1",
+     .valid = Bounds::Between(1, 64),
+     .preset_knob = true,
+     .doc = "a step with a predicted contact is taken as this many sub-steps; 1: never (below)"},
     {.key = "soil_drag",
      .type = Type::kChoice,
      .member = MemberOf<&O::soil_drag>(),

@@ -74,9 +74,9 @@ bool ParseSoilDragPoint(std::string_view name, SoilDragPoint* point);
 // Every option below is a row of kSolverOptions (after the struct): its key, unit, bounds and doc
 // line, from which [solver] in scene files, summary.json, IsValid and the docs' table are read.
 struct SolverOptions {
-  double dt_s = 0.002;                  // time step
-  double max_time_s = 300;              // a rock still moving then ends as max_time
-  double gravity_m_s2 = 9.81;           // along -z
+  double dt_s = 0.002;         // time step
+  double max_time_s = 300;     // a rock still moving then ends as max_time
+  double gravity_m_s2 = 9.81;  // along -z
   // Newton's impact law xi = gamma_E + epsilon gamma_A, one coefficient for the normal and the
   // tangential directions: the model is fully plastic (0). Only equal coefficients in [0, 1] are
   // energetically consistent for every contact configuration (Glocker 2013, Part I): with
@@ -108,6 +108,12 @@ struct SolverOptions {
   double penetration_tolerance = 0.01;
   // Where a predicted contact's percussion acts.
   PredictedLever predicted_lever = PredictedLever::kMidpoint;
+  // Impact sub-steps (docs/model.md, "Impact sub-steps"): a step whose contact set holds a
+  // predicted contact is taken as this many sub-steps of dt / impact_substeps, so that the
+  // percussion acts near the instant of the impact instead of up to a step early; 1: never (the
+  // scheme as before). Off by default until the calibration tests are re-derived for it; 4 brings
+  // cases/tirol at dt 2 ms within the standard errors of dt 0.5 ms.
+  int impact_substeps = 1;
   // Where the scar drag of a soil category (GroundModel::kLu2019) acts.
   SoilDragPoint soil_drag = SoilDragPoint::kCentreOfMass;
   // Rest: speed and angular speed below these thresholds, in contact, for rest_hold_s.
@@ -151,7 +157,7 @@ struct SolverOptionInfo {
     return plausible_lower > -Bounds::kInf || plausible_upper < Bounds::kInf;
   }
 };
-extern const std::array<SolverOptionInfo, 16> kSolverOptions;
+extern const std::array<SolverOptionInfo, 17> kSolverOptions;
 // nullptr when `key` is no option's key.
 const SolverOptionInfo* FindSolverOption(std::string_view key);
 

@@ -1,6 +1,7 @@
 #include "solver/step.hpp"
 
 #include <Eigen/LU>
+#include <algorithm>
 #include <cmath>
 
 #include "solver/contact_detection.hpp"
@@ -12,9 +13,8 @@ namespace talus {
 namespace {
 
 // Scar: grows with the speed while a contact carries load, decays as exp(-beta dt) otherwise.
-void UpdateScar(const Scene& scene, const StepReport& report, const StepWorkspace& workspace,
-                RockState& state) {
-  const double dt = scene.options.dt_s;
+void UpdateScar(const Scene& scene, double dt, const StepReport& report,
+                const StepWorkspace& workspace, RockState& state) {
   if (report.loaded) {
     state.scar_m += dt * state.velocity_m_s.norm();
     for (const Contact& c : workspace.contacts)
@@ -25,30 +25,30 @@ void UpdateScar(const Scene& scene, const StepReport& report, const StepWorkspac
   }
 }
 
-// End velocity under gravity alone.
-Eigen::Vector3d FreeVelocity(const SolverOptions& opt, const Eigen::Vector3d& v_begin) {
+// End velocity under gravity alone after dt.
+Eigen::Vector3d FreeVelocity(const SolverOptions& opt, double dt, const Eigen::Vector3d& v_begin) {
   Eigen::Vector3d velocity = v_begin;
-  velocity.z() -= opt.dt_s * opt.gravity_m_s2;
+  velocity.z() -= dt * opt.gravity_m_s2;
   return velocity;
 }
 
 // End point (drift the second half with the end velocities), time and scar.
-void EndStep(const Scene& scene, const StepReport& report, const StepWorkspace& workspace,
-             RockState& state) {
-  Drift(state, 0.5 * scene.options.dt_s);
-  state.time_s += scene.options.dt_s;
-  UpdateScar(scene, report, workspace, state);
+void EndStep(const Scene& scene, double dt, const StepReport& report,
+             const StepWorkspace& workspace, RockState& state) {
+  Drift(state, 0.5 * dt);
+  state.time_s += dt;
+  UpdateScar(scene, dt, report, workspace, state);
 }
 
 // Centre-of-mass reading of the viscous term: implicit drag -m nu v_E with the mean nu of the
 // step's contacts, m (1 + nu dt) v_E = m v_free + sum P. Divides the free velocity by 1 + nu dt
 // and multiplies the effective translational mass by it.
-void CentreOfMassDrag(const Scene& scene, const StepWorkspace& workspace,
+void CentreOfMassDrag(const Scene& scene, double dt, const StepWorkspace& workspace,
                       Eigen::Vector3d& velocity, EffectiveInertia& inertia) {
   double nu = 0;
   for (const Contact& c : workspace.contacts) nu += scene.ground.params(c.ground).nu_1_s;
   nu /= static_cast<double>(workspace.contacts.size());
-  const double drag_factor = 1.0 + nu * scene.options.dt_s;
+  const double drag_factor = 1.0 + nu * dt;
   velocity /= drag_factor;
   inertia.mass_kg *= drag_factor;
 }
@@ -61,13 +61,13 @@ double Phi(double x) { return x > 0 ? -std::expm1(-x) / x : 1.0; }
 // constant over the step: v_E = exp(-c_t dt) v_B + phi(c_t dt) dt F / m, and likewise Omega with
 // c_r after the free rotation. Contact percussions enter as F dt, so the effective mass and inertia
 // grow by 1 / phi. Both factors are in (0, 1]: the layer only takes energy.
-void DragLayer(const Scene& scene, const Eigen::Vector3d& centre, const Eigen::Vector3d& v_begin,
-               Eigen::Vector3d& velocity, Eigen::Vector3d& omega, EffectiveInertia& inertia) {
+void DragLayer(const Scene& scene, double dt, const Eigen::Vector3d& centre,
+               const Eigen::Vector3d& v_begin, Eigen::Vector3d& velocity, Eigen::Vector3d& omega,
+               EffectiveInertia& inertia) {
   double height = 0;
   if (!scene.terrain.Height(centre.x(), centre.y(), &height)) return;
   const GroundParams& g = scene.ground.params(scene.terrain.GroundAt(centre.x(), centre.y()));
   if (!g.HasDragLayer() || centre.z() - height > g.drag_height_m) return;
-  const double dt = scene.options.dt_s;
   const double x_t = g.drag_translational_1_s * dt;
   const double x_r = g.drag_rotational_1_s * dt;
   // velocity holds v_B + dt F / m (gravity): replace by exp(-x) v_B + phi(x) dt F / m.
@@ -78,18 +78,19 @@ void DragLayer(const Scene& scene, const Eigen::Vector3d& centre, const Eigen::V
 }
 
 // Scar drag of the scarring soil (Lu et al. 2019, eqs. 9 and 12; docs/model.md, "The scarring
-// soil"): F = (C_f + C_s) rho / 2 A zeta'^2 against the velocity v of the point where it acts, zeta'
-// the rate of penetration -- of its depth below the surface measured vertically, (v . n) / n_z
-// for the terrain's tangent plane with normal n under the centre of mass: zero for motion parallel
-// to the surface -- and A the frontal area of the hull's part below that plane, projected normal
-// to v. Implicit in v with zeta'^2 / |v| from the step's beginning: F = -k (zeta_B'^2 / |v_B|) v_E.
+// soil"): F = (C_f + C_s) rho / 2 A zeta'^2 against the velocity v of the point where it acts,
+// zeta' the rate of penetration -- of its depth below the surface measured vertically, (v . n) /
+// n_z for the terrain's tangent plane with normal n under the centre of mass: zero for motion
+// parallel to the surface -- and A the frontal area of the hull's part below that plane, projected
+// normal to v. Implicit in v with zeta'^2 / |v| from the step's beginning: F = -k (zeta_B'^2 /
+// |v_B|) v_E.
 // - centre of mass (the paper): m (1 + dt k zeta'^2 / (m |v|)) v_E = m v_free + sum P, folded into
 //   the contact solve as CentreOfMassDrag folds nu;
 // - submerged centroid: the percussion P = -h v_c,E (h = dt k zeta_c'^2 / |v_c|, kg) at the part's
 //   centroid c, v_c,E = v_c,free + K P with K the point's inverse mass matrix, solved before the
 //   contacts.
 // Both only take energy: P . v_c,E <= 0. Reports the penetration (m) along the plane's normal.
-void SoilDrag(const Scene& scene, const RockShape& rock, const RockState& mid,
+void SoilDrag(const Scene& scene, double dt, const RockShape& rock, const RockState& mid,
               const Eigen::Matrix3d& rotation, const RockState& begin, Eigen::Vector3d& velocity,
               Eigen::Vector3d& omega, EffectiveInertia& inertia, StepWorkspace& workspace,
               StepReport& report) {
@@ -103,7 +104,6 @@ void SoilDrag(const Scene& scene, const RockShape& rock, const RockState& mid,
   if (part.empty()) return;
   report.soil_rear_m = mid.position_m + part.rear_m;
   report.soil_front_m = mid.position_m + part.front_m;
-  const double dt = scene.options.dt_s;
   const double k = scene.ground.params(workspace.soil.ground).DragFactor_kg_m3();
   if (scene.options.soil_drag == SoilDragPoint::kCentreOfMass) {
     const double speed = begin.velocity_m_s.norm();
@@ -122,13 +122,12 @@ void SoilDrag(const Scene& scene, const RockShape& rock, const RockState& mid,
   const double rate = point_begin.dot(under.normal) / under.normal.z();
   const double h = dt * k * part.FrontalArea(point_begin / speed) * rate * rate / speed;
   // K = I / m - [a]x R Theta^-1 R' [a]x, the velocity change of point c per unit percussion there.
-  const Eigen::Vector3d inv_inertia =
-      rock.inertia_kg_m2.cwiseInverse() / inertia.inertia_scale;
+  const Eigen::Vector3d inv_inertia = rock.inertia_kg_m2.cwiseInverse() / inertia.inertia_scale;
   Eigen::Matrix3d cross_a;
   cross_a << 0, -a.z(), a.y(), a.z(), 0, -a.x(), -a.y(), a.x(), 0;
   const Eigen::Matrix3d rotated = rotation * inv_inertia.asDiagonal() * rotation.transpose();
-  const Eigen::Matrix3d mobility = Eigen::Matrix3d::Identity() / inertia.mass_kg -
-                                   cross_a * rotated * cross_a;
+  const Eigen::Matrix3d mobility =
+      Eigen::Matrix3d::Identity() / inertia.mass_kg - cross_a * rotated * cross_a;
   const Eigen::Vector3d point_free = velocity + (rotation * omega).cross(a);
   const Eigen::Vector3d percussion =
       -h * (Eigen::Matrix3d::Identity() + h * mobility).partialPivLu().solve(point_free);
@@ -136,12 +135,13 @@ void SoilDrag(const Scene& scene, const RockShape& rock, const RockState& mid,
   omega += inv_inertia.cwiseProduct(rotation.transpose() * a.cross(percussion));
 }
 
-}  // namespace
-
-StepReport Step(const Scene& scene, const RockShape& rock, RockState& state,
-                StepWorkspace& workspace, StageTimes* times) {
+// One step of length dt (docs/model.md). With may_split, a step whose contact set holds a predicted
+// contact (open at the midpoint, closing before the step ends) stops right after contact detection,
+// with the state and the workspace's warm start untouched, and reports split: the caller redoes it
+// as sub-steps.
+StepReport StepOnce(const Scene& scene, const RockShape& rock, double dt, bool may_split,
+                    RockState& state, StepWorkspace& workspace, StageTimes* times) {
   const SolverOptions& opt = scene.options;
-  const double dt = opt.dt_s;
   const RockState begin = state;
   StepReport report;
   StageClock clock(times);
@@ -155,29 +155,36 @@ StepReport Step(const Scene& scene, const RockShape& rock, RockState& state,
   clock.Lap(&StageTimes::free_rotation_s);
 
   // 3. Free end velocities: gravity, and the drag layer where the centre of mass is inside one.
-  Eigen::Vector3d velocity = FreeVelocity(opt, begin.velocity_m_s);
+  Eigen::Vector3d velocity = FreeVelocity(opt, dt, begin.velocity_m_s);
   EffectiveInertia inertia{rock.mass_kg, 1.0};
   if (scene.ground.AnyDragLayer())
-    DragLayer(scene, state.position_m, begin.velocity_m_s, velocity, omega, inertia);
+    DragLayer(scene, dt, state.position_m, begin.velocity_m_s, velocity, omega, inertia);
 
   // 4. Contact set at the midpoint: closed contacts and the vertices that the free motion (no
   // contacts) would carry deeper than the penetration tolerance below the terrain by the next
-  // midpoint.
+  // midpoint (the prediction's horizon is the step's length).
   const double allowed_depth = opt.penetration_tolerance * rock.thickness_m;
   const Eigen::Matrix3d rotation = state.orientation.toRotationMatrix();
-  const DetectResult detected = DetectContacts(scene, rock, state, rotation, velocity, omega,
-                                               PredictionHorizon(opt), allowed_depth, workspace);
+  const DetectResult detected =
+      DetectContacts(scene, rock, state, rotation, velocity, omega, dt, allowed_depth, workspace);
   if (detected == DetectResult::kOutsideDomain) {
     state = begin;
     report.outside_domain = true;
     return report;
   }
+  if (may_split)
+    for (const Contact& c : workspace.contacts)
+      if (c.gap_m > 0) {
+        state = begin;
+        report.split = true;
+        return report;
+      }
   report.clear = detected == DetectResult::kClear;
   state.soil_ground = workspace.soil.ground;
   state.soil_depth_m = workspace.soil.depth_m;
   report.in_soil = workspace.soil.submerged;
   if (workspace.soil.submerged)
-    SoilDrag(scene, rock, state, rotation, begin, velocity, omega, inertia, workspace, report);
+    SoilDrag(scene, dt, rock, state, rotation, begin, velocity, omega, inertia, workspace, report);
   clock.Lap(&StageTimes::contacts_s);
 
   // 5. Velocity update: the viscous term (centre-of-mass reading: implicit drag m (1 + nu dt) v_E
@@ -186,9 +193,9 @@ StepReport Step(const Scene& scene, const RockShape& rock, RockState& state,
     workspace.ForgetPercussions();
   } else {
     if (opt.viscous == ViscousReading::kCentreOfMass)
-      CentreOfMassDrag(scene, workspace, velocity, inertia);
+      CentreOfMassDrag(scene, dt, workspace, velocity, inertia);
     const ContactSolveReport solve =
-        SolveContacts(scene, rock, rotation, inertia, begin.velocity_m_s,
+        SolveContacts(scene, rock, dt, rotation, inertia, begin.velocity_m_s,
                       begin.angular_velocity_rad_s, velocity, omega, workspace);
     for (const Contact& c : workspace.contacts)
       report.contacts += c.gap_m == 0 || c.percussion.x() > 0;
@@ -201,10 +208,50 @@ StepReport Step(const Scene& scene, const RockShape& rock, RockState& state,
   clock.Lap(&StageTimes::solve_s);
 
   // 6. End point: drift the second half with the end velocities; 7. scar evolution.
-  EndStep(scene, report, workspace, state);
+  EndStep(scene, dt, report, workspace, state);
   clock.Lap(&StageTimes::end_s);
-  if (times) ++times->steps;
   return report;
+}
+
+}  // namespace
+
+StepReport Step(const Scene& scene, const RockShape& rock, RockState& state,
+                StepWorkspace& workspace, StageTimes* times) {
+  const SolverOptions& opt = scene.options;
+  // Newton's law (restitution > 0) takes the begin velocities of the step it acts in: its steps
+  // are not split, so that the rebound is -eps times the approach of a whole step.
+  const int substeps = opt.normal_restitution > 0 ? 1 : opt.impact_substeps;
+  if (times) ++times->steps;
+  StepReport report = StepOnce(scene, rock, opt.dt_s, substeps > 1, state, workspace, times);
+  if (!report.split) return report;
+  // A predicted contact: the step again as sub-steps of dt / substeps, so that the contact's
+  // percussion acts near the instant the vertex arrives rather than up to a whole step early
+  // (docs/model.md, "Impact sub-steps"). One report for the whole step: the most contacts and the
+  // sum of sweeps of any sub-step; loaded, in soil and unconverged if any sub-step was; the
+  // deepest soil penetration and the last sub-step's scar extent.
+  const RockState begin = state;
+  const double dt = opt.dt_s / substeps;
+  StepReport merged;
+  for (int k = 0; k < substeps; ++k) {
+    const StepReport sub = StepOnce(scene, rock, dt, false, state, workspace, times);
+    if (sub.outside_domain) {
+      state = begin;
+      return sub;
+    }
+    merged.contacts = std::max(merged.contacts, sub.contacts);
+    merged.iterations += sub.iterations;
+    merged.converged = merged.converged && sub.converged;
+    merged.loaded = merged.loaded || sub.loaded;
+    merged.in_soil = merged.in_soil || sub.in_soil;
+    merged.soil_penetration_m = std::max(merged.soil_penetration_m, sub.soil_penetration_m);
+    if (sub.in_soil) {
+      merged.soil_rear_m = sub.soil_rear_m;
+      merged.soil_front_m = sub.soil_front_m;
+    }
+  }
+  merged.substeps = substeps;
+  state.time_s = begin.time_s + opt.dt_s;  // the sub-steps' sum, without its round-off
+  return merged;
 }
 
 StepReport FlightStep(const Scene& scene, const RockShape& rock, RockState& state,
@@ -217,12 +264,12 @@ StepReport FlightStep(const Scene& scene, const RockShape& rock, RockState& stat
   state.angular_velocity_rad_s =
       FreeRotation(rock.inertia_kg_m2, state.angular_velocity_rad_s, scene.options.dt_s);
   clock.Lap(&StageTimes::free_rotation_s);
-  state.velocity_m_s = FreeVelocity(scene.options, state.velocity_m_s);
+  state.velocity_m_s = FreeVelocity(scene.options, scene.options.dt_s, state.velocity_m_s);
   workspace.contacts.clear();
   workspace.ForgetPercussions();
   state.soil_ground = -1;
   state.soil_depth_m = 0;
-  EndStep(scene, report, workspace, state);
+  EndStep(scene, scene.options.dt_s, report, workspace, state);
   clock.Lap(&StageTimes::end_s);
   if (times) ++times->steps;
   return report;

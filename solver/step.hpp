@@ -17,6 +17,10 @@ struct StepReport {
   bool outside_domain = false;  // a vertex near the ground is outside the DEM or over nodata
   bool clear = false;           // no vertex needed a test (bounding sphere clear, or FlightStep)
   bool in_soil = false;         // part of the hull is in a soil layer at the midpoint (Lu 2019)
+  // The step was taken as this many sub-steps (SolverOptions::impact_substeps), 1: as one.
+  int substeps = 1;
+  // Internal to Step: the step stopped after contact detection to be redone as sub-steps.
+  bool split = false;
   double soil_penetration_m = 0;  // deepest vertex below the surface's tangent plane, soil only
   // Soil only: the rear and front (world, m) of the hull's part below the surface along the
   // horizontal velocity, at the midpoint: the scar's extent in this step.
@@ -49,7 +53,10 @@ class StageClock {
 };
 
 // Advances state by one step of scene.options.dt_s. When outside_domain is reported the state is
-// left at the step's beginning.
+// left at the step's beginning. A step whose contact detection finds a predicted contact (a vertex
+// open at the midpoint and closing before the step ends) is taken as
+// SolverOptions::impact_substeps sub-steps of dt / impact_substeps instead (docs/model.md,
+// "Impact sub-steps"); the report covers the whole step.
 // `rock` is the shape of this rock (a scene may carry many); the overload without it uses
 // scene.rock.
 StepReport Step(const Scene& scene, const RockShape& rock, RockState& state,

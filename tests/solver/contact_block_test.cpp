@@ -95,8 +95,8 @@ Solved SolveEdge(const EdgeCase& e, ContactSolveMethod method, double tolerance,
     c.directions << n, t1, n.cross(t1);
   }
   Solved s{e.velocity, e.omega, {}};
-  s.report = SolveContacts(scene, scene.rock, e.rotation, {scene.rock.mass_kg, 1.0}, e.velocity,
-                           e.omega, s.velocity, s.omega, ws);
+  s.report = SolveContacts(scene, scene.rock, scene.options.dt_s, e.rotation,
+                           {scene.rock.mass_kg, 1.0}, e.velocity, e.omega, s.velocity, s.omega, ws);
   return s;
 }
 

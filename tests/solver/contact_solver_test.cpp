@@ -58,8 +58,8 @@ struct Fixture {
   }
   // Solves with (v, w) as both the begin and the free end velocities (an impulsive impact).
   ContactSolveReport Solve(double mass_kg = 0) {
-    return SolveContacts(scene, rock, rotation, {mass_kg > 0 ? mass_kg : rock.mass_kg, 1.0}, v, w,
-                         v, w, ws);
+    return SolveContacts(scene, rock, scene.options.dt_s, rotation,
+                         {mass_kg > 0 ? mass_kg : rock.mass_kg, 1.0}, v, w, v, w, ws);
   }
 };
 
@@ -183,7 +183,9 @@ TEST(SolveContacts, CornerImpactConservesAngularMomentumAboutTheContactPoint) {
       return Eigen::Vector3d(f.rotation * (inertia * f.w) - rb.cross(kMass * f.v));
     };
     auto energy = [&] { return 0.5 * kMass * f.v.squaredNorm() + 0.5 * f.w.dot(inertia * f.w); };
-    auto point = [&] { return Eigen::Vector3d(frame.transpose() * (f.v + f.rotation * f.w.cross(b))); };
+    auto point = [&] {
+      return Eigen::Vector3d(frame.transpose() * (f.v + f.rotation * f.w.cross(b)));
+    };
     ASSERT_LT(point().x(), 0) << "the corner approaches";
     const Eigen::Vector3d l0 = momentum();
     const double e0 = energy();
