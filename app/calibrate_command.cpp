@@ -4,7 +4,7 @@
 // runs, divides the rocks among MPI ranks, prints the run's progress, keeps DIR/checkpoint.json
 // (every evaluation as it comes, so that an interrupted calibration resumes (--resume) to the
 // result an uninterrupted one gives) and writes the fitted ground table, calibration.json,
-// history.csv and the plots, all complete or none.
+// history.csv, the plots and report.html, all complete or none.
 
 #include <unistd.h>
 
@@ -35,6 +35,7 @@
 #include "io/calibration_file.hpp"
 #include "io/calibration_outputs.hpp"
 #include "io/calibration_plots.hpp"
+#include "io/calibration_report_html.hpp"
 #include "talus/version.hpp"
 
 namespace talus::app {
@@ -276,17 +277,22 @@ void WriteOutputs(const CalibrateArgs& args, const Loaded& loaded,
                         io::ShapeTableToml(file, objective, run));
     outputs.push_back("shape_table.toml");
   }
-  WriteFileAtomically(staging->path("convergence.svg"), io::ConvergenceSvg(run.fit));
+  io::CalibrationReportInput report;
+  report.convergence_svg = io::ConvergenceSvg(run.fit);
+  WriteFileAtomically(staging->path("convergence.svg"), report.convergence_svg);
   for (const std::string& kind : objective.kinds()) {
     if (kind == "deposit") continue;
     const std::string name = "observed_vs_simulated_" + kind + ".svg";
-    WriteFileAtomically(staging->path(name), io::ObservedSimulatedSvg(kind, run.before.observations,
-                                                                      run.after.observations));
+    report.observed_simulated.push_back(
+        io::ObservedSimulatedSvg(kind, run.before.observations, run.after.observations));
+    WriteFileAtomically(staging->path(name), report.observed_simulated.back());
     outputs.push_back(name);
   }
+  report.calibration_json = io::CalibrationJson(file, objective, run, kVersion);
+  WriteFileAtomically(staging->path("report.html"), io::CalibrationReportHtml(report));
+  outputs.push_back("report.html");
   outputs.push_back("calibration.json");
-  WriteFileAtomically(staging->path("calibration.json"),
-                      io::CalibrationJson(file, objective, run, kVersion));
+  WriteFileAtomically(staging->path("calibration.json"), report.calibration_json);
   ThrowIfInterrupted();
   staging->Commit(outputs);  // calibration.json last
   const bool budget = run.BudgetEndedAFit();

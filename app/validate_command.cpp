@@ -1,6 +1,7 @@
 // talus validate: how well does a parameter set explain what was observed? Runs an event's scene
 // (its runs, with an ensemble of orientations each), scores the simulated counterparts of every
-// observation and writes scores.json, observations.csv and the plots (docs/validation.md).
+// observation and writes scores.json, observations.csv, the plots and report.html
+// (docs/validation.md).
 
 #include <algorithm>
 #include <chrono>
@@ -24,6 +25,7 @@
 #include "io/event_file.hpp"
 #include "io/validate_event.hpp"
 #include "io/validation_outputs.hpp"
+#include "io/validation_report_html.hpp"
 #include "talus/version.hpp"
 
 namespace talus::app {
@@ -74,16 +76,26 @@ int RunValidate(const ValidateArgs& args) {
     io::WriteTextFile(out("observations.csv"), io::ObservationsCsv(report));
     io::WriteTextFile(out("observed_vs_simulated.svg"), io::ObservedVsSimulatedSvg(report));
     io::WriteTextFile(out("pit.svg"), io::PitSvg(report));
+    std::string deposits;
     if (!event.observations.deposits.empty()) {
-      io::WriteDepositsPng(out("deposits.png"), event, simulated);
+      deposits = io::DepositsPng(event, simulated);
+      WriteFileAtomically(out("deposits.png"), deposits);
       outputs.push_back("deposits.png");
     }
-    io::WriteTextFile(out("scores.json"), io::ScoresJson(event, report, run));
+    const std::string scores = io::ScoresJson(event, report, run);
+    WriteFileAtomically(out("report.html"), io::ValidationReportHtml({scores, &report, deposits}));
+    outputs.push_back("report.html");
+    io::WriteTextFile(out("scores.json"), scores);
     outputs.push_back("scores.json");  // last: scores.json is there only with its outputs
     ThrowIfInterrupted();
     staging->Commit(outputs);
     std::printf("%s", report.FullReport().c_str());
     std::printf("Wrote %zu files to %s\n", outputs.size(), args.out.c_str());
+    std::fflush(stdout);
+    // The scene's were printed before the run.
+    const std::vector<std::string> warnings = io::ValidationWarnings(event, run);
+    for (std::size_t k = event.scene.warnings.size(); k < warnings.size(); ++k)
+      std::fprintf(stderr, "talus validate: WARNING: %s\n", warnings[k].c_str());
   });
 }
 

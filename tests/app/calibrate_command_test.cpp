@@ -89,8 +89,15 @@ TEST(CalibrateCommand, WritesTheGroundTableJsonAndHistory) {
   EXPECT_NE(output.find("Calibration report"), std::string::npos) << output;
   for (const char* name :
        {"ground_table.toml", "ground_table.csv", "history.csv", "calibration.json",
-        "convergence.svg", "observed_vs_simulated_runout.svg"})
+        "convergence.svg", "observed_vs_simulated_runout.svg", "report.html"})
     EXPECT_TRUE(fs::exists(dir / "out" / name)) << name;
+  // report.html: the fitted table, the plots inline (convergence, the profile, observed vs
+  // simulated).
+  const std::string report = Slurp(dir / "out" / "report.html");
+  EXPECT_NE(report.find("<h2>Fitted parameters</h2>"), std::string::npos);
+  EXPECT_NE(report.find("<th>medium_soft.mu_min</th>"), std::string::npos) << report;
+  EXPECT_NE(report.find(">Profile of medium_soft.mu_min"), std::string::npos);
+  EXPECT_NE(report.find(">run-out: observed vs simulated median</text>"), std::string::npos);
   // The plots: one dot per feasible evaluation and the best-so-far line; one dot per run before
   // and one after.
   const std::string convergence = Slurp(dir / "out" / "convergence.svg");

@@ -27,46 +27,10 @@ using talus::app::testing::Slurp;
 
 using talus::app::testing::Write;
 
-// Three runs of two blocks on a short 35 degree slope, observed rest positions and run-outs, and
-// impacts (each run starts 2 m above the ground, so its first contact episode is an impact).
+// The small event of run_talus.hpp in a fresh directory.
 fs::path MakeEvent(const std::string& name, const std::string& event_extra = "") {
   fs::path dir = FreshDir(name);
-  Write(dir / "scene.toml", R"([terrain]
-plane = { slope_deg = 35, slope_length_m = 20, runout_m = 10, width_m = 12, cell_m = 1 }
-default_ground = "medium_soft"
-[blocks]
-file = "blocks.csv"
-shape = "box"
-[release]
-runs = "runs.csv"
-rocks = 6
-seed = 3
-[solver]
-max_time_s = 4
-)");
-  Write(dir / "blocks.csv",
-        "block_id,mass_kg,size_x_m,size_y_m,size_z_m\nA,60,0.4,0.4,0.3\n"
-        "B,80,0.5,0.4,0.3\n");
-  Write(dir / "runs.csv",
-        "trajectory_id,x_m,y_m,height_m,vx_mps,block_id\nr1,3,0,2,1,A\n"
-        "r2,3,2,2,2,B\nr3,4,-2,2,0,A\n");
-  Write(dir / "observed.csv",
-        "trajectory_id,x_m,y_m,observed_runout_m\nr1,20,0,17\n"
-        "r2,22,2,19\nr3,18,-2,14\n");
-  Write(dir / "impacts.csv",
-        "trajectory_id,incoming_speed_mps,outgoing_speed_mps\nr1,6,3\n"
-        "r2,6.5,3.5\n");
-  Write(dir / "event.toml", R"(scene = "scene.toml"
-[[observations]]
-kind = "runout"
-file = "observed.csv"
-[[observations]]
-kind = "deposits"
-file = "observed.csv"
-[[observations]]
-kind = "impacts"
-file = "impacts.csv"
-)" + event_extra);
+  talus::app::testing::WriteSmallEvent(dir, event_extra);
   return dir;
 }
 
@@ -81,11 +45,24 @@ TEST(ValidateCommand, WritesScoresThatDoNotDependOnTheThreadCount) {
               0)
         << output;
   }
-  for (const char* file :
-       {"scores.json", "observations.csv", "observed_vs_simulated.svg", "pit.svg", "deposits.png"})
+  for (const char* file : {"scores.json", "observations.csv", "observed_vs_simulated.svg",
+                           "pit.svg", "deposits.png", "report.html"})
     EXPECT_TRUE(fs::exists(dir / "out1" / file)) << file;
+  // report.html: the same for any thread count (no timings), with the scores and the warnings.
+  const std::string report = Slurp(dir / "out1" / "report.html");
+  EXPECT_EQ(report, Slurp(dir / "out2" / "report.html"));
+  EXPECT_NE(report.find("<th>run-out (m)</th><td>3</td><td>3</td><td>CRPS</td>"),
+            std::string::npos);
+  // 4 s is too short for some of the rocks: their run-outs are censored, and validate says so on
+  // the console, in scores.json and first in report.html.
+  EXPECT_NE(output.find("talus validate: WARNING: "), std::string::npos) << output;
+  EXPECT_NE(output.find("still moving at max_time_s = 4 s"), std::string::npos) << output;
+  EXPECT_NE(report.find("still moving at max_time_s = 4 s"), std::string::npos);
+  EXPECT_LT(report.find("<h2>Warnings</h2>"), report.find("Scores per kind"));
   EXPECT_EQ(Slurp(dir / "out1" / "observations.csv"), Slurp(dir / "out2" / "observations.csv"));
   const auto scores = nlohmann::json::parse(Slurp(dir / "out1" / "scores.json"));
+  ASSERT_EQ(scores["warnings"].size(), 1u) << scores["warnings"];
+  EXPECT_NE(scores["warnings"][0].get<std::string>().find("max_time"), std::string::npos);
   EXPECT_EQ(scores["runs"], 3);
   EXPECT_EQ(scores["rocks_per_run"], 6);
   EXPECT_EQ(scores["observations"], 3 + 3 + 2 * 2);  // runouts, deposits, 2 per impact
@@ -156,6 +133,8 @@ TEST(ValidateCommand, ChantSuraSingleImpactsAreScoredWithTheirScarDepths) {
             0)
       << output;
   EXPECT_EQ(output.find("Not scored: "), std::string::npos) << output;
+  // The runs stop at 0.6 s by design: a single impact is not censored by max_time, so no warning.
+  EXPECT_EQ(output.find("max_time"), std::string::npos) << output;
   const auto scores = nlohmann::json::parse(Slurp(dir / "out" / "scores.json"));
   EXPECT_EQ(scores["runs"], 6);
   EXPECT_EQ(scores["observations"], 12);
