@@ -14,6 +14,7 @@
 #include <optional>
 
 #include "app/commands.hpp"
+#include "app/console.hpp"
 #include "app/ensemble_args.hpp"
 #include "app/interrupt.hpp"
 #include "app/run_verb.hpp"
@@ -44,10 +45,10 @@ int RunValidate(const ValidateArgs& args) {
     event = io::LoadEvent(args.event);
     args.ensemble.ApplyTo(event.scene.release);
   } catch (const InputError& e) {
-    std::cerr << "talus validate: " << e.what() << "\n";
+    Fail("validate", e.what());
     return kExitBadInput;
   } catch (const std::exception& e) {
-    std::cerr << "talus validate: cannot load " << args.event << ": " << e.what() << "\n";
+    Fail("validate", "cannot load " + args.event + ": " + e.what());
     return kExitRunFailed;
   }
   Verb verb{.name = "validate", .out = args.out};
@@ -55,7 +56,7 @@ int RunValidate(const ValidateArgs& args) {
   return RunVerb(verb, [&](std::optional<StagingDirectory>& staging) {
     PrintSceneWarnings(event.scene, "validate");
     const ensemble::ReleaseSpec& release = event.scene.release;
-    std::printf("Event %s: %zu observations (%zu scalar, %zu deposits) of %ld runs x %ld rocks\n",
+    Say("Event %s: %zu observations (%zu scalar, %zu deposits) of %ld runs x %ld rocks\n",
                 args.event.c_str(), event.observations.size(), event.observations.scalars.size(),
                 event.observations.deposits.size(), release.release_count(),
                 release.rocks_per_release);
@@ -65,8 +66,15 @@ int RunValidate(const ValidateArgs& args) {
     const auto out = [&](const std::string& name) { return staging->path(name); };
     io::EventValidationOptions options;
     options.threads = args.ensemble.threads;
-    options.progress = [](long, long) { ThrowIfInterrupted(); };
-    options.say = [](const std::string& line) { std::printf("%s\n", line.c_str()); };
+    ProgressBar progress;  // the runs' rocks, on a terminal
+    options.progress = [&progress](long done, long total) {
+      ThrowIfInterrupted();
+      progress(done, total);
+    };
+    options.say = [&progress](const std::string& line) {
+      progress.Break();
+      Say("%s\n", line.c_str());
+    };
     const io::EventValidation validation = io::ValidateEvent(event, options);
     const fieldobs::ValidationReport& report = validation.report;
     const fieldobs::EnsembleSamples& simulated = *validation.simulated;
@@ -89,13 +97,12 @@ int RunValidate(const ValidateArgs& args) {
     outputs.push_back("scores.json");  // last: scores.json is there only with its outputs
     ThrowIfInterrupted();
     staging->Commit(outputs);
-    std::printf("%s", report.FullReport().c_str());
-    std::printf("Wrote %zu files to %s\n", outputs.size(), args.out.c_str());
-    std::fflush(stdout);
+    Say("%s", report.FullReport().c_str());
+    Say("Wrote %zu files to %s\n", outputs.size(), args.out.c_str());
     // The scene's were printed before the run.
     const std::vector<std::string> warnings = io::ValidationWarnings(event, run);
     for (std::size_t k = event.scene.warnings.size(); k < warnings.size(); ++k)
-      std::fprintf(stderr, "talus validate: WARNING: %s\n", warnings[k].c_str());
+      Warn("validate", warnings[k]);
   });
 }
 

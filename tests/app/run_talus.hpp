@@ -157,12 +157,14 @@ inline std::string WithoutTimings(const std::string& summary) {
   return j.dump(2);
 }
 
-// Every file of `dir` by name, summary.json without timings: what must be byte-identical between
-// runs that differ only in how the rocks were split (threads, ranks, parts).
+// Every file of `dir` by name, summary.json without timings and without run.log (the command line
+// and wall time): what must be byte-identical between runs that differ only in how the rocks were
+// split (threads, ranks, parts).
 inline std::map<std::string, std::string> OutputsWithoutTimings(const std::filesystem::path& dir) {
   std::map<std::string, std::string> files;
   for (const auto& entry : std::filesystem::directory_iterator(dir)) {
     const std::string name = entry.path().filename().string();
+    if (name == "run.log") continue;
     files[name] =
         name == "summary.json" ? WithoutTimings(Slurp(entry.path())) : Slurp(entry.path());
   }

@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -91,6 +92,36 @@ TEST(ValidateCommand, AFileSizeLimitIsOneErrorAndLeavesNothing) {
   EXPECT_TRUE(!fs::exists(out) || fs::is_empty(out)) << output;
 }
 
+// Under a terminal (script(1) gives the program one) validate shows the rocks' progress; --quiet
+// silences it and the information, not the warning; run.log keeps what was said either way.
+TEST(ValidateCommand, ProgressOnATerminalAndQuietKeepsOnlyWarningsButRunLogKeepsAll) {
+  if (std::system("command -v script >/dev/null 2>&1") != 0) GTEST_SKIP() << "no script(1)";
+  const fs::path dir = MakeEvent("quiet");
+  const auto on_a_terminal = [&](const std::string& out, const std::string& more) {
+    std::string output;
+    EXPECT_EQ(RunCommand("script -qec '" + std::string(TALUS_BINARY) + " validate " +
+                             (dir / "event.toml").string() + " --out " + (dir / out).string() +
+                             more + "' /dev/null",
+                         &output),
+              0)
+        << output;
+    return output;
+  };
+  const std::string talkative = on_a_terminal("out", "");
+  EXPECT_NE(talkative.find("\r[###"), std::string::npos) << talkative;  // the progress bar
+  EXPECT_NE(talkative.find(" rocks "), std::string::npos);
+  EXPECT_NE(talkative.find("Event "), std::string::npos);
+  const std::string quiet = on_a_terminal("quiet", " --quiet");
+  EXPECT_EQ(quiet.find("[#"), std::string::npos) << quiet;
+  EXPECT_EQ(quiet.find("Event "), std::string::npos) << quiet;
+  EXPECT_EQ(quiet.rfind("talus validate: WARNING: ", 0), 0u) << quiet;
+  const std::string log = Slurp(dir / "quiet" / "run.log");
+  for (const char* line : {"talus ", "command: ", " validate ", " --quiet\n", "\nEvent ",
+                           "\nWrote 6 files to ", "talus validate: WARNING: ", "finished: exit 0"})
+    EXPECT_NE(log.find(line), std::string::npos) << line << "\n" << log;
+  EXPECT_EQ(log.find("[#"), std::string::npos);  // progress is not kept
+}
+
 TEST(ValidateCommand, BadEventsFailBeforeAnyRockNamingFileLineAndKey) {
   std::string output;
   const fs::path dir = MakeEvent("validate_bad",
@@ -105,6 +136,7 @@ TEST(ValidateCommand, BadEventsFailBeforeAnyRockNamingFileLineAndKey) {
             std::string::npos)
       << output;
   EXPECT_FALSE(fs::exists(dir / "out" / "scores.json"));
+  EXPECT_FALSE(fs::exists(dir / "out" / "run.log"));  // only a run that succeeded leaves one
   // An observation of a run the scene does not have.
   const fs::path other = MakeEvent("validate_run");
   Write(other / "observed.csv", "trajectory_id,x_m,y_m,observed_runout_m\nr1,20,0,17\nr9,1,1,1\n");
