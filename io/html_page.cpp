@@ -69,7 +69,10 @@ std::string Begin(const std::string& title, const std::string& note_html) {
   return html;
 }
 
-std::string End() { return "</body>\n</html>\n"; }
+std::string End() {
+  return "<p class=\"note\">Names, units, heights and percentiles are defined once in the "
+         "glossary (docs/glossary.md).</p>\n</body>\n</html>\n";
+}
 
 std::string Number(double v, const char* format) {
   return std::isfinite(v) ? FormatDouble(v, format) : "&ndash;";

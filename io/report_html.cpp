@@ -170,7 +170,7 @@ std::string DistributionsSection(const RockColumns& r) {
   std::string html = "<h2>Distributions over the rocks</h2>\n<div class=\"plots\">\n";
   html += HistogramSvg("Runout", "runout (m)", r.runout_m);
   html += HistogramSvg("Largest kinetic energy", std::string("energy (") + kEnergyUnit + ")", energy_kj);
-  html += HistogramSvg("Largest jump height", "jump height of the centre of mass (m)",
+  html += HistogramSvg("Largest jump height", "jump height: centre of mass, along the normal (m)",
                        r.max_jump_height_m);
   html +=
       "</div>\n<table>\n<tr><th></th><th>mean</th><th>median</th><th>90 %</th><th>95 %</th>"
@@ -184,7 +184,7 @@ std::string DistributionsSection(const RockColumns& r) {
   stats_row("runout (m)", r.runout_m);
   stats_row("largest speed (m/s)", r.max_speed_m_s);
   stats_row((std::string("largest kinetic energy (") + kEnergyUnit + ")").c_str(), energy_kj);
-  stats_row("largest jump height (m)", r.max_jump_height_m);
+  stats_row("largest jump height, along the normal (m)", r.max_jump_height_m);
   stats_row("travel angle (&deg;)", r.travel_angle_deg);
   html +=
       "</table>\n<p class=\"note\">Percentiles are nearest-rank, over the rocks (one value per "
@@ -234,8 +234,9 @@ std::string EvaluationLinesSection(const Json& summary) {
   }
   html +=
       "<p class=\"note\">Over the rocks that crossed each line, at the first crossing of the "
-      "centre of mass (evaluation_lines.csv); heights are vertical, above the terrain; the "
-      "bounce height is that of the rock's lowest point. Percentiles are nearest-rank.</p>\n";
+      "centre of mass (evaluation_lines.csv); heights are vertical, above the terrain (unlike "
+      "the jump height, along the normal); the bounce height is that of the rock's lowest point. "
+      "Percentiles are nearest-rank.</p>\n";
   return html;
 }
 

@@ -49,6 +49,8 @@ TEST(HtmlPage, APageIsOneDocumentWithoutScripts) {
   EXPECT_NE(page.find("<p class=\"note\">note</p>"), std::string::npos);
   EXPECT_EQ(page.find("<script"), std::string::npos);
   EXPECT_EQ(page.substr(page.size() - 8), "</html>\n");
+  // Every report points at the one place its quantities are defined.
+  EXPECT_NE(page.find("docs/glossary.md"), std::string::npos);
 }
 
 }  // namespace
