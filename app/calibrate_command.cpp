@@ -59,7 +59,7 @@ constexpr double kCheckpointEvery_s = 10;
 // "fold1") or a phase it announced ("Measuring the roughness and the profiles at the optimum").
 struct CalibrationPhase {
   std::string phase = "starting";
-  std::string last;  // the optimisation's last evaluation, as its status line said it
+  std::string last;   // the optimisation's last evaluation, as its status line said it
   int evaluated = 0;  // ensembles run in this phase
   void Begin(const std::string& name) {
     phase = name;
@@ -207,10 +207,8 @@ void PrintHeader(const CalibrateArgs& args, const Loaded& loaded, const Processe
       loaded.file.options.optimizer.algorithm.c_str(),
       processes.mpi() ? (", " + std::to_string(processes.size) + " MPI ranks").c_str() : "",
       objective.options().tolerance_m_s, loaded.file.tolerance_source.c_str());
-  if (!holdout.empty())
-    Say("Holding out %zu runs: %s\n", holdout.size(), Join(holdout).c_str());
-  if (!loaded.checkpoint.stages.empty())
-    Say("Resuming from %s\n", loaded.checkpoint_path.c_str());
+  if (!holdout.empty()) Say("Holding out %zu runs: %s\n", holdout.size(), Join(holdout).c_str());
+  if (!loaded.checkpoint.stages.empty()) Say("Resuming from %s\n", loaded.checkpoint_path.c_str());
 }
 
 // The checkpoint holds every evaluation so far; rewriting it after each one would cost time and

@@ -29,8 +29,8 @@ int RunDemo(std::uint64_t seed) {
       "%llu\n",
       scene.rock.mass_kg, static_cast<unsigned long long>(seed));
   Say("  %s\n", result.BriefReport().c_str());
-  Say("  end position (%.2f, %.2f, %.2f) m, runout %.1f m from release\n", end.x(), end.y(), end.z(),
-      result.runout_m);
+  Say("  end position (%.2f, %.2f, %.2f) m, runout %.1f m from release\n", end.x(), end.y(),
+      end.z(), result.runout_m);
   return result.end == EndReason::kFailed ? kExitRunFailed : kExitOk;
 }
 

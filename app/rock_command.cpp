@@ -84,8 +84,7 @@ int BuildRock(const char* verb, RockArgs& args, pointclouds::RockReport* report)
   if (*args.mass) args.spec.mass_kg = args.mass_kg;
   try {
     pointclouds::MakeRock(args.spec, report);
-    for (const std::string& warning : report->warnings)
-      Warn(std::string("rock ") + verb, warning);
+    for (const std::string& warning : report->warnings) Warn(std::string("rock ") + verb, warning);
     return kExitOk;
   } catch (const std::bad_alloc&) {
     std::cerr << "talus rock " << verb << ": out of memory\n";
@@ -124,10 +123,9 @@ int RunHull(RockArgs& args) {
     std::cerr << "talus rock hull: " << e.what() << "\n";
     return kExitRunFailed;
   }
-  Say("Wrote the hull of %s (%zu vertices, %zu triangles, %s frame) to %s\n",
-      report.source.c_str(), static_cast<std::size_t>(report.hull_vertices),
-      static_cast<std::size_t>(report.hull_faces), args.principal ? "principal" : "input",
-      args.out.c_str());
+  Say("Wrote the hull of %s (%zu vertices, %zu triangles, %s frame) to %s\n", report.source.c_str(),
+      static_cast<std::size_t>(report.hull_vertices), static_cast<std::size_t>(report.hull_faces),
+      args.principal ? "principal" : "input", args.out.c_str());
   return kExitOk;
 }
 

@@ -8,8 +8,8 @@
 #include <filesystem>
 #include <fstream>
 
-#include "app/interrupt.hpp"
 #include "app/console.hpp"
+#include "app/interrupt.hpp"
 #include "common/error.hpp"
 #include "io/barriers_csv.hpp"
 #include "io/evaluation_lines_csv.hpp"

@@ -143,8 +143,9 @@ int RunSimulate(const SimulateArgs& args) {
         DescribeRocks(scene).c_str());
     PrintSceneWarnings(scene);
     Say("Needs about %s of memory (%s available) and %s of disk (%s free)\n",
-        io::FormatBytes(needs.memory_bytes()).c_str(), io::FormatBytes(capacity.memory_bytes).c_str(),
-        io::FormatBytes(needs.disk_bytes()).c_str(), io::FormatBytes(capacity.disk_bytes).c_str());
+        io::FormatBytes(needs.memory_bytes()).c_str(),
+        io::FormatBytes(capacity.memory_bytes).c_str(), io::FormatBytes(needs.disk_bytes()).c_str(),
+        io::FormatBytes(capacity.disk_bytes).c_str());
     // Every output is written into a staging directory and moved into --out only when all are
     // complete: a failed or interrupted run leaves --out as it was.
     staging.emplace(args.out);

@@ -57,9 +57,8 @@ int RunValidate(const ValidateArgs& args) {
     PrintSceneWarnings(event.scene, "validate");
     const ensemble::ReleaseSpec& release = event.scene.release;
     Say("Event %s: %zu observations (%zu scalar, %zu deposits) of %ld runs x %ld rocks\n",
-                args.event.c_str(), event.observations.size(), event.observations.scalars.size(),
-                event.observations.deposits.size(), release.release_count(),
-                release.rocks_per_release);
+        args.event.c_str(), event.observations.size(), event.observations.scalars.size(),
+        event.observations.deposits.size(), release.release_count(), release.rocks_per_release);
     PrintNotScored(event.not_scored);
     // Every output is staged and moved into --out only when all are complete.
     staging.emplace(args.out);

@@ -70,10 +70,10 @@ std::string ObservedSimulatedSvg(const std::string& kind,
   Pad(lo, hi);
   const Axis x{lo, hi, kLeft, kWidth - kRight}, y{lo, hi, kHeight - kBottom, kTop};
   const bool dimensionless = unit.empty() || unit == "1";
-  std::string out = Frame(html::HumanLabel(kind) + ": observed vs simulated median",
-                          dimensionless ? "observed" : "observed (" + unit + ")",
-                          dimensionless ? "simulated median" : "simulated median (" + unit + ")",
-                          x, y);
+  std::string out =
+      Frame(html::HumanLabel(kind) + ": observed vs simulated median",
+            dimensionless ? "observed" : "observed (" + unit + ")",
+            dimensionless ? "simulated median" : "simulated median (" + unit + ")", x, y);
   Add(out, "<line x1=\"", F(x(lo)), "\" y1=\"", F(y(lo)), "\" x2=\"", F(x(hi)), "\" y2=\"",
       F(y(hi)), "\" stroke=\"black\" stroke-dasharray=\"4 3\"/>\n");
   const auto dots = [&](const std::vector<fieldobs::ObservationScore>& set, const char* colour) {
@@ -110,9 +110,9 @@ std::string ProfileSvg(const std::string& name, const std::string& unit,
   Pad(x_lo, x_hi);
   Pad(y_lo, y_hi);
   const Axis x{x_lo, x_hi, kLeft, kWidth - kRight}, y{y_lo, y_hi, kHeight - kBottom, kTop};
-  std::string out = Frame("Profile of " + name + (identified ? "" : " (flat: unidentified)"),
-                          unit.empty() || unit == "1" ? name : name + " (" + unit + ")",
-                          "objective", x, y);
+  std::string out =
+      Frame("Profile of " + name + (identified ? "" : " (flat: unidentified)"),
+            unit.empty() || unit == "1" ? name : name + " (" + unit + ")", "objective", x, y);
   std::string line;
   for (std::size_t k = 0; k < values.size() && k < objective.size(); ++k) {
     if (!std::isfinite(values[k]) || !std::isfinite(objective[k])) continue;
@@ -122,9 +122,9 @@ std::string ProfileSvg(const std::string& name, const std::string& unit,
   }
   Add(out, "<polyline points=\"", line, "\" fill=\"none\" stroke=\"#1f5fbf\"/>\n");
   if (std::isfinite(fitted))
-    Add(out, "<line x1=\"", F(x(fitted)), "\" x2=\"", F(x(fitted)), "\" y1=\"", F(kTop),
-        "\" y2=\"", F(kHeight - kBottom), "\" stroke=\"#d7191c\" stroke-dasharray=\"4 3\"/>\n",
-        "<text x=\"", F(x(fitted) + 4), "\" y=\"", F(kTop + 14), "\" fill=\"#d7191c\">fitted</text>\n");
+    Add(out, "<line x1=\"", F(x(fitted)), "\" x2=\"", F(x(fitted)), "\" y1=\"", F(kTop), "\" y2=\"",
+        F(kHeight - kBottom), "\" stroke=\"#d7191c\" stroke-dasharray=\"4 3\"/>\n", "<text x=\"",
+        F(x(fitted) + 4), "\" y=\"", F(kTop + 14), "\" fill=\"#d7191c\">fitted</text>\n");
   return out + "</svg>\n";
 }
 

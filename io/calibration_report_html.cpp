@@ -75,15 +75,15 @@ std::string ParametersSection(const Json& c) {
 std::string ObjectiveSection(const Json& c) {
   std::vector<std::vector<std::string>> rows;
   for (const Json& k : c["kinds"])
-    rows.push_back({Escape(html::HumanLabel(k.value("kind", std::string()))) +
-                        UnitSuffix(k.value("unit", "")),
-                    Number(NumberOf(k["weight"])), Number(NumberOf(k["score_before"])),
-                    Number(NumberOf(k["score_after"])), Cell(k["scored_after"])});
+    rows.push_back(
+        {Escape(html::HumanLabel(k.value("kind", std::string()))) + UnitSuffix(k.value("unit", "")),
+         Number(NumberOf(k["weight"])), Number(NumberOf(k["score_before"])),
+         Number(NumberOf(k["score_after"])), Cell(k["scored_after"])});
   std::string out = "<h2>Objective</h2>\n";
   Add(out, "<p>Objective ", Number(NumberOf(c["objective"]["before"])), " before, ",
       Number(NumberOf(c["objective"]["after"])), " after the fit.</p>\n");
-  out += html::Table({"kind (unit)", "weight", "mean CRPS before", "mean CRPS after", "scored"},
-                     rows);
+  out +=
+      html::Table({"kind (unit)", "weight", "mean CRPS before", "mean CRPS after", "scored"}, rows);
   return out;
 }
 
@@ -110,10 +110,10 @@ std::string HeldOutKinds(const Json& kinds) {
   std::vector<std::vector<std::string>> rows;
   for (const Json& k : kinds) {
     const double fitted = NumberOf(k["crps_fitted"]), reference = NumberOf(k["crps_reference"]);
-    rows.push_back({Escape(html::HumanLabel(k.value("kind", std::string()))) +
-                        UnitSuffix(k.value("unit", "")),
-                    Cell(k["scored"]), Number(fitted), Number(reference),
-                    Number(reference > 0 ? 1 - fitted / reference : NAN, "%.3f")});
+    rows.push_back(
+        {Escape(html::HumanLabel(k.value("kind", std::string()))) + UnitSuffix(k.value("unit", "")),
+         Cell(k["scored"]), Number(fitted), Number(reference),
+         Number(reference > 0 ? 1 - fitted / reference : NAN, "%.3f")});
   }
   return html::Table(
       {"kind (unit)", "scored", "mean CRPS, fitted", "mean CRPS, reference", "skill"}, rows);
@@ -132,8 +132,8 @@ std::string HeldOutSection(const Json& c) {
       rows.push_back({std::to_string(++fold), Cell(f["runs"]), Number(NumberOf(f["objective"])),
                       Cell(f["evaluations"]), Cell(f["termination"]), Cell(f["fitted"])});
     out += "<h2>Cross-validation</h2>\n" +
-           html::Table({"fold", "held-out runs", "objective of its fit", "evaluations",
-                        "ended by", "fitted values"},
+           html::Table({"fold", "held-out runs", "objective of its fit", "evaluations", "ended by",
+                        "fitted values"},
                        rows) +
            "<p>Over every fold's held-out runs:</p>\n" +
            HeldOutKinds(c["cross_validation"]["kinds"]);

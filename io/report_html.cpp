@@ -111,11 +111,11 @@ std::string WhatRanSection(const Json& summary) {
   html += html::Warnings(get("warnings"));
 
   html += "<h2>What ran</h2>\n";
-  html +=
-      html::KeyValueTable(summary, {"ends", "raised_at_release", "stayed_at_release", "steps",
-                              "unconverged_steps", "threads", "wall_time_s", "trajectories_per_s",
-                              "outputs", "blocks", "talus_version", "inputs_hash_fnv1a64",
-                              "evaluation_lines", "barriers", "warnings"});
+  html += html::KeyValueTable(
+      summary,
+      {"ends", "raised_at_release", "stayed_at_release", "steps", "unconverged_steps", "threads",
+       "wall_time_s", "trajectories_per_s", "outputs", "blocks", "talus_version",
+       "inputs_hash_fnv1a64", "evaluation_lines", "barriers", "warnings"});
   if (summary.contains("rock") && summary["rock"].is_object()) {
     html += "<h3>Rock</h3>\n";
     html += html::KeyValueTable(summary["rock"]);
@@ -158,7 +158,8 @@ std::string MapsSection(const RunReportInput& input) {
   std::string html = "<h2>Maps</h2>\n";
   for (const ensemble::RasterLayer* layer : maps) {
     const std::string png = QuickLookPng(*input.dem, layer, input.paths, {}, input.lines);
-    html += html::PngFigure(png, layer->name, LegendOf(*layer).title + " (" + layer->name + ".tif)");
+    html +=
+        html::PngFigure(png, layer->name, LegendOf(*layer).title + " (" + layer->name + ".tif)");
   }
   return html;
 }
@@ -169,7 +170,8 @@ std::string DistributionsSection(const RockColumns& r) {
   for (double e : r.max_kinetic_energy_j) energy_kj.push_back(e / kJoulesPerEnergyUnit);
   std::string html = "<h2>Distributions over the rocks</h2>\n<div class=\"plots\">\n";
   html += HistogramSvg("Runout", "runout (m)", r.runout_m);
-  html += HistogramSvg("Largest kinetic energy", std::string("energy (") + kEnergyUnit + ")", energy_kj);
+  html += HistogramSvg("Largest kinetic energy", std::string("energy (") + kEnergyUnit + ")",
+                       energy_kj);
   html += HistogramSvg("Largest jump height", "jump height: centre of mass, along the normal (m)",
                        r.max_jump_height_m);
   html +=
@@ -250,14 +252,16 @@ std::string BarriersSection(const Json& summary) {
   };
   std::string html =
       "<h2>Barriers</h2>\n<table>\n<tr><th>barrier</th><th>type</th><th>height (m)</th>"
-      "<th>capacity (" + std::string(kEnergyUnit) + ")</th><th>rocks</th><th>reached</th><th>stopped</th><th>overtopped</th>"
+      "<th>capacity (" +
+      std::string(kEnergyUnit) +
+      ")</th><th>rocks</th><th>reached</th><th>stopped</th><th>overtopped</th>"
       "<th>broke through</th><th>passing probability</th></tr>\n";
   for (const Json& b : barriers)
     Add(html, "<tr><th>", Cell(b["name"]), "</th><td>", Cell(b["type"]), "</td><td>",
-        Cell(b["height_m"]), "</td><td>", Number(number(b["capacity_J"]) / kJoulesPerEnergyUnit, "%.0f"),
-        "</td><td>", Cell(b["rocks"]), "</td><td>", Cell(b["reached"]), "</td><td>",
-        Cell(b["stopped"]), "</td><td>", Cell(b["overtopped"]), "</td><td>",
-        Cell(b["broke_through"]), "</td><td>",
+        Cell(b["height_m"]), "</td><td>",
+        Number(number(b["capacity_J"]) / kJoulesPerEnergyUnit, "%.0f"), "</td><td>",
+        Cell(b["rocks"]), "</td><td>", Cell(b["reached"]), "</td><td>", Cell(b["stopped"]),
+        "</td><td>", Cell(b["overtopped"]), "</td><td>", Cell(b["broke_through"]), "</td><td>",
         Number(100 * number(b["passing_probability"]), "%.1f"), " %</td></tr>\n");
   html += "</table>\n";
   const std::pair<const char*, const char*> quantities[] = {

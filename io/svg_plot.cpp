@@ -80,8 +80,8 @@ std::string Frame(const std::string& title, const std::string& x_label, const st
     Add(out, "<text x=\"", F(x(x_ticks[k])), "\" y=\"", F(kHeight - kBottom + 14),
         "\" text-anchor=\"middle\">", x_labels[k], "</text>\n");
   for (std::size_t k = 0; k < y_ticks.size(); ++k)
-    Add(out, "<text x=\"", F(kLeft - 4), "\" y=\"", F(y(y_ticks[k]) + 4),
-        "\" text-anchor=\"end\">", y_labels[k], "</text>\n");
+    Add(out, "<text x=\"", F(kLeft - 4), "\" y=\"", F(y(y_ticks[k]) + 4), "\" text-anchor=\"end\">",
+        y_labels[k], "</text>\n");
   Add(out, "<text x=\"", F(kLeft + (kWidth - kLeft - kRight) / 2), "\" y=\"", F(kHeight - 10),
       "\" text-anchor=\"middle\">", Escape(x_label), "</text>\n");
   Add(out, "<text transform=\"translate(14,", F(kTop + (kHeight - kTop - kBottom) / 2),
@@ -91,10 +91,11 @@ std::string Frame(const std::string& title, const std::string& x_label, const st
 
 std::string Stack(const std::vector<std::string>& plots, int columns, const std::string& empty) {
   const int n = static_cast<int>(plots.size());
-  const int across = std::max(1, std::min(columns, n)), down = std::max(1, (n + across - 1) / across);
+  const int across = std::max(1, std::min(columns, n)),
+            down = std::max(1, (n + across - 1) / across);
   std::string out;
-  Add(out, "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"", F(across * kWidth),
-      "\" height=\"", F(n > 0 ? down * kHeight : 40), "\" font-family=\"sans-serif\">\n");
+  Add(out, "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"", F(across * kWidth), "\" height=\"",
+      F(n > 0 ? down * kHeight : 40), "\" font-family=\"sans-serif\">\n");
   if (n == 0)
     Add(out, "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n<text x=\"20\" y=\"24\">",
         Escape(empty), "</text>\n");
@@ -108,11 +109,20 @@ std::string Escape(const std::string& text) {
   std::string out;
   for (char c : text) {
     switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += c;
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      default:
+        out += c;
     }
   }
   return out;

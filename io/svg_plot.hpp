@@ -40,8 +40,8 @@ std::vector<double> NiceTicks(double lo, double hi, int target = 5);
 std::vector<std::string> TickLabels(const std::vector<double>& ticks);
 
 // The opening of a kWidth × kHeight plot: white background, title, plot box, round ticks on each
-// axis (NiceTicks) and the axis labels (the title and labels are escaped here: pass them as plain text). The
-// caller adds the marks and closes it with "</svg>\n".
+// axis (NiceTicks) and the axis labels (the title and labels are escaped here: pass them as plain
+// text). The caller adds the marks and closes it with "</svg>\n".
 std::string Frame(const std::string& title, const std::string& x_label, const std::string& y_label,
                   const Axis& x, const Axis& y);
 

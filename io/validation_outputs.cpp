@@ -47,7 +47,8 @@ std::vector<std::string> ValidationWarnings(const EventFile& event, const Valida
   // first contact: an event of impacts alone (short runs by design) is not warned about them.
   bool endings_matter = !event.observations.deposits.empty();
   for (const auto& o : event.observations.scalars)
-    endings_matter = endings_matter || std::string(fieldobs::ToString(o.quantity)).rfind("impact_", 0) != 0;
+    endings_matter =
+        endings_matter || std::string(fieldobs::ToString(o.quantity)).rfind("impact_", 0) != 0;
   if (endings_matter)
     for (const std::string& w : ensemble::RunWarnings(run.ensemble, event.scene.scene.options))
       warnings.push_back(w);
@@ -162,15 +163,15 @@ std::string ObservedVsSimulatedPanel(const fieldobs::KindSummary& kind,
   const svg::Axis x{lo, hi, svg::kLeft, svg::kWidth - svg::kRight};
   const svg::Axis y{lo, hi, svg::kHeight - svg::kBottom, svg::kTop};
   const std::string label = html::HumanLabel(kind.kind);
-  std::string out = svg::Frame(label + ": simulated against observed",
-                               WithUnit("observed", kind.unit), WithUnit("simulated", kind.unit),
-                               x, y);
+  std::string out =
+      svg::Frame(label + ": simulated against observed", WithUnit("observed", kind.unit),
+                 WithUnit("simulated", kind.unit), x, y);
   Add(out, "<line x1=\"", F(x(lo)), "\" y1=\"", F(y(lo)), "\" x2=\"", F(x(hi)), "\" y2=\"",
       F(y(hi)), "\" stroke=\"black\" stroke-dasharray=\"4 3\"/>\n");
   for (const auto* s : obs) {
     Add(out, "<line x1=\"", F(x(s->observed)), "\" x2=\"", F(x(s->observed)), "\" y1=\"",
-        F(y(s->q05)), "\" y2=\"", F(y(s->q95)),
-        "\" stroke=\"#bbbbbb\" stroke-width=\"4\"><title>", svg::Escape(s->run), "</title></line>\n");
+        F(y(s->q05)), "\" y2=\"", F(y(s->q95)), "\" stroke=\"#bbbbbb\" stroke-width=\"4\"><title>",
+        svg::Escape(s->run), "</title></line>\n");
     Add(out, "<circle cx=\"", F(x(s->observed)), "\" cy=\"", F(y(s->median)),
         "\" r=\"3\" fill=\"#1f5fbf\"><title>", svg::Escape(s->run), "</title></circle>\n");
   }
@@ -195,9 +196,9 @@ std::string PitPanel(const fieldobs::KindSummary& kind) {
   const svg::Axis x{0, 1, svg::kLeft, svg::kWidth - svg::kRight};
   const svg::Axis y{0, std::max(double(most), 1.5 * expected), svg::kHeight - svg::kBottom,
                     svg::kTop};
-  std::string out = svg::Frame("PIT: " + html::HumanLabel(kind.kind) + " (" +
-                                   std::to_string(total) + " observations)",
-                               "probability integral transform", "observations", x, y);
+  std::string out = svg::Frame(
+      "PIT: " + html::HumanLabel(kind.kind) + " (" + std::to_string(total) + " observations)",
+      "probability integral transform", "observations", x, y);
   const double width = 1.0 / double(pit.counts.size());
   for (std::size_t b = 0; b < pit.counts.size(); ++b)
     Add(out, "<rect x=\"", F(x(double(b) * width) + 1), "\" y=\"", F(y(pit.counts[b])),
@@ -205,8 +206,8 @@ std::string PitPanel(const fieldobs::KindSummary& kind) {
         "\" fill=\"#6a8fd0\"/>\n");
   Add(out, "<line x1=\"", F(x(0)), "\" x2=\"", F(x(1)), "\" y1=\"", F(y(expected)), "\" y2=\"",
       F(y(expected)), "\" stroke=\"black\" stroke-dasharray=\"4 3\"/>\n");
-  Add(out, "<text x=\"", F(svg::kLeft + 6), "\" y=\"", F(svg::kTop + 14), "\">chi-square p = ",
-      Fmt(pit.p_value, "%.2g"), "; dashed: flat (calibrated)</text>\n");
+  Add(out, "<text x=\"", F(svg::kLeft + 6), "\" y=\"", F(svg::kTop + 14),
+      "\">chi-square p = ", Fmt(pit.p_value, "%.2g"), "; dashed: flat (calibrated)</text>\n");
   return out + "</svg>\n";
 }
 

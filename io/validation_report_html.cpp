@@ -31,9 +31,8 @@ std::string Percent(double fraction) {
 std::string Head(const Json& scores) {
   const std::string event = scores.value("event", std::string());
   return html::Begin("Talus validation: " + event,
-                     "Talus " + Cell(scores["talus_version"]) + ", scene " +
-                         Cell(scores["scene"]) + ", inputs hash (FNV-1a 64) " +
-                         Cell(scores["inputs_hash_fnv1a64"]) +
+                     "Talus " + Cell(scores["talus_version"]) + ", scene " + Cell(scores["scene"]) +
+                         ", inputs hash (FNV-1a 64) " + Cell(scores["inputs_hash_fnv1a64"]) +
                          ". Everything here is also in scores.json and observations.csv next to "
                          "this file (docs/validation.md).") +
          html::WarningsOrNone(scores["warnings"]);
@@ -44,27 +43,22 @@ std::string ScoresSection(const Json& scores) {
   std::vector<std::vector<std::string>> rows;
   for (const auto& [kind, k] : scores["kinds"].items()) {
     const std::string unit = k.value("unit", std::string());
-    rows.push_back({Escape(html::HumanLabel(kind)) + UnitSuffix(unit),
-                    Cell(k["observations"]),
-                    Cell(k["scored"]),
-                    Escape(html::HumanLabel(k.value("score", std::string()))),
-                    Number(NumberOf(k["mean_score"])),
-                    Number(NumberOf(k["mean_reference_score"])),
+    rows.push_back({Escape(html::HumanLabel(kind)) + UnitSuffix(unit), Cell(k["observations"]),
+                    Cell(k["scored"]), Escape(html::HumanLabel(k.value("score", std::string()))),
+                    Number(NumberOf(k["mean_score"])), Number(NumberOf(k["mean_reference_score"])),
                     Number(NumberOf(k["mean_climatology_score"])),
                     Number(NumberOf(k["skill_vs_reference"]), "%.3f"),
                     Number(NumberOf(k["skill_vs_climatology"]), "%.3f"),
-                    Percent(NumberOf(k["inside_90_fraction"])),
-                    Number(NumberOf(k["mean_bias"])),
+                    Percent(NumberOf(k["inside_90_fraction"])), Number(NumberOf(k["mean_bias"])),
                     Number(NumberOf(k["mean_sd"])),
-                    k.contains("pit") ? Number(NumberOf(k["pit"]["p_value"]), "%.2g")
-                                      : "&ndash;"});
+                    k.contains("pit") ? Number(NumberOf(k["pit"]["p_value"]), "%.2g") : "&ndash;"});
   }
   std::string out = "<h2>Scores per kind</h2>\n";
-  out += html::Table({"kind (unit)", "observations", "scored", "score", "mean score",
-                      "reference's mean score", "climatology's mean score", "skill vs reference",
-                      "skill vs climatology", "inside the 5-95 % band", "mean bias", "mean spread (sd)",
-                      "PIT p-value"},
-                     rows);
+  out += html::Table(
+      {"kind (unit)", "observations", "scored", "score", "mean score", "reference's mean score",
+       "climatology's mean score", "skill vs reference", "skill vs climatology",
+       "inside the 5-95 % band", "mean bias", "mean spread (sd)", "PIT p-value"},
+      rows);
   const Json& overall = scores["overall"];
   Add(out, "<p>Over the kinds: skill against the reference ",
       Number(NumberOf(overall["skill_vs_reference"]), "%.3f"), ", against climatology ",
@@ -84,8 +78,7 @@ std::string PlotsSection(const ValidationReportInput& input) {
   std::string out;
   const std::vector<std::string> scatter = ObservedVsSimulatedPanels(*input.report);
   const std::vector<std::string> pit = PitPanels(*input.report);
-  if (!scatter.empty())
-    out += "<h2>Observed and simulated</h2>\n" + html::Plots(scatter);
+  if (!scatter.empty()) out += "<h2>Observed and simulated</h2>\n" + html::Plots(scatter);
   if (!pit.empty()) out += "<h2>PIT histograms</h2>\n" + html::Plots(pit);
   if (!input.deposits_png.empty())
     out += "<h2>Deposits</h2>\n" +
@@ -106,17 +99,15 @@ std::string PerRunSection(const fieldobs::ValidationReport& report) {
   for (const std::string& run : runs)
     for (const fieldobs::ObservationScore* s : by_run[run]) {
       const bool deposit = s->kind == "deposit";
-      rows.push_back(
-          {Escape(run.empty() ? "(all)" : run),
-           Escape(html::HumanLabel(s->kind)) + UnitSuffix(s->unit),
-           deposit ? Number(s->observed_xy_m.x(), "%.1f") + ", " +
-                         Number(s->observed_xy_m.y(), "%.1f")
-                   : Number(s->observed),
-           (deposit ? "distance " : "") + Number(s->median),
-           (deposit ? "distance " : "") + Number(s->q05) + " &ndash; " + Number(s->q95),
-           Number(s->score),
-           Number(s->pit, "%.2f"),
-           s->scored ? std::to_string(s->members) : Escape(s->not_scored)});
+      rows.push_back({Escape(run.empty() ? "(all)" : run),
+                      Escape(html::HumanLabel(s->kind)) + UnitSuffix(s->unit),
+                      deposit ? Number(s->observed_xy_m.x(), "%.1f") + ", " +
+                                    Number(s->observed_xy_m.y(), "%.1f")
+                              : Number(s->observed),
+                      (deposit ? "distance " : "") + Number(s->median),
+                      (deposit ? "distance " : "") + Number(s->q05) + " &ndash; " + Number(s->q95),
+                      Number(s->score), Number(s->pit, "%.2f"),
+                      s->scored ? std::to_string(s->members) : Escape(s->not_scored)});
     }
   if (rows.empty()) return "";
   return "<h2>Per run</h2>\n" +
@@ -134,9 +125,9 @@ std::string RunSection(const Json& scores) {
   for (const auto& [ending, n] : scores["ends"].items())
     Add(out, "<tr><th>", Escape(html::HumanLabel(ending)), "</th><td>", Cell(n), "</td></tr>\n");
   out += "</table>\n<h2>What ran</h2>\n";
-  out += html::KeyValueTable(scores, {"talus_version", "inputs_hash_fnv1a64", "event", "scene",
-                                      "warnings", "kinds", "blocks", "ends", "overall",
-                                      "wall_time_s", "threads", "start_ground_mismatch"});
+  out += html::KeyValueTable(
+      scores, {"talus_version", "inputs_hash_fnv1a64", "event", "scene", "warnings", "kinds",
+               "blocks", "ends", "overall", "wall_time_s", "threads", "start_ground_mismatch"});
   return out;
 }
 
@@ -144,8 +135,8 @@ std::string RunSection(const Json& scores) {
 
 std::string ValidationReportHtml(const ValidationReportInput& input) {
   const Json scores = Json::parse(input.scores_json);
-  return Head(scores) + ScoresSection(scores) + PlotsSection(input) +
-         PerRunSection(*input.report) + RunSection(scores) + html::End();
+  return Head(scores) + ScoresSection(scores) + PlotsSection(input) + PerRunSection(*input.report) +
+         RunSection(scores) + html::End();
 }
 
 }  // namespace talus::io

@@ -312,8 +312,9 @@ max_time_s = 3
         "r4,4,3,1,slab\nr5,3,-4,1,round\n");
   Write(dir / "observed.csv",
         "trajectory_id,observed_runout_m\nr1,17\nr2,19\nr3,14\nr4,16\nr5,18\n");
-  Write(dir / "event.toml", "scene = \"scene.toml\"\n[[observations]]\nkind = \"runout\"\n"
-                            "file = \"observed.csv\"\n");
+  Write(dir / "event.toml",
+        "scene = \"scene.toml\"\n[[observations]]\nkind = \"runout\"\n"
+        "file = \"observed.csv\"\n");
   Write(dir / "cal.toml", R"(event = "event.toml"
 [[parameters]]
 category = "medium_soft"
@@ -361,11 +362,11 @@ enabled = false
 size_m = [0.5, 0.4, 0.2]
 shape = "box"
 )" + shapes.substr(shapes.find("[blocks.round]")));
-  ASSERT_EQ(RunCommand(std::string(TALUS_BINARY) + " simulate " +
-                           (dir / "fitted_scene.toml").string() + " --out " +
-                           (dir / "sim").string() + " --rocks 2",
-                       &output),
-            0)
+  ASSERT_EQ(
+      RunCommand(std::string(TALUS_BINARY) + " simulate " + (dir / "fitted_scene.toml").string() +
+                     " --out " + (dir / "sim").string() + " --rocks 2",
+                 &output),
+      0)
       << output;
   const auto summary = nlohmann::json::parse(Slurp(dir / "sim" / "summary.json"));
   EXPECT_EQ(summary["blocks"][0]["id"], "round");  // blocks in key order

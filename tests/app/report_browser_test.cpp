@@ -56,7 +56,8 @@ window.addEventListener('load', () => {
   Write(copy, checked);
   const std::string browser = std::string(TALUS_CHROMIUM) +
                               " --headless --no-sandbox --disable-gpu --virtual-time-budget=10000"
-                              " --dump-dom file://" + copy.string() + " 2>/dev/null";
+                              " --dump-dom file://" +
+                              copy.string() + " 2>/dev/null";
   std::string dom;
   if (RunCommand(browser, &dom) != 0) return "";
   return dom;
@@ -115,8 +116,9 @@ TEST(ReportInABrowser, ValidationReportLoadsWithItsMapAndPlots) {
 TEST(ReportInABrowser, CalibrationReportLoadsWithItsPlots) {
   const fs::path dir = FreshDir("talus_report_tests", "browser_calibrate");
   talus::app::testing::WriteSmallEvent(dir);
-  Write(dir / "event.toml", "scene = \"scene.toml\"\n[[observations]]\nkind = \"runout\"\n"
-                            "file = \"observed.csv\"\n");
+  Write(dir / "event.toml",
+        "scene = \"scene.toml\"\n[[observations]]\nkind = \"runout\"\n"
+        "file = \"observed.csv\"\n");
   Write(dir / "cal.toml", R"(event = "event.toml"
 [[parameters]]
 category = "medium_soft"

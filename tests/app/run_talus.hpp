@@ -103,8 +103,8 @@ shape = { box = [0.4, 0.4, 0.3] }
 [release]
 points = [[3, 0]]
 lines = [[[4, -2], [4, 2]]]
-rocks = )" + std::to_string(rocks) +
-         "\n" + more + "[solver]\nmax_time_s = 4\n[output]\n" + output;
+rocks = )" +
+         std::to_string(rocks) + "\n" + more + "[solver]\nmax_time_s = 4\n[output]\n" + output;
 }
 
 // The small event of the end-to-end tests, in `dir`: event.toml over scene.toml, three runs of two

@@ -688,7 +688,8 @@ TEST(SimulateCommand, RocksAtMaxTimeAreWarnedInTheConsoleTheSummaryAndTheReport)
   const std::string run_log = Slurp(out / "run.log");
   for (const std::string& line :
        {std::string("command: "), std::string(" --quiet\n"), std::string("\nScene "),
-        std::string("\nWrote "), "talus simulate: WARNING: " + expected, std::string("finished: exit 0")})
+        std::string("\nWrote "), "talus simulate: WARNING: " + expected,
+        std::string("finished: exit 0")})
     EXPECT_NE(run_log.find(line), std::string::npos) << line << "\n" << run_log;
   const auto summary = nlohmann::json::parse(Slurp(out / "summary.json"));
   ASSERT_EQ(summary["warnings"].size(), 1u) << summary["warnings"];

@@ -73,7 +73,8 @@ TEST(SvgPlot, TicksAreRoundNumbersInsideTheAxis) {
 
 TEST(SvgPlot, TickLabelsHaveTheDecimalsOfTheirStep) {
   EXPECT_EQ(TickLabels({0, 100, 200}), (std::vector<std::string>{"0", "100", "200"}));
-  EXPECT_EQ(TickLabels({-1, -0.5, 0, 0.5}), (std::vector<std::string>{"-1.0", "-0.5", "0.0", "0.5"}));
+  EXPECT_EQ(TickLabels({-1, -0.5, 0, 0.5}),
+            (std::vector<std::string>{"-1.0", "-0.5", "0.0", "0.5"}));
   EXPECT_EQ(TickLabels({0, 2.5, 5}), (std::vector<std::string>{"0.0", "2.5", "5.0"}));
   EXPECT_EQ(TickLabels({3.15, 3.2, 3.25}), (std::vector<std::string>{"3.15", "3.20", "3.25"}));
   EXPECT_EQ(TickLabels({0, 2e6, 4e6}), (std::vector<std::string>{"0", "2e+06", "4e+06"}));

@@ -5,8 +5,6 @@
 
 #include "io/validation_outputs.hpp"
 
-#include "io/svg_plot.hpp"
-
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -18,6 +16,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "io/svg_plot.hpp"
 #include "test_files.hpp"
 
 namespace talus::io {
@@ -141,8 +140,9 @@ TEST(ValidationPlots, PanelsForScoredScalarKindsAndPitBarsInProportion) {
   EXPECT_EQ(svg.find("deposit"), std::string::npos) << "no panel for deposits";
   EXPECT_EQ(ObservedVsSimulatedPanels(Report()).size(), 1u);
   const std::regex dot("<circle ");
-  EXPECT_EQ(std::distance(std::sregex_iterator(svg.begin(), svg.end(), dot), std::sregex_iterator()),
-            2);  // the scored scalars' medians
+  EXPECT_EQ(
+      std::distance(std::sregex_iterator(svg.begin(), svg.end(), dot), std::sregex_iterator()),
+      2);  // the scored scalars' medians
   EXPECT_NE(svg.find("<title>a, b</title>"), std::string::npos);
   // The one plot writer's frame: round ticks (the old panels had 95.5, 103.8, ...).
   EXPECT_NE(svg.find(">100</text>"), std::string::npos) << svg;

@@ -59,7 +59,8 @@ std::string Scores(const std::string& warnings) {
 
 TEST(ValidationReportHtml, ShowsWarningsScoresWithUnitsPlotsAndOneRowPerObservation) {
   const fieldobs::ValidationReport report = Report();
-  const std::string html = ValidationReportHtml({Scores(R"(["2 of 12 rocks left the DEM"])"), &report, ""});
+  const std::string html =
+      ValidationReportHtml({Scores(R"(["2 of 12 rocks left the DEM"])"), &report, ""});
   EXPECT_EQ(html.rfind("<!DOCTYPE html>", 0), 0u);
   EXPECT_NE(html.find("<h1>Talus validation: ev.toml</h1>"), std::string::npos);
   // Warnings first, before the scores.
