@@ -111,8 +111,9 @@ TEST(ReportInABrowser, ValidationReportLoadsWithItsMapAndPlots) {
   EXPECT_NE(dom.find("Scores per kind"), std::string::npos);
 }
 
-// report.html of `talus calibrate` on the small event's run-outs (one parameter, 4 evaluations):
-// the convergence, the profile and the observed-vs-simulated plot are laid out.
+// report.html of `talus calibrate` on the small event's run-outs (one parameter, 4 evaluations,
+// no covariance: seconds): the convergence, the profile and the observed-vs-simulated plot are
+// laid out.
 TEST(ReportInABrowser, CalibrationReportLoadsWithItsPlots) {
   const fs::path dir = FreshDir("talus_report_tests", "browser_calibrate");
   talus::app::testing::WriteSmallEvent(dir);
@@ -132,6 +133,8 @@ max_evaluations = 4
 steps = [1e-2]
 seeds = 1
 profile_points = 3
+[uncertainty]
+enabled = false
 )");
   std::string output;
   ASSERT_EQ(RunCommand(std::string(TALUS_BINARY) + " calibrate " + (dir / "cal.toml").string() +
