@@ -4,7 +4,7 @@
 // runs, divides the rocks among MPI ranks, prints the run's progress, keeps DIR/checkpoint.json
 // (every evaluation as it comes, so that an interrupted calibration resumes (--resume) to the
 // result an uninterrupted one gives) and writes the fitted ground table, calibration.json,
-// history.csv and the plots, all complete or none.
+// history.csv, the plots and report.html, all complete or none.
 
 #include <unistd.h>
 
@@ -24,6 +24,7 @@
 #include <sstream>
 
 #include "app/commands.hpp"
+#include "app/console.hpp"
 #include "app/interrupt.hpp"
 #include "app/mpi_session.hpp"
 #include "app/run_verb.hpp"
@@ -35,6 +36,7 @@
 #include "io/calibration_file.hpp"
 #include "io/calibration_outputs.hpp"
 #include "io/calibration_plots.hpp"
+#include "io/calibration_report_html.hpp"
 #include "talus/version.hpp"
 
 namespace talus::app {
@@ -52,6 +54,30 @@ struct CalibrateArgs {
 const char* kCheckpoint = "checkpoint.json";
 // Seconds between two writes of the checkpoint during an optimisation.
 constexpr double kCheckpointEvery_s = 10;
+
+// The phase a calibration is in, for its status line on a terminal: an optimisation's stage ("fit",
+// "fold1") or a phase it announced ("Measuring the roughness and the profiles at the optimum").
+struct CalibrationPhase {
+  std::string phase = "starting";
+  std::string last;   // the optimisation's last evaluation, as its status line said it
+  int evaluated = 0;  // ensembles run in this phase
+  void Begin(const std::string& name) {
+    phase = name;
+    last.clear();
+    evaluated = 0;
+  }
+  // The rocks of the ensemble running now (the objective's progress).
+  void Rocks(long done, long total) {
+    if (total <= 0 || !ShowsProgress()) return;
+    Status((last.empty() ? "  " + phase + ": evaluation " + std::to_string(evaluated + 1) : last) +
+           "  [rocks " + std::to_string(done) + "/" + std::to_string(total) + "]");
+    if (done == total) ++evaluated;
+  }
+};
+CalibrationPhase& CalibrationStatus() {
+  static CalibrationPhase phase;
+  return phase;
+}
 
 std::string Join(const std::vector<std::string>& items) {
   std::string out;
@@ -75,7 +101,7 @@ struct Processes {
   bool mpi() const { return static_cast<bool>(agree); }
   int Step(int code, const std::string& message) const {
     if (agree) return agree(code, message);
-    if (code != 0) std::cerr << "talus calibrate: " << message << "\n";
+    if (code != 0) Fail("calibrate", message);
     return code;
   }
 };
@@ -113,7 +139,10 @@ int Load(const CalibrateArgs& args, const Processes& processes, Loaded* loaded,
     file = io::LoadCalibration(args.file);
     calibration::ObjectiveOptions objective = file.objective;
     objective.threads = args.threads;
-    objective.progress = [](long, long) { ThrowIfInterrupted(); };
+    objective.progress = [root = processes.root()](long done, long total) {
+      ThrowIfInterrupted();
+      if (root) CalibrationStatus().Rocks(done, total);
+    };
     objective.run_ensemble = processes.runner;
     const io::EventFile& event = file.event;
     if (processes.root()) PrintSceneWarnings(event.scene, "calibrate");
@@ -171,19 +200,15 @@ void PrintHeader(const CalibrateArgs& args, const Loaded& loaded, const Processe
   const calibration::Objective& objective = loaded.problem->objective();
   const ensemble::ReleaseSpec& release = objective.release();
   const std::vector<std::string>& holdout = loaded.problem->holdout();
-  std::printf(
-      "Calibration %s: %d parameters, %zu observations of %ld runs x %ld rocks, %s%s\n"
+  Say("Calibration %s: %d parameters, %zu observations of %ld runs x %ld rocks, %s%s\n"
       "Contact solve: tolerance %g m/s (%s)\n",
       args.file.c_str(), objective.dimension(), loaded.problem->fitted_runs().observations.size(),
       release.release_count(), release.rocks_per_release,
       loaded.file.options.optimizer.algorithm.c_str(),
       processes.mpi() ? (", " + std::to_string(processes.size) + " MPI ranks").c_str() : "",
       objective.options().tolerance_m_s, loaded.file.tolerance_source.c_str());
-  if (!holdout.empty())
-    std::printf("Holding out %zu runs: %s\n", holdout.size(), Join(holdout).c_str());
-  if (!loaded.checkpoint.stages.empty())
-    std::printf("Resuming from %s\n", loaded.checkpoint_path.c_str());
-  std::fflush(stdout);
+  if (!holdout.empty()) Say("Holding out %zu runs: %s\n", holdout.size(), Join(holdout).c_str());
+  if (!loaded.checkpoint.stages.empty()) Say("Resuming from %s\n", loaded.checkpoint_path.c_str());
 }
 
 // The checkpoint holds every evaluation so far; rewriting it after each one would cost time and
@@ -217,7 +242,7 @@ class CheckpointKeeper {
     try {
       Save();
     } catch (const std::exception& e) {
-      std::cerr << "talus calibrate: the checkpoint could not be written: " << e.what() << "\n";
+      Fail("calibrate", std::string("the checkpoint could not be written: ") + e.what());
     }
   }
 
@@ -232,26 +257,38 @@ calibration::CalibrationOptions RunOptions(const Loaded& loaded, const Processes
                                            CheckpointKeeper& keeper) {
   calibration::CalibrationOptions options = loaded.file.options;
   options.replay = loaded.checkpoint.stages;
-  const bool terminal = ::isatty(STDOUT_FILENO) != 0;
-  options.on_optimization_begins = [&keeper](const std::string& stage) { keeper.Begin(stage); };
+  // On a terminal, one status line: the optimisation's last evaluation, or the phase and how far
+  // its current evaluation's rocks are (CalibrationStatus); elsewhere a line per evaluation.
+  const bool terminal = ShowsProgress() && processes.root();
+  options.on_optimization_begins = [&keeper](const std::string& stage) {
+    keeper.Begin(stage);
+    CalibrationStatus().Begin(stage);
+  };
   options.on_evaluation = [&keeper, &processes, terminal](const std::string& stage,
                                                           const calibration::Evaluation& e,
                                                           int index) {
     keeper.Keep(stage, e, index);
     // Under MPI the ranks stop together, inside an evaluation (the runner agrees on it).
     if (!processes.mpi()) ThrowIfInterrupted();
-    std::printf("%s  %s evaluation %4d  objective %-12.6g %s%s", terminal ? "\r" : "",
-                stage.c_str(), index, e.value, e.feasible ? "" : "(infeasible)",
-                terminal ? "   " : "\n");
-    std::fflush(stdout);
+    char line[160];
+    std::snprintf(line, sizeof line, "  %s evaluation %4d  objective %-12.6g %s", stage.c_str(),
+                  index, e.value, e.feasible ? "" : "(infeasible)");
+    CalibrationStatus().last = line;
+    if (terminal)
+      Status(line);
+    else
+      Say("%s\n", line);
   };
-  options.on_optimization_ends = [&keeper, terminal](const std::string&) {
+  options.on_optimization_ends = [&keeper](const std::string&) {
     keeper.Save();
-    if (terminal) std::printf("\n");
+    CalibrationStatus().last.clear();
+    EndStatus();
   };
   options.on_progress = [](const std::string& text) {
-    std::printf("%s", text.c_str());
-    std::fflush(stdout);
+    Say("%s", text.c_str());
+    // "Measuring the roughness and the profiles at the optimum...": the phase now running.
+    if (const auto dots = text.find("..."); dots != std::string::npos)
+      CalibrationStatus().Begin(text.substr(0, dots));
   };
   return options;
 }
@@ -276,28 +313,30 @@ void WriteOutputs(const CalibrateArgs& args, const Loaded& loaded,
                         io::ShapeTableToml(file, objective, run));
     outputs.push_back("shape_table.toml");
   }
-  WriteFileAtomically(staging->path("convergence.svg"), io::ConvergenceSvg(run.fit));
+  io::CalibrationReportInput report;
+  report.convergence_svg = io::ConvergenceSvg(run.fit);
+  WriteFileAtomically(staging->path("convergence.svg"), report.convergence_svg);
   for (const std::string& kind : objective.kinds()) {
     if (kind == "deposit") continue;
     const std::string name = "observed_vs_simulated_" + kind + ".svg";
-    WriteFileAtomically(staging->path(name), io::ObservedSimulatedSvg(kind, run.before.observations,
-                                                                      run.after.observations));
+    report.observed_simulated.push_back(
+        io::ObservedSimulatedSvg(kind, run.before.observations, run.after.observations));
+    WriteFileAtomically(staging->path(name), report.observed_simulated.back());
     outputs.push_back(name);
   }
+  report.calibration_json = io::CalibrationJson(file, objective, run, kVersion);
+  WriteFileAtomically(staging->path("report.html"), io::CalibrationReportHtml(report));
+  outputs.push_back("report.html");
   outputs.push_back("calibration.json");
-  WriteFileAtomically(staging->path("calibration.json"),
-                      io::CalibrationJson(file, objective, run, kVersion));
+  WriteFileAtomically(staging->path("calibration.json"), report.calibration_json);
   ThrowIfInterrupted();
   staging->Commit(outputs);  // calibration.json last
   const bool budget = run.BudgetEndedAFit();
   if (!budget) std::filesystem::remove(loaded.checkpoint_path);
-  std::printf("Wrote %zu files to %s in %.1f s%s\n", outputs.size(), args.out.c_str(),
-              run.wall_time_s,
-              budget ? " (a budget ended a fit: checkpoint.json kept for --resume)" : "");
-  std::fflush(stdout);
+  Say("Wrote %zu files to %s in %.1f s%s\n", outputs.size(), args.out.c_str(), run.wall_time_s,
+      budget ? " (a budget ended a fit: checkpoint.json kept for --resume)" : "");
   for (const std::string& warning : calibration::CalibrationWarnings(run, objective))
-    std::fprintf(stderr, "talus calibrate: WARNING: %s\n", warning.c_str());
-  std::fflush(stderr);
+    Warn("calibrate", warning);
 }
 
 int RunCalibrate(const CalibrateArgs& args, const Processes& processes) {
@@ -314,7 +353,10 @@ int RunCalibrate(const CalibrateArgs& args, const Processes& processes) {
   }
   if (const int failed = processes.Step(code, message)) return failed;
   const InterruptScope interrupts;
-  if (root) RemoveStaleTemporaries(args.out);
+  if (root) {
+    RemoveStaleTemporaries(args.out);
+    SetRunLogDirectory(args.out);
+  }
   PrintHeader(args, loaded, processes);
 
   CheckpointKeeper keeper(loaded, root);
@@ -322,7 +364,7 @@ int RunCalibrate(const CalibrateArgs& args, const Processes& processes) {
   VerbHooks hooks;
   hooks.on_failure = [&](bool interrupted) {
     keeper.SaveBeforeLeaving();
-    if (interrupted && root) std::printf("\n");
+    if (interrupted && root) EndStatus();
   };
   hooks.interrupted_message = [&](const Interrupted& e) {
     return std::string(e.what()) + "; no output written, " + args.out +
@@ -408,9 +450,9 @@ int RunCalibrateOnProcesses(const CalibrateArgs& args) {
   if (LaunchedRanks() <= 1) return RunCalibrate(args, Processes{});
 #if !TALUS_HAVE_MPI
   if (LaunchedRank() == 0)
-    std::cerr << "talus calibrate: started as " << LaunchedRanks()
-              << " MPI processes, but this talus was built without MPI (configure with "
-                 "-DTALUS_WITH_MPI=ON, or run one process)\n";
+    Fail("calibrate", "started as " + std::to_string(LaunchedRanks()) +
+                          " MPI processes, but this talus was built without MPI (configure with "
+                          "-DTALUS_WITH_MPI=ON, or run one process)");
   return kExitBadInput;
 #else
   const MpiSession mpi;
@@ -424,14 +466,14 @@ int RunCalibrateOnProcesses(const CalibrateArgs& args) {
   processes.broadcast = [&mpi](const std::string& text) { return BroadcastText(mpi, text); };
   // Rank 0 tells the story; the others would tell it again.
   if (mpi.rank() != 0 && !std::freopen("/dev/null", "w", stdout))
-    std::cerr << "talus calibrate: rank " << mpi.rank() << " cannot silence its output\n";
+    Fail("calibrate", "rank " + std::to_string(mpi.rank()) + " cannot silence its output");
   try {
     return RunCalibrate(args, processes);
   } catch (const Interrupted& e) {
     // A signal while this rank waited for the others outside a run (mpirun ends every rank when
     // one dies): unwinding to here removed this rank's temporary files.
-    std::cerr << "talus calibrate: rank " << mpi.rank() << ": " << e.what()
-              << " while waiting for the other ranks\n";
+    Fail("calibrate", "rank " + std::to_string(mpi.rank()) + ": " + e.what() +
+                          " while waiting for the other ranks");
     return ExitCodeForSignal(e.signal());
   }
 #endif

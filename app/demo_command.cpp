@@ -7,6 +7,7 @@
 #include <memory>
 
 #include "app/commands.hpp"
+#include "app/console.hpp"
 #include "scenes/scenes.hpp"
 #include "solver/simulate.hpp"
 
@@ -24,13 +25,12 @@ int RunDemo(std::uint64_t seed) {
   SimulationWorkspace workspace;
   const RockResult result = SimulateRock(scene, start, workspace);
   const auto& end = result.final_state.position_m;
-  std::printf(
-      "Demo: EOTA221 block (%.0f kg) released 1 m above a 40 deg ramp (medium_hard ground), seed "
+  Say("Demo: EOTA221 block (%.0f kg) released 1 m above a 40 deg ramp (medium_hard ground), seed "
       "%llu\n",
       scene.rock.mass_kg, static_cast<unsigned long long>(seed));
-  std::printf("  %s\n", result.BriefReport().c_str());
-  std::printf("  end position (%.2f, %.2f, %.2f) m, runout %.1f m from release\n", end.x(), end.y(),
-              end.z(), result.runout_m);
+  Say("  %s\n", result.BriefReport().c_str());
+  Say("  end position (%.2f, %.2f, %.2f) m, runout %.1f m from release\n", end.x(), end.y(),
+      end.z(), result.runout_m);
   return result.end == EndReason::kFailed ? kExitRunFailed : kExitOk;
 }
 

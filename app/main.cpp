@@ -5,9 +5,11 @@
 #include <csignal>
 #include <cstdio>
 #include <exception>
+#include <functional>
 #include <vector>
 
 #include "app/commands.hpp"
+#include "app/console.hpp"
 #include "talus/version.hpp"
 
 namespace {
@@ -27,16 +29,31 @@ int Run(int argc, char** argv) {
       talus::app::AddCalibrateCommand(app), talus::app::AddMergeCommand(app),
   };
 
+  // --quiet on every verb: no information and no progress, warnings and errors still (console.hpp).
+  bool quiet = false;
+  const std::function<void(CLI::App*)> add_quiet = [&](CLI::App* verb) {
+    verb->add_flag("-q,--quiet", quiet,
+                   "Print no information or progress, only warnings and errors (run.log in --out "
+                   "still has everything)");
+    for (CLI::App* sub : verb->get_subcommands([](CLI::App*) { return true; })) add_quiet(sub);
+  };
+  for (CLI::App* verb : app.get_subcommands([](CLI::App*) { return true; })) add_quiet(verb);
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     // --help and --version end here with 0; every usage error is bad input.
     return app.exit(e) == 0 ? talus::app::kExitOk : talus::app::kExitBadInput;
   }
-  // A runner returns -1 when its verb was not the one chosen.
+  talus::app::SetQuiet(quiet);
+  talus::app::SetCommandLine(argc, argv);
+  // A runner returns -1 when its verb was not the one chosen. A verb that wrote into --out sets
+  // where run.log goes; it is written when the verb succeeded.
   for (const auto& run : runners) {
     const int status = run();
-    if (status >= 0) return status;
+    if (status < 0) continue;
+    talus::app::WriteRunLog(status);
+    return status;
   }
   return talus::app::kExitOk;
 }

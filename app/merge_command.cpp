@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "app/commands.hpp"
+#include "app/console.hpp"
 #include "app/interrupt.hpp"
 #include "app/run_outputs.hpp"
 #include "app/run_verb.hpp"
@@ -40,10 +41,10 @@ int RunMerge(const MergeArgs& args) {
     for (const io::PartialInfo& part : parts) io::CheckPartFiles(part);
     scene = LoadSceneOfPart(parts.front());
   } catch (const InputError& e) {
-    std::cerr << "talus merge: " << e.what() << "\n";
+    Fail("merge", e.what());
     return kExitBadInput;
   } catch (const std::exception& e) {
-    std::cerr << "talus merge: " << e.what() << "\n";
+    Fail("merge", e.what());
     return kExitRunFailed;
   }
   return RunVerb({.name = "merge", .out = args.out}, [&](std::optional<StagingDirectory>& staging) {
@@ -60,10 +61,9 @@ int RunMerge(const MergeArgs& args) {
     const std::vector<std::string> files =
         MergeIntoStaging(scene, parts, threads, wall_time_s, *staging, &report);
     CommitOutputs(*staging, files, args.out);
-    std::printf("Merged %zu parts of %s: %s\n", parts.size(), scene.path.c_str(),
-                report.BriefReport().c_str());
-    std::printf("Wrote %zu files to %s\n", files.size(), args.out.c_str());
-    std::fflush(stdout);
+    Say("Merged %zu parts of %s: %s\n", parts.size(), scene.path.c_str(),
+        report.BriefReport().c_str());
+    Say("Wrote %zu files to %s\n", files.size(), args.out.c_str());
     PrintRunWarnings(report, scene, "merge");
   });
 }

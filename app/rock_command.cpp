@@ -8,6 +8,7 @@
 #include <string>
 
 #include "app/commands.hpp"
+#include "app/console.hpp"
 #include "pointclouds/rock_source.hpp"
 
 namespace talus::app {
@@ -83,8 +84,7 @@ int BuildRock(const char* verb, RockArgs& args, pointclouds::RockReport* report)
   if (*args.mass) args.spec.mass_kg = args.mass_kg;
   try {
     pointclouds::MakeRock(args.spec, report);
-    for (const std::string& warning : report->warnings)
-      std::cerr << "talus rock " << verb << ": WARNING: " << warning << "\n";
+    for (const std::string& warning : report->warnings) Warn(std::string("rock ") + verb, warning);
     return kExitOk;
   } catch (const std::bad_alloc&) {
     std::cerr << "talus rock " << verb << ": out of memory\n";
@@ -101,6 +101,7 @@ int BuildRock(const char* verb, RockArgs& args, pointclouds::RockReport* report)
 int RunInfo(RockArgs& args) {
   pointclouds::RockReport report;
   if (const int status = BuildRock("info", args, &report); status != kExitOk) return status;
+  // The report is what the verb is for: printed with --quiet too.
   std::cout << (args.json ? report.ToJson() + "\n" : report.FullReport());
   return kExitOk;
 }
@@ -122,9 +123,9 @@ int RunHull(RockArgs& args) {
     std::cerr << "talus rock hull: " << e.what() << "\n";
     return kExitRunFailed;
   }
-  std::cout << "Wrote the hull of " << report.source << " (" << report.hull_vertices
-            << " vertices, " << report.hull_faces << " triangles, "
-            << (args.principal ? "principal" : "input") << " frame) to " << args.out << "\n";
+  Say("Wrote the hull of %s (%zu vertices, %zu triangles, %s frame) to %s\n", report.source.c_str(),
+      static_cast<std::size_t>(report.hull_vertices), static_cast<std::size_t>(report.hull_faces),
+      args.principal ? "principal" : "input", args.out.c_str());
   return kExitOk;
 }
 

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "app/console.hpp"
 #include "app/interrupt.hpp"
 #include "common/error.hpp"
 #include "io/barriers_csv.hpp"
@@ -417,7 +418,7 @@ void CommitOutputs(StagingDirectory& staging, const std::vector<std::string>& fi
     stale += fs::remove(fs::path(dir) / name, error) ? 1 : 0;
   }
   WriteFileAtomically(manifest.string(), ManifestText(files));
-  if (stale > 0) std::printf("Removed %d outputs of an earlier run from %s\n", stale, dir.c_str());
+  if (stale > 0) Say("Removed %d outputs of an earlier run from %s\n", stale, dir.c_str());
 }
 
 io::SceneFile LoadSceneOfPart(const io::PartialInfo& part) {

@@ -6,6 +6,7 @@
 #include <iostream>
 
 #include "app/commands.hpp"
+#include "app/console.hpp"
 #include "common/error.hpp"
 
 namespace talus::app {
@@ -38,22 +39,21 @@ VerbOutcome RunStaged(const std::string& out, std::optional<StagingDirectory>& s
 }
 
 int RunVerb(const Verb& verb, const std::function<void(std::optional<StagingDirectory>&)>& work) {
-  const auto fail = [&verb](const std::string& message) {
-    std::cerr << "talus " << verb.name << ": " << message << "\n";
-  };
+  const auto fail = [&verb](const std::string& message) { Fail(verb.name, message); };
   std::string why = PrepareOutputDirectory(verb.out);
   if (why.empty() && verb.checks) why = verb.checks();
   if (!why.empty()) {
     fail(why);
     return kExitBadInput;
   }
+  SetRunLogDirectory(verb.out);  // written by main when the verb succeeded
   // From here on SIGINT / SIGTERM unwind the run: no temporary file is left behind.
   const InterruptScope interrupts;
   std::signal(SIGXFSZ, SIG_IGN);  // a file-size limit is a write error ("File too large")
   const auto stale = RemoveStaleTemporaries(verb.out);
   if (verb.say_removed_temporaries && !stale.empty())
-    std::printf("Removed %zu temporary files of interrupted runs from %s\n", stale.size(),
-                verb.out.c_str());
+    Say("Removed %zu temporary files of interrupted runs from %s\n", stale.size(),
+        verb.out.c_str());
   std::optional<StagingDirectory> staging;
   const VerbOutcome outcome = RunStaged(
       verb.out, staging, [&] { work(staging); }, verb.hooks);

@@ -2,8 +2,6 @@
 // talus simulate, shared by its one-process run (simulate_command.cpp) and its MPI run
 // (simulate_mpi.cpp): the command-line arguments, loading and checking them, the messages.
 
-#include <unistd.h>
-
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -12,6 +10,7 @@
 #include <string>
 #include <utility>
 
+#include "app/console.hpp"
 #include "app/ensemble_args.hpp"
 #include "ensemble/runner.hpp"
 #include "io/scene_file.hpp"
@@ -58,11 +57,11 @@ int LaunchedRank();
 // one process. Only rank 0 prints and writes --out; every rank returns the same exit code.
 int RunSimulateOnRanks(const SimulateArgs& args);
 
-// "rocks done / total, rate, time left" on a terminal; nothing otherwise.
+// "rocks done / total, rate, time left" as the status line on a terminal (console.hpp); nothing
+// otherwise or with --quiet.
 class ProgressBar {
  public:
-  ProgressBar()
-      : enabled_(::isatty(STDERR_FILENO) != 0), start_(std::chrono::steady_clock::now()) {}
+  ProgressBar() : enabled_(ShowsProgress()), start_(std::chrono::steady_clock::now()) {}
   void operator()(long done, long total) {
     if (!enabled_ || total <= 0) return;
     const double elapsed =
@@ -71,22 +70,18 @@ class ProgressBar {
     const double left = rate > 0 ? double(total - done) / rate : 0.0;
     constexpr int kWidth = 30;
     const int filled = static_cast<int>(kWidth * done / total);
-    std::fprintf(stderr, "\r[%-*.*s] %ld/%ld rocks  %.1f/s  %s left   ", kWidth, filled,
-                 "##############################", done, total, rate,
-                 done > 0 ? (std::to_string(std::lround(left)) + " s").c_str() : "?");
-    shown_ = done < total;
-    if (done == total) std::fprintf(stderr, "\n");
-    std::fflush(stderr);
+    char line[160];
+    std::snprintf(line, sizeof line, "[%-*.*s] %ld/%ld rocks  %.1f/s  %s left", kWidth, filled,
+                  "##############################", done, total, rate,
+                  done > 0 ? (std::to_string(std::lround(left)) + " s").c_str() : "?");
+    Status(line);
+    if (done == total) EndStatus();
   }
   // Ends a bar left unfinished, so that a message starts on a line of its own.
-  void Break() {
-    if (shown_) std::fprintf(stderr, "\n");
-    shown_ = false;
-  }
+  void Break() { EndStatus(); }
 
  private:
   bool enabled_;
-  bool shown_ = false;
   std::chrono::steady_clock::time_point start_;
 };
 

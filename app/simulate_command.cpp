@@ -15,6 +15,7 @@
 #include <string>
 
 #include "app/commands.hpp"
+#include "app/console.hpp"
 #include "app/interrupt.hpp"
 #include "app/run_outputs.hpp"
 #include "app/run_verb.hpp"
@@ -56,21 +57,17 @@ std::string DescribeRocks(const io::SceneFile& scene) {
 }
 
 void PrintSceneWarnings(const io::SceneFile& scene, const char* command) {
-  for (const std::string& warning : scene.warnings)
-    std::fprintf(stderr, "talus %s: WARNING: %s\n", command, warning.c_str());
-  std::fflush(stderr);
+  for (const std::string& warning : scene.warnings) Warn(command, warning);
 }
 
 void PrintRunWarnings(const ensemble::EnsembleReport& report, const io::SceneFile& scene,
                       const char* command) {
   for (const std::string& warning : ensemble::RunWarnings(report, scene.scene.options))
-    std::fprintf(stderr, "talus %s: WARNING: %s\n", command, warning.c_str());
-  std::fflush(stderr);
+    Warn(command, warning);
 }
 
 void PrintNotScored(const std::vector<std::string>& not_scored) {
-  for (const std::string& line : not_scored) std::printf("Not scored: %s\n", line.c_str());
-  std::fflush(stdout);
+  for (const std::string& line : not_scored) Say("Not scored: %s\n", line.c_str());
 }
 
 int LoadForSimulate(const SimulateArgs& args, io::SceneFile* scene, std::pair<long, long>* range,
@@ -91,7 +88,7 @@ int LoadForSimulate(const SimulateArgs& args, io::SceneFile* scene, std::pair<lo
                          "'; known: " + kSolverPresetNames.List());
       io::UseSolverPreset(*scene, preset);
       for (const std::string& key : scene->solver_keys_overridden)
-        std::printf("--preset %s overrides the scene's %s\n", args.preset.c_str(), key.c_str());
+        Say("--preset %s overrides the scene's %s\n", args.preset.c_str(), key.c_str());
     }
     args.ensemble.ApplyTo(scene->release);
     // --self-check wins over the scene's [solver] self_check.
@@ -126,7 +123,7 @@ int RunSimulate(const SimulateArgs& args) {
   io::SceneFile scene;
   std::pair<long, long> range;  // rocks [first, end) to run
   if (std::string message; const int code = LoadForSimulate(args, &scene, &range, &message)) {
-    std::cerr << "talus simulate: " << message << "\n";
+    Fail("simulate", message);
     return code;
   }
   Verb verb{.name = "simulate", .out = args.out};
@@ -142,15 +139,13 @@ int RunSimulate(const SimulateArgs& args) {
   ProgressBar progress;
   verb.hooks.on_failure = [&progress](bool) { progress.Break(); };
   return RunVerb(verb, [&](std::optional<StagingDirectory>& staging) {
-    std::printf("Scene %s: %s; %s\n", args.scene.c_str(), scene.terrain_description.c_str(),
-                DescribeRocks(scene).c_str());
+    Say("Scene %s: %s; %s\n", args.scene.c_str(), scene.terrain_description.c_str(),
+        DescribeRocks(scene).c_str());
     PrintSceneWarnings(scene);
-    std::printf("Needs about %s of memory (%s available) and %s of disk (%s free)\n",
-                io::FormatBytes(needs.memory_bytes()).c_str(),
-                io::FormatBytes(capacity.memory_bytes).c_str(),
-                io::FormatBytes(needs.disk_bytes()).c_str(),
-                io::FormatBytes(capacity.disk_bytes).c_str());
-    std::fflush(stdout);
+    Say("Needs about %s of memory (%s available) and %s of disk (%s free)\n",
+        io::FormatBytes(needs.memory_bytes()).c_str(),
+        io::FormatBytes(capacity.memory_bytes).c_str(), io::FormatBytes(needs.disk_bytes()).c_str(),
+        io::FormatBytes(capacity.disk_bytes).c_str());
     // Every output is written into a staging directory and moved into --out only when all are
     // complete: a failed or interrupted run leaves --out as it was.
     staging.emplace(args.out);
@@ -168,9 +163,8 @@ int RunSimulate(const SimulateArgs& args) {
       if (!scene.evaluation_lines.empty())
         check.evaluation_lines =
             std::make_shared<const std::vector<ensemble::EvaluationLine>>(scene.evaluation_lines);
-      std::printf("Self-check: %ld rocks at dt %g s and %g s ...\n", check.rocks,
-                  scene.scene.options.dt_s, scene.scene.options.dt_s / check.dt_divisor);
-      std::fflush(stdout);
+      Say("Self-check: %ld rocks at dt %g s and %g s ...\n", check.rocks, scene.scene.options.dt_s,
+          scene.scene.options.dt_s / check.dt_divisor);
       self_check = ensemble::RunSelfCheck(scene.scene, scene.release, check);
       ThrowIfInterrupted();
     }
@@ -179,17 +173,15 @@ int RunSimulate(const SimulateArgs& args) {
         scene, args.ensemble.threads, range.first, range.second, !args.rock_range.empty(), *staging,
         show_progress, &report, self_check ? &*self_check : nullptr);
     CommitOutputs(*staging, files, args.out);
-    std::printf("%s\n", report.BriefReport().c_str());
+    Say("%s\n", report.BriefReport().c_str());
     if (self_check)
-      std::printf(
-          "%s(%.1f s; statistics as run, refined, difference +- standard error; * beyond "
+      Say("%s(%.1f s; statistics as run, refined, difference +- standard error; * beyond "
           "%.2f standard errors, a 5 %% chance of a false alarm over all)\n",
           self_check->BriefReport().c_str(), self_check->wall_time_s, self_check->threshold);
     if (!args.rock_range.empty())
-      std::printf("Wrote rocks %ld:%ld of %ld as a partial result (merge with talus merge)\n",
-                  range.first, range.second, scene.release.total_rocks());
-    std::printf("Wrote %zu files to %s\n", files.size(), args.out.c_str());
-    std::fflush(stdout);
+      Say("Wrote rocks %ld:%ld of %ld as a partial result (merge with talus merge)\n", range.first,
+          range.second, scene.release.total_rocks());
+    Say("Wrote %zu files to %s\n", files.size(), args.out.c_str());
     PrintRunWarnings(report, scene);
   });
 }

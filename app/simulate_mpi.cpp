@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "app/commands.hpp"
+#include "app/console.hpp"
 #include "app/interrupt.hpp"
 #include "app/mpi_session.hpp"
 #include "app/run_outputs.hpp"
@@ -172,12 +173,12 @@ int SimulateOnRanks(const MpiSession& mpi, const SimulateArgs& args) {
   const InterruptScope interrupts;
   ProgressBar progress;
   if (root) {
+    SetRunLogDirectory(args.out);  // written by main when the run succeeded
     if (const auto stale = RemoveStaleTemporaries(args.out); !stale.empty())
-      std::printf("Removed %zu temporary files of interrupted runs from %s\n", stale.size(),
-                  args.out.c_str());
-    std::printf("Scene %s: %s; %s; %d ranks\n", args.scene.c_str(),
-                scene.terrain_description.c_str(), DescribeRocks(scene).c_str(), mpi.size());
-    std::fflush(stdout);
+      Say("Removed %zu temporary files of interrupted runs from %s\n", stale.size(),
+          args.out.c_str());
+    Say("Scene %s: %s; %s; %d ranks\n", args.scene.c_str(), scene.terrain_description.c_str(),
+        DescribeRocks(scene).c_str(), mpi.size());
     PrintSceneWarnings(scene);
   }
 
@@ -240,9 +241,8 @@ int SimulateOnRanks(const MpiSession& mpi, const SimulateArgs& args) {
           MergeIntoStaging(scene, parts, report.threads, wall_time_s, *staging, &merged);
       part.reset();
       CommitOutputs(*staging, files, args.out);
-      std::printf("%s on %d ranks\n", merged.BriefReport().c_str(), mpi.size());
-      std::printf("Wrote %zu files to %s\n", files.size(), args.out.c_str());
-      std::fflush(stdout);
+      Say("%s on %d ranks\n", merged.BriefReport().c_str(), mpi.size());
+      Say("Wrote %zu files to %s\n", files.size(), args.out.c_str());
       PrintRunWarnings(merged, scene);
     }
   });

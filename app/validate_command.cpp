@@ -1,6 +1,7 @@
 // talus validate: how well does a parameter set explain what was observed? Runs an event's scene
 // (its runs, with an ensemble of orientations each), scores the simulated counterparts of every
-// observation and writes scores.json, observations.csv and the plots (docs/validation.md).
+// observation and writes scores.json, observations.csv, the plots and report.html
+// (docs/validation.md).
 
 #include <algorithm>
 #include <chrono>
@@ -13,6 +14,7 @@
 #include <optional>
 
 #include "app/commands.hpp"
+#include "app/console.hpp"
 #include "app/ensemble_args.hpp"
 #include "app/interrupt.hpp"
 #include "app/run_verb.hpp"
@@ -24,6 +26,7 @@
 #include "io/event_file.hpp"
 #include "io/validate_event.hpp"
 #include "io/validation_outputs.hpp"
+#include "io/validation_report_html.hpp"
 #include "talus/version.hpp"
 
 namespace talus::app {
@@ -42,10 +45,10 @@ int RunValidate(const ValidateArgs& args) {
     event = io::LoadEvent(args.event);
     args.ensemble.ApplyTo(event.scene.release);
   } catch (const InputError& e) {
-    std::cerr << "talus validate: " << e.what() << "\n";
+    Fail("validate", e.what());
     return kExitBadInput;
   } catch (const std::exception& e) {
-    std::cerr << "talus validate: cannot load " << args.event << ": " << e.what() << "\n";
+    Fail("validate", "cannot load " + args.event + ": " + e.what());
     return kExitRunFailed;
   }
   Verb verb{.name = "validate", .out = args.out};
@@ -53,18 +56,24 @@ int RunValidate(const ValidateArgs& args) {
   return RunVerb(verb, [&](std::optional<StagingDirectory>& staging) {
     PrintSceneWarnings(event.scene, "validate");
     const ensemble::ReleaseSpec& release = event.scene.release;
-    std::printf("Event %s: %zu observations (%zu scalar, %zu deposits) of %ld runs x %ld rocks\n",
-                args.event.c_str(), event.observations.size(), event.observations.scalars.size(),
-                event.observations.deposits.size(), release.release_count(),
-                release.rocks_per_release);
+    Say("Event %s: %zu observations (%zu scalar, %zu deposits) of %ld runs x %ld rocks\n",
+        args.event.c_str(), event.observations.size(), event.observations.scalars.size(),
+        event.observations.deposits.size(), release.release_count(), release.rocks_per_release);
     PrintNotScored(event.not_scored);
     // Every output is staged and moved into --out only when all are complete.
     staging.emplace(args.out);
     const auto out = [&](const std::string& name) { return staging->path(name); };
     io::EventValidationOptions options;
     options.threads = args.ensemble.threads;
-    options.progress = [](long, long) { ThrowIfInterrupted(); };
-    options.say = [](const std::string& line) { std::printf("%s\n", line.c_str()); };
+    ProgressBar progress;  // the runs' rocks, on a terminal
+    options.progress = [&progress](long done, long total) {
+      ThrowIfInterrupted();
+      progress(done, total);
+    };
+    options.say = [&progress](const std::string& line) {
+      progress.Break();
+      Say("%s\n", line.c_str());
+    };
     const io::EventValidation validation = io::ValidateEvent(event, options);
     const fieldobs::ValidationReport& report = validation.report;
     const fieldobs::EnsembleSamples& simulated = *validation.simulated;
@@ -74,16 +83,25 @@ int RunValidate(const ValidateArgs& args) {
     io::WriteTextFile(out("observations.csv"), io::ObservationsCsv(report));
     io::WriteTextFile(out("observed_vs_simulated.svg"), io::ObservedVsSimulatedSvg(report));
     io::WriteTextFile(out("pit.svg"), io::PitSvg(report));
+    std::string deposits;
     if (!event.observations.deposits.empty()) {
-      io::WriteDepositsPng(out("deposits.png"), event, simulated);
+      deposits = io::DepositsPng(event, simulated);
+      WriteFileAtomically(out("deposits.png"), deposits);
       outputs.push_back("deposits.png");
     }
-    io::WriteTextFile(out("scores.json"), io::ScoresJson(event, report, run));
+    const std::string scores = io::ScoresJson(event, report, run);
+    WriteFileAtomically(out("report.html"), io::ValidationReportHtml({scores, &report, deposits}));
+    outputs.push_back("report.html");
+    io::WriteTextFile(out("scores.json"), scores);
     outputs.push_back("scores.json");  // last: scores.json is there only with its outputs
     ThrowIfInterrupted();
     staging->Commit(outputs);
-    std::printf("%s", report.FullReport().c_str());
-    std::printf("Wrote %zu files to %s\n", outputs.size(), args.out.c_str());
+    Say("%s", report.FullReport().c_str());
+    Say("Wrote %zu files to %s\n", outputs.size(), args.out.c_str());
+    // The scene's were printed before the run.
+    const std::vector<std::string> warnings = io::ValidationWarnings(event, run);
+    for (std::size_t k = event.scene.warnings.size(); k < warnings.size(); ++k)
+      Warn("validate", warnings[k]);
   });
 }
 

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "io/html_page.hpp"
 #include "io/svg_plot.hpp"
 
 namespace talus::io {
@@ -68,8 +69,11 @@ std::string ObservedSimulatedSvg(const std::string& kind,
   if (!std::isfinite(lo)) lo = hi = 0;
   Pad(lo, hi);
   const Axis x{lo, hi, kLeft, kWidth - kRight}, y{lo, hi, kHeight - kBottom, kTop};
-  std::string out = Frame(kind + ": observed vs simulated median", "observed (" + unit + ")",
-                          "simulated median (" + unit + ")", x, y);
+  const bool dimensionless = unit.empty() || unit == "1";
+  std::string out =
+      Frame(html::HumanLabel(kind) + ": observed vs simulated median",
+            dimensionless ? "observed" : "observed (" + unit + ")",
+            dimensionless ? "simulated median" : "simulated median (" + unit + ")", x, y);
   Add(out, "<line x1=\"", F(x(lo)), "\" y1=\"", F(y(lo)), "\" x2=\"", F(x(hi)), "\" y2=\"",
       F(y(hi)), "\" stroke=\"black\" stroke-dasharray=\"4 3\"/>\n");
   const auto dots = [&](const std::vector<fieldobs::ObservationScore>& set, const char* colour) {
@@ -83,6 +87,44 @@ std::string ObservedSimulatedSvg(const std::string& kind,
   Add(out, "<text x=\"", F(kLeft + 6), "\" y=\"", F(kTop + 14),
       "\" fill=\"#999999\">before</text>\n<text x=\"", F(kLeft + 6), "\" y=\"", F(kTop + 28),
       "\" fill=\"#1f5fbf\">after</text>\n");
+  return out + "</svg>\n";
+}
+
+std::string ProfileSvg(const std::string& name, const std::string& unit,
+                       const std::vector<double>& values, const std::vector<double>& objective,
+                       double fitted, bool identified) {
+  double x_lo = INFINITY, x_hi = -INFINITY, y_lo = INFINITY, y_hi = -INFINITY;
+  for (std::size_t k = 0; k < values.size() && k < objective.size(); ++k)
+    if (std::isfinite(values[k]) && std::isfinite(objective[k])) {
+      x_lo = std::min(x_lo, values[k]);
+      x_hi = std::max(x_hi, values[k]);
+      y_lo = std::min(y_lo, objective[k]);
+      y_hi = std::max(y_hi, objective[k]);
+    }
+  if (std::isfinite(fitted)) {
+    x_lo = std::min(x_lo, fitted);
+    x_hi = std::max(x_hi, fitted);
+  }
+  if (!std::isfinite(x_lo)) x_lo = x_hi = 0;
+  if (!std::isfinite(y_lo)) y_lo = y_hi = 0;
+  Pad(x_lo, x_hi);
+  Pad(y_lo, y_hi);
+  const Axis x{x_lo, x_hi, kLeft, kWidth - kRight}, y{y_lo, y_hi, kHeight - kBottom, kTop};
+  std::string out =
+      Frame("Profile of " + name + (identified ? "" : " (flat: unidentified)"),
+            unit.empty() || unit == "1" ? name : name + " (" + unit + ")", "objective", x, y);
+  std::string line;
+  for (std::size_t k = 0; k < values.size() && k < objective.size(); ++k) {
+    if (!std::isfinite(values[k]) || !std::isfinite(objective[k])) continue;
+    Add(out, "<circle cx=\"", F(x(values[k])), "\" cy=\"", F(y(objective[k])),
+        "\" r=\"3\" fill=\"#1f5fbf\"/>\n");
+    Add(line, line.empty() ? "" : " ", F(x(values[k])), ",", F(y(objective[k])));
+  }
+  Add(out, "<polyline points=\"", line, "\" fill=\"none\" stroke=\"#1f5fbf\"/>\n");
+  if (std::isfinite(fitted))
+    Add(out, "<line x1=\"", F(x(fitted)), "\" x2=\"", F(x(fitted)), "\" y1=\"", F(kTop), "\" y2=\"",
+        F(kHeight - kBottom), "\" stroke=\"#d7191c\" stroke-dasharray=\"4 3\"/>\n", "<text x=\"",
+        F(x(fitted) + 4), "\" y=\"", F(kTop + 14), "\" fill=\"#d7191c\">fitted</text>\n");
   return out + "</svg>\n";
 }
 

@@ -1,7 +1,7 @@
 #pragma once
 // The plots of `talus calibrate` as small, deterministic SVG files (docs/calibration.md): the
-// convergence of the objective over the evaluations, and the observed against the simulated
-// median of each scalar observation kind before and after the fit.
+// convergence of the objective over the evaluations, the observed against the simulated median of
+// each scalar observation kind before and after the fit, and each parameter's profile.
 
 #include <string>
 #include <vector>
@@ -20,5 +20,11 @@ std::string ConvergenceSvg(const calibration::OptimizerSummary& summary);
 std::string ObservedSimulatedSvg(const std::string& kind,
                                  const std::vector<fieldobs::ObservationScore>& before,
                                  const std::vector<fieldobs::ObservationScore>& after);
+
+// A parameter's profile: the objective (y) along the parameter's values (x) with the others at
+// the optimum, the fitted value as a dashed line; "flat: unidentified" in the title when it is.
+std::string ProfileSvg(const std::string& name, const std::string& unit,
+                       const std::vector<double>& values, const std::vector<double>& objective,
+                       double fitted, bool identified);
 
 }  // namespace talus::io

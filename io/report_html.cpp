@@ -1,8 +1,5 @@
 #include "io/report_html.hpp"
 
-#include <cpl_conv.h>
-#include <cpl_string.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -14,77 +11,20 @@
 #include "common/error.hpp"
 #include "common/format.hpp"
 #include "common/statistics.hpp"
+#include "io/html_page.hpp"
 #include "io/quicklook.hpp"
 #include "io/svg_plot.hpp"
 
 namespace talus::io {
 namespace {
 
-using Json = nlohmann::ordered_json;
+using html::Cell;
+using html::Json;
+using html::kEnergyUnit;
+using html::kJoulesPerEnergyUnit;
+using html::Number;
 using svg::Add;
 using svg::Escape;
-
-// A value for a table cell: numbers with up to 6 significant digits, text escaped.
-std::string Cell(const Json& value) {
-  if (value.is_number_float()) {
-    return FormatDouble(value.get<double>(), "%.6g");
-  }
-  if (value.is_string()) return Escape(value.get<std::string>());
-  if (value.is_array()) {
-    std::string out;
-    for (const Json& v : value) Add(out, out.empty() ? "" : ", ", Cell(v));
-    return out;
-  }
-  return Escape(value.dump());
-}
-
-std::string Number(double v, const char* format = "%.4g") {
-  return std::isfinite(v) ? FormatDouble(v, format) : "&ndash;";
-}
-
-// A two-column table of the scalar members of `object` (nested objects left out).
-std::string KeyValueTable(const Json& object, const std::vector<std::string>& skip = {}) {
-  std::string out = "<table>\n";
-  for (const auto& [key, value] : object.items()) {
-    if (value.is_object() || std::find(skip.begin(), skip.end(), key) != skip.end()) continue;
-    Add(out, "<tr><th>", Escape(key), "</th><td>", Cell(value), "</td></tr>\n");
-  }
-  return out + "</table>\n";
-}
-
-// One row per member of `object` (each an object), one column per key any of them has.
-std::string RowsTable(const Json& object, const std::string& first_column) {
-  std::vector<std::string> columns;
-  for (const auto& [name, row] : object.items())
-    for (const auto& [key, value] : row.items())
-      if (std::find(columns.begin(), columns.end(), key) == columns.end()) columns.push_back(key);
-  std::string out = "<table>\n<tr><th>" + Escape(first_column) + "</th>";
-  for (const std::string& c : columns) Add(out, "<th>", Escape(c), "</th>");
-  out += "</tr>\n";
-  for (const auto& [name, row] : object.items()) {
-    Add(out, "<tr><th>", Escape(name), "</th>");
-    for (const std::string& c : columns)
-      Add(out, "<td>", row.contains(c) ? Cell(row[c]) : "", "</td>");
-    out += "</tr>\n";
-  }
-  return out + "</table>\n";
-}
-
-std::string Base64(const std::string& bytes) {
-  char* encoded =
-      CPLBase64Encode(static_cast<int>(bytes.size()), reinterpret_cast<const GByte*>(bytes.data()));
-  std::string out = encoded ? encoded : "";
-  CPLFree(encoded);
-  return out;
-}
-
-constexpr const char* kStyle =
-    R"(body{font-family:sans-serif;max-width:1100px;margin:2em auto;color:#222}
-h1{font-size:1.5em}h2{font-size:1.2em;border-bottom:1px solid #ccc;padding-bottom:.2em;margin-top:1.6em}
-table{border-collapse:collapse;margin:.5em 0}th,td{border:1px solid #ccc;padding:.2em .6em;text-align:left}
-td{font-variant-numeric:tabular-nums}figure{display:inline-block;margin:.5em 1em .5em 0;vertical-align:top}
-figure img{width:520px;max-width:100%;border:1px solid #ccc}figure{max-width:520px}figcaption{font-size:.9em;color:#555}
-.plots svg{margin:.3em;border:1px solid #ddd}.note{color:#555;font-size:.9em})";
 
 }  // namespace
 
@@ -158,39 +98,27 @@ std::string HistogramSvg(const std::string& title, const std::string& x_label,
 
 namespace {
 
-// The run's warnings (summary.json "warnings"), before anything else; nothing when there are none.
-std::string WarningsSection(const Json& summary) {
-  if (!summary.contains("warnings") || !summary["warnings"].is_array() ||
-      summary["warnings"].empty())
-    return "";
-  std::string html = "<h2>Warnings</h2>\n<ul class=\"warnings\">\n";
-  for (const Json& w : summary["warnings"])
-    if (w.is_string()) Add(html, "<li>", Escape(w.get<std::string>()), "</li>\n");
-  return html + "</ul>\n";
-}
-
 // The page's head and "What ran": scene, version, inputs hash, the summary's settings, the rock.
 std::string WhatRanSection(const Json& summary) {
   const auto get = [&](const char* key) { return summary.contains(key) ? summary[key] : Json(); };
-  std::string html = "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n";
-  Add(html, "<title>Talus run: ", Cell(get("scene")), "</title>\n<style>\n", kStyle,
-      "\n</style>\n</head>\n<body>\n");
-  Add(html, "<h1>Talus run: ", Cell(get("scene")), "</h1>\n");
-  Add(html, "<p class=\"note\">Talus ", Cell(get("talus_version")), ", inputs hash (FNV-1a 64) ",
-      Cell(get("inputs_hash_fnv1a64")),
-      ". Everything here is also in summary.json, rocks.csv and "
-      "the GeoTIFFs next to this file.</p>\n");
-  html += WarningsSection(summary);
+  const std::string scene = get("scene").is_string() ? get("scene").get<std::string>() : "";
+  std::string html = html::Begin(
+      "Talus run: " + scene,
+      "Talus " + Cell(get("talus_version")) + ", inputs hash (FNV-1a 64) " +
+          Cell(get("inputs_hash_fnv1a64")) +
+          ". Everything here is also in summary.json, rocks.csv and the GeoTIFFs next to this "
+          "file.");
+  html += html::Warnings(get("warnings"));
 
   html += "<h2>What ran</h2>\n";
-  html +=
-      KeyValueTable(summary, {"ends", "raised_at_release", "stayed_at_release", "steps",
-                              "unconverged_steps", "threads", "wall_time_s", "trajectories_per_s",
-                              "outputs", "blocks", "talus_version", "inputs_hash_fnv1a64",
-                              "evaluation_lines", "barriers", "warnings"});
+  html += html::KeyValueTable(
+      summary,
+      {"ends", "raised_at_release", "stayed_at_release", "steps", "unconverged_steps", "threads",
+       "wall_time_s", "trajectories_per_s", "outputs", "blocks", "talus_version",
+       "inputs_hash_fnv1a64", "evaluation_lines", "barriers", "warnings"});
   if (summary.contains("rock") && summary["rock"].is_object()) {
     html += "<h3>Rock</h3>\n";
-    html += KeyValueTable(summary["rock"]);
+    html += html::KeyValueTable(summary["rock"]);
   }
   return html;
 }
@@ -206,7 +134,8 @@ std::string EndingsSection(const Json& summary) {
         rocks > 0 ? Number(100 * n / rocks, "%.1f") + " %" : "", "</td></tr>\n");
   };
   if (summary.contains("ends"))
-    for (const auto& [ending, n] : summary["ends"].items()) count_row(Escape(ending), n);
+    for (const auto& [ending, n] : summary["ends"].items())
+      count_row(Escape(html::HumanLabel(ending)), n);
   count_row("raised at release", get("raised_at_release"));
   count_row("stayed at release", get("stayed_at_release"));
   html += "</table>\n";
@@ -229,9 +158,8 @@ std::string MapsSection(const RunReportInput& input) {
   std::string html = "<h2>Maps</h2>\n";
   for (const ensemble::RasterLayer* layer : maps) {
     const std::string png = QuickLookPng(*input.dem, layer, input.paths, {}, input.lines);
-    Add(html, "<figure><img alt=\"", Escape(layer->name), "\" src=\"data:image/png;base64,",
-        Base64(png), "\"><figcaption>", Escape(LegendOf(*layer).title), " (", Escape(layer->name),
-        ".tif)</figcaption></figure>\n");
+    html +=
+        html::PngFigure(png, layer->name, LegendOf(*layer).title + " (" + layer->name + ".tif)");
   }
   return html;
 }
@@ -239,11 +167,12 @@ std::string MapsSection(const RunReportInput& input) {
 // "Distributions over the rocks": histograms and a table of statistics.
 std::string DistributionsSection(const RockColumns& r) {
   std::vector<double> energy_kj;
-  for (double e : r.max_kinetic_energy_j) energy_kj.push_back(e / 1000);
+  for (double e : r.max_kinetic_energy_j) energy_kj.push_back(e / kJoulesPerEnergyUnit);
   std::string html = "<h2>Distributions over the rocks</h2>\n<div class=\"plots\">\n";
   html += HistogramSvg("Runout", "runout (m)", r.runout_m);
-  html += HistogramSvg("Largest kinetic energy", "energy (kJ)", energy_kj);
-  html += HistogramSvg("Largest jump height", "jump height of the centre of mass (m)",
+  html += HistogramSvg("Largest kinetic energy", std::string("energy (") + kEnergyUnit + ")",
+                       energy_kj);
+  html += HistogramSvg("Largest jump height", "jump height: centre of mass, along the normal (m)",
                        r.max_jump_height_m);
   html +=
       "</div>\n<table>\n<tr><th></th><th>mean</th><th>median</th><th>90 %</th><th>95 %</th>"
@@ -256,8 +185,8 @@ std::string DistributionsSection(const RockColumns& r) {
   };
   stats_row("runout (m)", r.runout_m);
   stats_row("largest speed (m/s)", r.max_speed_m_s);
-  stats_row("largest kinetic energy (kJ)", energy_kj);
-  stats_row("largest jump height (m)", r.max_jump_height_m);
+  stats_row((std::string("largest kinetic energy (") + kEnergyUnit + ")").c_str(), energy_kj);
+  stats_row("largest jump height, along the normal (m)", r.max_jump_height_m);
   stats_row("travel angle (&deg;)", r.travel_angle_deg);
   html +=
       "</table>\n<p class=\"note\">Percentiles are nearest-rank, over the rocks (one value per "
@@ -283,7 +212,7 @@ std::string EvaluationLinesSection(const Json& summary) {
   html += "</table>\n";
   const std::pair<const char*, const char*> quantities[] = {
       {"speed_m_s", "speed (m/s)"},
-      {"energy_J", "kinetic energy (kJ)"},
+      {"energy_J", "kinetic energy"},
       {"com_height_m", "height of the centre of mass (m)"},
       {"bounce_height_m", "bounce height (m)"}};
   for (const Json& line : lines) {
@@ -291,10 +220,11 @@ std::string EvaluationLinesSection(const Json& summary) {
         "</h3>\n<table>\n<tr><th></th><th>mean</th>"
         "<th>median</th><th>90 %</th><th>95 %</th><th>99 %</th><th>largest</th></tr>\n");
     for (const auto& [key, label] : quantities) {
-      Add(html, "<tr><th>", label, "</th>");
+      const bool energy = std::string(key) == "energy_J";
+      const double scale = energy ? 1 / kJoulesPerEnergyUnit : 1.0;
+      Add(html, "<tr><th>", label, energy ? std::string(" (") + kEnergyUnit + ")" : "", "</th>");
       for (const char* statistic : {"mean", "p50", "p90", "p95", "p99", "max"}) {
         const Json& v = line[key][statistic];
-        const double scale = std::string(key) == "energy_J" ? 1e-3 : 1.0;
         Add(html, "<td>",
             Number(v.is_number() ? scale * v.get<double>()
                                  : std::numeric_limits<double>::quiet_NaN()),
@@ -306,8 +236,9 @@ std::string EvaluationLinesSection(const Json& summary) {
   }
   html +=
       "<p class=\"note\">Over the rocks that crossed each line, at the first crossing of the "
-      "centre of mass (evaluation_lines.csv); heights are vertical, above the terrain; the "
-      "bounce height is that of the rock's lowest point. Percentiles are nearest-rank.</p>\n";
+      "centre of mass (evaluation_lines.csv); heights are vertical, above the terrain (unlike "
+      "the jump height, along the normal); the bounce height is that of the rock's lowest point. "
+      "Percentiles are nearest-rank.</p>\n";
   return html;
 }
 
@@ -321,27 +252,30 @@ std::string BarriersSection(const Json& summary) {
   };
   std::string html =
       "<h2>Barriers</h2>\n<table>\n<tr><th>barrier</th><th>type</th><th>height (m)</th>"
-      "<th>capacity (kJ)</th><th>rocks</th><th>reached</th><th>stopped</th><th>overtopped</th>"
+      "<th>capacity (" +
+      std::string(kEnergyUnit) +
+      ")</th><th>rocks</th><th>reached</th><th>stopped</th><th>overtopped</th>"
       "<th>broke through</th><th>passing probability</th></tr>\n";
   for (const Json& b : barriers)
     Add(html, "<tr><th>", Cell(b["name"]), "</th><td>", Cell(b["type"]), "</td><td>",
-        Cell(b["height_m"]), "</td><td>", Number(1e-3 * number(b["capacity_J"]), "%.0f"),
-        "</td><td>", Cell(b["rocks"]), "</td><td>", Cell(b["reached"]), "</td><td>",
-        Cell(b["stopped"]), "</td><td>", Cell(b["overtopped"]), "</td><td>",
-        Cell(b["broke_through"]), "</td><td>",
+        Cell(b["height_m"]), "</td><td>",
+        Number(number(b["capacity_J"]) / kJoulesPerEnergyUnit, "%.0f"), "</td><td>",
+        Cell(b["rocks"]), "</td><td>", Cell(b["reached"]), "</td><td>", Cell(b["stopped"]),
+        "</td><td>", Cell(b["overtopped"]), "</td><td>", Cell(b["broke_through"]), "</td><td>",
         Number(100 * number(b["passing_probability"]), "%.1f"), " %</td></tr>\n");
   html += "</table>\n";
   const std::pair<const char*, const char*> quantities[] = {
-      {"impact_energy_J", "kinetic energy at the barrier (kJ)"},
+      {"impact_energy_J", "kinetic energy at the barrier"},
       {"passing_height_m", "passing height (m)"},
-      {"passing_energy_J", "kinetic energy of the rocks that passed, after it (kJ)"}};
+      {"passing_energy_J", "kinetic energy of the rocks that passed, after it"}};
   for (const Json& b : barriers) {
     Add(html, "<h3>", Cell(b["name"]),
         "</h3>\n<table>\n<tr><th></th><th>mean</th>"
         "<th>median</th><th>90 %</th><th>95 %</th><th>99 %</th><th>largest</th></tr>\n");
     for (const auto& [key, label] : quantities) {
-      Add(html, "<tr><th>", label, "</th>");
-      const double scale = std::string(key) == "passing_height_m" ? 1.0 : 1e-3;
+      const bool energy = std::string(key) != "passing_height_m";
+      const double scale = energy ? 1 / kJoulesPerEnergyUnit : 1.0;
+      Add(html, "<tr><th>", label, energy ? std::string(" (") + kEnergyUnit + ")" : "", "</th>");
       for (const char* statistic : {"mean", "p50", "p90", "p95", "p99", "max"})
         Add(html, "<td>", Number(scale * number(b[key][statistic])), "</td>");
       html += "</tr>\n";
@@ -362,19 +296,18 @@ std::string SettingsSection(const Json& summary) {
   std::string html;
   if (summary.contains("ground")) {
     html += "<h2>Ground table</h2>\n";
-    html += RowsTable(summary["ground"], "category");
+    html += html::RowsTable(summary["ground"], "category");
   }
   if (summary.contains("solver")) {
     html += "<h2>Solver options</h2>\n";
-    html += KeyValueTable(summary["solver"]);
+    html += html::KeyValueTable(summary["solver"]);
   }
   if (summary.contains("outputs")) {
     html += "<h2>Files</h2>\n<p>";
     html += Cell(summary["outputs"]);
     html += "</p>\n";
   }
-  html += "</body>\n</html>\n";
-  return html;
+  return html + html::End();
 }
 
 }  // namespace

@@ -4,11 +4,12 @@
 #include <cmath>
 #include <cstdio>
 #include <nlohmann/json.hpp>
-#include <sstream>
 #include <stdexcept>
 
 #include "common/atomic_file.hpp"
 #include "common/format.hpp"
+#include "ensemble/run_warnings.hpp"
+#include "io/html_page.hpp"
 #include "io/quicklook.hpp"
 #include "io/rocks_csv.hpp"
 #include "io/svg_plot.hpp"
@@ -38,6 +39,20 @@ nlohmann::ordered_json BlockBiasJson(const std::vector<fieldobs::BlockBias>& bia
                    {"mean_bias", Num(b.mean_bias)},
                    {"mean_score", Num(b.mean_score)}});
   return out;
+}
+
+std::vector<std::string> ValidationWarnings(const EventFile& event, const ValidationRun& run) {
+  std::vector<std::string> warnings = event.scene.warnings;
+  // The endings censor where rocks end (run-outs, deposits, reach), not a single impact's
+  // first contact: an event of impacts alone (short runs by design) is not warned about them.
+  bool endings_matter = !event.observations.deposits.empty();
+  for (const auto& o : event.observations.scalars)
+    endings_matter =
+        endings_matter || std::string(fieldobs::ToString(o.quantity)).rfind("impact_", 0) != 0;
+  if (endings_matter)
+    for (const std::string& w : ensemble::RunWarnings(run.ensemble, event.scene.scene.options))
+      warnings.push_back(w);
+  return warnings;
 }
 
 std::string ScoresJson(const EventFile& event, const fieldobs::ValidationReport& report,
@@ -91,7 +106,7 @@ std::string ScoresJson(const EventFile& event, const fieldobs::ValidationReport&
   }
   j["kinds"] = kinds;
   j["blocks"] = BlockBiasJson(fieldobs::BiasByBlock(report.observations, event.scene.release));
-  j["warnings"] = event.scene.warnings;
+  j["warnings"] = ValidationWarnings(event, run);
   nlohmann::ordered_json mismatches = nlohmann::ordered_json::array();
   for (const GroundMismatch& m : event.scene.ground_mismatches)
     mismatches.push_back({{"run", m.run},
@@ -120,107 +135,105 @@ std::string ObservationsCsv(const fieldobs::ValidationReport& report) {
   return out;
 }
 
-std::string ObservedVsSimulatedSvg(const fieldobs::ValidationReport& report) {
-  // One panel per scalar kind: observations sorted by observed value along x; for each, the
-  // simulated 5-95 % band (grey bar), median (blue tick) and the observed value (red dot).
-  const int width = 720, panel = 260, margin = 50;
-  std::vector<const fieldobs::KindSummary*> kinds;
-  for (const auto& k : report.kinds)
-    if (k.kind != "deposit" && k.scored > 0) kinds.push_back(&k);
-  const int height = std::max(1, static_cast<int>(kinds.size())) * (panel + 30) + 20;
-  std::ostringstream svg;
-  svg << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << width << "\" height=\"" << height
-      << "\" font-family=\"sans-serif\" font-size=\"12\">\n<rect width=\"100%\" height=\"100%\" "
-         "fill=\"white\"/>\n";
-  if (kinds.empty()) svg << "<text x=\"20\" y=\"20\">no scalar observation was scored</text>\n";
-  int top = 20;
-  for (const fieldobs::KindSummary* k : kinds) {
-    std::vector<const fieldobs::ObservationScore*> obs;
-    for (const auto& s : report.observations)
-      if (s.kind == k->kind && s.scored) obs.push_back(&s);
-    std::sort(obs.begin(), obs.end(), [](auto* a, auto* b) { return a->observed < b->observed; });
-    double lo = obs.front()->observed, hi = lo;
-    for (const auto* s : obs) {
-      lo = std::min({lo, s->observed, s->q05});
-      hi = std::max({hi, s->observed, s->q95});
-    }
-    if (hi <= lo) hi = lo + 1;
-    const double pad = 0.05 * (hi - lo);
-    lo -= pad;
-    hi += pad;
-    const int x0 = margin + 10, x1 = width - 20, y0 = top + 20, y1 = top + panel;
-    auto y = [&](double v) { return y1 - (v - lo) / (hi - lo) * (y1 - y0); };
-    svg << "<text x=\"" << x0 << "\" y=\"" << top + 12 << "\" font-weight=\"bold\">"
-        << svg::Escape(k->kind) << " (" << svg::Escape(k->unit)
-        << "): observed (red) vs simulated 5-95 % band "
-        << "and median (blue); mean CRPS " << Fmt(k->mean_score) << "</text>\n";
-    svg << "<rect x=\"" << x0 << "\" y=\"" << y0 << "\" width=\"" << x1 - x0 << "\" height=\""
-        << y1 - y0 << "\" fill=\"none\" stroke=\"#888\"/>\n";
-    for (int t = 0; t <= 4; ++t) {
-      const double v = lo + (hi - lo) * t / 4;
-      svg << "<text x=\"" << x0 - 4 << "\" y=\"" << y(v) + 4 << "\" text-anchor=\"end\">" << Fmt(v)
-          << "</text>\n";
-    }
-    const double step = double(x1 - x0) / double(obs.size());
-    for (std::size_t i = 0; i < obs.size(); ++i) {
-      const double x = x0 + (double(i) + 0.5) * step;
-      const auto* s = obs[i];
-      svg << "<line x1=\"" << x << "\" x2=\"" << x << "\" y1=\"" << y(s->q05) << "\" y2=\""
-          << y(s->q95) << "\" stroke=\"#bbb\" stroke-width=\"" << std::max(1.0, 0.6 * step)
-          << "\"><title>" << svg::Escape(s->run) << "</title></line>\n";
-      svg << "<line x1=\"" << x - 0.4 * step << "\" x2=\"" << x + 0.4 * step << "\" y1=\""
-          << y(s->median) << "\" y2=\"" << y(s->median) << "\" stroke=\"#1f4fbf\" "
-          << "stroke-width=\"2\"/>\n";
-      svg << "<circle cx=\"" << x << "\" cy=\"" << y(s->observed)
-          << "\" r=\"3\" fill=\"#d7191c\"/>\n";
-    }
-    top += panel + 30;
+namespace {
+
+// "observed (m)", or "observed" for a dimensionless kind.
+std::string WithUnit(const std::string& what, const std::string& unit) {
+  return unit.empty() || unit == "1" ? what : what + " (" + unit + ")";
+}
+
+// One kind's scored observations: each at its observed value (x) with its simulated 5-95 % band
+// (grey bar, the run's id as its tooltip) and median (dot), and the 1:1 line.
+std::string ObservedVsSimulatedPanel(const fieldobs::KindSummary& kind,
+                                     const std::vector<fieldobs::ObservationScore>& observations) {
+  using svg::Add;
+  using svg::F;
+  std::vector<const fieldobs::ObservationScore*> obs;
+  for (const auto& s : observations)
+    if (s.kind == kind.kind && s.scored) obs.push_back(&s);
+  double lo = INFINITY, hi = -INFINITY;
+  for (const auto* s : obs)
+    for (double v : {s->observed, s->q05, s->q95})
+      if (std::isfinite(v)) {
+        lo = std::min(lo, v);
+        hi = std::max(hi, v);
+      }
+  if (!std::isfinite(lo)) lo = hi = 0;
+  svg::Pad(lo, hi);
+  const svg::Axis x{lo, hi, svg::kLeft, svg::kWidth - svg::kRight};
+  const svg::Axis y{lo, hi, svg::kHeight - svg::kBottom, svg::kTop};
+  const std::string label = html::HumanLabel(kind.kind);
+  std::string out =
+      svg::Frame(label + ": simulated against observed", WithUnit("observed", kind.unit),
+                 WithUnit("simulated", kind.unit), x, y);
+  Add(out, "<line x1=\"", F(x(lo)), "\" y1=\"", F(y(lo)), "\" x2=\"", F(x(hi)), "\" y2=\"",
+      F(y(hi)), "\" stroke=\"black\" stroke-dasharray=\"4 3\"/>\n");
+  for (const auto* s : obs) {
+    Add(out, "<line x1=\"", F(x(s->observed)), "\" x2=\"", F(x(s->observed)), "\" y1=\"",
+        F(y(s->q05)), "\" y2=\"", F(y(s->q95)), "\" stroke=\"#bbbbbb\" stroke-width=\"4\"><title>",
+        svg::Escape(s->run), "</title></line>\n");
+    Add(out, "<circle cx=\"", F(x(s->observed)), "\" cy=\"", F(y(s->median)),
+        "\" r=\"3\" fill=\"#1f5fbf\"><title>", svg::Escape(s->run), "</title></circle>\n");
   }
-  svg << "</svg>\n";
-  return svg.str();
+  Add(out, "<text x=\"", F(svg::kLeft + 6), "\" y=\"", F(svg::kTop + 14),
+      "\">grey: simulated 5-95 %, dot: median, dashed: 1:1</text>\n<text x=\"", F(svg::kLeft + 6),
+      "\" y=\"", F(svg::kTop + 28), "\">mean CRPS ", Fmt(kind.mean_score), " ",
+      kind.unit == "1" ? "" : svg::Escape(kind.unit), "</text>\n");
+  return out + "</svg>\n";
+}
+
+// One kind's PIT histogram: a calibrated ensemble gives bars as high as the dashed line.
+std::string PitPanel(const fieldobs::KindSummary& kind) {
+  using svg::Add;
+  using svg::F;
+  const fieldobs::PitHistogram& pit = kind.pit;
+  int total = 0, most = 1;
+  for (int c : pit.counts) {
+    total += c;
+    most = std::max(most, c);
+  }
+  const double expected = double(total) / double(pit.counts.size());
+  const svg::Axis x{0, 1, svg::kLeft, svg::kWidth - svg::kRight};
+  const svg::Axis y{0, std::max(double(most), 1.5 * expected), svg::kHeight - svg::kBottom,
+                    svg::kTop};
+  std::string out = svg::Frame(
+      "PIT: " + html::HumanLabel(kind.kind) + " (" + std::to_string(total) + " observations)",
+      "probability integral transform", "observations", x, y);
+  const double width = 1.0 / double(pit.counts.size());
+  for (std::size_t b = 0; b < pit.counts.size(); ++b)
+    Add(out, "<rect x=\"", F(x(double(b) * width) + 1), "\" y=\"", F(y(pit.counts[b])),
+        "\" width=\"", F(x(width) - x(0) - 2), "\" height=\"", F(y(0) - y(pit.counts[b])),
+        "\" fill=\"#6a8fd0\"/>\n");
+  Add(out, "<line x1=\"", F(x(0)), "\" x2=\"", F(x(1)), "\" y1=\"", F(y(expected)), "\" y2=\"",
+      F(y(expected)), "\" stroke=\"black\" stroke-dasharray=\"4 3\"/>\n");
+  Add(out, "<text x=\"", F(svg::kLeft + 6), "\" y=\"", F(svg::kTop + 14),
+      "\">chi-square p = ", Fmt(pit.p_value, "%.2g"), "; dashed: flat (calibrated)</text>\n");
+  return out + "</svg>\n";
+}
+
+}  // namespace
+
+std::vector<std::string> ObservedVsSimulatedPanels(const fieldobs::ValidationReport& report) {
+  std::vector<std::string> panels;
+  for (const auto& k : report.kinds)
+    if (k.kind != "deposit" && k.scored > 0)
+      panels.push_back(ObservedVsSimulatedPanel(k, report.observations));
+  return panels;
+}
+
+std::vector<std::string> PitPanels(const fieldobs::ValidationReport& report) {
+  std::vector<std::string> panels;
+  for (const auto& k : report.kinds)
+    if (!k.pit.counts.empty()) panels.push_back(PitPanel(k));
+  return panels;
+}
+
+std::string ObservedVsSimulatedSvg(const fieldobs::ValidationReport& report) {
+  return svg::Stack(ObservedVsSimulatedPanels(report), 2, "no scalar observation was scored");
 }
 
 std::string PitSvg(const fieldobs::ValidationReport& report) {
-  // One histogram per scalar kind; a calibrated ensemble gives flat bars (dashed line).
-  std::vector<const fieldobs::KindSummary*> kinds;
-  for (const auto& k : report.kinds)
-    if (!k.pit.counts.empty()) kinds.push_back(&k);
-  const int w = 320, h = 220;
-  const int width = std::max(1, static_cast<int>(kinds.size())) * w;
-  std::ostringstream svg;
-  svg << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << width << "\" height=\"" << h
-      << "\" font-family=\"sans-serif\" font-size=\"12\">\n<rect width=\"100%\" height=\"100%\" "
-         "fill=\"white\"/>\n";
-  if (kinds.empty()) svg << "<text x=\"20\" y=\"20\">no PIT histogram (too few scalars)</text>\n";
-  for (std::size_t p = 0; p < kinds.size(); ++p) {
-    const fieldobs::PitHistogram& pit = kinds[p]->pit;
-    const int left = static_cast<int>(p) * w + 30, bottom = h - 30, top = 40;
-    int total = 0, most = 1;
-    for (int c : pit.counts) {
-      total += c;
-      most = std::max(most, c);
-    }
-    const double expected = double(total) / double(pit.counts.size());
-    const double top_value = std::max(double(most), 1.5 * expected);
-    const double bar = double(w - 50) / double(pit.counts.size());
-    svg << "<text x=\"" << left
-        << "\" y=\"16\" font-weight=\"bold\">PIT: " << svg::Escape(kinds[p]->kind)
-        << "</text>\n<text x=\"" << left
-        << "\" y=\"32\">chi-square p = " << Fmt(pit.p_value, "%.2g") << " (" << total
-        << " observations)</text>\n";
-    for (std::size_t b = 0; b < pit.counts.size(); ++b) {
-      const double height = (bottom - top) * pit.counts[b] / top_value;
-      svg << "<rect x=\"" << left + b * bar << "\" y=\"" << bottom - height << "\" width=\""
-          << bar - 2 << "\" height=\"" << height << "\" fill=\"#6a8fd0\"/>\n";
-    }
-    const double ey = bottom - (bottom - top) * expected / top_value;
-    svg << "<line x1=\"" << left << "\" x2=\"" << left + (w - 50) << "\" y1=\"" << ey << "\" y2=\""
-        << ey << "\" stroke=\"black\" stroke-dasharray=\"4 3\"/>\n";
-    svg << "<text x=\"" << left << "\" y=\"" << bottom + 14 << "\">0</text><text x=\""
-        << left + (w - 50) << "\" y=\"" << bottom + 14 << "\" text-anchor=\"end\">1</text>\n";
-  }
-  svg << "</svg>\n";
-  return svg.str();
+  return svg::Stack(PitPanels(report), 3, "no PIT histogram (too few scalars)");
 }
 
 void WriteTextFile(const std::string& path, const std::string& text) {
@@ -232,14 +245,13 @@ void WriteTextFile(const std::string& path, const std::string& text) {
   file.Commit();
 }
 
-void WriteDepositsPng(const std::string& path, const EventFile& event,
-                      const fieldobs::EnsembleSamples& simulated) {
+std::string DepositsPng(const EventFile& event, const fieldobs::EnsembleSamples& simulated) {
   std::vector<MapMarker> markers;
   for (const Eigen::Vector2d& end : simulated.EndPositions(""))
     markers.push_back({end, {40, 90, 220}, 1, "simulated rest position"});
   for (const fieldobs::DepositObservation& d : event.observations.deposits)
     markers.push_back({d.xy_m, {215, 25, 28}, 3, "observed rest position"});
-  WriteQuickLookPng(path, event.scene.scene.terrain.heights(), nullptr, {}, markers);
+  return QuickLookPng(event.scene.scene.terrain.heights(), nullptr, {}, markers);
 }
 
 }  // namespace talus::io

@@ -27,20 +27,30 @@ struct ValidationRun {
   ensemble::EnsembleReport ensemble;
 };
 
+// The scene's warnings and what the run's endings censor (ensemble::RunWarnings: rocks at
+// max_time, rocks that left the DEM, ...), one sentence each: scores.json's "warnings", printed
+// by talus validate and shown first in its report.html.
+std::vector<std::string> ValidationWarnings(const EventFile& event, const ValidationRun& run);
+
 std::string ScoresJson(const EventFile& event, const fieldobs::ValidationReport& report,
                        const ValidationRun& run);
 // Per block and kind: scored count, mean bias (simulated mean - observed) and mean score.
 nlohmann::ordered_json BlockBiasJson(const std::vector<fieldobs::BlockBias>& biases);
 std::string ObservationsCsv(const fieldobs::ValidationReport& report);
+// One plot per scored scalar kind (svg_plot.hpp's frame): each observation at its observed value
+// with its simulated 5-95 % band and median, and the 1:1 line.
+std::vector<std::string> ObservedVsSimulatedPanels(const fieldobs::ValidationReport& report);
+// One PIT histogram per kind that has one.
+std::vector<std::string> PitPanels(const fieldobs::ValidationReport& report);
+// The panels above as one SVG file each.
 std::string ObservedVsSimulatedSvg(const fieldobs::ValidationReport& report);
 std::string PitSvg(const fieldobs::ValidationReport& report);
 
 // Writes text to `path` completely or not at all. Throws std::runtime_error.
 void WriteTextFile(const std::string& path, const std::string& text);
 
-// deposits.png: the DEM's hillshade, simulated end positions (blue) and observed rest positions
-// (red), when the event has deposit observations.
-void WriteDepositsPng(const std::string& path, const EventFile& event,
-                      const fieldobs::EnsembleSamples& simulated);
+// deposits.png's bytes: the DEM's hillshade, simulated end positions (blue) and observed rest
+// positions (red), when the event has deposit observations.
+std::string DepositsPng(const EventFile& event, const fieldobs::EnsembleSamples& simulated);
 
 }  // namespace talus::io

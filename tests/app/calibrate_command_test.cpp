@@ -9,6 +9,7 @@
 #include <array>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -89,8 +90,20 @@ TEST(CalibrateCommand, WritesTheGroundTableJsonAndHistory) {
   EXPECT_NE(output.find("Calibration report"), std::string::npos) << output;
   for (const char* name :
        {"ground_table.toml", "ground_table.csv", "history.csv", "calibration.json",
-        "convergence.svg", "observed_vs_simulated_runout.svg"})
+        "convergence.svg", "observed_vs_simulated_runout.svg", "report.html"})
     EXPECT_TRUE(fs::exists(dir / "out" / name)) << name;
+  // report.html: the fitted table, the plots inline (convergence, the profile, observed vs
+  // simulated).
+  const std::string report = Slurp(dir / "out" / "report.html");
+  EXPECT_NE(report.find("<h2>Fitted parameters</h2>"), std::string::npos);
+  EXPECT_NE(report.find("<th>medium_soft.mu_min</th>"), std::string::npos) << report;
+  EXPECT_NE(report.find(">Profile of medium_soft.mu_min"), std::string::npos);
+  EXPECT_NE(report.find(">run-out: observed vs simulated median</text>"), std::string::npos);
+  // run.log: what was printed, evaluations included.
+  const std::string log = Slurp(dir / "out" / "run.log");
+  for (const char* line : {"command: ", " calibrate ", "\nCalibration ", "fit evaluation    0",
+                           "Calibration report", "finished: exit 0"})
+    EXPECT_NE(log.find(line), std::string::npos) << line << "\n" << log;
   // The plots: one dot per feasible evaluation and the best-so-far line; one dot per run before
   // and one after.
   const std::string convergence = Slurp(dir / "out" / "convergence.svg");
@@ -131,6 +144,40 @@ TEST(CalibrateCommand, WritesTheGroundTableJsonAndHistory) {
                  &output),
       0)
       << output;
+}
+
+// On a terminal (script(1) gives the program one) the phases show their progress as one status
+// line: the optimisation's last evaluation, or the phase and the rocks of its current evaluation;
+// --quiet silences it with the information (warnings stay).
+TEST(CalibrateCommand, PhasesShowProgressOnATerminalAndQuietSilencesIt) {
+  if (std::system("command -v script >/dev/null 2>&1") != 0) GTEST_SKIP() << "no script(1)";
+  const fs::path dir = MakeEvent("progress");
+  std::string cal = kGood;
+  cal.replace(cal.find("max_evaluations = 6"), 19, "max_evaluations = 2");
+  cal += "[uncertainty]\nenabled = false\n";
+  Write(dir / "cal.toml", cal);
+  const auto on_a_terminal = [&](const std::string& out, const std::string& more) {
+    std::string output;
+    EXPECT_EQ(RunCommand("script -qec '" + std::string(TALUS_BINARY) + " calibrate " +
+                             (dir / "cal.toml").string() + " --threads 2 --out " +
+                             (dir / out).string() + more + "' /dev/null",
+                         &output),
+              0)
+        << output;
+    return output;
+  };
+  const std::string talkative = on_a_terminal("out", "");
+  EXPECT_NE(talkative.find("\r  fit evaluation    1"), std::string::npos) << talkative;
+  EXPECT_NE(talkative.find("\r  Measuring the roughness and the profiles at the optimum: "
+                           "evaluation 1  [rocks "),
+            std::string::npos)
+      << talkative;
+  const std::string quiet = on_a_terminal("quiet", " --quiet");
+  EXPECT_EQ(quiet.find("evaluation"), std::string::npos) << quiet;
+  EXPECT_EQ(quiet.find("Calibration"), std::string::npos) << quiet;
+  std::istringstream lines(quiet);
+  for (std::string line; std::getline(lines, line);)
+    EXPECT_EQ(line.rfind("talus calibrate: WARNING: ", 0), 0u) << line;
 }
 
 // Each mistake is refused with exit code 2, naming the file, line and key, before any rock runs
@@ -265,8 +312,9 @@ max_time_s = 3
         "r4,4,3,1,slab\nr5,3,-4,1,round\n");
   Write(dir / "observed.csv",
         "trajectory_id,observed_runout_m\nr1,17\nr2,19\nr3,14\nr4,16\nr5,18\n");
-  Write(dir / "event.toml", "scene = \"scene.toml\"\n[[observations]]\nkind = \"runout\"\n"
-                            "file = \"observed.csv\"\n");
+  Write(dir / "event.toml",
+        "scene = \"scene.toml\"\n[[observations]]\nkind = \"runout\"\n"
+        "file = \"observed.csv\"\n");
   Write(dir / "cal.toml", R"(event = "event.toml"
 [[parameters]]
 category = "medium_soft"
@@ -314,11 +362,11 @@ enabled = false
 size_m = [0.5, 0.4, 0.2]
 shape = "box"
 )" + shapes.substr(shapes.find("[blocks.round]")));
-  ASSERT_EQ(RunCommand(std::string(TALUS_BINARY) + " simulate " +
-                           (dir / "fitted_scene.toml").string() + " --out " +
-                           (dir / "sim").string() + " --rocks 2",
-                       &output),
-            0)
+  ASSERT_EQ(
+      RunCommand(std::string(TALUS_BINARY) + " simulate " + (dir / "fitted_scene.toml").string() +
+                     " --out " + (dir / "sim").string() + " --rocks 2",
+                 &output),
+      0)
       << output;
   const auto summary = nlohmann::json::parse(Slurp(dir / "sim" / "summary.json"));
   EXPECT_EQ(summary["blocks"][0]["id"], "round");  // blocks in key order

@@ -103,8 +103,51 @@ shape = { box = [0.4, 0.4, 0.3] }
 [release]
 points = [[3, 0]]
 lines = [[[4, -2], [4, 2]]]
-rocks = )" + std::to_string(rocks) +
-         "\n" + more + "[solver]\nmax_time_s = 4\n[output]\n" + output;
+rocks = )" +
+         std::to_string(rocks) + "\n" + more + "[solver]\nmax_time_s = 4\n[output]\n" + output;
+}
+
+// The small event of the end-to-end tests, in `dir`: event.toml over scene.toml, three runs of two
+// blocks on a short 35 degree slope (each run starts 2 m above the ground, so its first contact
+// episode is an impact), observed rest positions and run-outs (observed.csv) and impacts
+// (impacts.csv); `event_extra` is appended to event.toml.
+inline void WriteSmallEvent(const std::filesystem::path& dir, const std::string& event_extra = "") {
+  Write(dir / "scene.toml", R"([terrain]
+plane = { slope_deg = 35, slope_length_m = 20, runout_m = 10, width_m = 12, cell_m = 1 }
+default_ground = "medium_soft"
+[blocks]
+file = "blocks.csv"
+shape = "box"
+[release]
+runs = "runs.csv"
+rocks = 6
+seed = 3
+[solver]
+max_time_s = 4
+)");
+  Write(dir / "blocks.csv",
+        "block_id,mass_kg,size_x_m,size_y_m,size_z_m\nA,60,0.4,0.4,0.3\n"
+        "B,80,0.5,0.4,0.3\n");
+  Write(dir / "runs.csv",
+        "trajectory_id,x_m,y_m,height_m,vx_mps,block_id\nr1,3,0,2,1,A\n"
+        "r2,3,2,2,2,B\nr3,4,-2,2,0,A\n");
+  Write(dir / "observed.csv",
+        "trajectory_id,x_m,y_m,observed_runout_m\nr1,20,0,17\n"
+        "r2,22,2,19\nr3,18,-2,14\n");
+  Write(dir / "impacts.csv",
+        "trajectory_id,incoming_speed_mps,outgoing_speed_mps\nr1,6,3\n"
+        "r2,6.5,3.5\n");
+  Write(dir / "event.toml", R"(scene = "scene.toml"
+[[observations]]
+kind = "runout"
+file = "observed.csv"
+[[observations]]
+kind = "deposits"
+file = "observed.csv"
+[[observations]]
+kind = "impacts"
+file = "impacts.csv"
+)" + event_extra);
 }
 
 // summary.json without what depends on the machine and the split (threads and timings).
@@ -114,12 +157,14 @@ inline std::string WithoutTimings(const std::string& summary) {
   return j.dump(2);
 }
 
-// Every file of `dir` by name, summary.json without timings: what must be byte-identical between
-// runs that differ only in how the rocks were split (threads, ranks, parts).
+// Every file of `dir` by name, summary.json without timings and without run.log (the command line
+// and wall time): what must be byte-identical between runs that differ only in how the rocks were
+// split (threads, ranks, parts).
 inline std::map<std::string, std::string> OutputsWithoutTimings(const std::filesystem::path& dir) {
   std::map<std::string, std::string> files;
   for (const auto& entry : std::filesystem::directory_iterator(dir)) {
     const std::string name = entry.path().filename().string();
+    if (name == "run.log") continue;
     files[name] =
         name == "summary.json" ? WithoutTimings(Slurp(entry.path())) : Slurp(entry.path());
   }

@@ -125,7 +125,8 @@ TEST(SimulateCommand, WritesEveryOutputIdenticallyForOneAndTwoThreads) {
     const std::string name = entry.path().filename().string();
     EXPECT_EQ(name.find(".talus-tmp-"), std::string::npos)
         << "temporary file left behind: " << name;
-    if (name != "summary.json") {  // it has the wall time and the threads
+    // summary.json has the wall time and the threads, run.log the command line and the timings.
+    if (name != "summary.json" && name != "run.log") {
       EXPECT_EQ(Slurp(entry.path()), Slurp(b / name)) << name << " differs between 1 and 2 threads";
       tifs += entry.path().extension() == ".tif";
     }
@@ -500,7 +501,7 @@ void InterruptARun(int signal, const std::string& name) {
       0)
       << log;
   const auto earlier = Snapshot(out);
-  ASSERT_EQ(earlier.size(), 18u);  // with the list of outputs, .talus-outputs
+  ASSERT_EQ(earlier.size(), 19u);  // with the list of outputs, .talus-outputs, and run.log
 
   const pid_t pid = StartTalus(
       {"simulate", (dir / "slow.toml").string(), "--out", out.string(), "--threads", "2"},
@@ -666,6 +667,7 @@ TEST(TalusCommandLine, ThreadsAreCappedAtAFewPerCore) {
 // Censored endings are said where the user looks: rocks still moving at max_time are a WARNING
 // line on stderr, an entry of summary.json's "warnings" and the "Warnings" list at the top of
 // report.html (ensemble/run_warnings.hpp; each rule has its own test in run_warnings_test.cpp).
+// With --quiet too: warnings are never silenced.
 TEST(SimulateCommand, RocksAtMaxTimeAreWarnedInTheConsoleTheSummaryAndTheReport) {
   const fs::path dir = FreshDir("max_time_warning");
   std::string scene = kScene;
@@ -674,12 +676,21 @@ TEST(SimulateCommand, RocksAtMaxTimeAreWarnedInTheConsoleTheSummaryAndTheReport)
   const fs::path out = dir / "out";
   std::string log;
   ASSERT_EQ(RunCommand(Talus("simulate " + (dir / "scene.toml").string() + " --out " +
-                             out.string() + " --threads 1"),
+                             out.string() + " --threads 1 --quiet"),
                        &log),
             0)
       << log;
   const std::string expected = "6 of 6 rocks (100.0 %) were still moving at max_time_s = 0.5 s";
   EXPECT_NE(log.find("talus simulate: WARNING: " + expected), std::string::npos) << log;
+  // --quiet: the warning and nothing else; run.log has what a run without it would have printed.
+  EXPECT_EQ(log.rfind("talus simulate: WARNING: ", 0), 0u) << log;
+  EXPECT_EQ(std::count(log.begin(), log.end(), '\n'), 1) << log;
+  const std::string run_log = Slurp(out / "run.log");
+  for (const std::string& line :
+       {std::string("command: "), std::string(" --quiet\n"), std::string("\nScene "),
+        std::string("\nWrote "), "talus simulate: WARNING: " + expected,
+        std::string("finished: exit 0")})
+    EXPECT_NE(run_log.find(line), std::string::npos) << line << "\n" << run_log;
   const auto summary = nlohmann::json::parse(Slurp(out / "summary.json"));
   ASSERT_EQ(summary["warnings"].size(), 1u) << summary["warnings"];
   EXPECT_NE(summary["warnings"][0].get<std::string>().find(expected), std::string::npos);

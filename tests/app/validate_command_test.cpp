@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -27,46 +28,10 @@ using talus::app::testing::Slurp;
 
 using talus::app::testing::Write;
 
-// Three runs of two blocks on a short 35 degree slope, observed rest positions and run-outs, and
-// impacts (each run starts 2 m above the ground, so its first contact episode is an impact).
+// The small event of run_talus.hpp in a fresh directory.
 fs::path MakeEvent(const std::string& name, const std::string& event_extra = "") {
   fs::path dir = FreshDir(name);
-  Write(dir / "scene.toml", R"([terrain]
-plane = { slope_deg = 35, slope_length_m = 20, runout_m = 10, width_m = 12, cell_m = 1 }
-default_ground = "medium_soft"
-[blocks]
-file = "blocks.csv"
-shape = "box"
-[release]
-runs = "runs.csv"
-rocks = 6
-seed = 3
-[solver]
-max_time_s = 4
-)");
-  Write(dir / "blocks.csv",
-        "block_id,mass_kg,size_x_m,size_y_m,size_z_m\nA,60,0.4,0.4,0.3\n"
-        "B,80,0.5,0.4,0.3\n");
-  Write(dir / "runs.csv",
-        "trajectory_id,x_m,y_m,height_m,vx_mps,block_id\nr1,3,0,2,1,A\n"
-        "r2,3,2,2,2,B\nr3,4,-2,2,0,A\n");
-  Write(dir / "observed.csv",
-        "trajectory_id,x_m,y_m,observed_runout_m\nr1,20,0,17\n"
-        "r2,22,2,19\nr3,18,-2,14\n");
-  Write(dir / "impacts.csv",
-        "trajectory_id,incoming_speed_mps,outgoing_speed_mps\nr1,6,3\n"
-        "r2,6.5,3.5\n");
-  Write(dir / "event.toml", R"(scene = "scene.toml"
-[[observations]]
-kind = "runout"
-file = "observed.csv"
-[[observations]]
-kind = "deposits"
-file = "observed.csv"
-[[observations]]
-kind = "impacts"
-file = "impacts.csv"
-)" + event_extra);
+  talus::app::testing::WriteSmallEvent(dir, event_extra);
   return dir;
 }
 
@@ -81,11 +46,24 @@ TEST(ValidateCommand, WritesScoresThatDoNotDependOnTheThreadCount) {
               0)
         << output;
   }
-  for (const char* file :
-       {"scores.json", "observations.csv", "observed_vs_simulated.svg", "pit.svg", "deposits.png"})
+  for (const char* file : {"scores.json", "observations.csv", "observed_vs_simulated.svg",
+                           "pit.svg", "deposits.png", "report.html"})
     EXPECT_TRUE(fs::exists(dir / "out1" / file)) << file;
+  // report.html: the same for any thread count (no timings), with the scores and the warnings.
+  const std::string report = Slurp(dir / "out1" / "report.html");
+  EXPECT_EQ(report, Slurp(dir / "out2" / "report.html"));
+  EXPECT_NE(report.find("<th>run-out (m)</th><td>3</td><td>3</td><td>CRPS</td>"),
+            std::string::npos);
+  // 4 s is too short for some of the rocks: their run-outs are censored, and validate says so on
+  // the console, in scores.json and first in report.html.
+  EXPECT_NE(output.find("talus validate: WARNING: "), std::string::npos) << output;
+  EXPECT_NE(output.find("still moving at max_time_s = 4 s"), std::string::npos) << output;
+  EXPECT_NE(report.find("still moving at max_time_s = 4 s"), std::string::npos);
+  EXPECT_LT(report.find("<h2>Warnings</h2>"), report.find("Scores per kind"));
   EXPECT_EQ(Slurp(dir / "out1" / "observations.csv"), Slurp(dir / "out2" / "observations.csv"));
   const auto scores = nlohmann::json::parse(Slurp(dir / "out1" / "scores.json"));
+  ASSERT_EQ(scores["warnings"].size(), 1u) << scores["warnings"];
+  EXPECT_NE(scores["warnings"][0].get<std::string>().find("max_time"), std::string::npos);
   EXPECT_EQ(scores["runs"], 3);
   EXPECT_EQ(scores["rocks_per_run"], 6);
   EXPECT_EQ(scores["observations"], 3 + 3 + 2 * 2);  // runouts, deposits, 2 per impact
@@ -114,6 +92,36 @@ TEST(ValidateCommand, AFileSizeLimitIsOneErrorAndLeavesNothing) {
   EXPECT_TRUE(!fs::exists(out) || fs::is_empty(out)) << output;
 }
 
+// Under a terminal (script(1) gives the program one) validate shows the rocks' progress; --quiet
+// silences it and the information, not the warning; run.log keeps what was said either way.
+TEST(ValidateCommand, ProgressOnATerminalAndQuietKeepsOnlyWarningsButRunLogKeepsAll) {
+  if (std::system("command -v script >/dev/null 2>&1") != 0) GTEST_SKIP() << "no script(1)";
+  const fs::path dir = MakeEvent("quiet");
+  const auto on_a_terminal = [&](const std::string& out, const std::string& more) {
+    std::string output;
+    EXPECT_EQ(RunCommand("script -qec '" + std::string(TALUS_BINARY) + " validate " +
+                             (dir / "event.toml").string() + " --out " + (dir / out).string() +
+                             more + "' /dev/null",
+                         &output),
+              0)
+        << output;
+    return output;
+  };
+  const std::string talkative = on_a_terminal("out", "");
+  EXPECT_NE(talkative.find("\r[###"), std::string::npos) << talkative;  // the progress bar
+  EXPECT_NE(talkative.find(" rocks "), std::string::npos);
+  EXPECT_NE(talkative.find("Event "), std::string::npos);
+  const std::string quiet = on_a_terminal("quiet", " --quiet");
+  EXPECT_EQ(quiet.find("[#"), std::string::npos) << quiet;
+  EXPECT_EQ(quiet.find("Event "), std::string::npos) << quiet;
+  EXPECT_EQ(quiet.rfind("talus validate: WARNING: ", 0), 0u) << quiet;
+  const std::string log = Slurp(dir / "quiet" / "run.log");
+  for (const char* line : {"talus ", "command: ", " validate ", " --quiet\n", "\nEvent ",
+                           "\nWrote 6 files to ", "talus validate: WARNING: ", "finished: exit 0"})
+    EXPECT_NE(log.find(line), std::string::npos) << line << "\n" << log;
+  EXPECT_EQ(log.find("[#"), std::string::npos);  // progress is not kept
+}
+
 TEST(ValidateCommand, BadEventsFailBeforeAnyRockNamingFileLineAndKey) {
   std::string output;
   const fs::path dir = MakeEvent("validate_bad",
@@ -128,6 +136,7 @@ TEST(ValidateCommand, BadEventsFailBeforeAnyRockNamingFileLineAndKey) {
             std::string::npos)
       << output;
   EXPECT_FALSE(fs::exists(dir / "out" / "scores.json"));
+  EXPECT_FALSE(fs::exists(dir / "out" / "run.log"));  // only a run that succeeded leaves one
   // An observation of a run the scene does not have.
   const fs::path other = MakeEvent("validate_run");
   Write(other / "observed.csv", "trajectory_id,x_m,y_m,observed_runout_m\nr1,20,0,17\nr9,1,1,1\n");
@@ -156,6 +165,8 @@ TEST(ValidateCommand, ChantSuraSingleImpactsAreScoredWithTheirScarDepths) {
             0)
       << output;
   EXPECT_EQ(output.find("Not scored: "), std::string::npos) << output;
+  // The runs stop at 0.6 s by design: a single impact is not censored by max_time, so no warning.
+  EXPECT_EQ(output.find("max_time"), std::string::npos) << output;
   const auto scores = nlohmann::json::parse(Slurp(dir / "out" / "scores.json"));
   EXPECT_EQ(scores["runs"], 6);
   EXPECT_EQ(scores["observations"], 12);

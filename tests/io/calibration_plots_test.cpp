@@ -102,7 +102,7 @@ TEST(ObservedSimulatedSvg, OneDotPerScoredObservationOfTheKindOnTheOneToOneLineW
       Score("runout", 100, 100), Score("runout", 150, 140), Score("runout", 90, 95, false),
       Score("impact_speed_out", 5, 5), Score("runout", 120, 125)};
   const std::string svg = ObservedSimulatedSvg("runout", before, after);
-  EXPECT_NE(svg.find("runout: observed vs simulated median"), std::string::npos);
+  EXPECT_NE(svg.find("run-out: observed vs simulated median"), std::string::npos);
   EXPECT_NE(svg.find("observed (m)"), std::string::npos);
   const std::vector<Dot> dots = Circles(svg);
   ASSERT_EQ(dots.size(), 5u);  // before: 2 (unscored, other kind, NaN median left out); after: 3

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <string>
+#include <vector>
 
 namespace talus::io::svg {
 namespace {
@@ -57,7 +58,29 @@ TEST(SvgPlot, EscapeReplacesTheFourMarkupCharactersAndNothingElse) {
   EXPECT_EQ(Escape(""), "");
 }
 
-TEST(SvgPlot, FrameHasTitleLabelsAndFiveTicksPerAxis) {
+TEST(SvgPlot, TicksAreRoundNumbersInsideTheAxis) {
+  // The report's histograms had ticks at 8.525 rocks and 434.4 m (a quarter of the range).
+  EXPECT_EQ(NiceTicks(0, 434.4), (std::vector<double>{0, 100, 200, 300, 400}));
+  EXPECT_EQ(NiceTicks(0, 8.525), (std::vector<double>{0, 2, 4, 6, 8}));
+  EXPECT_EQ(NiceTicks(-1, 1), (std::vector<double>{-1, -0.5, 0, 0.5, 1}));
+  EXPECT_EQ(NiceTicks(3.14, 3.35), (std::vector<double>{3.15, 3.2, 3.25, 3.3, 3.35}));
+  // Multiples of 2.5 x a power of ten, and a narrow range still gets two ticks or more.
+  EXPECT_EQ(NiceTicks(0, 11), (std::vector<double>{0, 2.5, 5, 7.5, 10}));
+  EXPECT_GE(NiceTicks(0.999, 1.001).size(), 2u);
+  for (double t : NiceTicks(-0.37, 0.52)) EXPECT_TRUE(t >= -0.37 && t <= 0.52) << t;
+  EXPECT_EQ(NiceTicks(5, 5), std::vector<double>{5});  // no range: one tick, no endless loop
+}
+
+TEST(SvgPlot, TickLabelsHaveTheDecimalsOfTheirStep) {
+  EXPECT_EQ(TickLabels({0, 100, 200}), (std::vector<std::string>{"0", "100", "200"}));
+  EXPECT_EQ(TickLabels({-1, -0.5, 0, 0.5}),
+            (std::vector<std::string>{"-1.0", "-0.5", "0.0", "0.5"}));
+  EXPECT_EQ(TickLabels({0, 2.5, 5}), (std::vector<std::string>{"0.0", "2.5", "5.0"}));
+  EXPECT_EQ(TickLabels({3.15, 3.2, 3.25}), (std::vector<std::string>{"3.15", "3.20", "3.25"}));
+  EXPECT_EQ(TickLabels({0, 2e6, 4e6}), (std::vector<std::string>{"0", "2e+06", "4e+06"}));
+}
+
+TEST(SvgPlot, FrameHasTitleLabelsAndRoundTicksOnEachAxis) {
   const Axis x{0, 4, kLeft, kWidth - kRight};
   const Axis y{-1, 1, kHeight - kBottom, kTop};
   const std::string svg = Frame("Convergence", "evaluation", "objective", x, y);
@@ -67,12 +90,13 @@ TEST(SvgPlot, FrameHasTitleLabelsAndFiveTicksPerAxis) {
   EXPECT_NE(svg.find("rotate(-90)\" text-anchor=\"middle\">objective</text>"), std::string::npos);
   // Ticks at 0, 1, 2, 3, 4 on x and -1, -0.5, 0, 0.5, 1 on y, placed by the axes.
   for (const char* tick : {">0</text>", ">1</text>", ">2</text>", ">3</text>", ">4</text>",
-                           ">-1</text>", ">-0.5</text>", ">0.5</text>"})
+                           ">-1.0</text>", ">-0.5</text>", ">0.5</text>"})
     EXPECT_GE(Count(svg, tick), 1) << tick;
   EXPECT_EQ(Count(svg, "text-anchor=\"end\">"), 5);  // the y ticks
   EXPECT_NE(svg.find("<text x=\"" + F(x(2)) + "\" y=\"" + F(kHeight - kBottom + 14) + "\""),
             std::string::npos);
-  EXPECT_NE(svg.find("y=\"" + F(y(0) + 4) + "\" text-anchor=\"end\">0</text>"), std::string::npos);
+  EXPECT_NE(svg.find("y=\"" + F(y(0) + 4) + "\" text-anchor=\"end\">0.0</text>"),
+            std::string::npos);
   // The caller closes the plot.
   EXPECT_EQ(svg.find("</svg>"), std::string::npos);
 }

@@ -16,6 +16,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "io/svg_plot.hpp"
 #include "test_files.hpp"
 
 namespace talus::io {
@@ -134,33 +135,38 @@ TEST(ObservationsCsv, OneRowPerObservationWithEmptyFieldsForMissingValues) {
 
 TEST(ValidationPlots, PanelsForScoredScalarKindsAndPitBarsInProportion) {
   const std::string svg = ObservedVsSimulatedSvg(Report());
-  EXPECT_NE(svg.find("runout (m): observed (red)"), std::string::npos);
-  EXPECT_EQ(svg.find("deposit ("), std::string::npos) << "no panel for deposits";
+  EXPECT_NE(svg.find(">run-out: simulated against observed</text>"), std::string::npos) << svg;
+  EXPECT_NE(svg.find(">observed (m)</text>"), std::string::npos);
+  EXPECT_EQ(svg.find("deposit"), std::string::npos) << "no panel for deposits";
+  EXPECT_EQ(ObservedVsSimulatedPanels(Report()).size(), 1u);
   const std::regex dot("<circle ");
-  EXPECT_EQ(std::distance(std::sregex_iterator(svg.begin(), svg.end(), dot), std::sregex_iterator()),
-            2);  // the scored scalars
+  EXPECT_EQ(
+      std::distance(std::sregex_iterator(svg.begin(), svg.end(), dot), std::sregex_iterator()),
+      2);  // the scored scalars' medians
   EXPECT_NE(svg.find("<title>a, b</title>"), std::string::npos);
+  // The one plot writer's frame: round ticks (the old panels had 95.5, 103.8, ...).
+  EXPECT_NE(svg.find(">100</text>"), std::string::npos) << svg;
   fieldobs::ValidationReport none;
   EXPECT_NE(ObservedVsSimulatedSvg(none).find("no scalar observation was scored"),
             std::string::npos);
   EXPECT_NE(PitSvg(none).find("no PIT histogram"), std::string::npos);
 
   // PIT: bars of counts 1, 4, 2 (7 observations) under a top of max(4, 1.5 * 7/3) = 4: heights
-  // (bottom - top) * count / 4 with bottom - top = 150.
+  // of the plot box's height times count / 4.
   fieldobs::ValidationReport r = Report();
   r.kinds[0].pit.counts = {1, 4, 2};
   const std::string pit = PitSvg(r);
-  EXPECT_NE(pit.find("PIT: runout"), std::string::npos);
-  EXPECT_NE(pit.find("(7 observations)"), std::string::npos);
+  EXPECT_NE(pit.find("PIT: run-out (7 observations)"), std::string::npos) << pit;
   std::vector<double> heights;
   const std::regex bar(R"re(height="([0-9.]+)" fill="#6a8fd0")re");
   for (auto it = std::sregex_iterator(pit.begin(), pit.end(), bar); it != std::sregex_iterator();
        ++it)
     heights.push_back(std::stod((*it)[1]));
   ASSERT_EQ(heights.size(), 3u);
-  EXPECT_NEAR(heights[0], 150.0 * 1 / 4, 1e-9);
-  EXPECT_NEAR(heights[1], 150.0, 1e-9);
-  EXPECT_NEAR(heights[2], 150.0 * 2 / 4, 1e-9);
+  const double box = svg::kHeight - svg::kTop - svg::kBottom;
+  EXPECT_NEAR(heights[0], box * 1 / 4, 0.01);
+  EXPECT_NEAR(heights[1], box, 0.01);
+  EXPECT_NEAR(heights[2], box * 2 / 4, 0.01);
 }
 
 TEST(WriteTextFile, WritesTheWholeTextOrThrowsLeavingNothing) {
