@@ -253,8 +253,8 @@ void TreeLayer(Writer& out, const Forest& forest, const std::string& tree_impact
     for (int row = 0; row < table.rows(); ++row) {
       const double tree = table.NonNegativeNumber(row, "tree");
       if (!(tree < static_cast<double>(n)) || tree != static_cast<double>(static_cast<long>(tree)))
-        throw InputError(table.Where(row, "tree") + ": no tree " + TenDigits(tree) + " in the forest of " +
-                         std::to_string(n) + " trees");
+        throw InputError(table.Where(row, "tree") + ": no tree " + TenDigits(tree) +
+                         " in the forest of " + std::to_string(n) + " trees");
       const auto k = static_cast<std::size_t>(tree);
       ++rocks[k];
       impacts[k] += static_cast<long>(table.NonNegativeNumber(row, "impacts"));

@@ -181,8 +181,8 @@ ResourceEstimate EstimateResources(const SceneFile& scene, int threads) {
                         "a sparser or smaller [forest]"});
     // rocks.gpkg's trees layer: a point of 7 fields per stem with its index entries.
     if (output.geopackage)
-      e.disk.push_back({"rocks.gpkg trees", stems * kGeoPackageBytesPerTree,
-                        "a sparser or smaller [forest]"});
+      e.disk.push_back(
+          {"rocks.gpkg trees", stems * kGeoPackageBytesPerTree, "a sparser or smaller [forest]"});
   }
   if (output.geopackage)
     e.disk.push_back({"rocks.gpkg",

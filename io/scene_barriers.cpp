@@ -82,8 +82,8 @@ void ApplyFeatureAttributes(const std::vector<std::string>& fields,
     const char* unit = height ? "m" : "kJ";
     if (!(number > 0 && number <= max))
       throw InputError(where + ": attribute '" + field + "' is " + v.text + ": the " +
-                       (height ? "height" : "capacity") + " must be a number > 0 and <= " +
-                       TenDigits(max) + " " + unit +
+                       (height ? "height" : "capacity") +
+                       " must be a number > 0 and <= " + TenDigits(max) + " " + unit +
                        (height && number == 0
                             ? " (a barrier only rocks touching the ground meet: height_m = 0 in "
                               "its own table)"
@@ -126,14 +126,15 @@ void LoadBarriers(const Context& context, const toml::node* node, SceneFile& out
       if (s.Has(field_key) && !s.Has("file"))
         s.Fail(field_key, "only the line features of a vector file ('file') have attributes");
       if (s.Has(field_key) && s.Has(table_key))
-        s.Fail(table_key, "give " + table_key + " or " + field_key + " (each feature's own), not both");
+        s.Fail(table_key,
+               "give " + table_key + " or " + field_key + " (each feature's own), not both");
       fields.push_back(s.Has(field_key) ? s.String(field_key, "") : "");
-      if (s.Has(field_key) && fields.back().empty()) s.Fail(field_key, "the attribute name is empty");
+      if (s.Has(field_key) && fields.back().empty())
+        s.Fail(field_key, "the attribute name is empty");
     }
     Barrier b;
     if (fields[2].empty()) {
-      if (!s.Has("type"))
-        s.Fail("type", "missing: \"flexible_net\", \"rigid_wall\" or \"dam\"");
+      if (!s.Has("type")) s.Fail("type", "missing: \"flexible_net\", \"rigid_wall\" or \"dam\"");
       const std::string type = s.String("type", "");
       if (!ParseBarrierType(type, &b.type))
         s.Fail("type", "unknown barrier type '" + type +

@@ -295,10 +295,11 @@ SceneFile LoadSceneTable(const toml::table& root, const std::string& path,
   LoadOutput(output, out.output);
   if (!out.has_forest && std::count(out.output.rasters.begin(), out.output.rasters.end(),
                                     ensemble::RasterKind::kTreeHits) > 0)
-    output.Fail("rasters", out.forest_model == "drag"
-                               ? "tree_hits counts the impacts on explicit stems: [forest] model "
-                                 "= \"drag\" has none"
-                               : "tree_hits counts the impacts on stems: the scene has no [forest]");
+    output.Fail("rasters",
+                out.forest_model == "drag"
+                    ? "tree_hits counts the impacts on explicit stems: [forest] model "
+                      "= \"drag\" has none"
+                    : "tree_hits counts the impacts on stems: the scene has no [forest]");
   if (!out.release.blocks.empty() && out.release.runs.empty())
     context.Fail(root.get("blocks"), "blocks",
                  "blocks are for the runs of a run table ([release] runs = \"file.csv\")");

@@ -102,7 +102,7 @@ struct SceneFile {
   // in scene.forest_drag, with the stands above and the rasters below), "" without [forest].
   std::string forest_model;
   std::string forest_density_raster, forest_dbh_raster;  // model = "drag", resolved; "" without
-  long forest_drag_cells = 0;  // model = "drag": DEM nodes in a stand
+  long forest_drag_cells = 0;                            // model = "drag": DEM nodes in a stand
   ForestModel forest_drag_model;  // model = "drag": its breaking energy and height
 };
 

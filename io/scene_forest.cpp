@@ -327,8 +327,8 @@ ForestDrag BuildDragLayer(const Context& context, const Section& s,
            "stems_per_ha_raster and dbh_raster go together: a stand needs both its density and "
            "its DBH");
   if (s.Has("stems_per_ha_raster")) {
-    const std::vector<double> density = RasterOnDem(context, s, "stems_per_ha_raster", dem, out,
-                                                    &out.forest_density_raster);
+    const std::vector<double> density =
+        RasterOnDem(context, s, "stems_per_ha_raster", dem, out, &out.forest_density_raster);
     const std::vector<double> dbh =
         RasterOnDem(context, s, "dbh_raster", dem, out, &out.forest_dbh_raster);
     std::map<std::pair<double, double>, int> index;
@@ -343,8 +343,7 @@ ForestDrag BuildDragLayer(const Context& context, const Section& s,
       if (!(dbh[k] > 0 && dbh[k] <= kMaxDbh_cm))
         s.Fail("dbh_raster", out.forest_dbh_raster + ": DBH " + TenDigits(dbh[k]) + " cm at " +
                                  NodeAt(dem, k) + ", where " + out.forest_density_raster +
-                                 " has stems, must be > 0 and <= " + TenDigits(kMaxDbh_cm) +
-                                 " cm");
+                                 " has stems, must be > 0 and <= " + TenDigits(kMaxDbh_cm) + " cm");
       auto [it, added] = index.try_emplace({n, dbh[k]}, static_cast<int>(list.size()));
       if (added)
         list.push_back(DragStand{n / 1e4, dbh[k] / 100, model.BreakingEnergy_J(dbh[k] / 100)});
@@ -358,7 +357,8 @@ ForestDrag BuildDragLayer(const Context& context, const Section& s,
       rings.push_back(input.rings);
       burn.push_back(static_cast<int>(list.size()));
       const double dbh_m = input.stand.dbh_cm / 100;
-      list.push_back(DragStand{input.stand.stems_per_ha / 1e4, dbh_m, model.BreakingEnergy_J(dbh_m)});
+      list.push_back(
+          DragStand{input.stand.stems_per_ha / 1e4, dbh_m, model.BreakingEnergy_J(dbh_m)});
       out.stands.push_back(input.stand);
       if (input.stand.dbh_sd_cm > 0)
         out.warnings.push_back(input.where +
@@ -400,8 +400,9 @@ void LoadForest(const Context& context, const Section& s, bool given, SceneFile&
   } else {
     for (const char* key : {"stems_per_ha_raster", "dbh_raster"})
       if (s.Has(key))
-        s.Fail(key, std::string(key) + " is for model = \"drag\"; explicit trees come from trees, "
-                                       "stands or stands_file");
+        s.Fail(key, std::string(key) +
+                        " is for model = \"drag\"; explicit trees come from trees, "
+                        "stands or stands_file");
     if (!s.Has("trees") && !s.Has("stands") && !s.Has("stands_file"))
       s.Fail("trees",
              "a [forest] needs trees = \"trees.csv\", stands = [{ polygon = ..., "

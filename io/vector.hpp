@@ -56,8 +56,8 @@ std::vector<GroundPolygon> ReadGroundPolygons(const std::string& path,
 struct FeatureValue {
   enum class Kind { kNoField, kNull, kNumber, kText };
   Kind kind = Kind::kNoField;
-  double number = 0;  // kNumber
-  std::string text;   // kNumber and kText: the value as GDAL prints it
+  double number = 0;   // kNumber
+  std::string text;    // kNumber and kText: the value as GDAL prints it
   std::string fields;  // kNoField: the layer's fields, "a, b, c" ("none")
 };
 std::vector<ensemble::EvaluationLine> ReadLineFeatures(

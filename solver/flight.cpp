@@ -112,8 +112,7 @@ int ClearFlightSteps(const Scene& scene, const RockShape& rock, const RockState&
   const Eigen::Vector3d& v = state.velocity_m_s;
   TerrainSample under;
   if (max_steps <= 0 || !terrain.Sample(p.x(), p.y(), &under)) return 0;
-  const Flight flight{opt.dt_s, opt.gravity_m_s2, PredictionHorizon(opt),
-                      HighestDragLayer(scene)};
+  const Flight flight{opt.dt_s, opt.gravity_m_s2, PredictionHorizon(opt), HighestDragLayer(scene)};
   const double rho = rock.bounding_radius_m;
   const double spin = rho * MaxAngularSpeed(rock, state);
   // Vertices stay within rho of the centre, and predicted end points within reach of it.

@@ -99,11 +99,12 @@ class Forest {
 // impact parameter, and at most the stem's breaking energy (it breaks then). Spread over the
 // path, dE/dt = -lambda |v_h| dE: as a drag on v and Omega with one rate
 //   c = lambda |v_h| min(E_max, eta E) / (2 E)   (1/s),
-// evaluated at the step's beginning and integrated by the drag layer's exact form (solver/step.cpp).
+// evaluated at the step's beginning and integrated by the drag layer's exact form
+// (solver/step.cpp).
 struct DragStand {
-  double stems_per_m2 = 0;      // n, > 0
-  double dbh_m = 0;             // D, > 0
-  double breaking_energy_J = 0; // E_max(D) of the ForestModel, > 0
+  double stems_per_m2 = 0;       // n, > 0
+  double dbh_m = 0;              // D, > 0
+  double breaking_energy_J = 0;  // E_max(D) of the ForestModel, > 0
 };
 
 class ForestDrag {

@@ -72,7 +72,8 @@ void DragLayer(const Scene& scene, const RockShape& rock, const Eigen::Vector3d&
   double c_t = ground_layer ? g.drag_translational_1_s : 0.0;
   double c_r = ground_layer ? g.drag_rotational_1_s : 0.0;
   if (!scene.forest_drag.empty()) {
-    const double c = ForestDragRate_1_s(scene.forest_drag, rock, begin, centre, centre.z() - height);
+    const double c =
+        ForestDragRate_1_s(scene.forest_drag, rock, begin, centre, centre.z() - height);
     c_t += c;
     c_r += c;
   }

@@ -283,9 +283,9 @@ TEST(RocksGeoPackage, TreesAreALayerWithTheirDbhHitsAndBreakages) {
                          "\n2,1,0,r,12,22,45,1,1.7,12,22,8,900000,150000,1"
                          "\n0,2,0,r,10,20,30,1,2.0,10,20,6,50000,50000,0\n");
   const std::string path = (dir / "rocks.gpkg").string();
-  WriteRocksGeoPackage(path, (dir / "rocks.csv").string(), "", testing::Wkt(31287), "", "",
-                       GeoPackageScene{nullptr, nullptr, nullptr, &forest,
-                                       (dir / "tree_impacts.csv").string()});
+  WriteRocksGeoPackage(
+      path, (dir / "rocks.csv").string(), "", testing::Wkt(31287), "", "",
+      GeoPackageScene{nullptr, nullptr, nullptr, &forest, (dir / "tree_impacts.csv").string()});
   Dataset gpkg(path);
   ASSERT_NE(gpkg.d, nullptr);
   OGRLayer* trees = gpkg.d->GetLayerByName("trees");
@@ -298,9 +298,8 @@ TEST(RocksGeoPackage, TreesAreALayerWithTheirDbhHitsAndBreakages) {
     long rocks, impacts, broken;
     double absorbed_kj;
   };
-  const Expected expected[] = {{10, 20, 5, 30, 1, 1, 0, 50},
-                               {11, 21, 6, 20, 0, 0, 0, 0},
-                               {12, 22, 7, 45, 2, 3, 1, 400}};
+  const Expected expected[] = {
+      {10, 20, 5, 30, 1, 1, 0, 50}, {11, 21, 6, 20, 0, 0, 0, 0}, {12, 22, 7, 45, 2, 3, 1, 400}};
   for (long k = 0; k < 3; ++k) {
     SCOPED_TRACE(k);
     std::unique_ptr<OGRFeature> f(trees->GetNextFeature());
@@ -327,10 +326,9 @@ TEST(RocksGeoPackage, TreesAreALayerWithTheirDbhHitsAndBreakages) {
   testing::WriteText(dir / "tree_impacts.csv", std::string(TreeImpactsCsvWriter::Header()) +
                                                    "\n3,0,0,r,12,22,45,2,1.5,12,22,8,3,2,0\n");
   try {
-    WriteRocksGeoPackage((dir / "bad.gpkg").string(), (dir / "rocks.csv").string(), "", "", "",
-                         "",
-                         GeoPackageScene{nullptr, nullptr, nullptr, &forest,
-                                         (dir / "tree_impacts.csv").string()});
+    WriteRocksGeoPackage(
+        (dir / "bad.gpkg").string(), (dir / "rocks.csv").string(), "", "", "", "",
+        GeoPackageScene{nullptr, nullptr, nullptr, &forest, (dir / "tree_impacts.csv").string()});
     ADD_FAILURE() << "no error";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("tree_impacts.csv:2"), std::string::npos) << e.what();

@@ -97,9 +97,9 @@ TEST(SceneBarriers, EachFeatureOfAFileCarriesItsOwnHeightCapacityAndType) {
  "geometry": {"type": "LineString", "coordinates": [[20, -10], [20, 10]]}},
 {"type": "Feature", "properties": {"name": "lower", "h": 6, "cap": "5000", "kind": "dam"},
  "geometry": {"type": "MultiLineString", "coordinates": [[[50, -10], [50, 0]], [[52, 0], [52, 10]]]}}]})";
-  testing::WriteText(dir / "scene.toml",
-                     kScene + "file = \"nets.geojson\"\nheight_field = \"h\"\n"
-                              "capacity_field = \"cap\"\ntype_field = \"kind\"\n");
+  testing::WriteText(dir / "scene.toml", kScene +
+                                             "file = \"nets.geojson\"\nheight_field = \"h\"\n"
+                                             "capacity_field = \"cap\"\ntype_field = \"kind\"\n");
   SceneFile s = LoadScene((dir / "scene.toml").string());
   ASSERT_EQ(s.scene.barriers.size(), 3u);  // the multi-line gives one barrier per part
   EXPECT_EQ(s.scene.barriers[1].name, "lower part 1");
@@ -117,8 +117,9 @@ TEST(SceneBarriers, EachFeatureOfAFileCarriesItsOwnHeightCapacityAndType) {
   }
   // Capacity per feature, height and type from the table.
   testing::WriteText(dir / "scene.toml",
-                     kScene + "file = \"nets.geojson\"\nname_field = \"name\"\n"
-                              "capacity_field = \"cap\"\nheight_m = 4\ntype = \"rigid_wall\"\n");
+                     kScene +
+                         "file = \"nets.geojson\"\nname_field = \"name\"\n"
+                         "capacity_field = \"cap\"\nheight_m = 4\ntype = \"rigid_wall\"\n");
   s = LoadScene((dir / "scene.toml").string());
   ASSERT_EQ(s.scene.barriers.size(), 3u);
   EXPECT_EQ(s.scene.barriers[0].capacity_J, 500e3);
@@ -133,7 +134,8 @@ TEST(SceneBarriers, AFeaturesMissingOrNonPositiveAttributeIsAnErrorNamingFileFea
     std::ofstream(dir / "nets.geojson") << R"({"type": "FeatureCollection", "features": [
 {"type": "Feature", "properties": {"name": "a", "h": 4, "cap": 500, "kind": "dam"},
  "geometry": {"type": "LineString", "coordinates": [[20, -10], [20, 10]]}},
-{"type": "Feature", "properties": )" + properties + R"(,
+{"type": "Feature", "properties": )" + properties +
+                                               R"(,
  "geometry": {"type": "LineString", "coordinates": [[50, -10], [50, 10]]}}]})";
     testing::WriteText(dir / "scene.toml", kScene + "file = \"nets.geojson\"\n" + table);
     try {

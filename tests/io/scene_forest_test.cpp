@@ -362,9 +362,11 @@ TEST(SceneForest, TheDragModelReadsDensityAndDbhRasters) {
 TEST(SceneForest, TheDragModelsBadInputIsAnErrorNamingTheKey) {
   EXPECT_HAS(ErrorOf(kStand + "model = \"forest\"\n"),
              "forest.model: unknown forest model 'forest'");
-  EXPECT_HAS(ErrorOf("[forest]\nmodel = \"drag\"\n"), "forest.model: model = \"drag\" needs stands");
-  EXPECT_HAS(ErrorOf("[forest]\nmodel = \"drag\"\ntrees = \"trees.csv\"\n", "x_m,y_m,dbh_cm\n30,0,30\n"),
-             "forest.trees: model = \"drag\" has no explicit trees");
+  EXPECT_HAS(ErrorOf("[forest]\nmodel = \"drag\"\n"),
+             "forest.model: model = \"drag\" needs stands");
+  EXPECT_HAS(
+      ErrorOf("[forest]\nmodel = \"drag\"\ntrees = \"trees.csv\"\n", "x_m,y_m,dbh_cm\n30,0,30\n"),
+      "forest.trees: model = \"drag\" has no explicit trees");
   EXPECT_HAS(ErrorOf(kStand + "model = \"drag\"\nfriction = 0.3\n"),
              "forest.friction: model = \"drag\" has no explicit trees");
   EXPECT_HAS(ErrorOf(kStand + "model = \"drag\"\nstems_per_ha_raster = \"d.tif\"\n"),

@@ -301,7 +301,8 @@ ForestDrag Stand(const Scene& scene, double x0, double x1, double y0, double y1,
 TEST(ForestDrag, UniformStandSlowsAFlyingRockAsTheDerivationSays) {
   // No gravity; the 1 m cube (m = 2700 kg, w = (6 / pi)^(1/3) = 1.2407 m) flies along +x 1 m
   // above flat ground through a stand of n = 400 /ha, D = 30 cm (E_max = 99.96 kJ): lambda =
-  // n (D + w) = 0.06163 stems per metre. Pure translation, E = m v^2 / 2, so dv/dt = -lambda dE / m:
+  // n (D + w) = 0.06163 stems per metre. Pure translation, E = m v^2 / 2, so dv/dt = -lambda dE /
+  // m:
   // - above v* = sqrt(2 E_max / (eta m)) = 10.54 m/s every hit breaks its stem and takes E_max:
   //   dv/dt = -a, a = lambda E_max / m = 2.28 m/s^2, v = v0 - a t;
   // - below it each hit takes eta E: dv/dt = -k v^2, k = lambda eta / 2, v = v* / (1 + k v* t').
