@@ -151,7 +151,9 @@ std::vector<std::string> WriteSummaryOutputs(const io::SceneFile& scene,
         scene.output.trajectories ? staging.path("trajectories.h5") : std::string(), scene.crs_wkt,
         scene.evaluation_lines.empty() ? std::string() : staging.path("evaluation_lines.csv"),
         scene.scene.barriers.empty() ? std::string() : staging.path("barriers.csv"),
-        io::GeoPackageScene{&scene.release, &scene.evaluation_lines, &scene.scene.barriers});
+        io::GeoPackageScene{&scene.release, &scene.evaluation_lines, &scene.scene.barriers,
+                            &scene.scene.forest,
+                            scene.has_forest ? staging.path("tree_impacts.csv") : std::string()});
     outputs.push_back("rocks.gpkg");
   }
   if (scene.output.report) outputs.push_back("report.html");

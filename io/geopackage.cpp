@@ -15,6 +15,7 @@
 #include "common/atomic_file.hpp"
 #include "common/csv_table.hpp"
 #include "common/error.hpp"
+#include "common/format.hpp"
 #include "io/raster.hpp"
 #include "io/trajectory_file.hpp"
 
@@ -241,6 +242,51 @@ void SceneLayers(Writer& out, const GeoPackageScene& scene) {
   }
 }
 
+// Layer `trees` (GeoPackageScene): the stems, with the hits of tree_impacts.csv summed per stem.
+void TreeLayer(Writer& out, const Forest& forest, const std::string& tree_impacts_csv) {
+  const std::size_t n = forest.stems().size();
+  std::vector<long> rocks(n, 0), impacts(n, 0), broken(n, 0);
+  std::vector<double> absorbed_J(n, 0.0);
+  if (!tree_impacts_csv.empty()) {
+    const CsvTable table = CsvTable::Read(tree_impacts_csv);
+    table.Require({"tree", "impacts", "absorbed_J", "broken"});
+    for (int row = 0; row < table.rows(); ++row) {
+      const double tree = table.NonNegativeNumber(row, "tree");
+      if (!(tree < static_cast<double>(n)) || tree != static_cast<double>(static_cast<long>(tree)))
+        throw InputError(table.Where(row, "tree") + ": no tree " + TenDigits(tree) +
+                         " in the forest of " + std::to_string(n) + " trees");
+      const auto k = static_cast<std::size_t>(tree);
+      ++rocks[k];
+      impacts[k] += static_cast<long>(table.NonNegativeNumber(row, "impacts"));
+      broken[k] += table.NonNegativeNumber(row, "broken") > 0;
+      absorbed_J[k] += table.NonNegativeNumber(row, "absorbed_J");
+    }
+  }
+  OGRLayer* layer = out.Layer("trees", wkbPoint25D);
+  out.Field(layer, "tree", OFTInteger64);
+  out.Field(layer, "dbh_cm", OFTReal);
+  out.Field(layer, "breaking_energy_kj", OFTReal);
+  out.Field(layer, "rocks_hit", OFTInteger64);
+  out.Field(layer, "impacts", OFTInteger64);
+  out.Field(layer, "broken", OFTInteger64);
+  out.Field(layer, "absorbed_kj", OFTReal);
+  for (std::size_t k = 0; k < n; ++k) {
+    const Stem& stem = forest.stems()[k];
+    OGRFeature feature(layer->GetLayerDefn());
+    feature.SetField(0, static_cast<GIntBig>(k));
+    feature.SetField(1, 100 * stem.dbh_m);
+    feature.SetField(2, forest.capacity_J(static_cast<int>(k)) / 1000);
+    feature.SetField(3, static_cast<GIntBig>(rocks[k]));
+    feature.SetField(4, static_cast<GIntBig>(impacts[k]));
+    feature.SetField(5, static_cast<GIntBig>(broken[k]));
+    feature.SetField(6, absorbed_J[k] / 1000);
+    OGRPoint point(stem.position_m.x(), stem.position_m.y(), stem.ground_m);
+    feature.SetGeometry(&point);
+    out.Add(layer, feature);
+  }
+  out.Flush();
+}
+
 }  // namespace
 
 void WriteRocksGeoPackage(const std::string& path, const std::string& rocks_csv,
@@ -258,6 +304,7 @@ void WriteRocksGeoPackage(const std::string& path, const std::string& rocks_csv,
     PointLayer(out, "barrier_impacts", barriers_csv, "x_m", "y_m", "z_m");
 
   SceneLayers(out, scene);
+  if (scene.forest && !scene.forest->empty()) TreeLayer(out, *scene.forest, scene.tree_impacts_csv);
 
   std::vector<std::string> fields;
   if (!trajectories_h5.empty()) {

@@ -4,8 +4,8 @@
 // and, when trajectories.h5 was written, `paths` (one 3-D line per rock through its trajectory
 // samples, with the rock, its run and how it ended), and with evaluation lines
 // `evaluation_crossings` (one 3-D point per row of evaluation_lines.csv, at the first crossing of
-// the centre of mass, with every column as a field), and the scene's releases, evaluation lines and
-// barriers (GeoPackageScene). Built from rocks.csv and trajectories.h5 after
+// the centre of mass, with every column as a field), and the scene's releases, evaluation lines,
+// barriers and trees (GeoPackageScene). Built from rocks.csv and trajectories.h5 after
 // they are complete, so a run split into parts gives the same file; the GeoPackage's timestamps are
 // fixed (2000-01-01T00:00:00Z), so the same rocks give the same bytes.
 
@@ -15,6 +15,7 @@
 #include "ensemble/evaluation_lines.hpp"
 #include "ensemble/release.hpp"
 #include "solver/barriers.hpp"
+#include "solver/forest.hpp"
 
 namespace talus::io {
 
@@ -22,10 +23,17 @@ namespace talus::io {
 // `release_lines`, `release_polygons` with the release's index and name; a run table's runs as
 // points), its evaluation lines (`evaluation_lines`, with their names) and barriers (`barriers`,
 // with name, type, height_m and capacity_kj). Layers without features are not written.
+// With a forest of explicit trees: layer `trees`, a 3-D point per stem at its foot with its index
+// (`tree`, as in tree_impacts.csv), `dbh_cm`, `breaking_energy_kj` and what the run's rocks did to
+// it, from the complete `tree_impacts_csv`: `rocks_hit` (rocks that touched it), `impacts` (their
+// contact episodes), `broken` (rocks that broke it) and `absorbed_kj` (energy it took, summed).
+// Every stem is a feature, hit or not.
 struct GeoPackageScene {
   const ensemble::ReleaseSpec* release = nullptr;
   const std::vector<ensemble::EvaluationLine>* evaluation_lines = nullptr;
   const std::vector<Barrier>* barriers = nullptr;
+  const Forest* forest = nullptr;
+  std::string tree_impacts_csv = {};
 };
 
 // Writes the GeoPackage atomically. `trajectories_h5` empty: no `paths` layer;

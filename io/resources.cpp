@@ -42,6 +42,7 @@ constexpr double kTreeImpactRowsPerRock = 20;
 // each).
 constexpr double kGeoPackageBytesPerRock = 700;
 constexpr double kGeoPackageBytesPerVertex = 24;
+constexpr double kGeoPackageBytesPerTree = 200;
 constexpr double kGeoTiffBytesPerCell = 4;
 
 // The heap's own bytes per allocation (glibc: an 8-byte header, 16-byte granularity), and the
@@ -178,6 +179,10 @@ ResourceEstimate EstimateResources(const SceneFile& scene, int threads) {
     const double stems = double(scene.scene.forest.stems().size());
     e.memory.push_back({"forest", stems * (sizeof(Stem) + sizeof(double) + 2 * sizeof(int)),
                         "a sparser or smaller [forest]"});
+    // rocks.gpkg's trees layer: a point of 7 fields per stem with its index entries.
+    if (output.geopackage)
+      e.disk.push_back(
+          {"rocks.gpkg trees", stems * kGeoPackageBytesPerTree, "a sparser or smaller [forest]"});
   }
   if (output.geopackage)
     e.disk.push_back({"rocks.gpkg",

@@ -278,7 +278,8 @@ SceneFile LoadSceneTable(const toml::table& root, const std::string& path,
   scene_tables::LoadBarriers(context, root.get("barriers"), out);
   scene_tables::LoadForest(context,
                            Section(context, SubTable(context, root, "forest"), "forest",
-                                   {"trees", "dbh_field", "stands", "stands_file", "stem_height_m",
+                                   {"model", "trees", "dbh_field", "stands", "stands_file",
+                                    "stems_per_ha_raster", "dbh_raster", "stem_height_m",
                                     "friction", "energy_coefficient_j", "energy_exponent", "seed"}),
                            root.get("forest") != nullptr, out);
   const Section solver(context, SubTable(context, root, "solver"), "solver", SolverKeys());
@@ -294,7 +295,11 @@ SceneFile LoadSceneTable(const toml::table& root, const std::string& path,
   LoadOutput(output, out.output);
   if (!out.has_forest && std::count(out.output.rasters.begin(), out.output.rasters.end(),
                                     ensemble::RasterKind::kTreeHits) > 0)
-    output.Fail("rasters", "tree_hits counts the impacts on stems: the scene has no [forest]");
+    output.Fail("rasters",
+                out.forest_model == "drag"
+                    ? "tree_hits counts the impacts on explicit stems: [forest] model "
+                      "= \"drag\" has none"
+                    : "tree_hits counts the impacts on stems: the scene has no [forest]");
   if (!out.release.blocks.empty() && out.release.runs.empty())
     context.Fail(root.get("blocks"), "blocks",
                  "blocks are for the runs of a run table ([release] runs = \"file.csv\")");

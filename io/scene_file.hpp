@@ -98,6 +98,12 @@ struct SceneFile {
   std::string stands_file;          // [forest] stands_file, resolved; "" without
   std::vector<ForestStand> stands;  // inline stands first, then those of stands_file
   std::uint64_t forest_seed = 0;
+  // [forest] model: "trees" (explicit stems in scene.forest; has_forest), "drag" (the drag layer
+  // in scene.forest_drag, with the stands above and the rasters below), "" without [forest].
+  std::string forest_model;
+  std::string forest_density_raster, forest_dbh_raster;  // model = "drag", resolved; "" without
+  long forest_drag_cells = 0;                            // model = "drag": DEM nodes in a stand
+  ForestModel forest_drag_model;  // model = "drag": its breaking energy and height
 };
 
 // Loads and validates a scene. Throws talus::InputError with "<file>:<line>: <key>: <reason>".

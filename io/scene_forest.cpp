@@ -3,12 +3,15 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <limits>
+#include <map>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "common/csv_table.hpp"
 #include "common/error.hpp"
+#include "io/raster.hpp"
 #include "io/scene_tables.hpp"
 #include "io/vector.hpp"
 #include "solver/random.hpp"
@@ -191,12 +194,19 @@ void DrawStand(const std::vector<std::vector<Eigen::Vector2d>>& rings, std::uint
   stand->trees = count;
 }
 
+// One stand as given: its rings (outer, then holes; in the DEM's CRS), its numbers and where it
+// was given (for errors).
+struct StandInput {
+  std::vector<std::vector<Eigen::Vector2d>> rings;
+  SceneFile::ForestStand stand;
+  std::string where;
+};
+
 // stands = [{ polygon = [[x, y], ...], stems_per_ha, dbh_cm, dbh_sd_cm }] (or [[forest.stands]]
-// tables), then the polygons of stands_file; stand k draws from stream k.
-void DrawStands(const Context& context, const Section& forest, const Terrain& terrain,
-                const std::string& crs_wkt, std::uint64_t seed, std::vector<Stem>* stems,
-                SceneFile& out) {
-  std::uint64_t stream = 0;
+// tables), then the polygons of stands_file, each checked.
+std::vector<StandInput> ReadStands(const Context& context, const Section& forest,
+                                   const std::string& crs_wkt, SceneFile& out) {
+  std::vector<StandInput> stands;
   if (forest.Has("stands")) {
     const toml::array* list = forest.Node("stands")->as_array();
     if (!list || list->empty() || !list->is_array_of_tables())
@@ -208,18 +218,16 @@ void DrawStands(const Context& context, const Section& forest, const Terrain& te
                       {"polygon", "stems_per_ha", "dbh_cm", "dbh_sd_cm"});
       for (const char* required : {"polygon", "stems_per_ha", "dbh_cm"})
         if (!s.Has(required)) s.Fail(required, "missing");
-      SceneFile::ForestStand stand;
+      StandInput& input = stands.emplace_back();
+      SceneFile::ForestStand& stand = input.stand;
       stand.stems_per_ha = s.Number("stems_per_ha", 0);
       stand.dbh_cm = s.Number("dbh_cm", 0);
       stand.dbh_sd_cm = s.Number("dbh_sd_cm", 0);
-      const std::vector<std::vector<Eigen::Vector2d>> rings = {
-          PointList(s, s.Node("polygon"), s.Key("polygon"))};
-      if (rings.front().size() < 3) s.Fail("polygon", "a stand needs at least 3 points");
-      stand.area_m2 = AreaOf(rings);
+      input.rings = {PointList(s, s.Node("polygon"), s.Key("polygon"))};
+      if (input.rings.front().size() < 3) s.Fail("polygon", "a stand needs at least 3 points");
+      stand.area_m2 = AreaOf(input.rings);
       if (const auto [key, why] = StandProblem(stand); !key.empty()) s.Fail(key, why);
-      const std::string where = context.Where(s.Node("polygon")) + ": " + s.Key("polygon");
-      DrawStand(rings, seed, stream++, terrain, where, &stand, stems);
-      out.stands.push_back(stand);
+      input.where = context.Where(s.Node("polygon")) + ": " + s.Key("polygon");
     }
   }
   if (forest.Has("stands_file")) {
@@ -227,32 +235,180 @@ void DrawStands(const Context& context, const Section& forest, const Terrain& te
     const std::string key =
         context.Where(forest.Node("stands_file")) + ": " + forest.Key("stands_file");
     for (const StandPolygon& polygon : ReadStandPolygons(path, crs_wkt, key)) {
-      SceneFile::ForestStand stand;
+      StandInput& input = stands.emplace_back();
+      SceneFile::ForestStand& stand = input.stand;
       stand.stems_per_ha = polygon.stems_per_ha;
       stand.dbh_cm = polygon.dbh_cm;
       stand.dbh_sd_cm = polygon.dbh_sd_cm;
       if (polygon.rings.empty() || polygon.rings.front().size() < 3)
         throw InputError(polygon.where + ": a stand needs at least 3 points");
+      input.rings = polygon.rings;
       stand.area_m2 = AreaOf(polygon.rings);
       if (const auto [field, why] = StandProblem(stand); !field.empty())
         throw InputError(polygon.where + ": " + field + ": " + why);
-      DrawStand(polygon.rings, seed, stream++, terrain, polygon.where, &stand, stems);
-      out.stands.push_back(stand);
+      input.where = polygon.where;
     }
     out.inputs.push_back(path);
     out.stands_file = path;
   }
+  return stands;
+}
+
+// model = "trees": each stand's trees drawn, stand k from stream k.
+void DrawStands(std::vector<StandInput>& stands, const Terrain& terrain, std::uint64_t seed,
+                std::vector<Stem>* stems, SceneFile& out) {
+  for (std::size_t k = 0; k < stands.size(); ++k) {
+    StandInput& input = stands[k];
+    DrawStand(input.rings, seed, k, terrain, input.where, &input.stand, stems);
+    out.stands.push_back(input.stand);
+  }
+}
+
+// A raster of the drag model read onto the DEM's nodes: each node takes the value of the raster
+// cell holding it (NaN off the raster or on nodata). Reprojected to the DEM's CRS first when it has
+// another (as the ground raster); it must overlap the DEM.
+std::vector<double> RasterOnDem(const Context& context, const Section& s, const std::string& key,
+                                const GridGeometry& dem, SceneFile& out, std::string* path) {
+  *path = context.Resolve(s.String(key, ""));
+  const std::string what = context.Where(s.Node(key)) + ": " + s.Key(key);
+  std::string reprojected_from;
+  const Raster raster = ReadRasterIn(*path, out.crs_wkt, what, &reprojected_from);
+  if (!reprojected_from.empty())
+    out.warnings.push_back(what + ": reprojected from " + DescribeCrs(reprojected_from) +
+                           " to the DEM's CRS (nearest neighbour)");
+  const GridGeometry& g = raster.grid;
+  std::vector<double> values(static_cast<std::size_t>(dem.nx) * dem.ny,
+                             std::numeric_limits<double>::quiet_NaN());
+  bool overlaps = false;
+  for (int j = 0; j < dem.ny; ++j)
+    for (int i = 0; i < dem.nx; ++i) {
+      const double u = std::floor((dem.x0_m + i * dem.dx_m - g.x0_m) / g.dx_m + 0.5);
+      const double v = std::floor((dem.y0_m + j * dem.dy_m - g.y0_m) / g.dy_m + 0.5);
+      if (!(u >= 0 && u < g.nx && v >= 0 && v < g.ny)) continue;
+      overlaps = true;
+      values[static_cast<std::size_t>(j) * dem.nx + i] =
+          raster.values[static_cast<std::size_t>(v) * g.nx + static_cast<std::size_t>(u)];
+    }
+  if (!overlaps)
+    s.Fail(key, *path + " covers x " + TenDigits(g.x0_m - 0.5 * g.dx_m) + " .. " +
+                    TenDigits(g.x_max_m() + 0.5 * g.dx_m) + ", y " +
+                    TenDigits(g.y0_m - 0.5 * g.dy_m) + " .. " +
+                    TenDigits(g.y_max_m() + 0.5 * g.dy_m) + ", none of the DEM (x " +
+                    TenDigits(dem.x0_m) + " .. " + TenDigits(dem.x_max_m()) + ", y " +
+                    TenDigits(dem.y0_m) + " .. " + TenDigits(dem.y_max_m()) + ")");
+  out.inputs.push_back(*path);
+  return values;
+}
+
+// "(x, y)" of DEM node k, for errors.
+std::string NodeAt(const GridGeometry& g, std::size_t k) {
+  const double x = g.x0_m + static_cast<double>(k % g.nx) * g.dx_m;
+  const double y = g.y0_m + static_cast<double>(k / g.nx) * g.dy_m;
+  std::string text = "(";
+  text += TenDigits(x);
+  text += ", ";
+  text += TenDigits(y);
+  text += ")";
+  return text;
+}
+
+// model = "drag": the stands on the DEM's nodes (a node takes the stand of the last polygon holding
+// it, over the rasters' stand there) as a ForestDrag of the model's breaking energy and height.
+// The rasters: stems_per_ha_raster (nodata or 0: no forest) and dbh_raster (cm, where there are
+// stems); each distinct pair of values is a stand.
+ForestDrag BuildDragLayer(const Context& context, const Section& s,
+                          const std::vector<StandInput>& stands, const ForestModel& model,
+                          SceneFile& out) {
+  const GridGeometry& dem = out.scene.terrain.heights().grid;
+  std::vector<DragStand> list;
+  std::vector<int> cells(static_cast<std::size_t>(dem.nx) * dem.ny, -1);
+  if (s.Has("stems_per_ha_raster") != s.Has("dbh_raster"))
+    s.Fail(s.Has("dbh_raster") ? "dbh_raster" : "stems_per_ha_raster",
+           "stems_per_ha_raster and dbh_raster go together: a stand needs both its density and "
+           "its DBH");
+  if (s.Has("stems_per_ha_raster")) {
+    const std::vector<double> density =
+        RasterOnDem(context, s, "stems_per_ha_raster", dem, out, &out.forest_density_raster);
+    const std::vector<double> dbh =
+        RasterOnDem(context, s, "dbh_raster", dem, out, &out.forest_dbh_raster);
+    std::map<std::pair<double, double>, int> index;
+    for (std::size_t k = 0; k < cells.size(); ++k) {
+      const double n = density[k];
+      if (std::isnan(n) || n == 0) continue;
+      if (!(n > 0 && n <= kMaxStemsPerHa))
+        s.Fail("stems_per_ha_raster", out.forest_density_raster + ": " + TenDigits(n) +
+                                          " stems per hectare at " + NodeAt(dem, k) +
+                                          " must be > 0 and <= " + TenDigits(kMaxStemsPerHa) +
+                                          " (nodata or 0: no forest)");
+      if (!(dbh[k] > 0 && dbh[k] <= kMaxDbh_cm))
+        s.Fail("dbh_raster", out.forest_dbh_raster + ": DBH " + TenDigits(dbh[k]) + " cm at " +
+                                 NodeAt(dem, k) + ", where " + out.forest_density_raster +
+                                 " has stems, must be > 0 and <= " + TenDigits(kMaxDbh_cm) + " cm");
+      auto [it, added] = index.try_emplace({n, dbh[k]}, static_cast<int>(list.size()));
+      if (added)
+        list.push_back(DragStand{n / 1e4, dbh[k] / 100, model.BreakingEnergy_J(dbh[k] / 100)});
+      cells[k] = it->second;
+    }
+  }
+  if (!stands.empty()) {
+    std::vector<std::vector<std::vector<Eigen::Vector2d>>> rings;
+    std::vector<int> burn;
+    for (const StandInput& input : stands) {
+      rings.push_back(input.rings);
+      burn.push_back(static_cast<int>(list.size()));
+      const double dbh_m = input.stand.dbh_cm / 100;
+      list.push_back(
+          DragStand{input.stand.stems_per_ha / 1e4, dbh_m, model.BreakingEnergy_J(dbh_m)});
+      out.stands.push_back(input.stand);
+      if (input.stand.dbh_sd_cm > 0)
+        out.warnings.push_back(input.where +
+                               ": forest: dbh_sd_cm is not used by model = \"drag\", which takes "
+                               "the mean DBH");
+    }
+    const std::vector<int> burnt = RasterisePolygons(dem, rings, burn);
+    for (std::size_t k = 0; k < cells.size(); ++k)
+      if (burnt[k] >= 0) cells[k] = burnt[k];
+  }
+  out.forest_drag_cells = std::count_if(cells.begin(), cells.end(), [](int k) { return k >= 0; });
+  if (out.forest_drag_cells == 0)
+    out.warnings.push_back(context.Where(s.Node("model")) +
+                           ": forest: no node of the DEM lies in a stand: the drag layer acts "
+                           "nowhere");
+  return ForestDrag(dem, std::move(cells), std::move(list), model.stem_height_m);
 }
 
 }  // namespace
 
 void LoadForest(const Context& context, const Section& s, bool given, SceneFile& out) {
   if (!given) return;
-  if (!s.Has("trees") && !s.Has("stands") && !s.Has("stands_file"))
-    s.Fail("trees",
-           "a [forest] needs trees = \"trees.csv\", stands = [{ polygon = ..., "
-           "stems_per_ha = ..., dbh_cm = ... }] or stands_file = \"stands.gpkg\" (or "
-           "several)");
+  const std::string model_name = s.String("model", "trees");
+  if (model_name != "trees" && model_name != "drag")
+    s.Fail("model", "unknown forest model '" + model_name +
+                        "': \"trees\" (explicit stems, the default) or \"drag\" (a drag layer "
+                        "from the stands' density and DBH)");
+  const bool drag = model_name == "drag";
+  if (drag) {
+    for (const char* key : {"trees", "dbh_field", "friction", "seed"})
+      if (s.Has(key))
+        s.Fail(key, std::string("model = \"drag\" has no explicit trees: ") + key +
+                        " is for model = \"trees\"");
+    if (!s.Has("stands") && !s.Has("stands_file") && !s.Has("stems_per_ha_raster"))
+      s.Fail("model",
+             "model = \"drag\" needs stands = [{ polygon = ..., stems_per_ha = ..., dbh_cm = ... "
+             "}], stands_file = \"stands.gpkg\" or stems_per_ha_raster and dbh_raster (or "
+             "several)");
+  } else {
+    for (const char* key : {"stems_per_ha_raster", "dbh_raster"})
+      if (s.Has(key))
+        s.Fail(key, std::string(key) +
+                        " is for model = \"drag\"; explicit trees come from trees, "
+                        "stands or stands_file");
+    if (!s.Has("trees") && !s.Has("stands") && !s.Has("stands_file"))
+      s.Fail("trees",
+             "a [forest] needs trees = \"trees.csv\", stands = [{ polygon = ..., "
+             "stems_per_ha = ..., dbh_cm = ... }] or stands_file = \"stands.gpkg\" (or "
+             "several)");
+  }
   ForestModel model;
   model.stem_height_m = s.Number("stem_height_m", model.stem_height_m);
   RequireWithin(s, "stem_height_m", model.stem_height_m, 0, kMaxStemHeight_m, "m");
@@ -263,13 +419,21 @@ void LoadForest(const Context& context, const Section& s, bool given, SceneFile&
   RequireWithin(s, "energy_exponent", model.energy_exponent, 0, 5, "");
   std::string why;
   if (!model.IsValid(&why)) s.FailCheck(why);
+  out.forest_model = model_name;
+  std::vector<StandInput> stands = ReadStands(context, s, out.crs_wkt, out);
+  if (drag) {
+    out.scene.forest_drag = BuildDragLayer(context, s, stands, model, out);
+    if (!out.scene.forest_drag.IsValid(&why)) s.Fail("model", why);
+    out.forest_drag_model = model;
+    return;
+  }
   const long seed = s.Integer("seed", static_cast<long>(out.release.seed));
   if (seed < 0) s.Fail("seed", std::to_string(seed) + " must be >= 0");
   out.forest_seed = static_cast<std::uint64_t>(seed);
 
   std::vector<Stem> stems;
   if (s.Has("trees")) ReadTrees(context, s, out.scene.terrain, out.crs_wkt, &stems, out);
-  DrawStands(context, s, out.scene.terrain, out.crs_wkt, out.forest_seed, &stems, out);
+  DrawStands(stands, out.scene.terrain, out.forest_seed, &stems, out);
   if (static_cast<long>(stems.size()) > kMaxTrees)
     s.Fail("stands",
            std::to_string(stems.size()) + " trees, more than " + std::to_string(kMaxTrees));

@@ -233,6 +233,7 @@ std::string SummaryJson(const SceneFile& scene, const ensemble::EnsembleReport& 
     const Forest& forest = scene.scene.forest;
     const ForestModel& model = forest.model();
     nlohmann::ordered_json f;
+    f["model"] = "trees";
     f["trees"] = forest.stems().size();
     f["trees_file"] = scene.trees_file;
     f["trees_from_file"] = scene.trees_from_file;
@@ -257,6 +258,26 @@ std::string SummaryJson(const SceneFile& scene, const ensemble::EnsembleReport& 
           {"rocks_hitting", trees->rocks_hitting}, {"rocks_breaking", trees->rocks_breaking},
           {"breakages", trees->breakages},         {"stems_hit", trees->stems_hit},
           {"absorbed_J", trees->absorbed_J}};
+    j["forest"] = f;
+  }
+  if (scene.forest_model == "drag") {
+    const ForestModel& model = scene.forest_drag_model;
+    nlohmann::ordered_json f;
+    f["model"] = "drag";
+    nlohmann::ordered_json stands = nlohmann::ordered_json::array();
+    for (const SceneFile::ForestStand& s : scene.stands)
+      stands.push_back(
+          {{"area_m2", s.area_m2}, {"stems_per_ha", s.stems_per_ha}, {"dbh_cm", s.dbh_cm}});
+    f["stands_file"] = scene.stands_file;
+    f["stands"] = stands;
+    f["stems_per_ha_raster"] = scene.forest_density_raster;
+    f["dbh_raster"] = scene.forest_dbh_raster;
+    f["dem_nodes_in_forest"] = scene.forest_drag_cells;
+    f["stem_height_m"] = model.stem_height_m;
+    f["breaking_energy"] = {{"coefficient_J", model.energy_coefficient_J},
+                            {"exponent", model.energy_exponent},
+                            {"law", "E_max = coefficient * DBH[cm]^exponent"}};
+    f["rate"] = "c = n (DBH + w) |v_h| min(E_max, 2/3 E) / (2 E) on v and Omega (docs/model.md)";
     j["forest"] = f;
   }
   if (self_check) j["self_check"] = SelfCheckJson(*self_check);

@@ -226,12 +226,12 @@ std::vector<GroundPolygon> ReadGroundPolygons(const std::string& path,
   return out;
 }
 
-std::vector<ensemble::EvaluationLine> ReadLineFeatures(const std::string& path,
-                                                       const std::string& target_crs_wkt,
-                                                       const std::string& name_field,
-                                                       bool require_field, const std::string& what,
-                                                       std::vector<std::string>* where_out) {
+std::vector<ensemble::EvaluationLine> ReadLineFeatures(
+    const std::string& path, const std::string& target_crs_wkt, const std::string& name_field,
+    bool require_field, const std::string& what, std::vector<std::string>* where_out,
+    const std::vector<std::string>& fields, std::vector<std::vector<FeatureValue>>* values) {
   std::vector<ensemble::EvaluationLine> out;
+  std::vector<FeatureValue> feature_values;  // of the feature being collected
   std::function<void(const OGRGeometry&, const std::string&, const std::string&)> collect =
       [&](const OGRGeometry& geometry, const std::string& name, const std::string& where) {
         const OGRwkbGeometryType type = wkbFlatten(geometry.getGeometryType());
@@ -240,6 +240,7 @@ std::vector<ensemble::EvaluationLine> ReadLineFeatures(const std::string& path,
           ensemble::EvaluationLine& l = out.emplace_back();
           l.name = name;
           where_out->push_back(where);
+          if (values) values->push_back(feature_values);
           for (int k = 0; k < line.getNumPoints(); ++k)
             l.vertices_m.emplace_back(line.getX(k), line.getY(k));
         } else if (type == wkbMultiLineString) {
@@ -258,6 +259,29 @@ std::vector<ensemble::EvaluationLine> ReadLineFeatures(const std::string& path,
                    std::string name;
                    if (field >= 0 && feature.IsFieldSetAndNotNull(field))
                      name = feature.GetFieldAsString(field);
+                   feature_values.assign(fields.size(), FeatureValue{});
+                   for (std::size_t k = 0; k < fields.size(); ++k) {
+                     FeatureValue& v = feature_values[k];
+                     const int index = feature.GetFieldIndex(fields[k].c_str());
+                     if (index < 0) {
+                       for (int f = 0; f < feature.GetFieldCount(); ++f)
+                         v.fields += (f ? ", " : "") +
+                                     std::string(feature.GetFieldDefnRef(f)->GetNameRef());
+                       if (v.fields.empty()) v.fields = "none";
+                       continue;
+                     }
+                     if (!feature.IsFieldSetAndNotNull(index)) {
+                       v.kind = FeatureValue::Kind::kNull;
+                       continue;
+                     }
+                     v.text = feature.GetFieldAsString(index);
+                     const OGRFieldType t = feature.GetFieldDefnRef(index)->GetType();
+                     v.kind = t == OFTInteger || t == OFTInteger64 || t == OFTReal
+                                  ? FeatureValue::Kind::kNumber
+                                  : FeatureValue::Kind::kText;
+                     if (v.kind == FeatureValue::Kind::kNumber)
+                       v.number = feature.GetFieldAsDouble(index);
+                   }
                    collect(geometry, name, where);
                  });
   if (out.empty()) throw InputError(what + ": " + path + " has no line");

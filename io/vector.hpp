@@ -51,11 +51,20 @@ std::vector<GroundPolygon> ReadGroundPolygons(const std::string& path,
 // `name_field` attribute; a file without that field gives unnamed lines (empty names), unless
 // `require_field`. Other geometries are errors. Throws InputError naming `what`, the file and the
 // feature. *where gets, per line, "<what> (<path>, feature <fid>)" for the caller's checks.
-std::vector<ensemble::EvaluationLine> ReadLineFeatures(const std::string& path,
-                                                       const std::string& target_crs_wkt,
-                                                       const std::string& name_field,
-                                                       bool require_field, const std::string& what,
-                                                       std::vector<std::string>* where);
+// With `fields`, *values gets per line the values of those attributes of its feature, in order
+// (FeatureValue: absent when the layer has no such field or the feature's is null).
+struct FeatureValue {
+  enum class Kind { kNoField, kNull, kNumber, kText };
+  Kind kind = Kind::kNoField;
+  double number = 0;   // kNumber
+  std::string text;    // kNumber and kText: the value as GDAL prints it
+  std::string fields;  // kNoField: the layer's fields, "a, b, c" ("none")
+};
+std::vector<ensemble::EvaluationLine> ReadLineFeatures(
+    const std::string& path, const std::string& target_crs_wkt, const std::string& name_field,
+    bool require_field, const std::string& what, std::vector<std::string>* where,
+    const std::vector<std::string>& fields = {},
+    std::vector<std::vector<FeatureValue>>* values = nullptr);
 
 // Surveyed rest positions from the point features of a vector file, in the DEM's CRS: reprojected
 // when the file and the DEM both have a CRS; an error when the file has one and the DEM none (a

@@ -69,8 +69,10 @@ double MaxAngularSpeed(const RockShape& rock, const RockState& state) {
          std::sqrt(w.dot(rock.inertia_kg_m2.cwiseProduct(w)) / rock.inertia_kg_m2.minCoeff());
 }
 
-double HighestDragLayer(const GroundTable& ground) {
-  double highest = 0;
+// The highest drag layer of the ground categories and the forest's.
+double HighestDragLayer(const Scene& scene) {
+  const GroundTable& ground = scene.ground;
+  double highest = scene.forest_drag.empty() ? 0.0 : scene.forest_drag.height_m();
   for (int g = 0; g < ground.size(); ++g)
     if (ground.params(g).HasDragLayer())
       highest = std::max(highest, ground.params(g).drag_height_m);
@@ -110,8 +112,7 @@ int ClearFlightSteps(const Scene& scene, const RockShape& rock, const RockState&
   const Eigen::Vector3d& v = state.velocity_m_s;
   TerrainSample under;
   if (max_steps <= 0 || !terrain.Sample(p.x(), p.y(), &under)) return 0;
-  const Flight flight{opt.dt_s, opt.gravity_m_s2, PredictionHorizon(opt),
-                      HighestDragLayer(scene.ground)};
+  const Flight flight{opt.dt_s, opt.gravity_m_s2, PredictionHorizon(opt), HighestDragLayer(scene)};
   const double rho = rock.bounding_radius_m;
   const double spin = rho * MaxAngularSpeed(rock, state);
   // Vertices stay within rho of the centre, and predicted end points within reach of it.

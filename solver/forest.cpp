@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <numbers>
 
 namespace talus {
 namespace {
@@ -291,6 +292,63 @@ bool MeetStems(const Forest& forest, const RockShape& rock, RockState* state,
     h.touching =
         !h.broken && std::find(overlapping.begin(), overlapping.end(), h.stem) != overlapping.end();
   return acted;
+}
+
+ForestDrag::ForestDrag(GridGeometry grid, std::vector<int> cells, std::vector<DragStand> stands,
+                       double height_m)
+    : grid_(grid), cells_(std::move(cells)), stands_(std::move(stands)), height_m_(height_m) {}
+
+const DragStand* ForestDrag::StandAt(double x_m, double y_m) const {
+  const double u = std::floor((x_m - grid_.x0_m) / grid_.dx_m + 0.5);
+  const double v = std::floor((y_m - grid_.y0_m) / grid_.dy_m + 0.5);
+  if (!(u >= 0 && u < grid_.nx && v >= 0 && v < grid_.ny)) return nullptr;
+  const int k = cells_[static_cast<std::size_t>(v) * static_cast<std::size_t>(grid_.nx) +
+                       static_cast<std::size_t>(u)];
+  return k >= 0 ? &stands_[static_cast<std::size_t>(k)] : nullptr;
+}
+
+bool ForestDrag::IsValid(std::string* why) const {
+  auto fail = [&](const std::string& what) {
+    if (why) *why = "drag: " + what;
+    return false;
+  };
+  if (empty()) return true;
+  if (!grid_.IsValid(why)) return false;
+  if (cells_.size() != static_cast<std::size_t>(grid_.nx) * static_cast<std::size_t>(grid_.ny))
+    return fail("the grid has " + std::to_string(cells_.size()) + " cells, expected nx * ny");
+  if (!(std::isfinite(height_m_) && height_m_ > 0))
+    return fail("height_m = " + Number(height_m_) + " must be finite and > 0 m");
+  for (int k : cells_)
+    if (k < -1 || k >= static_cast<int>(stands_.size()))
+      return fail("a cell refers to stand " + std::to_string(k) + ", not in the list");
+  for (std::size_t k = 0; k < stands_.size(); ++k) {
+    const DragStand& s = stands_[k];
+    if (!(std::isfinite(s.stems_per_m2) && s.stems_per_m2 > 0 && std::isfinite(s.dbh_m) &&
+          s.dbh_m > 0 && std::isfinite(s.breaking_energy_J) && s.breaking_energy_J > 0))
+      return fail("stand " + std::to_string(k) + ": density " + Number(s.stems_per_m2) +
+                  " /m^2, dbh " + Number(s.dbh_m) + " m and breaking energy " +
+                  Number(s.breaking_energy_J) + " J must be finite and > 0");
+  }
+  return true;
+}
+
+double ForestDrag::RockWidth_m(const RockShape& rock) {
+  return std::cbrt(6 * rock.volume_m3 / std::numbers::pi);
+}
+
+double ForestDrag::Rate_1_s(const DragStand& stand, const RockShape& rock, const RockState& begin) {
+  const double energy_J = KineticEnergy(rock, begin.velocity_m_s, begin.angular_velocity_rad_s);
+  if (!(energy_J > 0)) return 0;
+  const double hits_per_m = stand.stems_per_m2 * (stand.dbh_m + RockWidth_m(rock));
+  const double per_hit_J = std::min(stand.breaking_energy_J, kPlasticShare * energy_J);
+  return hits_per_m * begin.velocity_m_s.head<2>().norm() * per_hit_J / (2 * energy_J);
+}
+
+double ForestDragRate_1_s(const ForestDrag& drag, const RockShape& rock, const RockState& begin,
+                          const Eigen::Vector3d& centre, double above_m) {
+  if (above_m > drag.height_m()) return 0;
+  const DragStand* stand = drag.StandAt(centre.x(), centre.y());
+  return stand ? ForestDrag::Rate_1_s(*stand, rock, begin) : 0.0;
 }
 
 }  // namespace talus

@@ -14,6 +14,7 @@
 
 #include "solver/polyhedron.hpp"
 #include "solver/state.hpp"
+#include "solver/terrain.hpp"
 
 namespace talus {
 
@@ -87,6 +88,61 @@ class Forest {
   std::vector<int> cell_start_;  // nx * ny + 1 offsets into order_
   std::vector<int> order_;       // stem indices sorted by cell
 };
+
+// Forest as a drag layer (`[forest] model = "drag"`; docs/model.md, "Forest as a drag layer"):
+// stands of stem density n (stems/m^2) and mean DBH D on a grid of their own, independent of the
+// ground categories. A rock whose centre of mass is in a stand and at most the stand's height
+// above the terrain meets, per metre of horizontal travel, lambda = n (D + w) stems on average (w
+// the rock's width: the diameter of the sphere of its volume). Each hit takes
+// dE = min(E_max(D), eta E) of its kinetic energy E (translational + rotational): eta = 2/3, the
+// mean share a fully plastic impact on a fixed round stem takes from a round rock over a uniform
+// impact parameter, and at most the stem's breaking energy (it breaks then). Spread over the
+// path, dE/dt = -lambda |v_h| dE: as a drag on v and Omega with one rate
+//   c = lambda |v_h| min(E_max, eta E) / (2 E)   (1/s),
+// evaluated at the step's beginning and integrated by the drag layer's exact form
+// (solver/step.cpp).
+struct DragStand {
+  double stems_per_m2 = 0;       // n, > 0
+  double dbh_m = 0;              // D, > 0
+  double breaking_energy_J = 0;  // E_max(D) of the ForestModel, > 0
+};
+
+class ForestDrag {
+ public:
+  static constexpr double kPlasticShare = 2.0 / 3.0;  // eta
+
+  ForestDrag() = default;
+  // cells: one per node of `grid` (cells centred on the nodes, as GroundGrid), row after row along
+  // y, each an index into `stands` or -1 (no forest); height_m: the layer's height above the
+  // terrain (the stems' height), > 0.
+  ForestDrag(GridGeometry grid, std::vector<int> cells, std::vector<DragStand> stands,
+             double height_m);
+
+  bool empty() const { return stands_.empty(); }
+  double height_m() const { return height_m_; }
+  const GridGeometry& grid() const { return grid_; }
+  const std::vector<int>& cells() const { return cells_; }
+  const std::vector<DragStand>& stands() const { return stands_; }
+  // The stand of the cell holding (x, y), or null.
+  const DragStand* StandAt(double x_m, double y_m) const;
+  bool IsValid(std::string* why) const;
+
+  // c (1/s) of the header for a rock of this shape with the velocities of `begin` in `stand`.
+  static double Rate_1_s(const DragStand& stand, const RockShape& rock, const RockState& begin);
+  // w: the diameter of the sphere of the rock's volume (m).
+  static double RockWidth_m(const RockShape& rock);
+
+ private:
+  GridGeometry grid_;
+  std::vector<int> cells_;
+  std::vector<DragStand> stands_;
+  double height_m_ = 0;
+};
+
+// The rate (1/s) of the forest's drag on the rock whose centre of mass is at `centre`, above_m
+// over the terrain, with the velocities of `begin`; 0 outside every stand or above the layer.
+double ForestDragRate_1_s(const ForestDrag& drag, const RockShape& rock, const RockState& begin,
+                          const Eigen::Vector3d& centre, double above_m);
 
 // What a rock did to one stem over its run (one record per stem it touched).
 struct StemHit {

@@ -15,6 +15,7 @@ bool Scene::IsValid(std::string* why) const {
   for (const Barrier& barrier : barriers)
     if (!barrier.IsValid(&reason)) return fail("barrier '" + barrier.name + "'");
   if (!forest.IsValid(&reason)) return fail("forest");
+  if (!forest_drag.IsValid(&reason)) return fail("forest");
   if (terrain.default_ground() < 0 || terrain.default_ground() >= ground.size()) {
     reason =
         "default ground index " + std::to_string(terrain.default_ground()) + " is not in the table";

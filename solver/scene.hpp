@@ -23,6 +23,8 @@ struct Scene {
   std::vector<Barrier> barriers;
   // Trees whose stems the rocks hit (solver/forest.hpp); none: no forest work at all.
   Forest forest;
+  // The forest as a drag layer (solver/forest.hpp, ForestDrag); empty: no forest drag work.
+  ForestDrag forest_drag;
 
   // Checks every part (each barrier too) and that the terrain's ground indices exist in the table.
   bool IsValid(std::string* why) const;

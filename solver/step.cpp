@@ -60,16 +60,27 @@ double Phi(double x) { return x > 0 ? -std::expm1(-x) / x : 1.0; }
 // the layer's height above the terrain under it, integrates m dv/dt = -m c_t v + F exactly for F
 // constant over the step: v_E = exp(-c_t dt) v_B + phi(c_t dt) dt F / m, and likewise Omega with
 // c_r after the free rotation. Contact percussions enter as F dt, so the effective mass and inertia
-// grow by 1 / phi. Both factors are in (0, 1]: the layer only takes energy.
-void DragLayer(const Scene& scene, double dt, const Eigen::Vector3d& centre,
-               const Eigen::Vector3d& v_begin, Eigen::Vector3d& velocity, Eigen::Vector3d& omega,
+// grow by 1 / phi. Both factors are in (0, 1]: the layer only takes energy. The forest's drag
+// (solver/forest.hpp, ForestDrag) adds its rate, from the step's beginning, to both c_t and c_r.
+void DragLayer(const Scene& scene, double dt, const RockShape& rock, const Eigen::Vector3d& centre,
+               const RockState& begin, Eigen::Vector3d& velocity, Eigen::Vector3d& omega,
                EffectiveInertia& inertia) {
   double height = 0;
   if (!scene.terrain.Height(centre.x(), centre.y(), &height)) return;
   const GroundParams& g = scene.ground.params(scene.terrain.GroundAt(centre.x(), centre.y()));
-  if (!g.HasDragLayer() || centre.z() - height > g.drag_height_m) return;
-  const double x_t = g.drag_translational_1_s * dt;
-  const double x_r = g.drag_rotational_1_s * dt;
+  const bool ground_layer = g.HasDragLayer() && centre.z() - height <= g.drag_height_m;
+  double c_t = ground_layer ? g.drag_translational_1_s : 0.0;
+  double c_r = ground_layer ? g.drag_rotational_1_s : 0.0;
+  if (!scene.forest_drag.empty()) {
+    const double c =
+        ForestDragRate_1_s(scene.forest_drag, rock, begin, centre, centre.z() - height);
+    c_t += c;
+    c_r += c;
+  }
+  if (!ground_layer && c_t == 0 && c_r == 0) return;
+  const Eigen::Vector3d& v_begin = begin.velocity_m_s;
+  const double x_t = c_t * dt;
+  const double x_r = c_r * dt;
   // velocity holds v_B + dt F / m (gravity): replace by exp(-x) v_B + phi(x) dt F / m.
   velocity = std::exp(-x_t) * v_begin + Phi(x_t) * (velocity - v_begin);
   omega *= std::exp(-x_r);
@@ -157,8 +168,8 @@ StepReport StepOnce(const Scene& scene, const RockShape& rock, double dt, bool m
   // 3. Free end velocities: gravity, and the drag layer where the centre of mass is inside one.
   Eigen::Vector3d velocity = FreeVelocity(opt, dt, begin.velocity_m_s);
   EffectiveInertia inertia{rock.mass_kg, 1.0};
-  if (scene.ground.AnyDragLayer())
-    DragLayer(scene, dt, state.position_m, begin.velocity_m_s, velocity, omega, inertia);
+  if (scene.ground.AnyDragLayer() || !scene.forest_drag.empty())
+    DragLayer(scene, dt, rock, state.position_m, begin, velocity, omega, inertia);
 
   // 4. Contact set at the midpoint: closed contacts and the vertices that the free motion (no
   // contacts) would carry deeper than the penetration tolerance below the terrain by the next

@@ -5,6 +5,8 @@
 #include <ogrsf_frmts.h>
 
 #include <algorithm>
+#include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <memory>
@@ -16,6 +18,7 @@
 #include "io/evaluation_lines_csv.hpp"
 #include "io/rocks_csv.hpp"
 #include "io/trajectory_file.hpp"
+#include "io/tree_impacts_csv.hpp"
 #include "solver/shapes.hpp"
 #include "test_files.hpp"
 
@@ -264,6 +267,75 @@ TEST(RocksGeoPackage, ReleasesEvaluationLinesAndBarriersAreLayers) {
   EXPECT_STREQ(second->GetFieldAsString("name"), "r2");
   EXPECT_EQ(runs_gpkg.d->GetLayerByName("release_polygons"), nullptr);
   EXPECT_EQ(runs_gpkg.d->GetLayerByName("barriers"), nullptr);
+}
+
+// With explicit trees: layer `trees`, every stem a 3-D point at its foot with its DBH, breaking
+// energy (38.7 DBH[cm]^2.31 J by default) and the rows of tree_impacts.csv summed per stem.
+TEST(RocksGeoPackage, TreesAreALayerWithTheirDbhHitsAndBreakages) {
+  const auto dir = testing::FreshDir("trees");
+  testing::WriteText(dir / "rocks.csv", RocksCsv(3));
+  const Forest forest({Stem{{10, 20}, 0.30, 5}, Stem{{11, 21}, 0.20, 6}, Stem{{12, 22}, 0.45, 7}},
+                      ForestModel{});
+  // Header of the writer; tree 2 hit by rocks 0 (twice, held) and 1 (broken), tree 0 by rock 2.
+  testing::WriteText(dir / "tree_impacts.csv",
+                     std::string(TreeImpactsCsvWriter::Header()) +
+                         "\n2,0,0,r,12,22,45,2,1.5,12,22,8,300000,250000,0"
+                         "\n2,1,0,r,12,22,45,1,1.7,12,22,8,900000,150000,1"
+                         "\n0,2,0,r,10,20,30,1,2.0,10,20,6,50000,50000,0\n");
+  const std::string path = (dir / "rocks.gpkg").string();
+  WriteRocksGeoPackage(
+      path, (dir / "rocks.csv").string(), "", testing::Wkt(31287), "", "",
+      GeoPackageScene{nullptr, nullptr, nullptr, &forest, (dir / "tree_impacts.csv").string()});
+  Dataset gpkg(path);
+  ASSERT_NE(gpkg.d, nullptr);
+  OGRLayer* trees = gpkg.d->GetLayerByName("trees");
+  ASSERT_NE(trees, nullptr);
+  EXPECT_EQ(trees->GetFeatureCount(), 3);
+  ASSERT_NE(trees->GetSpatialRef(), nullptr);
+  EXPECT_STREQ(trees->GetSpatialRef()->GetAuthorityCode(nullptr), "31287");
+  struct Expected {
+    double x, y, z, dbh_cm;
+    long rocks, impacts, broken;
+    double absorbed_kj;
+  };
+  const Expected expected[] = {
+      {10, 20, 5, 30, 1, 1, 0, 50}, {11, 21, 6, 20, 0, 0, 0, 0}, {12, 22, 7, 45, 2, 3, 1, 400}};
+  for (long k = 0; k < 3; ++k) {
+    SCOPED_TRACE(k);
+    std::unique_ptr<OGRFeature> f(trees->GetNextFeature());
+    ASSERT_NE(f, nullptr);
+    const Expected& e = expected[k];
+    EXPECT_EQ(f->GetFieldAsInteger64("tree"), k);
+    EXPECT_DOUBLE_EQ(f->GetFieldAsDouble("dbh_cm"), e.dbh_cm);
+    EXPECT_NEAR(f->GetFieldAsDouble("breaking_energy_kj"), 38.7 * std::pow(e.dbh_cm, 2.31) / 1000,
+                1e-9);
+    EXPECT_EQ(f->GetFieldAsInteger64("rocks_hit"), e.rocks);
+    EXPECT_EQ(f->GetFieldAsInteger64("impacts"), e.impacts);
+    EXPECT_EQ(f->GetFieldAsInteger64("broken"), e.broken);
+    EXPECT_DOUBLE_EQ(f->GetFieldAsDouble("absorbed_kj"), e.absorbed_kj);
+    const OGRPoint* p = f->GetGeometryRef()->toPoint();
+    EXPECT_EQ(p->getX(), e.x);
+    EXPECT_EQ(p->getY(), e.y);
+    EXPECT_EQ(p->getZ(), e.z);
+  }
+  // No layer without a forest; a row naming a tree the forest lacks is an error naming the line.
+  const std::string none = (dir / "none.gpkg").string();
+  WriteRocksGeoPackage(none, (dir / "rocks.csv").string(), "", "");
+  Dataset without(none);
+  EXPECT_EQ(without.d->GetLayerByName("trees"), nullptr);
+  testing::WriteText(dir / "tree_impacts.csv", std::string(TreeImpactsCsvWriter::Header()) +
+                                                   "\n3,0,0,r,12,22,45,2,1.5,12,22,8,3,2,0\n");
+  try {
+    WriteRocksGeoPackage(
+        (dir / "bad.gpkg").string(), (dir / "rocks.csv").string(), "", "", "", "",
+        GeoPackageScene{nullptr, nullptr, nullptr, &forest, (dir / "tree_impacts.csv").string()});
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("tree_impacts.csv:2"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("no tree 3 in the forest of 3 trees"), std::string::npos)
+        << e.what();
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir / "bad.gpkg"));
 }
 
 }  // namespace

@@ -87,6 +87,96 @@ TEST(SceneBarriers, AVectorFileGivesOneBarrierPerLineFeature) {
   EXPECT_EQ(s.scene.barriers[1].capacity_J, 5e7);
 }
 
+// height_field, capacity_field and type_field: each line feature's own height (m), capacity (kJ)
+// and type from its attributes (a number stored as text is read too), replacing the table's keys;
+// a table key still applies where no field is named.
+TEST(SceneBarriers, EachFeatureOfAFileCarriesItsOwnHeightCapacityAndType) {
+  const auto dir = testing::FreshDir("scene");
+  std::ofstream(dir / "nets.geojson") << R"({"type": "FeatureCollection", "features": [
+{"type": "Feature", "properties": {"name": "upper", "h": 3.5, "cap": 500, "kind": "flexible_net"},
+ "geometry": {"type": "LineString", "coordinates": [[20, -10], [20, 10]]}},
+{"type": "Feature", "properties": {"name": "lower", "h": 6, "cap": "5000", "kind": "dam"},
+ "geometry": {"type": "MultiLineString", "coordinates": [[[50, -10], [50, 0]], [[52, 0], [52, 10]]]}}]})";
+  testing::WriteText(dir / "scene.toml", kScene +
+                                             "file = \"nets.geojson\"\nheight_field = \"h\"\n"
+                                             "capacity_field = \"cap\"\ntype_field = \"kind\"\n");
+  SceneFile s = LoadScene((dir / "scene.toml").string());
+  ASSERT_EQ(s.scene.barriers.size(), 3u);  // the multi-line gives one barrier per part
+  EXPECT_EQ(s.scene.barriers[1].name, "lower part 1");
+  EXPECT_EQ(s.scene.barriers[2].name, "lower part 2");
+  const Barrier& upper = s.scene.barriers[0];
+  EXPECT_EQ(upper.name, "upper");
+  EXPECT_EQ(upper.type, BarrierType::kFlexibleNet);
+  EXPECT_EQ(upper.height_m, 3.5);
+  EXPECT_EQ(upper.capacity_J, 500e3);
+  for (int k : {1, 2}) {
+    const Barrier& lower = s.scene.barriers[static_cast<std::size_t>(k)];
+    EXPECT_EQ(lower.type, BarrierType::kDam);
+    EXPECT_EQ(lower.height_m, 6);
+    EXPECT_EQ(lower.capacity_J, 5000e3);
+  }
+  // Capacity per feature, height and type from the table.
+  testing::WriteText(dir / "scene.toml",
+                     kScene +
+                         "file = \"nets.geojson\"\nname_field = \"name\"\n"
+                         "capacity_field = \"cap\"\nheight_m = 4\ntype = \"rigid_wall\"\n");
+  s = LoadScene((dir / "scene.toml").string());
+  ASSERT_EQ(s.scene.barriers.size(), 3u);
+  EXPECT_EQ(s.scene.barriers[0].capacity_J, 500e3);
+  EXPECT_EQ(s.scene.barriers[2].capacity_J, 5000e3);
+  EXPECT_EQ(s.scene.barriers[2].height_m, 4);
+  EXPECT_EQ(s.scene.barriers[2].type, BarrierType::kRigidWall);
+}
+
+TEST(SceneBarriers, AFeaturesMissingOrNonPositiveAttributeIsAnErrorNamingFileFeatureAndField) {
+  const auto dir = testing::FreshDir("scene");
+  auto error = [&](const std::string& properties, const std::string& table) -> std::string {
+    std::ofstream(dir / "nets.geojson") << R"({"type": "FeatureCollection", "features": [
+{"type": "Feature", "properties": {"name": "a", "h": 4, "cap": 500, "kind": "dam"},
+ "geometry": {"type": "LineString", "coordinates": [[20, -10], [20, 10]]}},
+{"type": "Feature", "properties": )" + properties +
+                                               R"(,
+ "geometry": {"type": "LineString", "coordinates": [[50, -10], [50, 10]]}}]})";
+    testing::WriteText(dir / "scene.toml", kScene + "file = \"nets.geojson\"\n" + table);
+    try {
+      LoadScene((dir / "scene.toml").string());
+    } catch (const InputError& e) {
+      return e.what();
+    }
+    return "";
+  };
+  const std::string fields =
+      "height_field = \"h\"\ncapacity_field = \"cap\"\ntype_field = \"kind\"\n";
+  const std::string good = R"({"name": "b", "h": 4, "cap": 500, "kind": "dam"})";
+  EXPECT_EQ(error(good, fields), "");
+  EXPECT_HAS(error(R"({"name": "b", "h": 4, "cap": 0, "kind": "dam"})", fields),
+             "scene.toml:11: barriers[0].file (");
+  EXPECT_HAS(error(R"({"name": "b", "h": 4, "cap": 0, "kind": "dam"})", fields),
+             "nets.geojson, feature 1): attribute 'cap' is 0: the capacity must be a number > 0 "
+             "and <= 1000000 kJ");
+  EXPECT_HAS(error(R"({"name": "b", "h": 4, "cap": -20, "kind": "dam"})", fields),
+             "feature 1): attribute 'cap' is -20: the capacity must be a number > 0");
+  EXPECT_HAS(error(R"({"name": "b", "h": 4, "cap": "lots", "kind": "dam"})", fields),
+             "feature 1): attribute 'cap' is lots: the capacity must be a number");
+  EXPECT_HAS(error(R"({"name": "b", "h": 4, "cap": null, "kind": "dam"})", fields),
+             "feature 1): attribute 'cap' is empty");
+  EXPECT_HAS(error(R"({"name": "b", "h": 0, "cap": 500, "kind": "dam"})", fields),
+             "feature 1): attribute 'h' is 0: the height must be a number > 0 and <= 100 m (a "
+             "barrier only rocks touching the ground meet: height_m = 0 in its own table)");
+  EXPECT_HAS(error(R"({"name": "b", "h": -3, "cap": 500, "kind": "dam"})", fields),
+             "feature 1): attribute 'h' is -3: the height must be a number > 0");
+  EXPECT_HAS(error(R"({"name": "b", "h": 4, "cap": 500, "kind": "fence"})", fields),
+             "feature 1): attribute 'kind' is 'fence', not a barrier type");
+  EXPECT_HAS(error(good, "height_field = \"height\"\ncapacity_kj = 500\ntype = \"dam\"\n"),
+             "feature 0): no attribute 'height' (the attributes are: name, h, cap, kind)");
+  EXPECT_HAS(error(good, fields + "capacity_kj = 500\n"),
+             "barriers[0].capacity_kj: give capacity_kj or capacity_field (each feature's own), "
+             "not both");
+  EXPECT_HAS(ErrorOf(kNet + "capacity_field = \"cap\"\n"),
+             "barriers[0].capacity_field: only the line features of a vector file ('file') have "
+             "attributes");
+}
+
 TEST(SceneBarriers, BadInputIsAnErrorNamingFileLineAndKey) {
   EXPECT_HAS(ErrorOf(kNet + "capacity_kj = 0\n"),
              "scene.toml:15: barriers[0].capacity_kj: 0 kJ: the capacity must be > 0 kJ");

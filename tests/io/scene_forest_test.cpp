@@ -266,5 +266,117 @@ TEST(SceneForest, BadInputIsAnErrorNamingFileLineAndKey) {
              "output.rasters: tree_hits counts the impacts on stems: the scene has no [forest]");
 }
 
+// model = "drag": the stands on the DEM's nodes (1 m here) as ForestDrag stands of density
+// stems_per_ha / 1e4 per m^2, the mean DBH and E_max(DBH) of the model's law; no stems.
+TEST(SceneForest, TheDragModelPutsTheStandsOnTheDemGrid) {
+  const SceneFile s =
+      Load(kStand + "model = \"drag\"\nstem_height_m = 12\nenergy_coefficient_j = 40\n");
+  EXPECT_EQ(s.forest_model, "drag");
+  EXPECT_FALSE(s.has_forest);
+  EXPECT_TRUE(s.scene.forest.empty());
+  const ForestDrag& drag = s.scene.forest_drag;
+  ASSERT_FALSE(drag.empty());
+  EXPECT_EQ(drag.height_m(), 12);
+  const DragStand* inside = drag.StandAt(30, 0);
+  ASSERT_NE(inside, nullptr);
+  EXPECT_DOUBLE_EQ(inside->stems_per_m2, 0.5);
+  EXPECT_DOUBLE_EQ(inside->dbh_m, 0.3);
+  EXPECT_DOUBLE_EQ(inside->breaking_energy_J, 40 * std::pow(30.0, 2.31));
+  EXPECT_EQ(drag.StandAt(45, 0), nullptr);
+  EXPECT_EQ(drag.StandAt(30, 12), nullptr);
+  // Nodes 20 .. 40 on both axes, less one edge row: GDAL's rasteriser takes a node on a
+  // polygon's edge on one side only.
+  EXPECT_EQ(s.forest_drag_cells, 20 * 21);
+  ASSERT_EQ(s.stands.size(), 1u);
+  EXPECT_EQ(s.stands[0].trees, 0);
+  ASSERT_EQ(s.warnings.size(), 1u);
+  EXPECT_HAS(s.warnings[0], "dbh_sd_cm is not used by model = \"drag\"");
+  std::string why;
+  EXPECT_TRUE(s.scene.IsValid(&why)) << why;
+}
+
+// stems_per_ha_raster and dbh_raster: each DEM node takes the raster cell holding it; nodata or
+// 0 stems: no forest; a stand polygon lies over the rasters.
+TEST(SceneForest, TheDragModelReadsDensityAndDbhRasters) {
+  const auto dir = testing::FreshDir("scene");
+  // 4 x 2 cells of 5 m from (20, -5) to (40, 5): west to east 800, 0, nodata, 300 stems/ha.
+  const std::array<double, 6> gt = {20, 5, 0, 5, 0, -5};
+  testing::WriteGdalRaster(dir / "density.tif", {{800, 0, -1, 300}, {800, 0, -1, 300}}, gt, 0, -1);
+  testing::WriteGdalRaster(dir / "dbh.tif", {{25, 0, 0, 40}, {25, 0, 0, 40}}, gt, 0, -1);
+  const std::string forest =
+      "[forest]\nmodel = \"drag\"\nstems_per_ha_raster = \"density.tif\"\n"
+      "dbh_raster = \"dbh.tif\"\n";
+  testing::WriteText(dir / "scene.toml", kScene + forest);
+  SceneFile s = LoadScene((dir / "scene.toml").string());
+  const ForestDrag& drag = s.scene.forest_drag;
+  const DragStand* west = drag.StandAt(22, 0);
+  ASSERT_NE(west, nullptr);
+  EXPECT_DOUBLE_EQ(west->stems_per_m2, 0.08);
+  EXPECT_DOUBLE_EQ(west->dbh_m, 0.25);
+  const DragStand* east = drag.StandAt(38, -4);
+  ASSERT_NE(east, nullptr);
+  EXPECT_DOUBLE_EQ(east->stems_per_m2, 0.03);
+  EXPECT_DOUBLE_EQ(east->dbh_m, 0.40);
+  EXPECT_EQ(drag.StandAt(27, 0), nullptr);  // 0 stems
+  EXPECT_EQ(drag.StandAt(32, 0), nullptr);  // nodata
+  EXPECT_EQ(drag.StandAt(22, 7), nullptr);  // off the rasters
+  EXPECT_EQ(drag.stands().size(), 2u);
+  testing::WriteText(dir / "scene.toml",
+                     kScene + forest +
+                         "stands = [{ polygon = [[20, -2], [24, -2], [24, 2], [20, 2]], "
+                         "stems_per_ha = 100, dbh_cm = 50 }]\n");
+  s = LoadScene((dir / "scene.toml").string());
+  EXPECT_DOUBLE_EQ(s.scene.forest_drag.StandAt(22, 0)->dbh_m, 0.5);
+  EXPECT_DOUBLE_EQ(s.scene.forest_drag.StandAt(22, -4)->dbh_m, 0.25);
+  // A negative density, and a DBH of 0 where there are stems, name the file and the first DEM
+  // node (from the south-west) that takes such a cell: (35, 0) and (20, 0) take the northern row.
+  testing::WriteGdalRaster(dir / "density.tif", {{800, 0, -1, -300}, {800, 0, -1, 300}}, gt, 0, -1);
+  testing::WriteText(dir / "scene.toml", kScene + forest);
+  try {
+    LoadScene((dir / "scene.toml").string());
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_HAS(e.what(), "forest.stems_per_ha_raster: ");
+    EXPECT_HAS(e.what(), "density.tif: -300 stems per hectare at (35, 0) must be > 0");
+  }
+  testing::WriteGdalRaster(dir / "density.tif", {{800, 0, -1, 300}, {800, 0, -1, 300}}, gt, 0, -1);
+  testing::WriteGdalRaster(dir / "dbh.tif", {{0, 0, 0, 40}, {25, 0, 0, 40}}, gt, 0, -1);
+  try {
+    LoadScene((dir / "scene.toml").string());
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_HAS(e.what(), "forest.dbh_raster: ");
+    EXPECT_HAS(e.what(), "dbh.tif: DBH 0 cm at (20, 0), where");
+  }
+  // Rasters off the DEM.
+  testing::WriteGdalRaster(dir / "dbh.tif", {{25}}, {1000, 5, 0, 5, 0, -5}, 0, -1);
+  try {
+    LoadScene((dir / "scene.toml").string());
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_HAS(e.what(), "forest.dbh_raster: ");
+    EXPECT_HAS(e.what(), "none of the DEM");
+  }
+}
+
+TEST(SceneForest, TheDragModelsBadInputIsAnErrorNamingTheKey) {
+  EXPECT_HAS(ErrorOf(kStand + "model = \"forest\"\n"),
+             "forest.model: unknown forest model 'forest'");
+  EXPECT_HAS(ErrorOf("[forest]\nmodel = \"drag\"\n"),
+             "forest.model: model = \"drag\" needs stands");
+  EXPECT_HAS(
+      ErrorOf("[forest]\nmodel = \"drag\"\ntrees = \"trees.csv\"\n", "x_m,y_m,dbh_cm\n30,0,30\n"),
+      "forest.trees: model = \"drag\" has no explicit trees");
+  EXPECT_HAS(ErrorOf(kStand + "model = \"drag\"\nfriction = 0.3\n"),
+             "forest.friction: model = \"drag\" has no explicit trees");
+  EXPECT_HAS(ErrorOf(kStand + "model = \"drag\"\nstems_per_ha_raster = \"d.tif\"\n"),
+             "forest.stems_per_ha_raster: stems_per_ha_raster and dbh_raster go together");
+  EXPECT_HAS(ErrorOf(kStand + "dbh_raster = \"d.tif\"\n"),
+             "forest.dbh_raster: dbh_raster is for model = \"drag\"");
+  EXPECT_HAS(ErrorOf(kStand + "model = \"drag\"\nstem_height_m = 0\n"), "forest.stem_height_m");
+  EXPECT_HAS(ErrorOf(kStand + "model = \"drag\"\n[output]\nrasters = [\"tree_hits\"]\n"),
+             "tree_hits counts the impacts on explicit stems: [forest] model = \"drag\" has none");
+}
+
 }  // namespace
 }  // namespace talus::io

@@ -15,12 +15,14 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <numbers>
 #include <vector>
 
 #include "scenes/scenes.hpp"
 #include "solver/random.hpp"
 #include "solver/shapes.hpp"
 #include "solver/simulate.hpp"
+#include "solver/step.hpp"
 
 namespace talus {
 namespace {
@@ -275,6 +277,127 @@ TEST(Forest, ARockAboveTheStemsTopPassesBitForBitUnchanged) {
   EXPECT_TRUE(r.stem_hits.empty());
   EXPECT_EQ(r.final_state.position_m, free.final_state.position_m);
   EXPECT_EQ(r.final_state.velocity_m_s, free.final_state.velocity_m_s);
+}
+
+// The forest as a drag layer (ForestDrag; docs/model.md, "Forest as a drag layer"): on the
+// scene's DEM grid, the cells whose centres lie in [x0, x1] x [y0, y1] hold one stand of n stems
+// per hectare of DBH D, E_max(D) by the default ForestModel, 10 m high.
+ForestDrag Stand(const Scene& scene, double x0, double x1, double y0, double y1,
+                 double stems_per_ha, double dbh_m) {
+  const GridGeometry& grid = scene.terrain.heights().grid;
+  std::vector<int> cells(static_cast<std::size_t>(grid.nx) * grid.ny, -1);
+  for (int j = 0; j < grid.ny; ++j)
+    for (int i = 0; i < grid.nx; ++i) {
+      const double x = grid.x0_m + i * grid.dx_m, y = grid.y0_m + j * grid.dy_m;
+      if (x >= x0 && x <= x1 && y >= y0 && y <= y1)
+        cells[static_cast<std::size_t>(j) * grid.nx + i] = 0;
+    }
+  const ForestModel model;
+  return ForestDrag(grid, std::move(cells),
+                    {DragStand{stems_per_ha / 1e4, dbh_m, model.BreakingEnergy_J(dbh_m)}},
+                    model.stem_height_m);
+}
+
+TEST(ForestDrag, UniformStandSlowsAFlyingRockAsTheDerivationSays) {
+  // No gravity; the 1 m cube (m = 2700 kg, w = (6 / pi)^(1/3) = 1.2407 m) flies along +x 1 m
+  // above flat ground through a stand of n = 400 /ha, D = 30 cm (E_max = 99.96 kJ): lambda =
+  // n (D + w) = 0.06163 stems per metre. Pure translation, E = m v^2 / 2, so dv/dt = -lambda dE /
+  // m:
+  // - above v* = sqrt(2 E_max / (eta m)) = 10.54 m/s every hit breaks its stem and takes E_max:
+  //   dv/dt = -a, a = lambda E_max / m = 2.28 m/s^2, v = v0 - a t;
+  // - below it each hit takes eta E: dv/dt = -k v^2, k = lambda eta / 2, v = v* / (1 + k v* t').
+  // The scheme freezes the rate at each step's beginning and integrates it exactly over the step:
+  // per step it keeps v e^(-y) - (v - a dt) <= v y^2 / 2 = a^2 dt^2 / (2 v) too much above v*
+  // (y = a dt / v) and v (e^(-y) - 1 / (1 + y)) >= -v y^2 / 2 below it (y = k v dt); the first
+  // summed over the T* = 4.2 s above v* is at most a^2 dt T* / (2 v*) = 2.1e-3 m/s, the second
+  // under 1e-4 m/s. Tolerance 3e-3 m/s. Spinning about a principal axis (the cube's are all
+  // principal, free rotation keeps Omega), Omega decays at the same rate: Omega / |v| stays.
+  Scene scene = scenes::Incline(0, Cube(), GroundParams{kMu, kMu, 150, 2, 0});
+  scene.options.gravity_m_s2 = 0;
+  scene.forest_drag = Stand(scene, 0, 200, -100, 100, 400, 0.30);
+  std::string why;
+  ASSERT_TRUE(scene.IsValid(&why)) << why;
+  const double m = scene.rock.mass_kg, dt = scene.options.dt_s;
+  const double w = std::cbrt(6 / std::numbers::pi), e_max = ForestModel{}.BreakingEnergy_J(0.30);
+  EXPECT_NEAR(ForestDrag::RockWidth_m(scene.rock), w, 1e-12);
+  const double lambda = 0.04 * (0.30 + w), eta = 2.0 / 3.0;
+  const double a = lambda * e_max / m, v_star = std::sqrt(2 * e_max / (eta * m));
+  const double k = lambda * eta / 2, v0 = 20, t_star = (v0 - v_star) / a;
+  auto exact = [&](double t) {
+    return t <= t_star ? v0 - a * t : v_star / (1 + k * v_star * (t - t_star));
+  };
+  for (double spin : {0.0, 2.0}) {
+    StepWorkspace ws;
+    ws.Reset(scene.rock.vertices_m.size());
+    RockState s;
+    s.position_m = {10, 0, 1};
+    s.velocity_m_s = {v0, 0, 0};
+    s.angular_velocity_rad_s = {0, 0, spin};
+    int steps = 0;
+    for (double t : {1.0, 3.0, 4.0, 6.0, 8.0}) {
+      for (; steps < std::lround(t / dt); ++steps) Step(scene, s, ws);
+      SCOPED_TRACE("spin " + std::to_string(spin) + ", t = " + std::to_string(t));
+      if (spin == 0) {
+        EXPECT_NEAR(s.velocity_m_s.x(), exact(t), 3e-3);
+      } else {
+        // The rotational energy lowers the rate above v* (E_max is shared) and not below it.
+        EXPECT_GT(s.velocity_m_s.x(), exact(t) - 3e-3);
+        EXPECT_NEAR(s.angular_velocity_rad_s.z() / s.velocity_m_s.x(), spin / v0, 1e-12);
+      }
+      EXPECT_EQ(s.velocity_m_s.y(), 0);
+      EXPECT_EQ(s.velocity_m_s.z(), 0);
+    }
+  }
+  // The same rock standing still in the stand, or falling straight down, meets no stem.
+  RockState still;
+  still.angular_velocity_rad_s = {0, 0, 3};
+  EXPECT_EQ(ForestDrag::Rate_1_s(scene.forest_drag.stands()[0], scene.rock, still), 0);
+  still.velocity_m_s = {0, 0, -5};
+  EXPECT_EQ(ForestDrag::Rate_1_s(scene.forest_drag.stands()[0], scene.rock, still), 0);
+}
+
+TEST(ForestDrag, ActsOnlyInsideItsStandsAndBelowItsHeight) {
+  Scene scene = scenes::Incline(0, Cube(), GroundParams{kMu, kMu, 150, 2, 0});
+  scene.forest_drag = Stand(scene, 50, 100, -20, 20, 400, 0.30);  // cells of 5 m: edges +-2.5 m
+  const ForestDrag& drag = scene.forest_drag;
+  RockState moving;
+  moving.velocity_m_s = {10, 0, 0};
+  EXPECT_GT(ForestDragRate_1_s(drag, scene.rock, moving, {75, 0, 1}, 1.0), 0);
+  EXPECT_GT(ForestDragRate_1_s(drag, scene.rock, moving, {75, 0, 10}, 10.0), 0);
+  EXPECT_EQ(ForestDragRate_1_s(drag, scene.rock, moving, {75, 0, 10.01}, 10.01), 0);
+  EXPECT_GT(ForestDragRate_1_s(drag, scene.rock, moving, {47.6, 22.4, 1}, 1.0), 0);
+  EXPECT_EQ(ForestDragRate_1_s(drag, scene.rock, moving, {47.4, 0, 1}, 1.0), 0);
+  EXPECT_EQ(ForestDragRate_1_s(drag, scene.rock, moving, {75, 22.6, 1}, 1.0), 0);
+  EXPECT_EQ(ForestDragRate_1_s(drag, scene.rock, moving, {-75, 0, 1}, 1.0), 0);  // off the grid
+}
+
+TEST(ForestDrag, ARockOutsideTheStandsRunsBitForBitAsWithoutForest) {
+  // A cube tumbling down a 35 deg slope near y = 0 (released with its faces along the axes and
+  // spinning about y: it strays less than 5 m from y = 0), with and without a stand
+  // beside its path (y >= 40 m) and a drag layer in that stand that also shortens the flight
+  // windows: the same state bit for bit. The stand across its path does change it.
+  Scene scene = scenes::Incline(35, Cube(), GroundParams{0.35, 2.0, 150, 2, 0.6});
+  scene.options.max_time_s = 6;
+  RockState s;
+  s.position_m = {20, 0, 0};
+  s.velocity_m_s = {3, 0, 0};
+  s.angular_velocity_rad_s = {0, 2, 0};
+  TerrainSample ground;
+  ASSERT_TRUE(scene.terrain.Sample(20, 0, &ground));
+  s.position_m.z() = ground.height_m + 1.5;
+  SimulationWorkspace ws;
+  const RockResult free = SimulateRock(scene, s, ws);
+  EXPECT_LT(std::abs(free.final_state.position_m.y()), 5);
+  EXPECT_GT(free.final_state.position_m.x(), 40);
+  scene.forest_drag = Stand(scene, 0, 200, 40, 100, 400, 0.30);
+  const RockResult beside = SimulateRock(scene, s, ws);
+  EXPECT_EQ(beside.final_state.position_m, free.final_state.position_m);
+  EXPECT_EQ(beside.final_state.velocity_m_s, free.final_state.velocity_m_s);
+  EXPECT_EQ(beside.final_state.angular_velocity_rad_s, free.final_state.angular_velocity_rad_s);
+  EXPECT_EQ(beside.steps, free.steps);
+  scene.forest_drag = Stand(scene, 0, 200, -20, 20, 400, 0.30);
+  const RockResult across = SimulateRock(scene, s, ws);
+  EXPECT_GT((across.final_state.position_m - free.final_state.position_m).norm(), 1);
 }
 
 }  // namespace
