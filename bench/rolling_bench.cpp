@@ -3,9 +3,9 @@
 // about a face axis at --omega rad/s (its centre at the matching speed), on the seed's hard contact
 // or on the scarring soil (Lu et al. 2019, the paper's M_E 15 MN/m^2 and C_s 1.5), with Coulomb
 // friction --mu and the viscous term --nu under either reading (none by default). Prints per slope
-// whether it came to rest (speed below 0.02 m/s and angular speed below 0.05 rad/s for 1 s, the
-// default rest rule) and when, the distance travelled and the speeds at the end of --seconds. A
-// polygonal prism rolling with plastic impacts is McGeer's rimless wheel
+// whether it came to rest (SimulateRock's rule: speed below 0.02 m/s and angular speed below
+// 0.05 rad/s, in contact, for 1 s) and when, or how it ended, the distance travelled and the speeds
+// at the end of --seconds. A polygonal prism rolling with plastic impacts is McGeer's rimless wheel
 // (tests/solver/rolling_test.cpp checks the solver against its closed form); this shows where that
 // wheel stops for the block real runs use.
 
@@ -17,7 +17,7 @@
 
 #include "scenes/scenes.hpp"
 #include "solver/shapes.hpp"
-#include "solver/step.hpp"
+#include "solver/simulate.hpp"
 
 int main(int argc, char** argv) {
   using namespace talus;
@@ -56,8 +56,6 @@ int main(int argc, char** argv) {
     Scene scene = scenes::Incline(slope, rock, ground, 4000, 5);
     scene.options.dt_s = dt_s;
     scene.options.viscous = reading;
-    StepWorkspace ws;
-    ws.Reset(rock.vertices_m.size());
     RockState s;
     s.orientation = rock.PrincipalOrientation(Eigen::Quaterniond::Identity());
     TerrainSample plane;
@@ -65,21 +63,16 @@ int main(int argc, char** argv) {
     s.position_m = {50, 0, plane.height_m + a / 2 + 1e-3};
     s.angular_velocity_rad_s = s.orientation.inverse() * Eigen::Vector3d(0, omega, 0);
     s.velocity_m_s = {omega * a / 2, 0, 0};
-    const Eigen::Vector3d start = s.position_m;
-    const SolverOptions& opt = scene.options;
-    double still_s = 0, rest_at = -1;
-    const long steps = std::lround(seconds / dt_s);
-    for (long k = 0; k < steps && rest_at < 0; ++k) {
-      if (Step(scene, s, ws).outside_domain) break;
-      const bool still = s.velocity_m_s.norm() <= opt.rest_speed_m_s &&
-                         s.angular_velocity_rad_s.norm() <= opt.rest_angular_speed_rad_s;
-      still_s = still ? still_s + dt_s : 0;
-      if (still_s >= opt.rest_hold_s) rest_at = s.time_s;
-    }
-    std::printf("%9.1f  %9s  %10.1f  %13.2f  %15.2f\n", slope,
-                rest_at < 0 ? "moving" : std::to_string(rest_at).substr(0, 6).c_str(),
-                (s.position_m - start).norm(), s.velocity_m_s.norm(),
-                s.angular_velocity_rad_s.norm());
+    scene.options.max_time_s = seconds;
+    SimulationWorkspace workspace;
+    const RockResult result = SimulateRock(scene, rock, s, workspace);
+    const RockState& last = result.final_state;
+    const bool rest = result.end == EndReason::kRest;
+    std::printf(
+        "%9.1f  %9s  %10.1f  %13.2f  %15.2f\n", slope,
+        rest ? std::to_string(result.travel_time_s).substr(0, 6).c_str() : ToString(result.end),
+        (last.position_m - s.position_m).norm(), last.velocity_m_s.norm(),
+        last.angular_velocity_rad_s.norm());
   }
   return 0;
 }

@@ -184,6 +184,14 @@ ResourceEstimate EstimateResources(const SceneFile& scene, int threads) {
       e.disk.push_back(
           {"rocks.gpkg trees", stems * kGeoPackageBytesPerTree, "a sparser or smaller [forest]"});
   }
+  if (!scene.scene.forest_drag.empty()) {
+    // The forest as a drag layer: one stand index per DEM node, and the stands.
+    const ForestDrag& drag = scene.scene.forest_drag;
+    e.memory.push_back({"forest drag layer",
+                        double(drag.cells().size()) * sizeof(int) +
+                            double(drag.stands().size()) * sizeof(DragStand),
+                        "a coarser DEM"});
+  }
   if (output.geopackage)
     e.disk.push_back({"rocks.gpkg",
                       rocks * (kGeoPackageBytesPerRock +

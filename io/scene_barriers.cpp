@@ -1,6 +1,7 @@
 #include <toml++/toml.h>
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <cstdlib>
 #include <limits>
@@ -43,9 +44,12 @@ double NumberOf(const FeatureValue& v) {
   if (v.kind == FeatureValue::Kind::kNumber) return v.number;
   if (v.kind != FeatureValue::Kind::kText || v.text.empty())
     return std::numeric_limits<double>::quiet_NaN();
-  char* end = nullptr;
-  const double number = std::strtod(v.text.c_str(), &end);
-  return end && *end == '\0' ? number : std::numeric_limits<double>::quiet_NaN();
+  // std::from_chars: no locale, no hexadecimal, no surrounding blanks.
+  double number = 0;
+  const char* first = v.text.data();
+  const char* last = first + v.text.size();
+  const auto [end, error] = std::from_chars(first, last, number);
+  return error == std::errc() && end == last ? number : std::numeric_limits<double>::quiet_NaN();
 }
 
 // "<where>: <field>" and why a feature's attribute has no usable value, or "" when it has one.

@@ -25,6 +25,9 @@ void Pad(double& lo, double& hi) {
 
 std::vector<double> NiceTicks(double lo, double hi, int target) {
   if (!(hi > lo) || !std::isfinite(lo) || !std::isfinite(hi)) return {lo};
+  // A range of a few round-off units (values equal but for the last digits) has no round ticks
+  // inside: one tick, at its middle.
+  if (hi - lo <= 1e-12 * std::max(std::abs(lo), std::abs(hi))) return {0.5 * (lo + hi)};
   // The step is m x 10^e; a tick k m / 10^-e (or k m 10^e) is then the double nearest the round
   // number (3.15, not 63 x 0.05 = 3.1500000000000004).
   const double raw = (hi - lo) / std::max(1, target);
@@ -37,11 +40,20 @@ std::vector<double> NiceTicks(double lo, double hi, int target) {
       m = candidate;
       break;
     }
-  // Fewer than two ticks inside (a range shorter than a step from its first multiple): halve.
-  while (std::floor(hi / at(m) + 1e-9) - std::ceil(lo / at(m) - 1e-9) < 1) m /= 2;
+  // Fewer than two ticks inside (a range shorter than a step from its first multiple): halve,
+  // at most a few times (the step starts near (hi - lo) / target).
+  for (int halvings = 0;
+       halvings < 8 && std::floor(hi / at(m) + 1e-9) - std::ceil(lo / at(m) - 1e-9) < 1; ++halvings)
+    m /= 2;
+  // Ticks by an integer count, bounded, so that no rounding of k can keep the loop going.
+  const double first = std::ceil(lo / at(m) - 1e-9);
+  const double count = std::floor(hi / at(m) + 1e-9) - first + 1;
+  if (!(count >= 1 && count <= 1000)) return {0.5 * (lo + hi)};
   std::vector<double> ticks;
-  for (double k = std::ceil(lo / at(m) - 1e-9); at(k * m) <= hi + 1e-9 * at(m); ++k)
+  for (int i = 0; i < static_cast<int>(count); ++i) {
+    const double k = first + i;
     ticks.push_back(k == 0 ? 0.0 : at(k * m));  // never "-0"
+  }
   return ticks;
 }
 

@@ -160,7 +160,6 @@ constinit const std::array<SolverOptionInfo, 17> kSolverOptions = {{
      .member = MemberOf<&O::impact_substeps>(),
      .unit = "1",
      .valid = Bounds::Between(1, 64),
-     .preset_knob = true,
      .doc = "a step with a predicted contact is taken as this many sub-steps; 1: never (below)"},
     {.key = "soil_drag",
      .type = Type::kChoice,
@@ -237,6 +236,16 @@ bool SolverOptions::IsValid(std::string* why) const {
       msg << "tangential_restitution = " << tangential_restitution
           << " violates tangential_restitution == normal_restitution (Newton's impact law adds "
              "energy for unequal coefficients: Glocker 2013, Part I)";
+      *why = msg.str();
+    }
+    return false;
+  }
+  // Impact sub-steps split the plastic law's steps only (Newton's law keeps whole steps).
+  if (impact_substeps > 1 && normal_restitution > 0) {
+    if (why) {
+      std::ostringstream msg;
+      msg << "impact_substeps = " << impact_substeps << " needs normal_restitution = 0 (Newton's "
+          << "law takes the begin velocities of a whole step; it is " << normal_restitution << ")";
       *why = msg.str();
     }
     return false;

@@ -112,7 +112,8 @@ struct SolverOptions {
   // predicted contact is taken as this many sub-steps of dt / impact_substeps, so that the
   // percussion acts near the instant of the impact instead of up to a step early; 1: never (the
   // scheme as before). Off by default until the calibration tests are re-derived for it; 4 brings
-  // cases/tirol at dt 2 ms within the standard errors of dt 0.5 ms.
+  // cases/tirol at dt 2 ms within the standard errors of dt 0.5 ms (same k). Needs
+  // normal_restitution = 0 (IsValid).
   int impact_substeps = 1;
   // Where the scar drag of a soil category (GroundModel::kLu2019) acts.
   SoilDragPoint soil_drag = SoilDragPoint::kCentreOfMass;

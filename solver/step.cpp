@@ -230,7 +230,7 @@ StepReport Step(const Scene& scene, const RockShape& rock, RockState& state,
                 StepWorkspace& workspace, StageTimes* times) {
   const SolverOptions& opt = scene.options;
   // Newton's law (restitution > 0) takes the begin velocities of the step it acts in: its steps
-  // are not split, so that the rebound is -eps times the approach of a whole step.
+  // are not split (SolverOptions::IsValid refuses impact_substeps > 1 with it).
   const int substeps = opt.normal_restitution > 0 ? 1 : opt.impact_substeps;
   if (times) ++times->steps;
   StepReport report = StepOnce(scene, rock, opt.dt_s, substeps > 1, state, workspace, times);
@@ -239,10 +239,12 @@ StepReport Step(const Scene& scene, const RockShape& rock, RockState& state,
   // percussion acts near the instant the vertex arrives rather than up to a whole step early
   // (docs/model.md, "Impact sub-steps"). One report for the whole step: the most contacts and the
   // sum of sweeps of any sub-step; loaded, in soil and unconverged if any sub-step was; the
-  // deepest soil penetration and the last sub-step's scar extent.
+  // deepest soil penetration, and the scar from the first in-soil sub-step's rear to the last
+  // one's front.
   const RockState begin = state;
   const double dt = opt.dt_s / substeps;
   StepReport merged;
+  bool soil_seen = false;
   for (int k = 0; k < substeps; ++k) {
     const StepReport sub = StepOnce(scene, rock, dt, false, state, workspace, times);
     if (sub.outside_domain) {
@@ -255,9 +257,11 @@ StepReport Step(const Scene& scene, const RockShape& rock, RockState& state,
     merged.loaded = merged.loaded || sub.loaded;
     merged.in_soil = merged.in_soil || sub.in_soil;
     merged.soil_penetration_m = std::max(merged.soil_penetration_m, sub.soil_penetration_m);
+    // The scar this step cut: from the first sub-step's rear to the last one's front.
     if (sub.in_soil) {
-      merged.soil_rear_m = sub.soil_rear_m;
+      if (!soil_seen) merged.soil_rear_m = sub.soil_rear_m;
       merged.soil_front_m = sub.soil_front_m;
+      soil_seen = true;
     }
   }
   merged.substeps = substeps;

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -69,6 +70,15 @@ TEST(SvgPlot, TicksAreRoundNumbersInsideTheAxis) {
   EXPECT_GE(NiceTicks(0.999, 1.001).size(), 2u);
   for (double t : NiceTicks(-0.37, 0.52)) EXPECT_TRUE(t >= -0.37 && t <= 0.52) << t;
   EXPECT_EQ(NiceTicks(5, 5), std::vector<double>{5});  // no range: one tick, no endless loop
+  // A range of two round-off units (an objective that differs only in its last digits): the tick
+  // counter once grew past 2^53, where ++k no longer changes it, and never stopped. One tick.
+  const double lo = 1234.5678, hi = std::nextafter(std::nextafter(lo, 2e3), 2e3);
+  EXPECT_EQ(NiceTicks(lo, hi).size(), 1u);
+  // Just above that: a handful of ticks, all inside.
+  const std::vector<double> narrow = NiceTicks(lo, lo * (1 + 1e-10));
+  EXPECT_GE(narrow.size(), 1u);
+  EXPECT_LE(narrow.size(), 20u);
+  for (double t : narrow) EXPECT_TRUE(t >= lo && t <= lo * (1 + 1e-10)) << t;
 }
 
 TEST(SvgPlot, TickLabelsHaveTheDecimalsOfTheirStep) {

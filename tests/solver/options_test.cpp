@@ -57,6 +57,20 @@ TEST(Options, DefaultsAreValidAndBadValuesAreNamed) {
     EXPECT_FALSE(o.IsValid(&why)) << normal << ", " << tangential;
     EXPECT_NE(why.find("restitution"), std::string::npos) << why;
   }
+  // Impact sub-steps split the plastic law's steps only: with restitution they are refused by
+  // name, not silently ignored; 1 .. 64 otherwise.
+  o = SolverOptions{};
+  o.impact_substeps = 4;
+  EXPECT_TRUE(o.IsValid(&why)) << why;
+  o.normal_restitution = o.tangential_restitution = 0.3;
+  EXPECT_FALSE(o.IsValid(&why));
+  EXPECT_NE(why.find("impact_substeps = 4 needs normal_restitution = 0"), std::string::npos) << why;
+  for (const int k : {0, 65}) {
+    o = SolverOptions{};
+    o.impact_substeps = k;
+    EXPECT_FALSE(o.IsValid(&why)) << k;
+    EXPECT_NE(why.find("impact_substeps"), std::string::npos) << why;
+  }
 }
 
 // IsValid's messages: the key, the value, the bound and the unit.
