@@ -232,8 +232,8 @@ StepReport Step(const Scene& scene, const RockShape& rock, RockState& state,
   // Newton's law (restitution > 0) takes the begin velocities of the step it acts in: its steps
   // are not split (SolverOptions::IsValid refuses impact_substeps > 1 with it).
   const int substeps = opt.normal_restitution > 0 ? 1 : opt.impact_substeps;
-  if (times) ++times->steps;
   StepReport report = StepOnce(scene, rock, opt.dt_s, substeps > 1, state, workspace, times);
+  if (times && !report.outside_domain) ++times->steps;  // one step, whatever its parts
   if (!report.split) return report;
   // A predicted contact: the step again as sub-steps of dt / substeps, so that the contact's
   // percussion acts near the instant the vertex arrives rather than up to a whole step early
