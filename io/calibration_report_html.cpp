@@ -13,12 +13,9 @@ using html::Cell;
 using html::Json;
 using html::Number;
 using html::NumberOf;
+using html::UnitSuffix;
 using svg::Add;
 using svg::Escape;
-
-std::string UnitSuffix(const std::string& unit) {
-  return unit.empty() || unit == "1" ? "" : " (" + Escape(unit) + ")";
-}
 
 // "lo &ndash; hi" of a two-number array, or "&ndash;".
 std::string Interval(const Json& pair) {

@@ -93,6 +93,10 @@ std::string Cell(const Json& value) {
 
 double NumberOf(const Json& value) { return value.is_number() ? value.get<double>() : NAN; }
 
+std::string UnitSuffix(const std::string& unit) {
+  return unit.empty() || unit == "1" ? "" : " (" + Escape(unit) + ")";
+}
+
 std::string HumanLabel(const std::string& key) {
   if (const auto it = Labels().find(key); it != Labels().end()) return it->second;
   std::string words = key, unit;

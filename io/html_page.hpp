@@ -30,6 +30,8 @@ std::string Cell(const Json& value);
 // A number of a JSON value (NaN when it is not one).
 double NumberOf(const Json& value);
 
+// " (m)" after a label for a unit, "" for a dimensionless one ("" or "1"); the unit escaped.
+std::string UnitSuffix(const std::string& unit);
 // A JSON key or a column name as people read it: "max_speed_m_s" -> "max speed (m/s)",
 // "dt_s" -> "time step (s)", "mu_min" -> "μ_min"; a few keys have their own label.
 std::string HumanLabel(const std::string& key);

@@ -15,13 +15,9 @@ using html::Cell;
 using html::Json;
 using html::Number;
 using html::NumberOf;
+using html::UnitSuffix;
 using svg::Add;
 using svg::Escape;
-
-// " (m)" for a unit, "" for a dimensionless one.
-std::string UnitSuffix(const std::string& unit) {
-  return unit.empty() || unit == "1" ? "" : " (" + Escape(unit) + ")";
-}
 
 std::string Percent(double fraction) {
   return std::isfinite(fraction) ? Number(100 * fraction, "%.0f") + " %" : "&ndash;";
