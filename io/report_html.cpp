@@ -39,17 +39,7 @@ RockColumns ReadRockColumns(const std::string& rocks_csv) {
     const auto value = [&](std::size_t c) {
       const std::string& text = fields[c];
       if (text.empty()) return std::numeric_limits<double>::quiet_NaN();
-      std::size_t used = 0;
-      double v = 0;
-      try {
-        v = std::stod(text, &used);
-      } catch (const std::exception&) {
-        used = 0;
-      }
-      if (used != text.size())
-        throw InputError(rocks_csv + ":" + std::to_string(in.line()) + ": column '" +
-                         in.header()[c] + "': '" + text + "' is not a number");
-      return v;
+      return CsvFieldNumber(text, rocks_csv + ":" + std::to_string(in.line()), in.header()[c]);
     };
     out.runout_m.push_back(value(runout));
     out.max_kinetic_energy_j.push_back(value(energy));
