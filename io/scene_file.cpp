@@ -154,6 +154,15 @@ void LoadSolver(const Section& s, SolverOptions& o, SolverPreset& preset,
   }
   // One coefficient (SolverOptions): the tangential one follows the normal one unless given.
   if (!s.Has("tangential_restitution")) o.tangential_restitution = o.normal_restitution;
+  // Newton's law keeps whole steps: the sub-steps' default gives way to a restitution, and a
+  // scene that asks for both is told so rather than silently given whole steps.
+  if (o.normal_restitution > 0) {
+    if (s.Has("impact_substeps") && o.impact_substeps > 1)
+      s.FailCheck("impact_substeps = " + std::to_string(o.impact_substeps) +
+                  " needs normal_restitution = 0 (Newton's law takes the begin velocities of a "
+                  "whole step; it is " + RoundTrip(o.normal_restitution) + ")");
+    o.impact_substeps = 1;
+  }
   std::string why;
   if (!o.IsValid(&why)) s.FailCheck(why);
 }

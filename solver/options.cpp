@@ -240,16 +240,6 @@ bool SolverOptions::IsValid(std::string* why) const {
     }
     return false;
   }
-  // Impact sub-steps split the plastic law's steps only (Newton's law keeps whole steps).
-  if (impact_substeps > 1 && normal_restitution > 0) {
-    if (why) {
-      std::ostringstream msg;
-      msg << "impact_substeps = " << impact_substeps << " needs normal_restitution = 0 (Newton's "
-          << "law takes the begin velocities of a whole step; it is " << normal_restitution << ")";
-      *why = msg.str();
-    }
-    return false;
-  }
   return true;
 }
 

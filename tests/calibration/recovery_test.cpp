@@ -145,9 +145,28 @@ ObjectiveOptions TwoThreads() {
 // ends the sliding sooner. Measured: within-run sd 0.40 m, d mean / d mu_min -1.37 m, data's
 // standard error 0.067 (tolerance 0.20); the objective is flat below mu_min 0.3 (every block
 // slides), so the fits start above the truth.
+// Whole steps (impact_substeps = 1), the scheme these numbers were measured with. Under the
+// default impact sub-steps this problem's objective is flatter above the truth than its noise
+// (measured along mu_min 0.50, 0.55, .., 0.85: 0.996, 0.945, 0.813, 0.907, 0.929, 0.925, 0.861,
+// 0.948), Ceres from 0.85 stopped at 0.75 and BOBYQA's intervals missed the truth; with 48 runs it
+// has its minimum again (ScarsAtTheDefaultScheme below).
 const Problem& Scars() {
   static const Problem p = [] {
     testing::PlaneRuns runs(24, 4);
+    runs.scene.options.max_time_s = 3;
+    runs.scene.options.impact_substeps = 1;
+    return Draw(runs.scene, runs.release, Quantity::kScarLength, 0, testing::SetMediumHardMuMin,
+                0.5, 0.85);
+  }();
+  return p;
+}
+
+// The same at the default scheme (impact sub-steps), with 48 runs: measured along mu_min 0.45,
+// 0.50, .., 0.70: objective 0.977, 0.847, 0.816, 0.907, 1.004, 1.059; within-run sd 0.33 m,
+// d mean / d mu_min -1.12 m, data's standard error 0.048 (tolerance 0.14).
+const Problem& ScarsAtTheDefaultScheme() {
+  static const Problem p = [] {
+    testing::PlaneRuns runs(48, 4);
     runs.scene.options.max_time_s = 3;
     return Draw(runs.scene, runs.release, Quantity::kScarLength, 0, testing::SetMediumHardMuMin,
                 0.5, 0.85);
@@ -161,6 +180,20 @@ TEST(Recovery, BobyqaRecoversMuMinFromScarLengths) {
                             {Spec("medium_hard", GroundField::kMuMin, kLower, kUpper)},
                             TwoThreads());
   ExpectRecovered(objective, p, "bobyqa");
+}
+
+// BOBYQA at the default scheme. Measured: fitted 0.575, bootstrap interval [0.495, 0.679]
+// (standard error 0.051), combined with the seed refits (sd 0.067) 0.103, [0.381, 0.780]: the
+// seeds' spread is 1.4 times the data's standard error, so the combined error is 2.2 times the
+// data's, beyond the factor 2 the whole-step problem meets (not checked here). Ceres from 0.85
+// stops at its start on this problem (its first trust-region steps fail on the noise): the Ceres
+// path is checked on the whole-step scars and on the Tyrol run-outs.
+TEST(Recovery, BobyqaRecoversMuMinFromScarLengthsAtTheDefaultScheme) {
+  const Problem& p = ScarsAtTheDefaultScheme();
+  const Objective objective(p.scene, p.release, p.observations,
+                            {Spec("medium_hard", GroundField::kMuMin, kLower, kUpper)},
+                            TwoThreads());
+  ExpectRecovered(objective, p, "bobyqa", {}, {true, true, true, false});
 }
 
 // Ceres, every check. Measured: fitted 0.598 (step 0.059); bootstrap standard error 0.066 and
@@ -244,11 +277,12 @@ void SetTirolMuMin(Scene& scene, double mu_min) {
 
 // `runs` runs; kappa of the four categories set to `kappa_1_m` (0: Table 1's). The data's
 // standard error takes its slope from 9 points over mu_min 0.3 .. 0.7.
-Problem DrawTirol(int runs, double kappa_1_m) {
+Problem DrawTirol(int runs, double kappa_1_m, int impact_substeps = SolverOptions{}.impact_substeps) {
   const io::SceneFile file =
       io::LoadScene(std::string(TALUS_SOURCE_DIR) + "/cases/tirol/scene.toml");
   Scene scene = file.scene;
   scene.options.max_time_s = 15;
+  scene.options.impact_substeps = impact_substeps;
   if (kappa_1_m > 0)
     for (const char* category : kTirolCategories)
       scene.ground.mutable_params(scene.ground.IndexOfName(category)).kappa_1_m = kappa_1_m;
@@ -273,7 +307,9 @@ Problem DrawTirol(int runs, double kappa_1_m) {
 // problem serves the finite-difference step test (a Jacobian of noise) and the scan of
 // docs/calibration.md.
 const Problem& TirolUnidentified() {
-  static const Problem p = DrawTirol(24, 0);
+  // Whole steps, as measured below (TheStepChoice...): under the default sub-steps the noise-
+  // dominated curvature estimate came out at -0.026, where its sign is the noise's.
+  static const Problem p = DrawTirol(24, 0, 1);
   return p;
 }
 

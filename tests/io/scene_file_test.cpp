@@ -269,6 +269,16 @@ TEST(LoadScene, RestitutionIsOneCoefficient) {
              "tangential_restitution = -1 violates 0 <= tangential_restitution <= 1");
   EXPECT_HAS(ErrorOf(with("tangential_restitution = 0.5"), dir),
              "tangential_restitution = 0.5 violates");
+  // Newton's law keeps whole steps: impact_substeps' default gives way to a restitution, and a
+  // scene that asks for both is refused by name.
+  EXPECT_EQ(o.impact_substeps, 1);
+  testing::WriteText(dir / "scene.toml", with(""));
+  EXPECT_EQ(LoadScene((dir / "scene.toml").string()).scene.options.impact_substeps, 4);
+  EXPECT_HAS(ErrorOf(with("normal_restitution = 0.4\nimpact_substeps = 4"), dir),
+             "impact_substeps = 4 needs normal_restitution = 0 (Newton's law takes the begin "
+             "velocities of a whole step; it is 0.4)");
+  testing::WriteText(dir / "scene.toml", with("normal_restitution = 0.4\nimpact_substeps = 1"));
+  EXPECT_EQ(LoadScene((dir / "scene.toml").string()).scene.options.impact_substeps, 1);
 }
 
 TEST(LoadScene, ContactSolveMethodIsChosenByNameWithDidYouMean) {

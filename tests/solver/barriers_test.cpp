@@ -170,7 +170,7 @@ TEST(Barriers, CubeFlyingAboveTheBarrierPassesBitForBitUnchanged) {
 }
 
 // Contacts never add energy; neither does a barrier. Random tumbling rocks down a 40 deg incline
-// through a 0.5 m net of 25 kJ (of the 12, some overtop it, some are stopped, most break through):
+// through a 0.3 m net of 25 kJ (of the 12, measured: 2 overtop it, 6 are stopped, 4 break through):
 // the runs with and without it are the same step for step up to the crossing (the same bits), and
 // in the step that crosses, and in every event, the rock with the barrier has no more kinetic
 // energy than without it.
@@ -191,7 +191,7 @@ TEST(Barriers, NoBarrierAddsEnergy) {
     SimulationWorkspace ws;
     EnergyLog without_log(scene.rock);
     SimulateRock(scene, start, ws, &without_log);
-    scene.barriers = {Across(40, 0.5, 25000)};
+    scene.barriers = {Across(40, 0.3, 25000)};
     EnergyLog with_log(scene.rock);
     const RockResult r = SimulateRock(scene, start, ws, &with_log);
     std::size_t k = 0;
@@ -209,6 +209,7 @@ TEST(Barriers, NoBarrierAddsEnergy) {
       overtopped += e.outcome == BarrierOutcome::kOvertopped;
     }
   }
+  std::printf("broke through %d, stopped %d, overtopped %d\n", broke, stopped, overtopped);
   EXPECT_GT(broke, 0);
   EXPECT_GT(stopped, 0);
   EXPECT_GT(overtopped, 0);

@@ -445,6 +445,7 @@ TEST(Prediction, TouchLeverIsWhereTheVertexTouches) {
   // touch below a quarter of midpoint's.
   const double dt = 0.004;
   Scene scene = Flat(MakeRockShape(MakeBox(1, 1, 1), 2700), dt);
+  scene.options.impact_substeps = 1;  // the lever of a whole step's predicted contact
   const RockShape& rock = scene.rock;
   const double g = scene.options.gravity_m_s2;
   const Eigen::Vector3d omega_world = 60 * Eigen::Vector3d(0.3, 1, 0.2).normalized();

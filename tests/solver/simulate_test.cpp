@@ -133,6 +133,7 @@ TEST(Simulate, CentreOfMassReadingIsBitIdenticalToWave1) {
   Scene scene = scenes::Ramp40();
   scene.options.viscous = ViscousReading::kCentreOfMass;
   scene.options.tolerance_m_s = 1e-7;
+  scene.options.impact_substeps = 1;  // the whole steps of then
   SimulationWorkspace ws;
   for (const Golden& g : golden) {
     const RockResult r = SimulateRock(scene, scenes::Ramp40Release(scene, 1, g.rock), ws);
