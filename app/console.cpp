@@ -150,7 +150,7 @@ void WriteRunLog(int exit_code) {
   const std::string dir = State().log_directory;
   if (exit_code != 0 || dir.empty()) return;
   try {
-    WriteFileAtomically((std::filesystem::path(dir) / "run.log").string(), RunLogText(exit_code));
+    WriteFileAtomically((std::filesystem::path(dir) / kRunLog).string(), RunLogText(exit_code));
   } catch (const std::exception& e) {
     std::fprintf(stderr, "talus: WARNING: run.log not written: %s\n", e.what());
   }

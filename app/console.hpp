@@ -31,6 +31,8 @@ void EndStatus();
 
 // The directory run.log goes into when the verb succeeds (its --out); unset: no run.log (a verb
 // without --out, a rank other than 0).
+// The log a verb that succeeded leaves in its --out (WriteRunLog).
+inline constexpr const char* kRunLog = "run.log";
 void SetRunLogDirectory(const std::string& dir);
 // run.log's text: version, command line, start time, every kept line, then "finished: exit
 // <code> after <s> s".

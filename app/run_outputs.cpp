@@ -220,7 +220,8 @@ std::vector<std::string> TalusOutputNames() {
                                     "barriers.csv",
                                     "barriers_summary.csv",
                                     "tree_impacts.csv",
-                                    "tree_hits.tif"};
+                                    "tree_hits.tif",
+                                    kRunLog};
   for (const char* quantity : {"speed", "energy", "jump_height"}) {
     for (const char* statistic : {"max", "mean"})
       names.push_back(std::string(quantity) + "_" + statistic + ".tif");
@@ -406,8 +407,12 @@ void CommitOutputs(StagingDirectory& staging, const std::vector<std::string>& fi
   const std::vector<std::string> earlier = ReadManifest(manifest);
   // Until the files are in, the manifest lists the earlier run's and this one's: an interruption
   // in between leaves no file of either unlisted.
+  // The run log is listed too: written after the outputs by the verb that succeeded (WriteRunLog),
+  // it is this run's, never staged, and never removed here.
+  std::vector<std::string> listed = files;
+  listed.push_back(kRunLog);
   std::vector<std::string> both = earlier;
-  for (const std::string& name : files)
+  for (const std::string& name : listed)
     if (std::find(both.begin(), both.end(), name) == both.end()) both.push_back(name);
   WriteFileAtomically(manifest.string(), ManifestText(both));
   staging.Commit(files);
@@ -415,11 +420,11 @@ void CommitOutputs(StagingDirectory& staging, const std::vector<std::string>& fi
   // what that run's manifest lists is removed, never a file of the same name the user made.
   int stale = 0;
   for (const std::string& name : earlier) {
-    if (std::find(files.begin(), files.end(), name) != files.end()) continue;
+    if (std::find(listed.begin(), listed.end(), name) != listed.end()) continue;
     std::error_code error;
     stale += fs::remove(fs::path(dir) / name, error) ? 1 : 0;
   }
-  WriteFileAtomically(manifest.string(), ManifestText(files));
+  WriteFileAtomically(manifest.string(), ManifestText(listed));
   if (stale > 0) Say("Removed %d outputs of an earlier run from %s\n", stale, dir.c_str());
 }
 

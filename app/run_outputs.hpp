@@ -49,7 +49,7 @@ inline constexpr const char* kOutputManifest = ".talus-outputs";
 
 // Commits the staged files into `dir`, removes the outputs of the earlier run there that this one
 // did not replace (those its kOutputManifest lists, and only talus's output names: never a file
-// the user made; printing how many) and writes this run's manifest.
+// the user made; printing how many) and writes this run's manifest: `files` and the run log.
 void CommitOutputs(StagingDirectory& staging, const std::vector<std::string>& files,
                    const std::string& dir);
 

@@ -168,6 +168,7 @@ void EnsembleSamples::OnRock(const ensemble::RockOutcome& outcome) {
   rock.runout_m = outcome.result.runout_m;
   rock.end_m = outcome.result.final_state.position_m.head<2>();
   rock.start_m = outcome.start.position_m.head<2>();
+  rock.left_dem = outcome.result.end == EndReason::kLeftDomain;
   if (!outcome.episodes.empty()) {
     const ContactEpisode& e = outcome.episodes.front();
     const double in2 = e.velocity_in_m_s.squaredNorm();
@@ -272,6 +273,15 @@ std::vector<Eigen::Vector2d> EnsembleSamples::EndPositions(const std::string& ru
   return out;
 }
 
+std::vector<Eigen::Vector2d> EnsembleSamples::EndPositions(const std::string& run,
+                                                           bool left_dem) const {
+  std::vector<Eigen::Vector2d> out;
+  ForRun(run, [&](const Rock& r) {
+    if (r.left_dem == left_dem) out.push_back(r.end_m);
+  });
+  return out;
+}
+
 std::optional<Eigen::Vector2d> EnsembleSamples::StartOf(const std::string& run) const {
   if (run.empty()) return std::nullopt;
   std::optional<Eigen::Vector2d> start;
@@ -325,6 +335,7 @@ std::string EnsembleSamples::Serialize() const {
     Put<std::int32_t>(out, r.release);
     Put(out, r.runout_m);
     for (double v : {r.end_m.x(), r.end_m.y(), r.start_m.x(), r.start_m.y()}) Put(out, v);
+    Put<std::uint8_t>(out, r.left_dem ? 1 : 0);
     for (const auto* v :
          {&r.speed_out_m_s, &r.energy_ratio, &r.angular_speed_out_rad_s, &r.duration_s, &r.scar_m,
           &r.scar_depth_m, &r.segment_max_speed_m_s, &r.segment_mean_angular_speed_rad_s, &r.segment_max_jump_m})
@@ -349,6 +360,7 @@ void EnsembleSamples::Append(const std::string& bytes) {
     r.end_m.y() = in.Get<double>();
     r.start_m.x() = in.Get<double>();
     r.start_m.y() = in.Get<double>();
+    r.left_dem = in.Get<std::uint8_t>() != 0;
     for (auto* v :
          {&r.speed_out_m_s, &r.energy_ratio, &r.angular_speed_out_rad_s, &r.duration_s, &r.scar_m,
           &r.scar_depth_m, &r.segment_max_speed_m_s, &r.segment_mean_angular_speed_rad_s, &r.segment_max_jump_m})

@@ -50,8 +50,11 @@ class EnsembleSamples : public ensemble::RockSink {
   // do not give the quantity (no contact episode for an impact quantity) are left out.
   // Zone quantities take the zone's index.
   std::vector<double> Values(Quantity quantity, const std::string& run, int zone = -1) const;
-  // End positions (map coordinates) of the rocks of `run`, in rock order.
+  // End positions (map coordinates) of the rocks of `run`, in rock order: where each came to rest,
+  // was stopped or cut off, and for a rock that left the DEM, where it left.
   std::vector<Eigen::Vector2d> EndPositions(const std::string& run) const;
+  // The same, of only the rocks that left the DEM (left_dem) or only the others.
+  std::vector<Eigen::Vector2d> EndPositions(const std::string& run, bool left_dem) const;
   // Start position (horizontal) of `run`'s first rock, or nullopt for "" or an unknown run.
   std::optional<Eigen::Vector2d> StartOf(const std::string& run) const;
   long rocks() const { return static_cast<long>(rocks_.size()); }
@@ -69,6 +72,7 @@ class EnsembleSamples : public ensemble::RockSink {
     double runout_m = 0;
     Eigen::Vector2d end_m = Eigen::Vector2d::Zero();
     Eigen::Vector2d start_m = Eigen::Vector2d::Zero();
+    bool left_dem = false;  // ended as EndReason::kLeftDomain: end_m is where it left
     // From the first contact episode (and the first loaded one, for the scar).
     std::optional<double> speed_out_m_s, energy_ratio, angular_speed_out_rad_s, duration_s, scar_m,
         scar_depth_m;

@@ -247,8 +247,11 @@ void WriteTextFile(const std::string& path, const std::string& text) {
 
 std::string DepositsPng(const EventFile& event, const fieldobs::EnsembleSamples& simulated) {
   std::vector<MapMarker> markers;
-  for (const Eigen::Vector2d& end : simulated.EndPositions(""))
+  // A rock that left the DEM did not come to rest there: its end is where it left, drawn apart.
+  for (const Eigen::Vector2d& end : simulated.EndPositions("", false))
     markers.push_back({end, {40, 90, 220}, 1, "simulated rest position"});
+  for (const Eigen::Vector2d& end : simulated.EndPositions("", true))
+    markers.push_back({end, {150, 150, 150}, 1, "simulated rock leaving the DEM (where it left)"});
   for (const fieldobs::DepositObservation& d : event.observations.deposits)
     markers.push_back({d.xy_m, {215, 25, 28}, 3, "observed rest position"});
   return QuickLookPng(event.scene.scene.terrain.heights(), nullptr, {}, markers);

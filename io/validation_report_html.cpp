@@ -79,7 +79,8 @@ std::string PlotsSection(const ValidationReportInput& input) {
   if (!input.deposits_png.empty())
     out += "<h2>Deposits</h2>\n" +
            html::PngFigure(input.deposits_png, "deposits",
-                           "Observed (red) and simulated (blue) rest positions (deposits.png)");
+                           "Observed (red) and simulated (blue) rest positions, and where "
+                           "simulated rocks left the DEM (grey) (deposits.png)");
   return out;
 }
 

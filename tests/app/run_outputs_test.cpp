@@ -97,7 +97,7 @@ std::string Read(const fs::path& path) {
 
 // Run 1 writes rocks.csv and speed_max.tif; run 2 writes rocks.csv only: speed_max.tif of run 1
 // is removed, a user's notes.txt and a talus-named file the manifest does not list are kept, and
-// the manifest lists run 2's files.
+// the manifest lists run 2's files and the run log (written after it, by main).
 TEST(CommitOutputs, RemovesTheEarlierRunsOutputsThisRunDidNotReplaceAndNothingElse) {
   const fs::path dir = FreshDir("commit");
   Write(dir / "notes.txt", "mine");
@@ -107,7 +107,7 @@ TEST(CommitOutputs, RemovesTheEarlierRunsOutputsThisRunDidNotReplaceAndNothingEl
     Write(staging.path("speed_max.tif"), "run 1");
     CommitOutputs(staging, {"rocks.csv", "speed_max.tif"}, dir.string());
   }
-  EXPECT_EQ(Read(dir / kOutputManifest), "rocks.csv\nspeed_max.tif\n");
+  EXPECT_EQ(Read(dir / kOutputManifest), "rocks.csv\nspeed_max.tif\nrun.log\n");
   Write(dir / "energy_max.tif", "the user's own");
   {
     StagingDirectory staging(dir.string());
@@ -118,7 +118,7 @@ TEST(CommitOutputs, RemovesTheEarlierRunsOutputsThisRunDidNotReplaceAndNothingEl
   EXPECT_FALSE(fs::exists(dir / "speed_max.tif"));
   EXPECT_EQ(Read(dir / "notes.txt"), "mine");
   EXPECT_EQ(Read(dir / "energy_max.tif"), "the user's own");
-  EXPECT_EQ(Read(dir / kOutputManifest), "rocks.csv\n");
+  EXPECT_EQ(Read(dir / kOutputManifest), "rocks.csv\nrun.log\n");
   // A manifest naming a file that is no talus output (edited by hand) never removes it.
   Write(dir / kOutputManifest, "rocks.csv\nnotes.txt\n../escape.txt\n");
   {
@@ -128,7 +128,7 @@ TEST(CommitOutputs, RemovesTheEarlierRunsOutputsThisRunDidNotReplaceAndNothingEl
   }
   EXPECT_FALSE(fs::exists(dir / "rocks.csv"));
   EXPECT_EQ(Read(dir / "notes.txt"), "mine");
-  EXPECT_EQ(Read(dir / kOutputManifest), "summary.json\n");
+  EXPECT_EQ(Read(dir / kOutputManifest), "summary.json\nrun.log\n");
 }
 
 TEST(ParseRockRange, ParsesAColonBAndNamesTheOptionOtherwise) {

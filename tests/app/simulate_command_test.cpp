@@ -467,7 +467,7 @@ TEST(SimulateCommand, AUsersFilesNamedLikeOutputsStay) {
   EXPECT_EQ(log.find("Removed"), std::string::npos) << log;
   for (const std::string& name : users_files)
     EXPECT_EQ(Slurp(out / name), "the user's own file") << name;
-  EXPECT_EQ(Slurp(out / ".talus-outputs"), "rocks.csv\nsummary.json\n");
+  EXPECT_EQ(Slurp(out / ".talus-outputs"), "rocks.csv\nsummary.json\nrun.log\n");
   // The next run with a report removes nothing of the user's either; a third without one removes
   // the report the second wrote (its manifest lists it), not the user's partial.json.
   std::ofstream(dir / "report.toml") << LeanScene();
