@@ -160,7 +160,8 @@ void LoadSolver(const Section& s, SolverOptions& o, SolverPreset& preset,
     if (s.Has("impact_substeps") && o.impact_substeps > 1)
       s.FailCheck("impact_substeps = " + std::to_string(o.impact_substeps) +
                   " needs normal_restitution = 0 (Newton's law takes the begin velocities of a "
-                  "whole step; it is " + RoundTrip(o.normal_restitution) + ")");
+                  "whole step; it is " +
+                  RoundTrip(o.normal_restitution) + ")");
     o.impact_substeps = 1;
   }
   std::string why;

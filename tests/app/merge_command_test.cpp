@@ -157,8 +157,9 @@ stands = [{ polygon = [[5, -5], [16, -5], [16, 5], [5, 5]], stems_per_ha = 4000,
 }
 
 // Barriers: a net that stops some rocks and is broken through by others (measured: 2 and 2 of 10),
-// and a wall behind it that one of those breaks through. barriers.csv, barriers_summary.csv, rocks.csv's end_barrier and summary.json's
-// "barriers" merge to the single run's bytes (threads 1 and 2 in the parts, 2 in the single run).
+// and a wall behind it that one of those breaks through. barriers.csv, barriers_summary.csv,
+// rocks.csv's end_barrier and summary.json's "barriers" merge to the single run's bytes (threads 1
+// and 2 in the parts, 2 in the single run).
 TEST_F(MergeCommand, BarriersMergeToTheSingleRunsBytes) {
   talus::app::testing::Write(scene_, talus::app::testing::SmallSlopeScene(5, "", R"([[barriers]]
 name = "net, upper"

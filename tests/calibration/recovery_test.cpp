@@ -277,7 +277,8 @@ void SetTirolMuMin(Scene& scene, double mu_min) {
 
 // `runs` runs; kappa of the four categories set to `kappa_1_m` (0: Table 1's). The data's
 // standard error takes its slope from 9 points over mu_min 0.3 .. 0.7.
-Problem DrawTirol(int runs, double kappa_1_m, int impact_substeps = SolverOptions{}.impact_substeps) {
+Problem DrawTirol(int runs, double kappa_1_m,
+                  int impact_substeps = SolverOptions{}.impact_substeps) {
   const io::SceneFile file =
       io::LoadScene(std::string(TALUS_SOURCE_DIR) + "/cases/tirol/scene.toml");
   Scene scene = file.scene;

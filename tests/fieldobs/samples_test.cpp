@@ -64,8 +64,8 @@ TEST(EnsembleSamples, PartsSerialisedAndAppendedEqualTheWhole) {
 // keep the split.
 TEST(EnsembleSamples, RocksThatLeftTheDemAreToldApart) {
   Scene scene;
-  scene.terrain = Terrain(MakePlaneHeightfield({45, 20, 2, 30, 1}),
-                          scene.ground.IndexOfName("medium_hard"));
+  scene.terrain =
+      Terrain(MakePlaneHeightfield({45, 20, 2, 30, 1}), scene.ground.IndexOfName("medium_hard"));
   scene.rock = MakeRockShape(MakeBox(0.4, 0.4, 0.3), 2700);
   scene.options.max_time_s = 10;
   ensemble::ReleaseSpec release;
