@@ -90,7 +90,7 @@ std::string LeanScene() {
   lean.replace(lean.find("trajectories = true"), 19, "trajectories = false");
   lean.replace(lean.find("rasters = ["),
                lean.find("]\n", lean.find("rasters = [")) - lean.find("rasters = [") + 1,
-               "rasters = []\nquicklook = false");
+               "rasters = []\nquicklook = false\ngeopackage = false");
   return lean;
 }
 
@@ -137,7 +137,8 @@ TEST(SimulateCommand, WritesEveryOutputIdenticallyForOneAndTwoThreads) {
   }
   EXPECT_EQ(tifs, 12);
   EXPECT_TRUE(Slurp(a / "trajectories.h5") == Slurp(b / "trajectories.h5"));
-  for (const char* name : {"rocks.csv", "trajectories.h5", "summary.json", "quicklook.png"})
+  for (const char* name :
+       {"rocks.csv", "trajectories.h5", "summary.json", "quicklook.png", "rocks.gpkg"})
     EXPECT_TRUE(fs::exists(a / name)) << name;
   const auto summary = nlohmann::json::parse(Slurp(a / "summary.json"));
   EXPECT_EQ(summary["rocks"], 6);
@@ -506,6 +507,7 @@ TEST(SimulateCommand, ARunRemovesOutputsOfAnEarlierRunThatItDoesNotWrite) {
   ASSERT_TRUE(fs::exists(dir / "out" / "trajectories.h5"));
   ASSERT_TRUE(fs::exists(dir / "out" / "speed_p95.tif"));
   ASSERT_TRUE(fs::exists(dir / "out" / "speed_p50.tif"));
+  ASSERT_TRUE(fs::exists(dir / "out" / "rocks.gpkg"));  // on by default
   std::ofstream(dir / "out" / "notes.txt") << "the user's own file";
   ASSERT_EQ(RunCommand(std::string(TALUS_BINARY) + " simulate " + (dir / "lean.toml").string() +
                            " --out " + out,
@@ -516,6 +518,7 @@ TEST(SimulateCommand, ARunRemovesOutputsOfAnEarlierRunThatItDoesNotWrite) {
   EXPECT_FALSE(fs::exists(dir / "out" / "speed_p95.tif"));
   EXPECT_FALSE(fs::exists(dir / "out" / "speed_p50.tif"));
   EXPECT_FALSE(fs::exists(dir / "out" / "quicklook.png"));
+  EXPECT_FALSE(fs::exists(dir / "out" / "rocks.gpkg"));
   EXPECT_TRUE(fs::exists(dir / "out" / "rocks.csv"));
   EXPECT_TRUE(fs::exists(dir / "out" / "summary.json"));
   EXPECT_TRUE(fs::exists(dir / "out" / "notes.txt"));
@@ -575,7 +578,7 @@ void InterruptARun(int signal, const std::string& name) {
       0)
       << log;
   const auto earlier = Snapshot(out);
-  ASSERT_EQ(earlier.size(), 19u);  // with the list of outputs, .talus-outputs, and run.log
+  ASSERT_EQ(earlier.size(), 20u);  // with the list of outputs, .talus-outputs, and run.log
 
   const pid_t pid = StartTalus(
       {"simulate", (dir / "slow.toml").string(), "--out", out.string(), "--threads", "2"},
