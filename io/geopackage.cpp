@@ -141,7 +141,7 @@ class Writer {
       feature.SetField("styleQML", style.qml.c_str());
       feature.SetField("styleSLD", "");
       feature.SetField("useAsDefault", 1);
-      feature.SetField("description", "Talus: the classes and colours of the quick-look");
+      feature.SetField("description", "Talus default style");
       feature.SetField("owner", "");
       feature.SetField("update_time", 2000, 1, 1, 0, 0, 0.0f, 100);
       Add(table, feature);

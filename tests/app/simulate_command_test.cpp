@@ -805,7 +805,7 @@ rocks = 500000000
 [output]
 rasters = ["speed", "energy", "jump_height"]
 )";
-  // 10^9 rocks' trajectories of 100 s every 0.01 s: hundreds of TB.
+  // 10^9 rocks' trajectories of 100 s every 0.01 s, and their paths in rocks.gpkg: over a PB.
   std::string disk_scene = memory_scene;
   disk_scene.replace(disk_scene.find("rasters = "), std::string::npos,
                      "trajectories = true\nquicklook = false\n");
@@ -814,8 +814,8 @@ rasters = ["speed", "energy", "jump_height"]
        {"of memory besides the ", " is available (", "per-cell summaries behind the speed",
         "(fewer rocks (--rocks)", "nothing was run"}},
       {disk_scene,
-       {"the outputs need about ", " TB of disk, but ", "trajectories.h5 (10002 samples per rock",
-        "(trajectories = false", "nothing was run"}},
+       {"the outputs need about ", " PB of disk, but ", "trajectories.h5 (10002 samples per rock",
+        "(trajectories = false", "rocks.gpkg (geopackage = false", "nothing was run"}},
   };
   for (const auto& [text, parts] : cases) {
     std::ofstream(dir / "scene.toml") << text;
