@@ -6,16 +6,20 @@
 #include <ogrsf_frmts.h>
 
 #include <algorithm>
+#include <array>
 #include <memory>
 #include <stdexcept>
 #include <string>
 #include <tuple>
+#include <utility>
 #include <vector>
 
 #include "common/atomic_file.hpp"
 #include "common/csv_table.hpp"
 #include "common/error.hpp"
 #include "common/format.hpp"
+#include "io/layer_styles.hpp"
+#include "io/map_classes.hpp"
 #include "io/raster.hpp"
 #include "io/trajectory_file.hpp"
 
@@ -23,6 +27,12 @@ namespace talus::io {
 namespace {
 
 constexpr int kFeaturesPerTransaction = 20000;
+
+// Colours of the scene's layers: releases purple, trees green; evaluation lines and barriers as
+// the quick-look draws them, black over a white halo.
+constexpr std::array<unsigned char, 3> kReleaseRgb = {152, 78, 163};
+constexpr std::array<unsigned char, 3> kTreeRgb = {35, 139, 69};
+std::string MapLineQml() { return SingleSymbolQml({SymbolKind::kLine, {0, 0, 0}, 1, 0.6, true}); }
 
 // The field type of a rocks.csv, evaluation_lines.csv or barriers.csv column: counts and indices
 // as integers, names as text, the rest (coordinates, distances, speeds, energies, masses) as reals.
@@ -71,9 +81,11 @@ class Writer {
     }
   }
 
-  OGRLayer* Layer(const char* name, OGRwkbGeometryType type) {
+  // A layer whose default style in QGIS is `qml`.
+  OGRLayer* Layer(const char* name, OGRwkbGeometryType type, std::string qml) {
     OGRLayer* layer = dataset_->CreateLayer(name, srs_.get(), type, nullptr);
     if (!layer) Fail(std::string("cannot create the layer ") + name);
+    styles_.push_back({name, layer->GetGeometryColumn(), std::move(qml)});
     return layer;
   }
   void Field(OGRLayer* layer, const std::string& name, OGRFieldType type) {
@@ -92,6 +104,7 @@ class Writer {
   }
   void Close() {
     Flush();
+    WriteStyles();
     CPLErrorReset();
     GDALClose(dataset_.release());  // GDAL 3.6: no status; a failure leaves its error
     if (CPLGetLastErrorType() >= CE_Failure) Fail("cannot write");
@@ -102,7 +115,46 @@ class Writer {
     throw std::runtime_error(what + " " + path_ + ": " + CPLGetLastErrorMsg());
   }
 
+  // Table `layer_styles` as QGIS reads it (an attributes table, listed in gpkg_contents): one
+  // default style per layer, with a fixed update_time.
+  void WriteStyles() {
+    const char* const fid[] = {"FID=id", nullptr};
+    OGRLayer* table =
+        dataset_->CreateLayer("layer_styles", nullptr, wkbNone, const_cast<char**>(fid));
+    if (!table) Fail("cannot create the table layer_styles");
+    for (const char* name : {"f_table_catalog", "f_table_schema", "f_table_name",
+                             "f_geometry_column", "styleName", "styleQML", "styleSLD"})
+      Field(table, name, OFTString);
+    OGRFieldDefn use_as_default("useAsDefault", OFTInteger);
+    use_as_default.SetSubType(OFSTBoolean);
+    if (table->CreateField(&use_as_default) != OGRERR_NONE)
+      Fail("cannot create the field useAsDefault");
+    for (const char* name : {"description", "owner", "ui"}) Field(table, name, OFTString);
+    Field(table, "update_time", OFTDateTime);
+    for (const Style& style : styles_) {
+      OGRFeature feature(table->GetLayerDefn());
+      feature.SetField("f_table_catalog", "");
+      feature.SetField("f_table_schema", "");
+      feature.SetField("f_table_name", style.layer.c_str());
+      feature.SetField("f_geometry_column", style.geometry_column.c_str());
+      feature.SetField("styleName", style.layer.c_str());
+      feature.SetField("styleQML", style.qml.c_str());
+      feature.SetField("styleSLD", "");
+      feature.SetField("useAsDefault", 1);
+      feature.SetField("description", "Talus default style");
+      feature.SetField("owner", "");
+      feature.SetField("update_time", 2000, 1, 1, 0, 0, 0.0f, 100);
+      Add(table, feature);
+    }
+    Flush();
+  }
+
+  struct Style {
+    std::string layer, geometry_column, qml;
+  };
+
   std::string path_;
+  std::vector<Style> styles_;
   std::unique_ptr<GDALDataset, DatasetCloser> dataset_;
   std::unique_ptr<OGRSpatialReference> srs_;
   int pending_ = 0;
@@ -111,11 +163,11 @@ class Writer {
 // A layer of 3-D points at the columns x, y, z of `csv`, one per row, with every column as a
 // field (an empty cell is null); read record by record.
 void PointLayer(Writer& out, const char* name, const std::string& csv, const char* x_column,
-                const char* y_column, const char* z_column) {
+                const char* y_column, const char* z_column, std::string qml) {
   CsvReader rows(csv);
   const std::vector<std::string>& columns = rows.header();
   const std::size_t x = rows.Column(x_column), y = rows.Column(y_column), z = rows.Column(z_column);
-  OGRLayer* layer = out.Layer(name, wkbPoint25D);
+  OGRLayer* layer = out.Layer(name, wkbPoint25D, std::move(qml));
   for (const std::string& c : columns) out.Field(layer, c, FieldType(c));
   std::vector<std::string> fields;
   const auto number = [&](std::size_t c) {
@@ -160,15 +212,17 @@ void SceneLayers(Writer& out, const GeoPackageScene& scene) {
   if (scene.release) {
     using Kind = ensemble::ReleaseGeometry::Kind;
     const ensemble::ReleaseSpec& r = *scene.release;
-    for (const auto& [kind, name, type] :
-         {std::tuple{Kind::kPoint, "release_points", wkbPoint},
-          std::tuple{Kind::kLine, "release_lines", wkbLineString},
-          std::tuple{Kind::kPolygon, "release_polygons", wkbPolygon}}) {
+    for (const auto& [kind, name, type, symbol, opacity, width_mm] :
+         {std::tuple{Kind::kPoint, "release_points", wkbPoint, SymbolKind::kMarker, 1.0, 2.6},
+          std::tuple{Kind::kLine, "release_lines", wkbLineString, SymbolKind::kLine, 1.0, 0.8},
+          std::tuple{Kind::kPolygon, "release_polygons", wkbPolygon, SymbolKind::kFill, 0.3,
+                     0.5}}) {
       const bool runs = kind == Kind::kPoint && !r.runs.empty();
       const bool any = runs || std::any_of(r.releases.begin(), r.releases.end(),
                                            [k = kind](const auto& g) { return g.kind == k; });
       if (!any) continue;
-      OGRLayer* layer = out.Layer(name, type);
+      OGRLayer* layer =
+          out.Layer(name, type, SingleSymbolQml({symbol, kReleaseRgb, opacity, width_mm}));
       out.Field(layer, "release", OFTInteger64);
       out.Field(layer, "name", OFTString);
       out.Field(layer, "rocks", OFTInteger64);
@@ -209,7 +263,7 @@ void SceneLayers(Writer& out, const GeoPackageScene& scene) {
     }
   }
   if (scene.evaluation_lines && !scene.evaluation_lines->empty()) {
-    OGRLayer* layer = out.Layer("evaluation_lines", wkbLineString);
+    OGRLayer* layer = out.Layer("evaluation_lines", wkbLineString, MapLineQml());
     out.Field(layer, "name", OFTString);
     for (const ensemble::EvaluationLine& l : *scene.evaluation_lines) {
       OGRFeature feature(layer->GetLayerDefn());
@@ -222,7 +276,7 @@ void SceneLayers(Writer& out, const GeoPackageScene& scene) {
     out.Flush();
   }
   if (scene.barriers && !scene.barriers->empty()) {
-    OGRLayer* layer = out.Layer("barriers", wkbLineString);
+    OGRLayer* layer = out.Layer("barriers", wkbLineString, MapLineQml());
     out.Field(layer, "name", OFTString);
     out.Field(layer, "type", OFTString);
     out.Field(layer, "height_m", OFTReal);
@@ -262,7 +316,8 @@ void TreeLayer(Writer& out, const Forest& forest, const std::string& tree_impact
       absorbed_J[k] += table.NonNegativeNumber(row, "absorbed_J");
     }
   }
-  OGRLayer* layer = out.Layer("trees", wkbPoint25D);
+  OGRLayer* layer =
+      out.Layer("trees", wkbPoint25D, SingleSymbolQml({SymbolKind::kMarker, kTreeRgb, 1, 1.6}));
   out.Field(layer, "tree", OFTInteger64);
   out.Field(layer, "dbh_cm", OFTReal);
   out.Field(layer, "breaking_energy_kj", OFTReal);
@@ -291,17 +346,21 @@ void TreeLayer(Writer& out, const Forest& forest, const std::string& tree_impact
 
 void WriteRocksGeoPackage(const std::string& path, const std::string& rocks_csv,
                           const std::string& trajectories_h5, const std::string& crs_wkt,
-                          const std::string& evaluation_lines_csv,
-                          const std::string& barriers_csv, const GeoPackageScene& scene) {
+                          const std::string& evaluation_lines_csv, const std::string& barriers_csv,
+                          const GeoPackageScene& scene) {
   const FixedGpkgDate fixed_date;
   AtomicFile file(path);
   Writer out(path, file.temp_path(), crs_wkt);
 
-  PointLayer(out, "end_points", rocks_csv, "x_end", "y_end", "z_end");
+  // Points coloured by energy, in the classes of the quick-look's energy map.
+  PointLayer(out, "end_points", rocks_csv, "x_end", "y_end", "z_end",
+             GraduatedMarkerQml("max_kinetic_energy_j", EnergyLegend()));
   if (!evaluation_lines_csv.empty())
-    PointLayer(out, "evaluation_crossings", evaluation_lines_csv, "x_m", "y_m", "z_m");
+    PointLayer(out, "evaluation_crossings", evaluation_lines_csv, "x_m", "y_m", "z_m",
+               GraduatedMarkerQml("energy_J", EnergyLegend()));
   if (!barriers_csv.empty())
-    PointLayer(out, "barrier_impacts", barriers_csv, "x_m", "y_m", "z_m");
+    PointLayer(out, "barrier_impacts", barriers_csv, "x_m", "y_m", "z_m",
+               GraduatedMarkerQml("energy_J", EnergyLegend()));
 
   SceneLayers(out, scene);
   if (scene.forest && !scene.forest->empty()) TreeLayer(out, *scene.forest, scene.tree_impacts_csv);
@@ -309,7 +368,9 @@ void WriteRocksGeoPackage(const std::string& path, const std::string& rocks_csv,
   std::vector<std::string> fields;
   if (!trajectories_h5.empty()) {
     const TrajectoryReader trajectories(trajectories_h5);
-    OGRLayer* lines = out.Layer("paths", wkbLineString25D);
+    OGRLayer* lines =
+        out.Layer("paths", wkbLineString25D,
+                  SingleSymbolQml({SymbolKind::kLine, kPathRgb, kPathOpacity, 0.4, false}));
     out.Field(lines, "rock", OFTInteger64);
     out.Field(lines, "run", OFTString);
     out.Field(lines, "end", OFTString);

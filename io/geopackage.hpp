@@ -5,9 +5,11 @@
 // samples, with the rock, its run and how it ended), and with evaluation lines
 // `evaluation_crossings` (one 3-D point per row of evaluation_lines.csv, at the first crossing of
 // the centre of mass, with every column as a field), and the scene's releases, evaluation lines,
-// barriers and trees (GeoPackageScene). Built from rocks.csv and trajectories.h5 after
-// they are complete, so a run split into parts gives the same file; the GeoPackage's timestamps are
-// fixed (2000-01-01T00:00:00Z), so the same rocks give the same bytes.
+// barriers and trees (GeoPackageScene); every layer has a default QGIS style in the table
+// `layer_styles` (layer_styles.hpp: the quick-look's classes). Built from rocks.csv and
+// trajectories.h5 after they are complete, so a run split into parts gives the same file; the
+// GeoPackage's timestamps are fixed (2000-01-01T00:00:00Z, the styles' update_time too), so the
+// same rocks give the same bytes.
 
 #include <string>
 #include <vector>
@@ -44,7 +46,6 @@ struct GeoPackageScene {
 void WriteRocksGeoPackage(const std::string& path, const std::string& rocks_csv,
                           const std::string& trajectories_h5, const std::string& crs_wkt,
                           const std::string& evaluation_lines_csv = "",
-                          const std::string& barriers_csv = "",
-                          const GeoPackageScene& scene = {});
+                          const std::string& barriers_csv = "", const GeoPackageScene& scene = {});
 
 }  // namespace talus::io

@@ -3,9 +3,7 @@
 // hillshade (north up), one raster on top in fixed classes (reach probability, else the largest
 // energy, speed or passages; transparent where no rock passed), the paths of sampled rocks in
 // blue, and beside the map a legend with the classes and their units, a scale bar and a north
-// arrow. The classes are absolute (the same value has the same colour in every run), so pictures
-// of different runs can be compared; for energy they include the 30 kJ and 300 kJ limits of the
-// intensity classes used in Swiss rockfall hazard zoning.
+// arrow. The classes are those of every map of a run (map_classes.hpp).
 
 #include <Eigen/Core>
 #include <array>
@@ -13,6 +11,7 @@
 #include <vector>
 
 #include "ensemble/rasters.hpp"
+#include "io/map_classes.hpp"
 #include "solver/terrain.hpp"
 
 namespace talus::io {
@@ -20,26 +19,6 @@ namespace talus::io {
 // The layer the quick-look shows: the first of reach_probability, energy_max, speed_max, passages
 // in `layers`, or nullptr.
 const ensemble::RasterLayer* QuickLookLayer(const std::vector<ensemble::RasterLayer>& layers);
-
-// One colour class of the quick-look's legend: the values in [lower, next class's lower), in the
-// raster's own unit; `label` in the unit the legend shows (e.g. kJ for an energy in J).
-struct ColourClass {
-  double lower = 0;
-  std::string label;
-  std::array<unsigned char, 3> rgb{};
-};
-
-// The legend of a layer: its title (with the unit shown) and its classes, lowest first. A value
-// that is zero or below, or nodata, is not coloured. Known layers: reach_probability, energy_*,
-// speed_*, jump_height_*, passages, deposits; others get five classes up to the layer's largest
-// value.
-struct QuickLookLegend {
-  std::string title;
-  std::vector<ColourClass> classes;
-  // Index of the class of `value`, or -1 when the value is not coloured.
-  int ClassOf(double value) const;
-};
-QuickLookLegend LegendOf(const ensemble::RasterLayer& layer);
 
 // A filled disc drawn on the map (e.g. observed and simulated rest positions); markers with a
 // label are listed in the legend (once per label).

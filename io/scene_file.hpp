@@ -23,7 +23,7 @@ struct OutputSpec {
   std::vector<ensemble::RasterKind> rasters;
   bool quicklook =
       true;  // quicklook.png: hillshade, reach probability or energy, sample trajectories
-  bool geopackage = false;  // rocks.gpkg: end points and (with trajectories) paths as GIS layers
+  bool geopackage = true;  // rocks.gpkg: end points and (with trajectories) paths as GIS layers
   bool report = true;       // report.html: one page with what ran, endings, maps and histograms
   // The percentiles (percent, ascending, each 1 .. 99) of the <quantity>_p<NN> rasters.
   std::vector<int> percentiles = {95};

@@ -1,9 +1,11 @@
 // End to end through the talus program: `talus simulate` on a tiny scene, its failures, its
 // interrupts and the command line's messages and exit codes.
 
+#include <cpl_minixml.h>
 #include <fcntl.h>
 #include <gdal_priv.h>
 #include <gtest/gtest.h>
+#include <ogrsf_frmts.h>
 #include <signal.h>  // NOLINT(modernize-deprecated-headers): POSIX kill is declared here
 #include <spawn.h>
 #include <sys/mount.h>
@@ -19,12 +21,14 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
 
+#include "io/map_classes.hpp"
 #include "run_talus.hpp"
 
 namespace {
@@ -86,7 +90,7 @@ std::string LeanScene() {
   lean.replace(lean.find("trajectories = true"), 19, "trajectories = false");
   lean.replace(lean.find("rasters = ["),
                lean.find("]\n", lean.find("rasters = [")) - lean.find("rasters = [") + 1,
-               "rasters = []\nquicklook = false");
+               "rasters = []\nquicklook = false\ngeopackage = false");
   return lean;
 }
 
@@ -133,7 +137,8 @@ TEST(SimulateCommand, WritesEveryOutputIdenticallyForOneAndTwoThreads) {
   }
   EXPECT_EQ(tifs, 12);
   EXPECT_TRUE(Slurp(a / "trajectories.h5") == Slurp(b / "trajectories.h5"));
-  for (const char* name : {"rocks.csv", "trajectories.h5", "summary.json", "quicklook.png"})
+  for (const char* name :
+       {"rocks.csv", "trajectories.h5", "summary.json", "quicklook.png", "rocks.gpkg"})
     EXPECT_TRUE(fs::exists(a / name)) << name;
   const auto summary = nlohmann::json::parse(Slurp(a / "summary.json"));
   EXPECT_EQ(summary["rocks"], 6);
@@ -142,6 +147,76 @@ TEST(SimulateCommand, WritesEveryOutputIdenticallyForOneAndTwoThreads) {
   int lines = 0;
   for (std::string line; std::getline(csv, line);) ++lines;
   EXPECT_EQ(lines, 7);
+}
+
+// rocks.gpkg is written by default, with the scene's releases, evaluation lines and barriers as
+// layers beside the rocks', and a default QGIS style per layer in layer_styles: points in the
+// quick-look's energy classes, the others one symbol each. ogrinfo (gdal-bin) lists every layer
+// and the table without an error.
+TEST(SimulateCommand, TheGeoPackageHasTheScenesLayersAndAStyleForEach) {
+  const fs::path dir = FreshDir("geopackage");
+  std::ofstream(dir / "scene.toml") << talus::app::testing::SmallSlopeScene(
+      2, "trajectories = true\n",
+      "[evaluation_lines]\nlines = [[[12, -6], [12, 6]]]\nnames = [\"mid\"]\n"
+      "[[barriers]]\nname = \"net\"\ntype = \"flexible_net\"\nline = [[18, -6], [18, 6]]\n"
+      "height_m = 3\ncapacity_kj = 500\n");
+  std::string log;
+  ASSERT_EQ(RunCommand(std::string(TALUS_BINARY) + " simulate " + (dir / "scene.toml").string() +
+                           " --out " + (dir / "out").string(),
+                       &log),
+            0)
+      << log;
+  const fs::path gpkg = dir / "out" / "rocks.gpkg";
+  ASSERT_TRUE(fs::exists(gpkg)) << log;
+
+  GDALAllRegister();
+  const std::unique_ptr<GDALDataset, decltype(&GDALClose)> dataset(
+      GDALDataset::Open(gpkg.c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY), GDALClose);
+  ASSERT_TRUE(dataset);
+  std::vector<std::string> layers;
+  for (OGRLayer* layer : dataset->GetLayers())
+    if (std::string(layer->GetName()) != "layer_styles") layers.push_back(layer->GetName());
+  std::sort(layers.begin(), layers.end());
+  EXPECT_EQ(layers, (std::vector<std::string>{"barrier_impacts", "barriers", "end_points",
+                                              "evaluation_crossings", "evaluation_lines", "paths",
+                                              "release_lines", "release_points"}));
+  OGRLayer* styles = dataset->GetLayerByName("layer_styles");
+  ASSERT_NE(styles, nullptr);
+  const std::size_t energy_classes = talus::io::EnergyLegend().classes.size();
+  std::vector<std::string> styled;
+  for (const auto& feature : *styles) {
+    const std::string layer = feature->GetFieldAsString("f_table_name");
+    styled.push_back(layer);
+    EXPECT_EQ(feature->GetFieldAsInteger("useAsDefault"), 1) << layer;
+    EXPECT_STREQ(feature->GetFieldAsString("f_geometry_column"), "geom") << layer;
+    EXPECT_STREQ(feature->GetFieldAsString("update_time"), "2000/01/01 00:00:00+00") << layer;
+    std::unique_ptr<CPLXMLNode, decltype(&CPLDestroyXMLNode)> qml(
+        CPLParseXMLString(feature->GetFieldAsString("styleQML")), CPLDestroyXMLNode);
+    ASSERT_TRUE(qml) << layer << ": the style is not XML";
+    const CPLXMLNode* renderer = CPLGetXMLNode(qml.get(), "=qgis.renderer-v2");
+    ASSERT_NE(renderer, nullptr) << layer;
+    std::size_t ranges = 0, symbols = 0;
+    for (const CPLXMLNode* c = CPLGetXMLNode(renderer, "ranges.range"); c; c = c->psNext)
+      ranges += c->eType == CXT_Element;
+    for (const CPLXMLNode* c = CPLGetXMLNode(renderer, "symbols.symbol"); c; c = c->psNext)
+      symbols += c->eType == CXT_Element;
+    const bool points =
+        layer == "end_points" || layer == "evaluation_crossings" || layer == "barrier_impacts";
+    EXPECT_EQ(ranges, points ? energy_classes : 0) << layer;
+    EXPECT_EQ(symbols, points ? energy_classes : 1) << layer;
+  }
+  std::sort(styled.begin(), styled.end());
+  EXPECT_EQ(styled, layers) << "one style per layer";
+
+  if (RunCommand("command -v ogrinfo", &log) != 0)
+    GTEST_SKIP() << "ogrinfo is not installed (Debian package gdal-bin, "
+                    "scripts/debian-packages.txt): the listing by ogrinfo is not checked";
+  ASSERT_EQ(RunCommand("ogrinfo -so -al " + gpkg.string(), &log), 0) << log;
+  EXPECT_EQ(log.find("ERROR"), std::string::npos) << log;
+  EXPECT_EQ(log.find("Warning"), std::string::npos) << log;
+  for (const std::string& layer : layers)
+    EXPECT_NE(log.find("Layer name: " + layer + "\n"), std::string::npos) << layer << "\n" << log;
+  EXPECT_NE(log.find("Layer name: layer_styles\n"), std::string::npos) << log;
 }
 
 // A 35° slope as an ESRI ASCII grid (30 x 12 cells of 1 m, no CRS) with a nodata hole of 3 x 3
@@ -432,6 +507,7 @@ TEST(SimulateCommand, ARunRemovesOutputsOfAnEarlierRunThatItDoesNotWrite) {
   ASSERT_TRUE(fs::exists(dir / "out" / "trajectories.h5"));
   ASSERT_TRUE(fs::exists(dir / "out" / "speed_p95.tif"));
   ASSERT_TRUE(fs::exists(dir / "out" / "speed_p50.tif"));
+  ASSERT_TRUE(fs::exists(dir / "out" / "rocks.gpkg"));  // on by default
   std::ofstream(dir / "out" / "notes.txt") << "the user's own file";
   ASSERT_EQ(RunCommand(std::string(TALUS_BINARY) + " simulate " + (dir / "lean.toml").string() +
                            " --out " + out,
@@ -442,6 +518,7 @@ TEST(SimulateCommand, ARunRemovesOutputsOfAnEarlierRunThatItDoesNotWrite) {
   EXPECT_FALSE(fs::exists(dir / "out" / "speed_p95.tif"));
   EXPECT_FALSE(fs::exists(dir / "out" / "speed_p50.tif"));
   EXPECT_FALSE(fs::exists(dir / "out" / "quicklook.png"));
+  EXPECT_FALSE(fs::exists(dir / "out" / "rocks.gpkg"));
   EXPECT_TRUE(fs::exists(dir / "out" / "rocks.csv"));
   EXPECT_TRUE(fs::exists(dir / "out" / "summary.json"));
   EXPECT_TRUE(fs::exists(dir / "out" / "notes.txt"));
@@ -501,7 +578,7 @@ void InterruptARun(int signal, const std::string& name) {
       0)
       << log;
   const auto earlier = Snapshot(out);
-  ASSERT_EQ(earlier.size(), 19u);  // with the list of outputs, .talus-outputs, and run.log
+  ASSERT_EQ(earlier.size(), 20u);  // with the list of outputs, .talus-outputs, and run.log
 
   const pid_t pid = StartTalus(
       {"simulate", (dir / "slow.toml").string(), "--out", out.string(), "--threads", "2"},
@@ -728,7 +805,7 @@ rocks = 500000000
 [output]
 rasters = ["speed", "energy", "jump_height"]
 )";
-  // 10^9 rocks' trajectories of 100 s every 0.01 s: hundreds of TB.
+  // 10^9 rocks' trajectories of 100 s every 0.01 s, and their paths in rocks.gpkg: over a PB.
   std::string disk_scene = memory_scene;
   disk_scene.replace(disk_scene.find("rasters = "), std::string::npos,
                      "trajectories = true\nquicklook = false\n");
@@ -737,8 +814,8 @@ rasters = ["speed", "energy", "jump_height"]
        {"of memory besides the ", " is available (", "per-cell summaries behind the speed",
         "(fewer rocks (--rocks)", "nothing was run"}},
       {disk_scene,
-       {"the outputs need about ", " TB of disk, but ", "trajectories.h5 (10002 samples per rock",
-        "(trajectories = false", "nothing was run"}},
+       {"the outputs need about ", " PB of disk, but ", "trajectories.h5 (10002 samples per rock",
+        "(trajectories = false", "rocks.gpkg (geopackage = false", "nothing was run"}},
   };
   for (const auto& [text, parts] : cases) {
     std::ofstream(dir / "scene.toml") << text;

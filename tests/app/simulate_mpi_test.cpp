@@ -48,7 +48,7 @@ TEST(SimulateMpi, RanksTimesThreadsGiveTheOneProcessBytes) {
   ASSERT_EQ(RunCommand(Talus() + args + (dir / "single").string() + " --threads 1", &log), 0)
       << log;
   const auto single = OutputsWithoutTimings(dir / "single");
-  ASSERT_EQ(single.size(), 20u);  // with the list of outputs, .talus-outputs
+  ASSERT_EQ(single.size(), 21u);  // with rocks.gpkg and the list of outputs, .talus-outputs
   ASSERT_GT(single.at("evaluation_lines.csv").size(), 200u);  // rocks crossed
   for (const auto& [ranks, threads] : {std::pair{2, 1}, std::pair{2, 2}, std::pair{3, 1}}) {
     const std::string name = "mpi-" + std::to_string(ranks) + "x" + std::to_string(threads);

@@ -10,6 +10,7 @@
 #include <fstream>
 #include <iterator>
 #include <memory>
+#include <string>
 #include <tuple>
 #include <vector>
 
@@ -30,16 +31,16 @@ std::string RocksCsv(int rocks) {
   std::string text = std::string(RocksCsvWriter::Header()) + "\n";
   for (int k = 0; k < rocks; ++k) {
     const std::string c = std::to_string(k);
-    text += c + ",0,\"run, " + c + "\",7," + (k == 0 ? "rest" : "left_domain") + ",10" + c +
-            ",20" + c + ",30" + c + ",12.5,13,2,3.5,4000,0.5,6,0,,100,0,0,0,30,hard,\n";
+    text += c + ",0,\"run, " + c + "\",7," + (k == 0 ? "rest" : "left_domain") + ",10" + c + ",20" +
+            c + ",30" + c + ",12.5,13,2,3.5,4000,0.5,6,0,,100,0,0,0,30,hard,\n";
   }
   return text;
 }
 
 struct Dataset {
   explicit Dataset(const std::string& path)
-      : d(static_cast<GDALDataset*>(GDALOpenEx(path.c_str(), GDAL_OF_VECTOR, nullptr, nullptr,
-                                               nullptr))) {}
+      : d(static_cast<GDALDataset*>(
+            GDALOpenEx(path.c_str(), GDAL_OF_VECTOR, nullptr, nullptr, nullptr))) {}
   ~Dataset() {
     if (d) GDALClose(d);
   }
@@ -129,6 +130,18 @@ TEST(RocksGeoPackage, SameRocksSameBytesAndLocalMetresForThePlane) {
   EXPECT_TRUE(srs->IsLocal());
   EXPECT_FALSE(srs->IsGeographic());
   EXPECT_EQ(srs->GetLinearUnits(nullptr), 1.0);
+  // One default QGIS style per layer, as dated as the rest of the file.
+  OGRLayer* styles = gpkg.d->GetLayerByName("layer_styles");
+  ASSERT_NE(styles, nullptr);
+  EXPECT_EQ(styles->GetGeomType(), wkbNone);
+  ASSERT_EQ(styles->GetFeatureCount(), 1);
+  const std::unique_ptr<OGRFeature> style(styles->GetNextFeature());
+  EXPECT_STREQ(style->GetFieldAsString("f_table_name"), "end_points");
+  EXPECT_STREQ(style->GetFieldAsString("f_geometry_column"), "geom");
+  EXPECT_EQ(style->GetFieldAsInteger("useAsDefault"), 1);
+  EXPECT_STREQ(style->GetFieldAsString("update_time"), "2000/01/01 00:00:00+00");
+  EXPECT_NE(std::string(style->GetFieldAsString("styleQML")).find("attr=\"max_kinetic_energy_j\""),
+            std::string::npos);
 }
 
 TEST(RocksGeoPackage, ABadRocksCsvIsAnErrorAndLeavesNoFile) {

@@ -95,17 +95,17 @@ TEST(EstimateResources, CountsEachPartFromTheScene) {
   // No raster, no trajectory: no raster work and no trajectories.h5.
   std::string lean = kScene;
   lean.replace(lean.find("trajectories = true"), 19, "trajectories = false");
-  lean.replace(lean.find("rasters = ["), std::string::npos, "quicklook = false\n");
+  lean.replace(lean.find("rasters = ["), std::string::npos,
+               "quicklook = false\ngeopackage = false\n");
   const ResourceEstimate bare = EstimateResources(Load(lean), 1);
   EXPECT_EQ(Find(bare.memory, "raster"), nullptr);
   EXPECT_EQ(Find(bare.memory, "values behind"), nullptr);
   EXPECT_EQ(Find(bare.memory, "quick-look"), nullptr);
   EXPECT_EQ(Find(bare.disk, "trajectories.h5"), nullptr);
-  EXPECT_EQ(Find(bare.disk, "rocks.gpkg"), nullptr);  // off by default
+  EXPECT_EQ(Find(bare.disk, "rocks.gpkg"), nullptr);  // asked off
 
-  // rocks.gpkg: a row per rock and, with trajectories, a vertex per sample.
-  std::string gis = kScene;
-  gis.replace(gis.find("trajectories = true"), 19, "trajectories = true\ngeopackage = true");
+  // rocks.gpkg (on by default): a row per rock and, with trajectories, a vertex per sample.
+  const std::string gis = kScene;
   const ResourceEstimate with_gpkg = EstimateResources(Load(gis), 1);
   const ResourceTerm* gpkg = Find(with_gpkg.disk, "rocks.gpkg");
   ASSERT_NE(gpkg, nullptr);
