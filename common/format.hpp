@@ -1,5 +1,6 @@
 #pragma once
-// Numbers as text: the few formats of the outputs and messages, each written once.
+// Numbers and text as the outputs write them: the few formats of the outputs and messages, each
+// written once.
 
 #include <string>
 
@@ -15,5 +16,7 @@ std::string TenDigits(double v);
 // The shortest text that reads back as exactly `v` ("0.1", "1e-07", "nan", "-inf"): files that
 // are read again.
 std::string RoundTrip(double v);
+// `text` with &, <, > and " escaped, for XML text and attribute values (SVG, HTML, QGIS styles).
+std::string XmlEscaped(const std::string& text);
 
 }  // namespace talus

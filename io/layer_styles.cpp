@@ -10,24 +10,6 @@
 namespace talus::io {
 namespace {
 
-// Text for an XML attribute value.
-std::string Escaped(const std::string& text) {
-  std::string out;
-  for (char c : text) {
-    if (c == '&')
-      out += "&amp;";
-    else if (c == '<')
-      out += "&lt;";
-    else if (c == '>')
-      out += "&gt;";
-    else if (c == '"')
-      out += "&quot;";
-    else
-      out += c;
-  }
-  return out;
-}
-
 std::string Colour(const std::array<unsigned char, 3>& rgb, double opacity) {
   return std::to_string(rgb[0]) + "," + std::to_string(rgb[1]) + "," + std::to_string(rgb[2]) +
          "," + std::to_string(static_cast<int>(opacity * 255 + 0.5));
@@ -43,8 +25,9 @@ std::string Bound(double value) { return FormatDouble(value, "%.17g"); }
 std::string Properties(const std::vector<std::pair<std::string, std::string>>& properties) {
   std::string options = "<Option type=\"Map\">", props;
   for (const auto& [key, value] : properties) {
-    options += "<Option name=\"" + key + "\" type=\"QString\" value=\"" + Escaped(value) + "\"/>";
-    props += "<prop k=\"" + key + "\" v=\"" + Escaped(value) + "\"/>";
+    options +=
+        "<Option name=\"" + key + "\" type=\"QString\" value=\"" + XmlEscaped(value) + "\"/>";
+    props += "<prop k=\"" + key + "\" v=\"" + XmlEscaped(value) + "\"/>";
   }
   return options + "</Option>" + props;
 }
@@ -117,10 +100,10 @@ std::string GraduatedMarkerQml(const std::string& field, const QuickLookLegend& 
                                                        : std::numeric_limits<double>::max();
     const std::string name = std::to_string(k);
     ranges += "<range lower=\"" + Bound(c.lower) + "\" upper=\"" + Bound(upper) + "\" symbol=\"" +
-              name + "\" label=\"" + Escaped(c.label) + "\" render=\"true\"/>";
+              name + "\" label=\"" + XmlEscaped(c.label) + "\" render=\"true\"/>";
     symbols += Symbol(name, {SymbolKind::kMarker, c.rgb, 1, 2.2, false});
   }
-  return Document("<renderer-v2 type=\"graduatedSymbol\" attr=\"" + Escaped(field) +
+  return Document("<renderer-v2 type=\"graduatedSymbol\" attr=\"" + XmlEscaped(field) +
                   "\" graduatedMethod=\"GraduatedColor\" symbollevels=\"0\" enableorderby=\"0\" "
                   "forceraster=\"0\"><ranges>" +
                   ranges + "</ranges><symbols>" + symbols + "</symbols></renderer-v2>");

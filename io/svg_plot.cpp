@@ -117,27 +117,6 @@ std::string Stack(const std::vector<std::string>& plots, int columns, const std:
   return out + "</svg>\n";
 }
 
-std::string Escape(const std::string& text) {
-  std::string out;
-  for (char c : text) {
-    switch (c) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      default:
-        out += c;
-    }
-  }
-  return out;
-}
+std::string Escape(const std::string& text) { return XmlEscaped(text); }
 
 }  // namespace talus::io::svg

@@ -32,5 +32,13 @@ TEST(Format, RoundTripIsTheShortestTextThatReadsBack) {
     EXPECT_EQ(std::stod(RoundTrip(v)), v) << RoundTrip(v);
 }
 
+// XML's five special characters but the apostrophe (attributes are written in double quotes);
+// anything else, UTF-8 included, passes unchanged.
+TEST(Format, XmlEscapedEscapesMarkupCharacters) {
+  EXPECT_EQ(XmlEscaped("a < b && c > \"d\" 'e' μ"),
+            "a &lt; b &amp;&amp; c &gt; &quot;d&quot; 'e' μ");
+  EXPECT_EQ(XmlEscaped(""), "");
+}
+
 }  // namespace
 }  // namespace talus
