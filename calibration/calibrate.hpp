@@ -141,8 +141,13 @@ struct CalibrationSummary {
   std::string FullReport() const;   // every stage's report
 };
 
+// A fitted value further than this many sds from its own prior's mean is a warning: under the
+// prior, 2 sds is the 95 % interval's edge, and the data have pulled the value beyond it.
+constexpr double kPriorConflictSds = 2.0;
+
 // What in a calibration's result deserves a warning, one sentence each, in this order: a
-// parameter the profiles or the covariance find unidentified; a fitted value at a bound of its
+// parameter the profiles or the covariance find unidentified; a fitted value more than
+// kPriorConflictSds from its own prior's mean; a fitted value at a bound of its
 // range (within 1e-3 of the range: the optimum may lie beyond); a profile point below the reported
 // optimum by more than the objective's noise level (the optimum is then not the best point
 // evaluated; within the noise it is not reported); a kind that the held-out runs, or the folds'

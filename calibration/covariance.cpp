@@ -74,7 +74,8 @@ std::string Names(const Uncertainty& out, const std::function<bool(int)>& pick) 
   return s;
 }
 
-// Sandwich: (J^T J)^-1 M (J^T J)^-1, M = sum over runs of (J_g^T r_g)(J_g^T r_g)^T, into
+// Sandwich: (J^T J)^-1 M (J^T J)^-1, M = sum over runs of (J_g^T r_g)(J_g^T r_g)^T (times
+// G / (G - n)) plus the prior's w sum_i J_i^T J_i over its rows, into
 // out.covariance_unit, with out.groups the runs with a score gradient. "" when computed, else why
 // not.
 std::string Sandwich(const Objective& objective, const RowMajor& inverse, Uncertainty& out) {
@@ -88,14 +89,30 @@ std::string Sandwich(const Objective& objective, const RowMajor& inverse, Uncert
     if (groups[static_cast<std::size_t>(i)] >= 0)
       gradients.row(groups[static_cast<std::size_t>(i)]) += out.residuals[i] * out.jacobian.row(i);
   for (int g = 0; g < group_count; ++g) out.groups += gradients.row(g).squaredNorm() > 0 ? 1 : 0;
-  const int free =
-      n - static_cast<int>(std::count(out.identified.begin(), out.identified.end(), false));
+  // The parameters the runs estimate: identified and moving some run's residuals (one that only
+  // its prior holds takes no degree of freedom from the runs).
+  int free = 0;
+  for (int j = 0; j < n; ++j) {
+    bool data = false;
+    for (int i = 0; i < m && !data; ++i)
+      data = groups[static_cast<std::size_t>(i)] >= 0 && out.jacobian(i, j) != 0;
+    free += out.identified[static_cast<std::size_t>(j)] && data ? 1 : 0;
+  }
   if (out.groups <= free)
     return "No covariance: " + std::to_string(out.groups) + " runs with a score gradient for " +
            std::to_string(free) + " parameters.";
   const Eigen::MatrixXd bread = inverse;
-  const Eigen::MatrixXd meat = gradients.transpose() * gradients;
-  out.covariance_unit = bread * meat * bread * (double(out.groups) / double(out.groups - free));
+  const Eigen::MatrixXd meat = gradients.transpose() * gradients *
+                               (double(out.groups) / double(out.groups - free));
+  // The prior's rows as pseudo-observations: a residual sqrt(w) (value - mean) / sd whose mean is
+  // uncertain by its sd varies with variance w, so its score gradient J_i^T r_i has variance
+  // w J_i^T J_i. A coordinate held by its prior alone then gets the prior's sd.
+  Eigen::MatrixXd prior_meat = Eigen::MatrixXd::Zero(n, n);
+  for (int i = 0; i < m; ++i)
+    if (groups[static_cast<std::size_t>(i)] < 0)
+      prior_meat += objective.options().prior_weight * out.jacobian.row(i).transpose() *
+                    out.jacobian.row(i);
+  out.covariance_unit = bread * (meat + prior_meat) * bread;
   out.computed = true;
   return "";
 }

@@ -10,7 +10,9 @@
 // g_g = 2 J_g^T r_g (J_g, r_g: the rows of run g, Objective::residual_groups; the prior's rows
 // belong to no run), times G / (G - n) for G runs and n coordinates. ceres::Covariance gives
 // (J^T J)^-1 at the optimum (dense SVD), and the covariance is (J^T J)^-1 M (J^T J)^-1 with
-// M = sum_g (J_g^T r_g)(J_g^T r_g)^T. Where J^T J is rank-deficient, Ceres refuses: each
+// M = sum_g (J_g^T r_g)(J_g^T r_g)^T. A prior (objective.hpp) adds its rows to J^T J and, as
+// pseudo-observations whose stated mean is uncertain by its sd, w J_p^T J_p to M: a coordinate
+// that only its prior holds gets the prior's sd, one the runs hold is unchanged. Where J^T J is rank-deficient, Ceres refuses: each
 // parameter is then profiled (ProfileParameters) and those whose profile is flat are held
 // constant (a ceres::SubsetManifold) for the covariance of the others, and reported unidentified.
 // Profiles measured beforehand (UncertaintyOptions::profiles) are used the same way from the

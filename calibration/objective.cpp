@@ -28,8 +28,6 @@ bool ObjectiveOptions::IsValid(std::string* why) const {
       msg << "weights." << kind << " = " << weight << " must be >= 0";
   if (msg.str().empty() && (!std::isfinite(prior_weight) || prior_weight < 0))
     msg << "prior_weight = " << prior_weight << " must be >= 0";
-  if (msg.str().empty() && prior_weight > 0 && !prior_reference)
-    msg << "prior_weight = " << prior_weight << " needs a prior_reference table";
   if (msg.str().empty() && threads < 0) msg << "threads = " << threads << " must be >= 0";
   if (msg.str().empty() && !(tolerance_m_s > 0 && tolerance_m_s < 1))
     msg << "tolerance_m_s = " << tolerance_m_s << " must be in (0, 1) m/s";
@@ -120,10 +118,23 @@ Objective::Objective(const Scene& scene, const ensemble::ReleaseSpec& release,
     }
   }
 
-  if (options_.prior_weight > 0) {
+  // The prior: a coordinate's own, else the reference table's pull, if any.
+  const std::vector<Coordinate>& coordinates = parameters_.coordinates();
+  for (const Coordinate& c : coordinates)
+    if (c.prior && options_.prior_weight == 0)
+      throw InputError(c.name + ": a prior (" + c.prior->Describe() +
+                       ") acts only with prior_weight > 0");
+  if (options_.prior_weight > 0 && options_.prior_reference) {
     prior_center_ = parameters_.UnitOf(*options_.prior_reference);
     *prior_center_ = prior_center_->cwiseMax(0.0).cwiseMin(1.0);
   }
+  if (options_.prior_weight > 0)
+    for (int j = 0; j < dimension(); ++j)
+      if (coordinates[static_cast<std::size_t>(j)].prior || prior_center_)
+        prior_coordinates_.push_back(j);
+  if (options_.prior_weight > 0 && prior_coordinates_.empty())
+    throw InputError("prior_weight = " + std::to_string(options_.prior_weight) +
+                     " but no prior: give a reference table or a parameter's own prior");
 
   // Residual groups: runs in order of first appearance; an observation of the whole scene alone.
   std::vector<std::string> runs;
@@ -138,7 +149,18 @@ Objective::Objective(const Scene& scene, const ensemble::ReleaseSpec& release,
   for (const auto& o : observations_.deposits) residual_groups_.push_back(group_of(o.run));
   for (std::size_t i = 0; i < observations_.scalars.size(); ++i)
     residual_groups_.push_back(residual_groups_[i]);
-  if (prior_center_) residual_groups_.insert(residual_groups_.end(), dimension(), -1);
+  residual_groups_.insert(residual_groups_.end(), prior_coordinates_.size(), -1);
+}
+
+Eigen::VectorXd Objective::PriorResiduals(const Eigen::VectorXd& u) const {
+  Eigen::VectorXd r(static_cast<Eigen::Index>(prior_coordinates_.size()));
+  for (std::size_t i = 0; i < prior_coordinates_.size(); ++i) {
+    const int j = prior_coordinates_[i];
+    const Coordinate& c = parameters_.coordinates()[static_cast<std::size_t>(j)];
+    r[static_cast<Eigen::Index>(i)] =
+        c.prior ? c.prior->Residual(c.ToValue(u[j])) : u[j] - (*prior_center_)[j];
+  }
+  return r;
 }
 
 GroundTable Objective::GroundOf(const Eigen::VectorXd& u) const {
@@ -257,10 +279,10 @@ Evaluation Objective::Run(const Eigen::VectorXd& u, const ensemble::ReleaseSpec&
       e.residuals[m + i] = std::sqrt(c * spread);
     }
   }
-  if (prior_center_) {
-    const Eigen::VectorXd d = u - *prior_center_;
-    e.prior = options_.prior_weight * d.squaredNorm();
-    e.residuals.tail(dimension()) = std::sqrt(options_.prior_weight) * d;
+  if (!prior_coordinates_.empty()) {
+    const Eigen::VectorXd r = PriorResiduals(u);
+    e.prior = options_.prior_weight * r.squaredNorm();
+    e.residuals.tail(r.size()) = std::sqrt(options_.prior_weight) * r;
   }
   e.value = e.data + e.prior;
   e.wall_time_s = elapsed();

@@ -3,7 +3,7 @@
 // -> the same rocks again (common random numbers: the same release, seed and per-rock streams for
 // every evaluation) -> fieldobs scores -> one number.
 //
-//   f(u) = sum_kind weight_kind * mean_score_kind(u) / scale_kind  +  prior_weight * |u - u_ref|^2
+//   f(u) = sum_kind weight_kind * mean_score_kind(u) / scale_kind  +  prior_weight * sum_j r_j^2
 //
 // mean_score_kind is the mean over the kind's scored observations of the CRPS (scalars) or energy
 // score (deposits), in the kind's unit. scale_kind is the kind's climatology score (the mean of
@@ -11,7 +11,9 @@
 // normalised, each term is 1 - skill vs climatology, dimensionless, so kinds of different units
 // (m, m/s, rad/s) add up and a weight of 1 means "as important as explaining the spread between
 // runs". Being fixed by the observations alone, the scale does not change the optimum of a single
-// kind. The prior pulls in unit coordinates towards a reference table (Table 1 by default).
+// kind. The prior's residual r_j of coordinate j is its own prior's (parameters.hpp: Prior, the
+// distance from the stated mean in sds), or, for a coordinate without one, u_j - u_ref_j, the pull
+// in unit coordinates towards a reference table (Table 1 by default), or none.
 //
 // The objective owns a copy of the scene whose terrain and shapes are shared, immutable
 // (solver/terrain.hpp), with the contact-solve tolerance of ObjectiveOptions in place of the
@@ -66,8 +68,10 @@ struct ObjectiveOptions {
   // fieldobs::ObservationScore::kind); kinds not listed weigh 1. A weight of 0 leaves a kind out.
   std::map<std::string, double> weights;
   bool normalise = true;  // divide each kind's mean score by its climatology score
-  // Prior: prior_weight * |u - u_ref|^2 with u_ref the unit coordinates of `prior_reference`
-  // (clamped to [0, 1]). Weight 0 (the default): no prior. Dimensionless when normalised.
+  // Prior: prior_weight * sum_j r_j^2 over the coordinates with a prior: a coordinate's own
+  // (ParameterSpec::prior), else u_j - u_ref_j with u_ref the unit coordinates of
+  // `prior_reference` (clamped to [0, 1]) when it is given. Weight 0 (the default): no prior
+  // (and a parameter's own prior is refused). Dimensionless when normalised.
   double prior_weight = 0;
   std::optional<GroundTable> prior_reference;
   int threads = 0;  // worker threads of each evaluation; 0: all cores
@@ -107,7 +111,7 @@ struct Evaluation {
   //    For a deposit (a 2-D energy score has no sign): sqrt(c energy_score);
   //  - then one per scalar observation, the *spread* residual sqrt(c CRPS_at_median): what the
   //    ensemble's width costs even without bias;
-  //  - then one per coordinate for the prior: sqrt(prior_weight) (u - u_ref).
+  //  - then one per coordinate with a prior: sqrt(prior_weight) r_j.
   // So the sum of squares is the data term plus the prior term. 0 for an observation that was
   // not scored. Objective::residual_groups() says which run each residual belongs to.
   Eigen::VectorXd residuals;
@@ -149,6 +153,13 @@ class Objective {
   // The scene as every evaluation runs it: the given one with options().tolerance_m_s.
   const Scene& scene() const { return scene_; }
   std::optional<Eigen::VectorXd> prior_center() const { return prior_center_; }
+  // The coordinates with a prior term, in order, and their residuals r_j at u.
+  const std::vector<int>& prior_coordinates() const { return prior_coordinates_; }
+  Eigen::VectorXd PriorResiduals(const Eigen::VectorXd& u) const;
+  // The prior term at u: prior_weight * |PriorResiduals(u)|^2 (0 without a prior).
+  double PriorTerm(const Eigen::VectorXd& u) const {
+    return prior_coordinates_.empty() ? 0.0 : options_.prior_weight * PriorResiduals(u).squaredNorm();
+  }
   bool needs_episodes() const { return episodes_; }
   // Per residual (Evaluation::residuals): the group of observations it belongs to -- one group
   // per run, one per observation of the whole scene --, and -1 for the prior's. Observations of
@@ -168,6 +179,7 @@ class Objective {
   std::vector<std::string> kinds_;  // observation kinds in order of first appearance
   std::vector<double> weights_, scales_;
   std::optional<Eigen::VectorXd> prior_center_;
+  std::vector<int> prior_coordinates_;
   std::vector<int> residual_groups_;
 };
 

@@ -118,9 +118,36 @@ bool ParameterSpec::IsValid(std::string* why) const {
     msg << "upper = " << upper << " must be <= " << kMaxFriction << " for a friction coefficient";
   else if (roughness && upper > kMaxRoughness)
     msg << "upper = " << upper << " must be <= " << kMaxRoughness << " for a roughness";
+  else if (prior && !std::isfinite(prior->mean + prior->sd + prior->factor))
+    msg << "prior: mean, sd and factor must be finite";
+  else if (prior && (prior->sd > 0) == (prior->factor > 0))
+    msg << "prior: give sd (> 0, a normal prior) or factor (> 1, a log-normal one), one of them";
+  else if (prior && prior->IsLogNormal() && !(prior->factor > 1))
+    msg << "prior: factor = " << prior->factor << " must be > 1 (one sd is this factor)";
+  else if (prior && (prior->sd < 0 || prior->factor < 0))
+    msg << "prior: sd and factor must be positive";
+  else if (prior && prior->IsLogNormal() && !(prior->mean > 0))
+    msg << "prior: mean = " << prior->mean << " must be > 0 for a log-normal prior";
+  else if (prior && !(prior->mean >= lower && prior->mean <= upper))
+    msg << "prior: mean = " << prior->mean << " lies outside the bounds [" << lower << ", "
+        << upper << "] (the prior would pull against a bound: widen the bounds)";
   if (msg.str().empty()) return true;
   if (why) *why = Name() + ": " + msg.str();
   return false;
+}
+
+double Prior::Residual(double value) const {
+  return IsLogNormal() ? std::log(value / mean) / std::log(factor) : (value - mean) / sd;
+}
+
+std::string Prior::Describe() const {
+  std::ostringstream text;
+  text.precision(6);
+  if (IsLogNormal())
+    text << "log-normal(" << mean << ", factor " << factor << ")";
+  else
+    text << "normal(" << mean << ", sd " << sd << ")";
+  return text.str();
 }
 
 double Coordinate::ToValue(double u) const {
@@ -181,6 +208,11 @@ ParameterSet::ParameterSet(std::vector<ParameterSpec> specs, const GroundTable& 
           first.lower != s.lower || first.upper != s.upper || first.UsesLog() != s.UsesLog())
         throw InputError(s.Name() + ": tie '" + s.tie + "' joins parameters of one field with " +
                          "equal bounds and transform, unlike " + first.Name());
+      if (s.prior && joined->prior && !(*s.prior == *joined->prior))
+        throw InputError(s.Name() + ": tie '" + s.tie + "' has two priors, " +
+                         joined->prior->Describe() + " and " + s.prior->Describe() +
+                         ": state one (or the same on every member)");
+      if (s.prior) joined->prior = s.prior;
       joined->members.push_back(static_cast<int>(k));
       continue;
     }
@@ -192,6 +224,7 @@ ParameterSet::ParameterSet(std::vector<ParameterSpec> specs, const GroundTable& 
     c.lower = s.lower;
     c.upper = s.upper;
     c.log = s.UsesLog();
+    c.prior = s.prior;
     coordinates_.push_back(c);
   }
   // mu_min <= mu_max must be possible in every category: the lowest mu_min against the highest

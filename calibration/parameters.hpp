@@ -50,6 +50,23 @@ bool ParseShapeField(const std::string& name, ShapeField* field);
 double& KnobOf(ensemble::ShapeKnobs& knobs, ShapeField field);
 double KnobOf(const ensemble::ShapeKnobs& knobs, ShapeField field);
 
+// What the user knows of one parameter before the fit, in the field's unit: a normal prior
+// (mean, sd), e.g. a measured size and its survey error, or a log-normal one (mean, factor), for
+// a parameter known to a factor (a viscosity, a scar-growth rate). Its residual r -- the value's
+// distance from the mean in sds, (value - mean) / sd or ln(value / mean) / ln(factor) -- enters
+// the objective as prior_weight * r^2 (objective.hpp).
+struct Prior {
+  double mean = 0;
+  double sd = 0;      // > 0: normal
+  double factor = 0;  // > 1: log-normal (one sd is this factor); sd and factor exclusive
+  bool IsLogNormal() const { return factor > 0; }
+  double Residual(double value) const;
+  bool operator==(const Prior& o) const {
+    return mean == o.mean && sd == o.sd && factor == o.factor;
+  }
+  std::string Describe() const;  // "normal(0.3, sd 0.05)", "log-normal(5, factor 2)"
+};
+
 // One free parameter: a field of one ground category or a knob of one block's shape, its
 // physical bounds and its transform.
 struct ParameterSpec {
@@ -65,6 +82,9 @@ struct ParameterSpec {
   // mu_min, mu_max, compaction_drag (GroundFieldInfo::log_scale) and every shape knob.
   std::optional<bool> log;
   std::string tie;  // parameters with the same non-empty tie share one coordinate
+  // Its own prior (members of a tie state the same one or none); none: the objective's reference
+  // prior, if any, acts on its coordinate.
+  std::optional<Prior> prior;
 
   static constexpr double kMaxFriction = 5.0;   // bound on mu_min and mu_max
   static constexpr double kMaxRoughness = 0.5;  // as the built-in rock takes it
@@ -73,7 +93,8 @@ struct ParameterSpec {
   std::string Name() const;       // "medium.mu_min", or "blocks.<id>.roughness"
   std::string FieldName() const;  // "mu_min", "roughness", ...
   const char* Unit() const;       // the field's unit
-  // False with the field, the value and the violated bound in *why.
+  // False with the field, the value and the violated bound in *why (a prior's too: finite, a
+  // positive sd or a factor above 1, its mean within the bounds).
   bool IsValid(std::string* why) const;
 };
 
@@ -83,6 +104,7 @@ struct Coordinate {
   std::vector<int> members;  // indices into ParameterSet::specs()
   double lower = 0, upper = 0;
   bool log = false;
+  std::optional<Prior> prior;  // its members' own prior, if one states it
   double ToValue(double u) const;     // unit coordinate -> value (u clamped to [0, 1])
   double ToUnit(double value) const;  // value -> unit coordinate (not clamped)
 };

@@ -101,7 +101,8 @@ std::vector<ParameterProfile> ProfileParameters(const Objective& objective,
   for (int j = 0; j < objective.dimension(); ++j) {
     ParameterProfile p;
     p.name = objective.parameters().coordinates()[j].name;
-    double lo = f_u, hi = f_u;
+    // Identified by the observations: the range of the data term, not of a prior's.
+    double lo = f_u - objective.PriorTerm(u), hi = lo;
     for (int k = 0; k < points; ++k) {
       Eigen::VectorXd v = u;
       v[j] = double(k) / (points - 1);
@@ -110,8 +111,8 @@ std::vector<ParameterProfile> ProfileParameters(const Objective& objective,
       p.values.push_back(e.values[j]);
       p.f.push_back(e.value);
       if (!e.feasible) continue;  // a crossing of mu_min and mu_max is not information
-      lo = std::min(lo, e.value);
-      hi = std::max(hi, e.value);
+      lo = std::min(lo, e.data);
+      hi = std::max(hi, e.data);
     }
     p.range = hi - lo;
     p.threshold = std::max(options.noise_multiple * noise, options.relative_floor * std::abs(f_u));

@@ -65,7 +65,7 @@ struct ProfileOptions {
 struct ParameterProfile {
   std::string name;
   std::vector<double> u, values, f;  // along the coordinate
-  double range = 0;                  // max f - min f
+  double range = 0;                  // max - min of the data term (f less its prior)
   double threshold = 0;              // what range had to exceed
   bool identified = false;
 };

@@ -68,7 +68,7 @@ void LoadParameters(const Context& context, const toml::table& root, Calibration
     const toml::table* t = array->get(k)->as_table();
     if (!t) context.Fail(array->get(k), name, "expected a table (category, field, lower, upper)");
     const Section s(context, t, name,
-                    {"category", "block", "field", "lower", "upper", "log", "tie"});
+                    {"category", "block", "field", "lower", "upper", "log", "tie", "prior"});
     ParameterSpec spec;
     if (s.Has("category") == s.Has("block"))
       s.Fail(s.Has("block") ? "block" : "category",
@@ -107,8 +107,19 @@ void LoadParameters(const Context& context, const toml::table& root, Calibration
     spec.upper = s.Number("upper", 0);
     if (s.Has("log")) spec.log = s.Bool("log", false);
     spec.tie = s.String("tie", "");
+    if (const toml::node* prior = s.Node("prior")) {
+      if (!prior->is_table())
+        s.Fail("prior", "expected a table { mean = ..., sd = ... } or { mean = ..., factor = ... }");
+      const Section p(context, prior->as_table(), name + ".prior", {"mean", "sd", "factor"});
+      if (!p.Has("mean")) p.Fail("mean", std::string("missing: the prior's mean, in ") + spec.Unit());
+      spec.prior = calibration::Prior{p.Number("mean", 0), p.Number("sd", 0), p.Number("factor", 0)};
+    }
     std::string why;
-    if (!spec.IsValid(&why)) s.Fail(spec.upper > spec.lower ? "lower" : "upper", why);
+    if (!spec.IsValid(&why))
+      s.Fail(why.find(": prior:") != std::string::npos ? "prior"
+             : spec.upper > spec.lower                 ? "lower"
+                                                       : "upper",
+             why);
     out.parameters.push_back(spec);
     where.push_back(t);
   }
@@ -124,6 +135,10 @@ void LoadParameters(const Context& context, const toml::table& root, Calibration
     context.Fail(at, "parameters", message);
   }
 }
+
+constexpr const char* kPriorNeedsWeight =
+    "a parameter's prior acts only with [objective] prior_weight > 0 (1: a departure of one sd "
+    "costs as much as a kind's climatology score)";
 
 void LoadObjective(const Context& context, const toml::table* table, CalibrationFile& out) {
   const Section s(context, table, "objective",
@@ -146,10 +161,19 @@ void LoadObjective(const Context& context, const toml::table* table, Calibration
   out.objective.normalise = s.Bool("normalise", true);
   out.objective.prior_weight = s.Checked(
       "prior_weight", 0.0, [](double v) { return v >= 0; }, "must be >= 0");
-  out.prior_reference = s.String("prior_reference", "table1");
-  if (out.prior_reference != "table1" && out.prior_reference != "scene")
-    s.Fail("prior_reference", "'" + out.prior_reference + "': expected \"table1\" or \"scene\"");
-  if (out.objective.prior_weight > 0)
+  // Parameters that state their own prior leave the others free unless a reference is named.
+  const bool own_priors = std::any_of(out.parameters.begin(), out.parameters.end(),
+                                      [](const ParameterSpec& p) { return p.prior.has_value(); });
+  out.prior_reference = s.String("prior_reference", own_priors ? "none" : "table1");
+  if (out.prior_reference != "table1" && out.prior_reference != "scene" &&
+      out.prior_reference != "none")
+    s.Fail("prior_reference",
+           "'" + out.prior_reference + "': expected \"table1\", \"scene\" or \"none\"");
+  if (own_priors && out.objective.prior_weight == 0 && s.Has("prior_weight"))
+    s.Fail("prior_weight", kPriorNeedsWeight);
+  if (out.objective.prior_weight > 0 && !own_priors && out.prior_reference == "none")
+    s.Fail("prior_reference", "\"none\" with no parameter's own prior: prior_weight acts on nothing");
+  if (out.objective.prior_weight > 0 && out.prior_reference != "none")
     out.objective.prior_reference = out.prior_reference == "scene"
                                         ? out.event.scene.scene.ground
                                         : ReferenceGround(out.event.scene.scene.ground, nullptr);
@@ -364,6 +388,11 @@ CalibrationFile LoadCalibration(const std::string& path) {
 
   LoadParameters(context, root, out);
   LoadObjective(context, SubTable(context, root, "objective"), out);
+  if (out.objective.prior_weight == 0)  // a prior without a weight, on the prior's line
+    for (std::size_t k = 0; k < out.parameters.size(); ++k)
+      if (out.parameters[k].prior)
+        context.Fail(root["parameters"][k]["prior"].node(),
+                     "parameters[" + std::to_string(k) + "].prior", kPriorNeedsWeight);
   LoadSolver(context, SubTable(context, root, "solver"), out);
   LoadOptimizer(context, SubTable(context, root, "optimizer"), out);
   LoadRoughness(context, SubTable(context, root, "roughness"), out);
@@ -378,9 +407,11 @@ CalibrationFile LoadCalibration(const std::string& path) {
   std::ostringstream path_text;  // every number at full precision
   path_text.precision(17);
   path_text << out.event.inputs_hash << ' ' << release.rocks_per_release << ' ' << release.seed;
-  for (const ParameterSpec& p : out.parameters)
+  for (const ParameterSpec& p : out.parameters) {
     path_text << ' ' << p.Name() << ' ' << p.lower << ' ' << p.upper << ' ' << p.UsesLog() << ' '
               << p.tie;
+    if (p.prior) path_text << " prior " << p.prior->mean << ' ' << p.prior->sd << ' ' << p.prior->factor;
+  }
   const calibration::ObjectiveOptions& ob = out.objective;
   for (const auto& [kind, weight] : ob.weights) path_text << ' ' << kind << ' ' << weight;
   path_text << ' ' << ob.normalise << ' ' << ob.prior_weight << ' ' << out.prior_reference << ' '

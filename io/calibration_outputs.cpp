@@ -198,6 +198,23 @@ json ParametersJson(const Objective& objective, const calibration::CalibrationSu
               {"initial", Number(s.initial.values[k])},
               {"final", Number(s.best.values[k])},
               {"final_unit_coordinate", Number(s.best.u[k])}};
+    // The prior on this coordinate: its own (and where the fit ended, in sds from its mean), the
+    // pull towards the reference table, or none.
+    const std::vector<int>& with_prior = objective.prior_coordinates();
+    const auto at = std::find(with_prior.begin(), with_prior.end(), static_cast<int>(j));
+    if (at == with_prior.end()) {
+      p["prior"] = nullptr;
+    } else {
+      const double r = objective.PriorResiduals(s.best.u)[at - with_prior.begin()];
+      if (c.prior && c.prior->IsLogNormal())
+        p["prior"] = {{"kind", "log-normal"}, {"mean", c.prior->mean}, {"factor", c.prior->factor}};
+      else if (c.prior)
+        p["prior"] = {{"kind", "normal"}, {"mean", c.prior->mean}, {"sd", c.prior->sd}};
+      else
+        p["prior"] = {{"kind", "reference"},
+                      {"unit_coordinate", Number((*objective.prior_center())[k])}};
+      p["prior"]["final_residual"] = Number(r);
+    }
     if (j < run.profiles.size()) {
       const auto& profile = run.profiles[j];
       p["identified"] = profile.identified;

@@ -111,6 +111,17 @@ py::list Parameters(const Calibration& c) {
     d["lower"] = coordinate.lower;
     d["upper"] = coordinate.upper;
     d["log"] = coordinate.log;
+    if (coordinate.prior) {
+      py::dict prior;
+      prior["mean"] = coordinate.prior->mean;
+      if (coordinate.prior->IsLogNormal())
+        prior["factor"] = coordinate.prior->factor;
+      else
+        prior["sd"] = coordinate.prior->sd;
+      d["prior"] = prior;
+    } else {
+      d["prior"] = py::none();
+    }
     const calibration::ParameterSpec& first =
         c.objective().parameters().specs()[static_cast<std::size_t>(coordinate.members.front())];
     d["unit"] = first.Unit();
@@ -177,8 +188,9 @@ void BindCalibration(py::module_& m) {
                   "are each evaluation's worker threads (0: all cores); rocks (per run and "
                   "evaluation) overrides the file's `rocks`.")
       .def_property_readonly("parameters", &Parameters,
-                             "The optimiser's coordinates: name, bounds, unit, log transform and "
-                             "the parameters a tie joins.")
+                             "The optimiser's coordinates: name, bounds, unit, log transform, "
+                             "the parameter's own prior (mean and sd or factor; None) and the "
+                             "parameters a tie joins.")
       .def_property_readonly("dimension", [](const Calibration& c) { return c.objective().dimension(); })
       .def_property_readonly("kinds", [](const Calibration& c) { return c.objective().kinds(); },
                              "The observation kinds the objective scores, in order.")

@@ -181,7 +181,7 @@ TEST(CalibrationWarnings, EachWeakOrCensoredResultIsSaid) {
   const std::vector<std::string> w = CalibrationWarnings(run, problem.objective());
   ASSERT_EQ(w.size(), 5u);
   EXPECT_EQ(w[0].rfind("medium_hard.mu_min is unidentified: over its whole range its profile "
-                       "changes the objective by 0.7, less than 0.9",
+                       "changes the objective's data term by 0.7, less than 0.9",
                        0),
             0u)
       << w[0];

@@ -58,8 +58,11 @@ struct LinearProblem {
     release.seed = 1;
   }
 
-  Objective Make(std::vector<ParameterSpec> specs, ResidualFn residual) const {
+  // With prior_weight > 0 the specs' own priors act (ObjectiveOptions::prior_weight).
+  Objective Make(std::vector<ParameterSpec> specs, ResidualFn residual,
+                 double prior_weight = 0) const {
     ObjectiveOptions options;
+    options.prior_weight = prior_weight;
     options.normalise = false;
     options.threads = 1;
     const int groups = static_cast<int>(release.runs.size());

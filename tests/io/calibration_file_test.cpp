@@ -185,5 +185,56 @@ TEST(LoadCalibration, ShapeParametersNameABlockAndItsKnob) {
       << both;
 }
 
+// A parameter's own prior: read in the field's unit; with it, prior_reference defaults to "none"
+// (the other parameters stay free); the prior enters the hash that ties a checkpoint to its
+// calibration; nonsense is refused naming the file, line and key.
+TEST(LoadCalibration, AParametersOwnPriorIsReadAndChecked) {
+  const std::string objective = "[objective]\nprior_weight = 0.5\n";
+  const CalibrationFile normal = LoadCalibration(
+      MakeCalibration("prior", "", "prior = { mean = 0.5, sd = 0.1 }\n" + objective));
+  ASSERT_EQ(normal.parameters.size(), 1u);
+  ASSERT_TRUE(normal.parameters[0].prior.has_value());
+  EXPECT_EQ(normal.parameters[0].prior->mean, 0.5);
+  EXPECT_EQ(normal.parameters[0].prior->sd, 0.1);
+  EXPECT_EQ(normal.prior_reference, "none");
+  EXPECT_FALSE(normal.objective.prior_reference.has_value());
+  EXPECT_EQ(normal.objective.prior_weight, 0.5);
+  const CalibrationFile wider = LoadCalibration(
+      MakeCalibration("prior2", "", "prior = { mean = 0.5, sd = 0.2 }\n" + objective));
+  EXPECT_NE(normal.path_hash, wider.path_hash);
+  const CalibrationFile log_normal = LoadCalibration(MakeCalibration(
+      "prior3", "", "prior = { mean = 0.4, factor = 1.5 }\n" + objective +
+                        "prior_reference = \"table1\"\n"));
+  EXPECT_EQ(log_normal.parameters[0].prior->factor, 1.5);
+  EXPECT_TRUE(log_normal.objective.prior_reference.has_value());
+
+  const struct {
+    std::string tail, error;
+  } bad[] = {
+      {"prior = { mean = 0.5, sd = 0.1 }\n",
+       ":7: parameters[0].prior: a parameter's prior acts only with [objective] prior_weight > 0"},
+      {"prior = { mean = 0.5, sd = 0.1 }\n[objective]\nprior_weight = 0\n",
+       ":9: objective.prior_weight: a parameter's prior acts only with [objective] prior_weight > 0"},
+      {"prior = { mean = 1.5, sd = 0.1 }\n" + objective,
+       ":7: parameters[0].prior: medium_soft.mu_min: prior: mean = 1.5 lies outside the bounds "
+       "[0.1, 0.9]"},
+      {"prior = { mean = 0.5 }\n" + objective,
+       ":7: parameters[0].prior: medium_soft.mu_min: prior: give sd (> 0, a normal prior) or "
+       "factor (> 1, a log-normal one), one of them"},
+      {"prior = { sd = 0.1 }\n" + objective,
+       ":7: parameters[0].prior.mean: missing: the prior's mean, in 1"},
+      {"prior = { mean = 0.5, sigma = 0.1 }\n" + objective,
+       ":7: parameters[0].prior.sigma: unknown key"},
+      {"prior = 0.5\n" + objective, ":7: parameters[0].prior: expected a table"},
+      {objective + "prior_reference = \"none\"\n",
+       ":9: objective.prior_reference: \"none\" with no parameter's own prior"},
+  };
+  for (const auto& c : bad) {
+    const std::string path = MakeCalibration("prior_bad", "", c.tail);
+    const std::string error = ErrorOf(path);
+    EXPECT_EQ(error.rfind(path + c.error, 0), 0u) << error;
+  }
+}
+
 }  // namespace
 }  // namespace talus::io
