@@ -284,20 +284,26 @@ std::vector<BlockBias> BiasByBlock(const std::vector<ObservationScore>& scores,
       BlockBias b;
       b.block = block;
       b.kind = kind;
-      double bias = 0, score = 0;
+      std::vector<double> bias;
+      double score = 0;
       for (const ObservationScore& s : scores) {
         const auto it = block_of.find(s.run);
         if (!s.scored || !std::isfinite(s.bias) || s.kind != kind || it == block_of.end() ||
             it->second != block)
           continue;
         b.unit = s.unit;
-        bias += s.bias;
+        bias.push_back(s.bias);
         score += s.score;
         ++b.scored;
       }
       if (b.scored == 0) continue;
-      b.mean_bias = bias / b.scored;
+      b.mean_bias = Mean(bias);
       b.mean_score = score / b.scored;
+      if (b.scored >= 2) {
+        double ss = 0;
+        for (double x : bias) ss += (x - b.mean_bias) * (x - b.mean_bias);
+        b.bias_standard_error = std::sqrt(ss / (b.scored - 1) / b.scored);
+      }
       out.push_back(b);
     }
   return out;

@@ -88,6 +88,10 @@ struct BlockBias {
   std::string kind, unit;
   int scored = 0;
   double mean_bias = kNaN;  // mean over the observations of (simulated mean - observed)
+  // Its standard error over the runs: the sd of the observations' biases / sqrt(scored) (NaN
+  // below 2). Runs of one block scatter (the Tschamut plate's observed run-outs by 25 m), so a
+  // block's bias over 4 runs is uncertain by about 12 m: judge a bias against it.
+  double bias_standard_error = kNaN;
   double mean_score = kNaN;
 };
 

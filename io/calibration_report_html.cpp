@@ -120,7 +120,8 @@ std::string HeldOutSection(const Json& c) {
   std::string out;
   if (c["holdout"].is_object()) {
     Add(out, "<h2>Held-out runs</h2>\n<p>Runs left out of the fit: ", Cell(c["holdout"]["runs"]),
-        ".</p>\n", HeldOutKinds(c["holdout"]["kinds"]));
+        ".</p>\n", HeldOutKinds(c["holdout"]["kinds"]),
+        html::BlockBiasTable(c["holdout"].value("blocks", Json())));
   }
   if (c["cross_validation"].is_object()) {
     std::vector<std::vector<std::string>> rows;
@@ -133,8 +134,11 @@ std::string HeldOutSection(const Json& c) {
                         "fitted values"},
                        rows) +
            "<p>Over every fold's held-out runs:</p>\n" +
-           HeldOutKinds(c["cross_validation"]["kinds"]);
+           HeldOutKinds(c["cross_validation"]["kinds"]) +
+           html::BlockBiasTable(c["cross_validation"].value("blocks", Json()));
   }
+  const std::string fitted = html::BlockBiasTable(c.value("fitted_runs_blocks", Json()));
+  if (!fitted.empty()) out += "<h2>Bias per block, fitted runs</h2>\n" + fitted;
   if (!out.empty())
     out +=
         "<p class=\"note\">Skill = 1 - fitted / reference: below 0 the fitted parameters predict "

@@ -152,6 +152,24 @@ std::string Table(const std::vector<std::string>& header,
   return out + "</table>\n";
 }
 
+std::string BlockBiasTable(const Json& blocks) {
+  if (!blocks.is_array() || blocks.empty()) return "";
+  std::vector<std::vector<std::string>> rows;
+  for (const Json& b : blocks)
+    rows.push_back({svg::Escape(b.value("block", std::string())),
+                    svg::Escape(HumanLabel(b.value("kind", std::string()))) +
+                        UnitSuffix(b.value("unit", std::string())),
+                    Cell(b["scored"]), Number(NumberOf(b["mean_bias"])),
+                    Number(NumberOf(b.value("bias_standard_error", Json()))),
+                    Number(NumberOf(b["mean_score"]))});
+  return Table({"block", "kind (unit)", "runs scored", "mean bias", "its standard error",
+                "mean score"},
+               rows) +
+         "<p class=\"note\">Bias = simulated mean - observed, over the block's runs; its standard "
+         "error is the sd of the runs' biases / sqrt(runs). Biases of opposite sign per block "
+         "point at the blocks' shapes (docs/calibration.md, \"Shape parameters\").</p>\n";
+}
+
 std::string Warnings(const Json& warnings) {
   if (!warnings.is_array() || warnings.empty()) return "";
   std::string html = "<h2>Warnings</h2>\n<ul class=\"warnings\">\n";

@@ -45,6 +45,9 @@ std::string RowsTable(const Json& object, const std::string& first_column);
 // is a header cell.
 std::string Table(const std::vector<std::string>& header,
                   const std::vector<std::vector<std::string>>& rows);
+// The per-block biases of scores.json or calibration.json ("blocks": block, kind, unit, scored,
+// mean_bias, bias_standard_error, mean_score) as a table; "" when there are none.
+std::string BlockBiasTable(const Json& blocks);
 
 // "<h2>Warnings</h2>" and a list of the strings of `warnings` (a JSON array); "" when there are
 // none.

@@ -37,6 +37,7 @@ nlohmann::ordered_json BlockBiasJson(const std::vector<fieldobs::BlockBias>& bia
                    {"unit", b.unit},
                    {"scored", b.scored},
                    {"mean_bias", Num(b.mean_bias)},
+                   {"bias_standard_error", Num(b.bias_standard_error)},
                    {"mean_score", Num(b.mean_score)}});
   return out;
 }

@@ -116,6 +116,13 @@ std::string PerRunSection(const fieldobs::ValidationReport& report) {
          "distances (m) from the observed rest position to the simulated ones.</p>\n";
 }
 
+// "Bias per block": what a ground table cannot remove and a block's shape can, with the standard
+// error over the block's runs to judge it by. Absent without blocks.
+std::string BlocksSection(const Json& scores) {
+  const std::string table = html::BlockBiasTable(scores.value("blocks", Json()));
+  return table.empty() ? "" : "<h2>Bias per block</h2>\n" + table;
+}
+
 // How the rocks ended and what ran.
 std::string RunSection(const Json& scores) {
   std::string out = "<h2>How the rocks ended</h2>\n<table>\n";
@@ -133,7 +140,7 @@ std::string RunSection(const Json& scores) {
 std::string ValidationReportHtml(const ValidationReportInput& input) {
   const Json scores = Json::parse(input.scores_json);
   return Head(scores) + ScoresSection(scores) + PlotsSection(input) + PerRunSection(*input.report) +
-         RunSection(scores) + html::End();
+         BlocksSection(scores) + RunSection(scores) + html::End();
 }
 
 }  // namespace talus::io

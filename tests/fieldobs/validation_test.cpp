@@ -374,10 +374,12 @@ TEST(BiasByBlock, MeansOverEachBlocksRunsByHand) {
   EXPECT_EQ(biases[0].block, "St. Leonard");
   EXPECT_EQ(biases[0].scored, 2);
   EXPECT_EQ(biases[0].mean_bias, 20);
+  EXPECT_DOUBLE_EQ(biases[0].bias_standard_error, 10);  // biases 30, 10: sd 14.14 / sqrt 2
   EXPECT_EQ(biases[0].mean_score, 14);
   EXPECT_EQ(biases[1].block, "Plate");
   EXPECT_EQ(biases[1].scored, 1);
   EXPECT_EQ(biases[1].mean_bias, -20);
+  EXPECT_TRUE(std::isnan(biases[1].bias_standard_error));  // one run: no spread
   EXPECT_EQ(biases[2].block, "[rock]");
   EXPECT_EQ(biases[2].mean_bias, 4);
   EXPECT_EQ(biases[2].kind, "runout");
