@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <iterator>
 #include <numbers>
 #include <vector>
 
@@ -434,21 +435,31 @@ TEST(ViscousFriction, StickingBlockFeelsNoViscousFriction) {
   EXPECT_LT(end.velocity_m_s.norm(), 1e-12);
 }
 
-// A 256-gon disk (radius 0.5 m, 0.3 m thick, axis across the motion) launched rolling without
-// slip at v0 on flat ground with mu = 1: its speed after `seconds` and the fraction of steps with
-// a contact (the polygon hops a little at some of its roll-overs: 7 % of the steps at 1.5 m/s).
-// Keep v0 below sqrt(g r) = 2.2 m/s: faster, the pivoting polygon leaves the ground between its
-// vertices (v^2 / r > g).
-struct Rolled {
-  double speed_m_s, contact_fraction;
-};
-Rolled RollDisk(ViscousReading reading, double nu, double v0, double seconds) {
-  const Eigen::Quaterniond axis_along_y(
-      Eigen::AngleAxisd(std::numbers::pi / 2, Eigen::Vector3d::UnitX()));
-  Scene scene = scenes::Incline(0, MakeRockShape(MakeCylinder(0.5, 0.3, 256), 2700),
-                                ConstantFriction(1.0, nu));
+// A 256-gon disk (radius 0.5 m, 0.3 m thick, axis across the motion) on flat ground with mu = 1.
+constexpr int kDiskSides = 256;
+constexpr double kDiskRadius_m = 0.5;
+Scene DiskScene(ViscousReading reading, double nu) {
+  Scene scene =
+      scenes::Incline(0, MakeRockShape(MakeCylinder(kDiskRadius_m, 0.3, kDiskSides), 2700),
+                      ConstantFriction(1.0, nu));
   scene.options.viscous = reading;
   scene.options.tolerance_m_s = 1e-12;
+  return scene;
+}
+
+// The disk launched rolling without slip at v0, turned about its axis by `phase` of the angle
+// between neighbouring vertices (which moves its roll-overs within the time grid): its speed after
+// `seconds`, its mean speed over the steps, and the fraction of steps with a contact. Keep v0
+// below sqrt(g r) = 2.2 m/s: faster, the pivoting polygon leaves the ground between its vertices
+// (v^2 / r > g).
+struct Rolled {
+  double speed_m_s, mean_speed_m_s, contact_fraction;
+};
+Rolled RollDisk(ViscousReading reading, double nu, double v0, double seconds, double phase = 0) {
+  const Eigen::Quaterniond axis_along_y(
+      Eigen::AngleAxisd(std::numbers::pi / 2, Eigen::Vector3d::UnitX()) *
+      Eigen::AngleAxisd(phase * 2 * std::numbers::pi / kDiskSides, Eigen::Vector3d::UnitZ()));
+  const Scene scene = DiskScene(reading, nu);
   StepWorkspace ws;
   ws.Reset(scene.rock.vertices_m.size());
   RockState s = Touching(scene, axis_along_y, 50, 0);
@@ -459,36 +470,110 @@ Rolled RollDisk(ViscousReading reading, double nu, double v0, double seconds) {
   s.angular_velocity_rad_s = s.orientation.inverse() * Eigen::Vector3d(0, v0 / r, 0);
   const int steps = static_cast<int>(std::lround(seconds / scene.options.dt_s));
   int contact_steps = 0;
-  for (int k = 0; k < steps; ++k) contact_steps += Step(scene, s, ws).contacts > 0;
-  return {s.velocity_m_s.x(), static_cast<double>(contact_steps) / steps};
+  double speed_sum = 0;
+  for (int k = 0; k < steps; ++k) {
+    contact_steps += Step(scene, s, ws).contacts > 0;
+    speed_sum += s.velocity_m_s.x();
+  }
+  return {s.velocity_m_s.x(), speed_sum / steps, static_cast<double>(contact_steps) / steps};
 }
 
 TEST(ViscousFriction, RollingWithoutSlipLosesNothingToViscousFriction) {
   // A disk rolling without slip: its contact point does not slip, so under the contact-friction
   // reading nu = 1 1/s takes nothing beyond what nu = 0 loses to the polygon's roll-over impacts.
   // Tolerance 1e-9 of v0 after 2 s (solver tolerance 1e-12 m/s; measured: 0, bit-identical).
-  // Under the centre-of-mass reading the drag -m nu v with the rolling constraint gives
-  // (m + Theta / r^2) dv/dt = -m nu v: the speed decays at 2 nu / 3 for a disk, not nu (the drag
-  // does not act on the spin), and only in the steps with a contact (fraction f). Closed form for
-  // the ratio to the nu = 0 run: exp(-f (2 nu / 3) t). Tolerance 3 % (the roll-over losses depend
-  // on the speed, and the polygon hops; measured: -0.13 % at v0 = 1.5 m/s with f = 0.927, -2 % at
-  // 1.0 and 0.5 m/s).
   const double v0 = 1.5, t = 2.0, nu = 1.0;
   const Rolled plain = RollDisk(ViscousReading::kContactFriction, 0.0, v0, t);
   const Rolled contact = RollDisk(ViscousReading::kContactFriction, nu, v0, t);
-  const Rolled centre = RollDisk(ViscousReading::kCentreOfMass, nu, v0, t);
-  const double ratio = centre.speed_m_s / plain.speed_m_s;
-  const double expected = std::exp(-centre.contact_fraction * (2 * nu / 3) * t);
-  std::printf(
-      "after %.1f s from %.1f m/s: nu = 0: %.9f m/s; nu = 1, contact friction: %.9f m/s "
-      "(difference %.2e); centre of mass: %.6f m/s, ratio to nu = 0 %.5f (closed form %.5f with "
-      "f = %.3f, %+.2f %%)\n",
-      t, v0, plain.speed_m_s, contact.speed_m_s, contact.speed_m_s - plain.speed_m_s,
-      centre.speed_m_s, ratio, expected, centre.contact_fraction, 100 * (ratio / expected - 1));
+  std::printf("after %.1f s from %.1f m/s: nu = 0: %.9f m/s; nu = 1: %.9f m/s (difference %.2e)\n",
+              t, v0, plain.speed_m_s, contact.speed_m_s, contact.speed_m_s - plain.speed_m_s);
   EXPECT_LT(plain.speed_m_s, v0);  // the roll-over impacts take energy out
   EXPECT_NEAR(contact.speed_m_s, plain.speed_m_s, 1e-9 * v0);
-  EXPECT_NEAR(ratio, expected, 0.03 * expected);
-  EXPECT_LT(ratio, 0.5);  // the readings differ by far more than the tolerances
+}
+
+TEST(ViscousFriction, CentreOfMassDragSlowsARollingDiskAtTwoThirdsNuInItsContactSteps) {
+  // The disk above under the centre-of-mass reading, nu = 1 1/s, from 1.5 m/s for 2 s.
+  // Closed form of a step: where the disk pivots on a sticking contact at lever r below its
+  // centre, the solve keeps the free motion's angular momentum about the pivot with the
+  // translational mass m (1 + nu dt) (CentreOfMassDrag), (Theta + m (1 + nu dt) r^2) w_E =
+  // (Theta + m r^2) w_E(nu = 0): the step divides the speed by 1 + a dt, a = nu m r^2 / (Theta +
+  // m r^2) = 2 nu / 3 for a disk (Theta = m r^2 / 2: the drag does not act on the spin). A step
+  // without a contact has no drag.
+  // Which steps have a contact is the scheme's doing, not the disk's (which never leaves the
+  // ground below sqrt(g r)): the contact acts at the midpoint configuration, so the rotation about
+  // the pivot lifts the pivot vertex by v^2 dt^2 / (2 r) a step (9e-6 m at 1.5 m/s) until a step
+  // finds it above the ground and flies, while each roll-over's arrival sets the new pivot below
+  // it again. The fraction f(v) of steps with a contact is therefore a property of the scheme of
+  // order zero in dt (measured at 1.5 m/s: 0.84, 0.87, 0.88 at dt = 2, 1, 0.5 ms; 0.97 at
+  // 0.5 m/s), and so is the loss rate L(v) = -d ln v / dt without drag (the roll-overs' plastic
+  // impacts, McGeer's eta per vertex as in rolling_test.cpp, and the landings after the flights).
+  // Both are measured here on rolls without drag (nu = 0: the reading under test never acts) at
+  // constant speeds 0.35, 0.40, .., 1.55 m/s, 0.5 s each, against their mean speeds. Prediction:
+  // per step dt, ln v -= f(v) ln(1 + a dt) + L(v) dt from v0, and ln v -= L(v) dt for the nu = 0
+  // run, f and L interpolated linearly; the ratio of the two speeds after t. The per-step factor
+  // is the scheme's own, so no time-step error enters beyond f and L. Ladder and runs are taken
+  // at 4 phases and averaged.
+  // Tolerance, from where the roll-overs fall in the time grid (the phase), measured over 32
+  // phases: one phase's ratio differs from its prediction by -0.38 % on average (sd 0.78 %); the
+  // mean over 4 phases (8 disjoint sets) by -0.37 % (sd 0.46 %, worst -1.18 %). |mean| + 3 sd =
+  // 1.75 %: tolerance 2 %. Measured with the reading broken on purpose: a drag that brakes the
+  // spin too (decay at nu, not 2 nu / 3) gave -48 %, a drag also in the steps without a contact
+  // -8.9 %.
+  const double v0 = 1.5, t = 2.0, nu = 1.0;
+  const double phases[] = {0, 0.25, 0.5, 0.75};
+  const double share = 1.0 / std::size(phases);
+
+  const Scene scene = DiskScene(ViscousReading::kCentreOfMass, nu);
+  const double m = scene.rock.mass_kg, dt = scene.options.dt_s;
+  const double theta = scene.rock.inertia_kg_m2.maxCoeff();  // about the axis
+  const double r2 = kDiskRadius_m * kDiskRadius_m;
+  const double a = nu * m * r2 / (theta + m * r2);
+
+  constexpr int kSpeeds = 25;
+  constexpr double kWindow_s = 0.5;
+  std::vector<double> speed(kSpeeds, 0.0), f(kSpeeds, 0.0), loss(kSpeeds, 0.0);
+  for (int j = 0; j < kSpeeds; ++j) {
+    const double v = 0.35 + 0.05 * j;
+    for (double phase : phases) {
+      const Rolled free = RollDisk(ViscousReading::kCentreOfMass, 0.0, v, kWindow_s, phase);
+      speed[j] += share * free.mean_speed_m_s;
+      f[j] += share * free.contact_fraction;
+      loss[j] += share * std::log(v / free.speed_m_s) / kWindow_s;
+    }
+  }
+  // Linear interpolation in the ladder's mean speeds, its end values beyond them.
+  const auto at = [&](const std::vector<double>& y, double v) {
+    if (v <= speed.front()) return y.front();
+    for (int j = 1; j < kSpeeds; ++j)
+      if (v <= speed[j])
+        return y[j - 1] + (y[j] - y[j - 1]) * (v - speed[j - 1]) / (speed[j] - speed[j - 1]);
+    return y.back();
+  };
+  double ln_drag = std::log(v0), ln_plain = std::log(v0);
+  const long steps = std::lround(t / dt);
+  for (long k = 0; k < steps; ++k) {
+    const double v_drag = std::exp(ln_drag), v_plain = std::exp(ln_plain);
+    ln_drag -= at(f, v_drag) * std::log1p(a * dt) + at(loss, v_drag) * dt;
+    ln_plain -= at(loss, v_plain) * dt;
+  }
+  const double expected = std::exp(ln_drag - ln_plain);
+
+  double ratio = 0, fraction = 0, plain_speed = 0;
+  for (double phase : phases) {
+    const Rolled centre = RollDisk(ViscousReading::kCentreOfMass, nu, v0, t, phase);
+    const Rolled plain = RollDisk(ViscousReading::kCentreOfMass, 0.0, v0, t, phase);
+    ratio += share * centre.speed_m_s / plain.speed_m_s;
+    fraction += share * centre.contact_fraction;
+    plain_speed += share * plain.speed_m_s;
+  }
+  std::printf(
+      "a = %.5f 1/s (2 nu / 3 = %.5f); after %.1f s from %.1f m/s: ratio to nu = 0 %.5f, "
+      "predicted %.5f (%+.2f %%; exp(-a t) %.5f); contact fraction %.3f; nu = 0: %.5f m/s "
+      "(ladder's %.5f)\n",
+      a, 2 * nu / 3, t, v0, ratio, expected, 100 * (ratio / expected - 1), std::exp(-a * t),
+      fraction, plain_speed, std::exp(ln_plain));
+  EXPECT_NEAR(a, 2 * nu / 3, 1e-3 * a);  // the 256-gon's inertia is the disk's
+  EXPECT_NEAR(ratio, expected, 0.02 * expected);
 }
 
 // Mechanical energy of ten EOTA221 blocks tumbling 10 s down the 40 deg ramp: its largest climb
