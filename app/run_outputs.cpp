@@ -158,7 +158,7 @@ std::vector<std::string> WriteSummaryOutputs(const io::SceneFile& scene,
   }
   if (scene.output.report) outputs.push_back("report.html");
   const std::string summary = io::SummaryJson(scene, report, kVersion, outputs, lines, self_check,
-                                              barriers, trees ? &*trees : nullptr);
+                                              barriers, trees ? &*trees : nullptr, layers);
   if (scene.output.report) {
     ThrowIfInterrupted();
     io::RunReportInput page;

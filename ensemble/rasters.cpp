@@ -231,8 +231,11 @@ std::vector<RasterLayer> RasterAccumulator::Finish(const Heightfield& dem) const
       if (s.count() == 0) continue;
       out[first].values[c] = s.max();
       out[first + 1].values[c] = static_cast<float>(s.mean());
-      for (std::size_t k = 0; k < request_.percentiles.size(); ++k)
-        out[first + 2 + k].values[c] = s.Percentile(request_.percentiles[k]);
+      for (std::size_t k = 0; k < request_.percentiles.size(); ++k) {
+        RasterLayer& percentile = out[first + 2 + k];
+        percentile.values[c] = s.Percentile(request_.percentiles[k]);
+        percentile.relative_error = std::max(percentile.relative_error, s.relative_error());
+      }
     }
     ++quantity;
   }

@@ -99,6 +99,10 @@ struct RasterLayer {
   // The counts of a count layer (passages, deposits) exactly, kNoData where the DEM has no height;
   // empty for the others. `values` holds them too, as float (exact up to 2^24).
   std::vector<std::int32_t> counts = {};
+  // A percentile layer's bound on |value - exact| / |exact|: the largest over its cells
+  // (ValueSummary::relative_error, which coarsens where a cell's values span many octaves); 0 for
+  // the others.
+  double relative_error = 0;
   static constexpr float kNoData = -9999.0f;
 };
 
@@ -106,8 +110,8 @@ struct RasterLayer {
 // percentiles whose result does not depend on the order of the rocks or on how they were split
 // between accumulators (Merge), to the bit. Memory: 4 bytes per cell for each of the slot,
 // passage and deposit grids in use, plus, per passed cell and requested quantity, one
-// ValueSummary (64 bytes) and 8 bytes per histogram bin it holds; it does not grow with the
-// number of rocks beyond the bins (at most 64 per octave of the cell's values).
+// ValueSummary (64 bytes) and 8 bytes per histogram bin it holds (at most
+// ValueSummary::kMaxBins, 2 kB); it does not grow with the number of rocks beyond the bins.
 class RasterAccumulator {
  public:
   explicit RasterAccumulator(const RasterRequest& request);

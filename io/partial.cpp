@@ -22,8 +22,8 @@ namespace {
 
 constexpr const char* kFormat = "talus partial result";
 // 2: the files' sizes and checksums; 3: the ending "barrier", rocks.csv's end_barrier column and
-// barriers.csv.
-constexpr int kFormatVersion = 3;
+// barriers.csv; 4: the cell summaries' level (bins capped at ValueSummary::kMaxBins).
+constexpr int kFormatVersion = 4;
 constexpr const char* kStateMagic = "talus partial state 1";
 
 std::string ReadWholeFile(const std::string& path) {

@@ -131,7 +131,8 @@ std::string SummaryJson(const SceneFile& scene, const ensemble::EnsembleReport& 
                         const std::vector<EvaluationLineSummary>& evaluation_lines,
                         const ensemble::SelfCheckReport* self_check,
                         const std::vector<BarrierSummary>& barriers,
-                        const TreeImpactSummary* trees) {
+                        const TreeImpactSummary* trees,
+                        const std::vector<ensemble::RasterLayer>& rasters) {
   nlohmann::ordered_json j;
   j["talus_version"] = version;
   j["scene"] = scene.path;
@@ -219,6 +220,12 @@ std::string SummaryJson(const SceneFile& scene, const ensemble::EnsembleReport& 
   j["raster_output"] = {{"rasters", RasterNames(scene.output.rasters)},
                         {"percentiles", scene.output.percentiles},
                         {"format", ToString(scene.output.raster_format)}};
+  // Per percentile raster, the bound on its values' relative error (cells whose values span
+  // many octaves hold coarser bins: ensemble/cell_summary.hpp).
+  nlohmann::ordered_json bounds = nlohmann::ordered_json::object();
+  for (const ensemble::RasterLayer& layer : rasters)
+    if (layer.relative_error > 0) bounds[layer.name] = layer.relative_error;
+  j["raster_output"]["percentile_relative_error"] = bounds;
   if (!scene.evaluation_lines.empty()) {
     nlohmann::ordered_json lines = nlohmann::ordered_json::array();
     for (const EvaluationLineSummary& s : evaluation_lines) lines.push_back(EvaluationLineJson(s));

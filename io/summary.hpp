@@ -25,7 +25,8 @@ std::string SummaryJson(const SceneFile& scene, const ensemble::EnsembleReport& 
                         const std::vector<EvaluationLineSummary>& evaluation_lines = {},
                         const ensemble::SelfCheckReport* self_check = nullptr,
                         const std::vector<BarrierSummary>& barriers = {},
-                        const TreeImpactSummary* trees = nullptr);
+                        const TreeImpactSummary* trees = nullptr,
+                        const std::vector<ensemble::RasterLayer>& rasters = {});
 
 // The ground table as used, as summary.json's "ground" holds it, on one line (compact JSON).
 std::string GroundTableJson(const GroundTable& table);
