@@ -5,6 +5,10 @@
 #include <cstring>
 
 namespace talus::ensemble {
+
+// The memory the rasters state per passed cell and quantity (rasters.hpp, docs/scenes.md).
+static_assert(sizeof(ValueSummary) == 64, "a cell summary is 64 bytes besides its bins");
+
 namespace {
 
 // `using` would not take __extension__, which keeps -Wpedantic quiet.
