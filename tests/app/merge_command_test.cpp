@@ -283,6 +283,31 @@ TEST_F(MergeCommand, ASceneChangedSinceThePartsRanIsRefused) {
   EXPECT_NE(log.find("changed since this part was run"), std::string::npos) << log;
 }
 
+// A part that an older talus wrote (partial.json format 3, FNV-1a checksums) is refused as bad
+// input naming its partial.json and the rocks to run again; nothing is written.
+TEST_F(MergeCommand, APartOfAnOlderTalusIsRefusedSayingWhatToRunAgain) {
+  std::string log;
+  const fs::path a = Part("0:5"), b = Part("5:10");
+  nlohmann::ordered_json info = nlohmann::ordered_json::parse(Slurp(b / "partial.json"));
+  info["format_version"] = 3;
+  info["inputs_hash_fnv1a64"] = "cbf29ce484222325";
+  info.erase("inputs_sha256");
+  for (auto& [name, entry] : info["files"].items()) {
+    entry.erase("sha256");
+    entry["fnv1a64"] = "af63bd4c8601b7df";
+  }
+  talus::app::testing::Write(b / "partial.json", info.dump(2) + "\n");
+  EXPECT_EQ(Merge({a, b}, &log), 2);
+  EXPECT_NE(log.find("talus merge: " + (b / "partial.json").string() +
+                     ": a part written by an older talus (partial result format 3, this talus "
+                     "reads 4; its checksums are FNV-1a, this talus checks SHA-256): run the part "
+                     "again with this talus (talus simulate " +
+                     scene_.string() + " --rock-range 5:10 and the options it ran with)"),
+            std::string::npos)
+      << log;
+  EXPECT_FALSE(fs::exists(dir_ / "merged"));
+}
+
 TEST_F(MergeCommand, BadRockRangesAreRefusedBeforeAnyWork) {
   for (const std::string range : {"5", "5:5", "7:3", "a:4", "0:11", "-1:3"}) {
     std::string log;
