@@ -4,6 +4,7 @@
 #include <charconv>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -38,13 +39,20 @@ std::string Range(long first, long end) {
   return std::to_string(first) + ":" + std::to_string(end);
 }
 
-// Size and SHA-256 of a file, read in chunks.
-PartialInfo::File FileEntry(const std::string& path) {
+// Size and SHA-256 of a file, read in chunks; `on_bytes`, when given, hears each chunk's size.
+PartialInfo::File FileEntry(const std::string& path,
+                            const std::function<void(std::uint64_t)>& on_bytes = {}) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw std::runtime_error("cannot read " + path);
   Sha256 hash;
   PartialInfo::File f;
-  f.bytes = hash.AddStream(in);
+  std::string chunk(1 << 20, '\0');
+  while (in.read(chunk.data(), static_cast<std::streamsize>(chunk.size())) || in.gcount() > 0) {
+    const auto n = static_cast<std::size_t>(in.gcount());
+    hash.Add(std::string_view(chunk.data(), n));
+    f.bytes += n;
+    if (on_bytes) on_bytes(n);
+  }
   if (in.bad()) throw std::runtime_error("cannot read " + path);
   f.sha256 = hash.HexDigest();
   return f;
@@ -195,7 +203,7 @@ PartialInfo ReadPartialInfo(const std::string& dir) {
   return p;
 }
 
-void CheckPartFiles(const PartialInfo& part) {
+void CheckPartFiles(const PartialInfo& part, const std::function<void(std::uint64_t)>& on_bytes) {
   const std::string json = (std::filesystem::path(part.dir) / "partial.json").string();
   std::vector<std::string> required = {"rocks.csv", "partial.bin"};
   if (part.trajectories) required.push_back("trajectories.h5");
@@ -208,7 +216,7 @@ void CheckPartFiles(const PartialInfo& part) {
       throw InputError(path + ": missing (partial.json lists it)");
     PartialInfo::File have;
     try {
-      have = FileEntry(path);
+      have = FileEntry(path, on_bytes);
     } catch (const std::runtime_error& e) {
       throw InputError(e.what());
     }

@@ -17,6 +17,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <optional>
 #include <string>
@@ -72,8 +73,11 @@ PartialInfo ReadPartialInfo(const std::string& dir);
 // Checks the files of a part against its partial.json: each listed file is there with its size
 // and checksum, rocks.csv and partial.bin (and trajectories.h5 when the part has trajectories)
 // are listed, rocks.csv holds exactly the part's rocks in order and evaluation_lines.csv only
-// crossings of them. Throws InputError naming the file (and line) and what is wrong.
-void CheckPartFiles(const PartialInfo& part);
+// crossings of them. Throws InputError naming the file (and line) and what is wrong. `on_bytes`,
+// when given, hears how many bytes were checksummed as the files are read (for a progress line:
+// files.bytes of partial.json add up to the total).
+void CheckPartFiles(const PartialInfo& part,
+                    const std::function<void(std::uint64_t)>& on_bytes = {});
 
 // Checks that parts belong to one ensemble (same version, scene inputs, seed, rocks) and that their
 // ranges cover it exactly once; returns them sorted by range. Throws InputError naming the parts

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <filesystem>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -306,6 +307,45 @@ TEST_F(MergeCommand, APartOfAnOlderTalusIsRefusedSayingWhatToRunAgain) {
             std::string::npos)
       << log;
   EXPECT_FALSE(fs::exists(dir_ / "merged"));
+}
+
+// On a terminal (script(1) gives the program one) merge shows its phases as one status line:
+// checking the parts' bytes, merging each output, writing the rasters and summary; --quiet
+// silences it with the information, and off a terminal there is none. run.log keeps what was
+// said, never the progress.
+TEST_F(MergeCommand, ProgressOnATerminalQuietSilencesItAndRunLogKeepsWhatWasSaid) {
+  if (std::system("command -v script >/dev/null 2>&1") != 0) GTEST_SKIP() << "no script(1)";
+  const fs::path a = Part("0:4"), b = Part("4:10");
+  const auto merge = [&](const std::string& out, const std::string& more, bool terminal) {
+    const std::string command =
+        Talus("merge " + a.string() + " " + b.string() + " --out " + (dir_ / out).string() + more);
+    std::string output;
+    EXPECT_EQ(RunCommand(terminal ? "script -qec '" + command + "' /dev/null" : command, &output),
+              0)
+        << output;
+    return output;
+  };
+  const std::string talkative = merge("out", "", true);
+  for (const char* phase :
+       {"\rChecking the parts [", " MB  ", "\rMerging rocks.csv [", "\rMerging trajectories.h5 [",
+        " 10/10 rocks ", "\rMerging evaluation_lines.csv [",
+        "\rMerging the rasters (partial.bin) [", "\rWriting the outputs [", " files  "})
+    EXPECT_NE(talkative.find(phase), std::string::npos) << phase << "\n" << talkative;
+  EXPECT_NE(talkative.find("Merged 2 parts of "), std::string::npos) << talkative;
+  const std::string quiet = merge("quiet", " --quiet", true);
+  EXPECT_EQ(quiet.find("[#"), std::string::npos) << quiet;
+  EXPECT_EQ(quiet.find("Merging"), std::string::npos) << quiet;
+  EXPECT_EQ(quiet.find("Merged"), std::string::npos) << quiet;
+  const std::string piped = merge("piped", "", false);
+  EXPECT_EQ(piped.find('\r'), std::string::npos) << piped;
+  EXPECT_EQ(piped.find("Checking the parts"), std::string::npos) << piped;
+  EXPECT_NE(piped.find("Merged 2 parts of "), std::string::npos) << piped;
+  const std::string log = Slurp(dir_ / "out" / "run.log");
+  for (const char* line :
+       {"command: ", " merge ", "\nMerged 2 parts of ", "\nWrote ", "finished: exit 0"})
+    EXPECT_NE(log.find(line), std::string::npos) << line << "\n" << log;
+  EXPECT_EQ(log.find("[#"), std::string::npos) << log;  // progress is not kept
+  EXPECT_EQ(log.find("Checking the parts"), std::string::npos) << log;
 }
 
 TEST_F(MergeCommand, BadRockRangesAreRefusedBeforeAnyWork) {
