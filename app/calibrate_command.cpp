@@ -165,6 +165,8 @@ int Load(const CalibrateArgs& args, const Processes& processes, Loaded* loaded,
       io::CheckEvaluations(saved, path, EvaluationShapes(*loaded->problem, args.folds));
       checkpoint.stages = saved.stages;
     } else if (exists) {
+      // One that cannot be resumed (an older talus's, damaged) says so now, not after --resume.
+      io::ReadCheckpoint(path);
       throw InputError(path +
                        " holds the evaluations of an unfinished calibration: resume it with "
                        "--resume, or remove it");

@@ -2,7 +2,9 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdarg>
 #include <cstdio>
 #include <ctime>
@@ -129,6 +131,21 @@ void EndStatus() {
   ConsoleState& s = State();
   const std::lock_guard lock(s.mutex);
   EndStatusLocked(s);
+}
+
+std::string ProgressLine(const std::string& label, double done, double total,
+                         const std::string& unit, int decimals, double elapsed_s) {
+  constexpr int kWidth = 30;
+  const double fraction = total > 0 ? std::clamp(done / total, 0.0, 1.0) : 0.0;
+  const int filled = static_cast<int>(kWidth * fraction);
+  const double rate = elapsed_s > 0 ? done / elapsed_s : 0.0;
+  const std::string left =
+      done > 0 && rate > 0 ? std::to_string(std::lround((total - done) / rate)) + " s" : "?";
+  char line[160];
+  std::snprintf(line, sizeof line, "[%-*.*s] %.*f/%.*f %s  %.1f/s  %s left", kWidth, filled,
+                "##############################", decimals, done, decimals, total, unit.c_str(),
+                rate, left.c_str());
+  return label.empty() ? std::string(line) : label + " " + line;
 }
 
 void SetRunLogDirectory(const std::string& dir) { State().log_directory = dir; }

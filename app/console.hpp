@@ -28,6 +28,11 @@ bool ShowsProgress();
 void Status(const std::string& text);
 // Ends a shown status line, so that what follows starts on a line of its own.
 void EndStatus();
+// A progress status line: "<label> [##########          ] <done>/<total> <unit>  <rate>/s  <n> s
+// left" (without a label it starts at the bar): done and total with `decimals` digits, the rate
+// per second so far with one, the time left at that rate ("?" before anything is done).
+std::string ProgressLine(const std::string& label, double done, double total,
+                         const std::string& unit, int decimals, double elapsed_s);
 
 // The directory run.log goes into when the verb succeeds (its --out); unset: no run.log (a verb
 // without --out, a rank other than 0).

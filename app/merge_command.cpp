@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <functional>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -29,16 +30,17 @@ int RunMerge(const MergeArgs& args) {
   namespace fs = std::filesystem;
   std::vector<io::PartialInfo> parts;
   io::SceneFile scene;
+  // On a terminal: checking the parts (every byte is read for its checksum), then each output
+  // merged and written. A message (Say, Fail) starts on a line of its own.
+  PhaseProgress progress;
   try {
     for (const std::string& dir : args.parts) {
       std::error_code error;
       if (fs::equivalent(dir, args.out, error))
         throw InputError("--out " + args.out +
                          " is one of the parts; merge into another directory");
-      parts.push_back(io::ReadPartialInfo(dir));
     }
-    parts = io::CheckPartials(std::move(parts));
-    for (const io::PartialInfo& part : parts) io::CheckPartFiles(part);
+    parts = ReadParts(args.parts, std::ref(progress));
     scene = LoadSceneOfPart(parts.front());
   } catch (const InputError& e) {
     Fail("merge", e.what());
@@ -59,7 +61,8 @@ int RunMerge(const MergeArgs& args) {
     }
     ensemble::EnsembleReport report;
     const std::vector<std::string> files =
-        MergeIntoStaging(scene, parts, threads, wall_time_s, *staging, &report);
+        MergeIntoStaging(scene, parts, threads, wall_time_s, *staging, &report, std::ref(progress));
+    progress.Break();
     CommitOutputs(*staging, files, args.out);
     Say("Merged %zu parts of %s: %s\n", parts.size(), scene.path.c_str(),
         report.BriefReport().c_str());

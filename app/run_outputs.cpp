@@ -78,24 +78,32 @@ class QuietGdal {
 
 // Writes the rasters, the quick-look and summary.json of a whole ensemble after `outputs`;
 // returns all files in commit order (summary.json last: it is there only with its outputs).
-std::vector<std::string> WriteSummaryOutputs(const io::SceneFile& scene,
-                                             const ensemble::EnsembleReport& report,
-                                             const std::vector<ensemble::RasterLayer>& layers,
-                                             const std::vector<io::SamplePath>& paths,
-                                             const StagingDirectory& staging,
-                                             std::vector<std::string> outputs,
-                                             const ensemble::SelfCheckReport* self_check) {
+// `progress`, when given, hears the files written of those that take time (rasters, quick-look,
+// GeoPackage, report, summary).
+std::vector<std::string> WriteSummaryOutputs(
+    const io::SceneFile& scene, const ensemble::EnsembleReport& report,
+    const std::vector<ensemble::RasterLayer>& layers, const std::vector<io::SamplePath>& paths,
+    const StagingDirectory& staging, std::vector<std::string> outputs,
+    const ensemble::SelfCheckReport* self_check, const MergeProgress& progress = {}) {
   const GridGeometry& dem = scene.scene.terrain.heights().grid;
   // GDAL would print every failed write of a full disk; the writers throw with its last message.
   const QuietGdal quiet_gdal;
   const std::string ground = io::GroundTableJson(scene.scene.ground);
+  const long files = static_cast<long>(layers.size()) + (scene.output.quicklook ? 1 : 0) +
+                     (scene.output.geopackage ? 1 : 0) + (scene.output.report ? 1 : 0) + 1;
+  long written = 0;
+  const auto wrote = [&](long n) {
+    written += n;
+    if (progress) progress("Writing the outputs", written, files, "files");
+  };
+  wrote(0);
   for (const ensemble::RasterLayer& layer : layers) {
     ThrowIfInterrupted();
     // What the raster is and which run made it; nothing that depends on the time or the split.
     const io::RasterMetadata metadata{layer.description,
                                       layer.unit,
                                       {{"TALUS_VERSION", kVersion},
-                                       {"TALUS_INPUTS_HASH", scene.inputs_hash},
+                                       {"TALUS_INPUTS_SHA256", scene.inputs_hash},
                                        {"TALUS_QUANTITY", layer.quantity},
                                        {"TALUS_STATISTIC", layer.statistic},
                                        {"TALUS_ROCKS", std::to_string(report.rocks)},
@@ -110,6 +118,7 @@ std::vector<std::string> WriteSummaryOutputs(const io::SceneFile& scene,
       io::WriteGeoTiff(staging.path(layer.name + ".tif"), dem, scene.crs_wkt, layer.values, true,
                        ensemble::RasterLayer::kNoData, metadata, scene.output.raster_format);
     outputs.push_back(layer.name + ".tif");
+    wrote(1);
   }
   ThrowIfInterrupted();
   // Evaluation lines: summarised from the complete evaluation_lines.csv.
@@ -143,6 +152,7 @@ std::vector<std::string> WriteSummaryOutputs(const io::SceneFile& scene,
     io::WriteQuickLookPng(staging.path("quicklook.png"), scene.scene.terrain.heights(),
                           io::QuickLookLayer(layers), xy, {}, map_lines);
     outputs.push_back("quicklook.png");
+    wrote(1);
   }
   if (scene.output.geopackage) {
     ThrowIfInterrupted();
@@ -155,6 +165,7 @@ std::vector<std::string> WriteSummaryOutputs(const io::SceneFile& scene,
                             &scene.scene.forest,
                             scene.has_forest ? staging.path("tree_impacts.csv") : std::string()});
     outputs.push_back("rocks.gpkg");
+    wrote(1);
   }
   if (scene.output.report) outputs.push_back("report.html");
   const std::string summary = io::SummaryJson(scene, report, kVersion, outputs, lines, self_check,
@@ -169,10 +180,12 @@ std::vector<std::string> WriteSummaryOutputs(const io::SceneFile& scene,
     page.lines = std::move(map_lines);
     page.rocks = io::ReadRockColumns(staging.path("rocks.csv"));
     WriteFileAtomically(staging.path("report.html"), io::RunReportHtml(page));
+    wrote(1);
   }
   WriteFileAtomically(staging.path("summary.json"), summary);
   ThrowIfInterrupted();
   outputs.push_back("summary.json");
+  wrote(1);
   return outputs;
 }
 
@@ -304,78 +317,104 @@ std::vector<std::string> RunIntoStaging(const io::SceneFile& scene, int threads,
 std::vector<std::string> MergeIntoStaging(const io::SceneFile& scene,
                                           const std::vector<io::PartialInfo>& parts, int threads,
                                           double wall_time_s, const StagingDirectory& staging,
-                                          ensemble::EnsembleReport* report) {
+                                          ensemble::EnsembleReport* report,
+                                          const MergeProgress& progress) {
+  const auto show = [&](const std::string& phase, long done, long total, const char* unit) {
+    if (progress) progress(phase, done, total, unit);
+  };
+  const long n_parts = static_cast<long>(parts.size());
   *report = ensemble::EnsembleReport{};
-  std::vector<std::string> outputs = {"rocks.csv"};
-  {
-    std::ofstream csv(staging.path("rocks.csv"), std::ios::binary);
-    for (std::size_t k = 0; k < parts.size(); ++k) {
+  std::vector<std::string> outputs;
+  // A CSV file of every part, appended in the parts' order under one header.
+  const auto merge_csv = [&](const std::string& name, const std::string& header) {
+    std::ofstream csv(staging.path(name), std::ios::binary);
+    for (long k = 0; k < n_parts; ++k) {
       ThrowIfInterrupted();
-      AppendCsv((fs::path(parts[k].dir) / "rocks.csv").string(), k > 0,
-                io::RocksCsvWriter::Header(), csv);
+      show("Merging " + name, k, n_parts, "parts");
+      AppendCsv((fs::path(parts[k].dir) / name).string(), k > 0, header, csv);
     }
     csv.close();
-    if (!csv) throw std::runtime_error("cannot write " + staging.path("rocks.csv"));
-  }
+    if (!csv) throw std::runtime_error("cannot write " + staging.path(name));
+    show("Merging " + name, n_parts, n_parts, "parts");
+    outputs.push_back(name);
+  };
+  merge_csv("rocks.csv", io::RocksCsvWriter::Header());
   if (scene.output.trajectories) {
     io::TrajectoryWriter out(staging.path("trajectories.h5"), scene.scene.rock, scene.crs_wkt);
+    long total = 0, done = 0;
+    for (const io::PartialInfo& part : parts) total += part.end_rock - part.first_rock;
     for (const io::PartialInfo& part : parts) {
       const io::TrajectoryReader in((fs::path(part.dir) / "trajectories.h5").string());
       for (long rock = part.first_rock; rock < part.end_rock; ++rock) {
         if ((rock & 255) == 0) ThrowIfInterrupted();
         out.Write(rock, in.Read(rock));
+        show("Merging trajectories.h5", ++done, total, "rocks");
       }
     }
     out.Commit();
     outputs.push_back("trajectories.h5");
   }
-  if (!scene.evaluation_lines.empty()) {
-    std::ofstream csv(staging.path("evaluation_lines.csv"), std::ios::binary);
-    for (std::size_t k = 0; k < parts.size(); ++k) {
-      ThrowIfInterrupted();
-      AppendCsv((fs::path(parts[k].dir) / "evaluation_lines.csv").string(), k > 0,
-                io::EvaluationLinesCsvWriter::Header(), csv);
-    }
-    csv.close();
-    if (!csv) throw std::runtime_error("cannot write " + staging.path("evaluation_lines.csv"));
-    outputs.push_back("evaluation_lines.csv");
-  }
-  if (!scene.scene.barriers.empty()) {
-    std::ofstream csv(staging.path("barriers.csv"), std::ios::binary);
-    for (std::size_t k = 0; k < parts.size(); ++k) {
-      ThrowIfInterrupted();
-      AppendCsv((fs::path(parts[k].dir) / "barriers.csv").string(), k > 0,
-                io::BarriersCsvWriter::Header(), csv);
-    }
-    csv.close();
-    if (!csv) throw std::runtime_error("cannot write " + staging.path("barriers.csv"));
-    outputs.push_back("barriers.csv");
-  }
-  if (scene.has_forest) {
-    std::ofstream csv(staging.path("tree_impacts.csv"), std::ios::binary);
-    for (std::size_t k = 0; k < parts.size(); ++k) {
-      ThrowIfInterrupted();
-      AppendCsv((fs::path(parts[k].dir) / "tree_impacts.csv").string(), k > 0,
-                io::TreeImpactsCsvWriter::Header(), csv);
-    }
-    csv.close();
-    if (!csv) throw std::runtime_error("cannot write " + staging.path("tree_impacts.csv"));
-    outputs.push_back("tree_impacts.csv");
-  }
+  if (!scene.evaluation_lines.empty())
+    merge_csv("evaluation_lines.csv", io::EvaluationLinesCsvWriter::Header());
+  if (!scene.scene.barriers.empty()) merge_csv("barriers.csv", io::BarriersCsvWriter::Header());
+  if (scene.has_forest) merge_csv("tree_impacts.csv", io::TreeImpactsCsvWriter::Header());
   const ensemble::RasterRequest request = scene.output.Request(scene.scene.terrain.heights().grid);
   std::optional<ensemble::RasterAccumulator> rasters;
   std::vector<io::SamplePath> paths;
-  for (const io::PartialInfo& part : parts) {
+  for (long k = 0; k < n_parts; ++k) {
     ThrowIfInterrupted();
-    io::ReadPartialState(part, request, &rasters, &paths);
-    report->AddCounts(part.counts);
+    show("Merging the rasters (partial.bin)", k, n_parts, "parts");
+    io::ReadPartialState(parts[k], request, &rasters, &paths);
+    report->AddCounts(parts[k].counts);
   }
+  show("Merging the rasters (partial.bin)", n_parts, n_parts, "parts");
   report->threads = threads;
   report->wall_time_s = wall_time_s;
   const std::vector<ensemble::RasterLayer> layers =
       rasters ? rasters->Finish(scene.scene.terrain.heights())
               : std::vector<ensemble::RasterLayer>{};
-  return WriteSummaryOutputs(scene, *report, layers, paths, staging, outputs, nullptr);
+  return WriteSummaryOutputs(scene, *report, layers, paths, staging, outputs, nullptr, progress);
+}
+
+PhaseProgress::PhaseProgress() : enabled_(ShowsProgress()) {}
+
+void PhaseProgress::operator()(const std::string& phase, long done, long total, const char* unit) {
+  if (!enabled_ || total <= 0) return;
+  const auto now = std::chrono::steady_clock::now();
+  if (phase != phase_) {
+    phase_ = phase;
+    start_ = now;
+  } else if (done < total && now - shown_ < std::chrono::milliseconds(100)) {
+    return;
+  }
+  shown_ = now;
+  const double elapsed_s = std::chrono::duration<double>(now - start_).count();
+  if (std::string(unit) == "bytes")
+    Status(ProgressLine(phase, double(done) / 1e6, double(total) / 1e6, "MB", 1, elapsed_s));
+  else
+    Status(ProgressLine(phase, double(done), double(total), unit, 0, elapsed_s));
+}
+
+void PhaseProgress::Break() {
+  if (enabled_) EndStatus();
+}
+
+std::vector<io::PartialInfo> ReadParts(const std::vector<std::string>& dirs,
+                                       const MergeProgress& progress) {
+  std::vector<io::PartialInfo> parts;
+  for (const std::string& dir : dirs) parts.push_back(io::ReadPartialInfo(dir));
+  parts = io::CheckPartials(std::move(parts));
+  // Every byte of every part is read for its checksum: the progress counts them.
+  long total = 0;
+  for (const io::PartialInfo& part : parts)
+    for (const auto& [name, file] : part.files) total += static_cast<long>(file.bytes);
+  long done = 0;
+  const auto on_bytes = [&](std::uint64_t n) {
+    done += static_cast<long>(n);
+    if (progress) progress("Checking the parts", done, total, "bytes");
+  };
+  for (const io::PartialInfo& part : parts) io::CheckPartFiles(part, on_bytes);
+  return parts;
 }
 
 namespace {

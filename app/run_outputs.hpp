@@ -3,6 +3,7 @@
 // or MPI ranks) and `talus merge`: running rocks into a staging directory as a whole run or as a
 // part (io/partial.hpp), merging parts, and writing the rasters, quick-look and summary.json.
 
+#include <chrono>
 #include <functional>
 #include <optional>
 #include <string>
@@ -34,14 +35,43 @@ std::vector<std::string> RunIntoStaging(const io::SceneFile& scene, int threads,
                                         ensemble::EnsembleReport* report,
                                         const ensemble::SelfCheckReport* self_check = nullptr);
 
+// What a merge is doing, for a progress line: `done` of `total` `unit`s ("bytes", "parts",
+// "rocks", "files") of `phase` ("Checking the parts", "Merging trajectories.h5", ...).
+using MergeProgress =
+    std::function<void(const std::string& phase, long done, long total, const char* unit)>;
+
+// A MergeProgress for the terminal: one status line through the phases, "<phase> [####      ]
+// 3/8 parts  1.2/s  4 s left" (bytes shown as MB), each phase with its own rate, redrawn at most
+// ten times a second; nothing off a terminal or with --quiet (console.hpp). What is said next
+// (Say) starts on a line of its own; Break ends the line before a message.
+class PhaseProgress {
+ public:
+  PhaseProgress();
+  void operator()(const std::string& phase, long done, long total, const char* unit);
+  void Break();
+
+ private:
+  bool enabled_;
+  std::string phase_;
+  std::chrono::steady_clock::time_point start_, shown_;
+};
+
+// Reads the parts in `dirs` (their partial.json), checks that they tile one run (io::CheckPartials)
+// and that each one's files are as it wrote them (io::CheckPartFiles: every byte is read for its
+// checksum, which `progress` counts); returns them sorted by range. Throws InputError naming the
+// part and what is wrong.
+std::vector<io::PartialInfo> ReadParts(const std::vector<std::string>& dirs,
+                                       const MergeProgress& progress = {});
+
 // Merges parts that CheckPartials accepted into `staging`: rocks.csv, trajectories.h5, rasters,
 // quick-look and summary.json, the same bytes as one run of all rocks (summary.json's threads and
 // timings aside: `threads` and `wall_time_s` are written there). Returns the files written, in
-// commit order; *report gets the merged counts.
+// commit order; *report gets the merged counts. `progress`, when given, hears each phase.
 std::vector<std::string> MergeIntoStaging(const io::SceneFile& scene,
                                           const std::vector<io::PartialInfo>& parts, int threads,
                                           double wall_time_s, const StagingDirectory& staging,
-                                          ensemble::EnsembleReport* report);
+                                          ensemble::EnsembleReport* report,
+                                          const MergeProgress& progress = {});
 
 // The list of the files a run wrote into its output directory, one name per line: what the next
 // run into the same directory may remove.

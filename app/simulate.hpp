@@ -3,9 +3,6 @@
 // (simulate_mpi.cpp): the command-line arguments, loading and checking them, the messages.
 
 #include <chrono>
-#include <cmath>
-#include <cstdint>
-#include <cstdio>
 #include <optional>
 #include <string>
 #include <utility>
@@ -66,15 +63,7 @@ class ProgressBar {
     if (!enabled_ || total <= 0) return;
     const double elapsed =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-    const double rate = elapsed > 0 ? double(done) / elapsed : 0.0;
-    const double left = rate > 0 ? double(total - done) / rate : 0.0;
-    constexpr int kWidth = 30;
-    const int filled = static_cast<int>(kWidth * done / total);
-    char line[160];
-    std::snprintf(line, sizeof line, "[%-*.*s] %ld/%ld rocks  %.1f/s  %s left", kWidth, filled,
-                  "##############################", done, total, rate,
-                  done > 0 ? (std::to_string(std::lround(left)) + " s").c_str() : "?");
-    Status(line);
+    Status(ProgressLine("", double(done), double(total), "rocks", 0, elapsed));
     if (done == total) EndStatus();
   }
   // Ends a bar left unfinished, so that a message starts on a line of its own.

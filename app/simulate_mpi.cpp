@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <optional>
 #include <string>
@@ -230,15 +231,18 @@ int SimulateOnRanks(const MpiSession& mpi, const SimulateArgs& args) {
       }
     }
     if (root) {
-      std::vector<io::PartialInfo> parts;
-      for (const fs::path& dir : dirs) parts.push_back(io::ReadPartialInfo(dir.string()));
-      parts = io::CheckPartials(std::move(parts));
-      for (const io::PartialInfo& p : parts) io::CheckPartFiles(p);  // as they were sent
+      // The parts checked as they were sent, and merged, with talus merge's progress when rank
+      // 0's stderr is a terminal (a launcher's pipe is not).
+      PhaseProgress merging;
+      std::vector<std::string> part_dirs;
+      for (const fs::path& dir : dirs) part_dirs.push_back(dir.string());
+      const std::vector<io::PartialInfo> parts = ReadParts(part_dirs, std::ref(merging));
       const double wall_time_s =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       ensemble::EnsembleReport merged;
-      const std::vector<std::string> files =
-          MergeIntoStaging(scene, parts, report.threads, wall_time_s, *staging, &merged);
+      const std::vector<std::string> files = MergeIntoStaging(
+          scene, parts, report.threads, wall_time_s, *staging, &merged, std::ref(merging));
+      merging.Break();
       part.reset();
       CommitOutputs(*staging, files, args.out);
       Say("%s on %d ranks\n", merged.BriefReport().c_str(), mpi.size());

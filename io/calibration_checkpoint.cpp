@@ -7,7 +7,7 @@
 #include <sstream>
 
 #include "common/error.hpp"
-#include "common/fnv1a.hpp"
+#include "common/sha256.hpp"
 
 namespace talus::io {
 namespace {
@@ -77,7 +77,7 @@ json Body(const CalibrationCheckpoint& c) {
     stages[name] = list;
   }
   return {
-      {"path_hash", c.path_hash}, {"holdout", c.holdout}, {"folds", c.folds}, {"stages", stages}};
+      {"path_sha256", c.path_hash}, {"holdout", c.holdout}, {"folds", c.folds}, {"stages", stages}};
 }
 
 // "" when `e` fits `shape` and holds finite numbers where an evaluation always does (u, values,
@@ -115,7 +115,7 @@ std::string CheckEvaluation(const Evaluation& e, const EvaluationShape& shape) {
 
 std::string CheckpointJson(const CalibrationCheckpoint& c) {
   json j = Body(c);
-  j["fnv1a64"] = Fnv1a64Hex(j.dump());
+  j["sha256"] = Sha256Hex(j.dump());
   return j.dump() + "\n";
 }
 
@@ -124,27 +124,34 @@ CalibrationCheckpoint ReadCheckpoint(const std::string& path) {
   if (!in) throw InputError(path + ": cannot read the checkpoint");
   std::stringstream text;
   text << in.rdbuf();
+  const std::string start_afresh =
+      "remove it and run talus calibrate without --resume to start afresh";
   CalibrationCheckpoint c;
   std::string saved_hash;
   try {
     const json j = json::parse(text.str());
-    c.path_hash = j.at("path_hash").get<std::string>();
+    // An older talus checksummed a checkpoint with FNV-1a 64 ("fnv1a64") and tied it to its
+    // calibration by an FNV-1a hash too: neither can be checked or matched any more.
+    if (j.is_object() && j.contains("fnv1a64"))
+      throw InputError(path +
+                       ": a checkpoint of an older talus (its checksum is FNV-1a, \"fnv1a64\"; "
+                       "this talus checks SHA-256), which cannot be resumed: " +
+                       start_afresh);
+    c.path_hash = j.at("path_sha256").get<std::string>();
     c.holdout = j.at("holdout").get<std::vector<std::string>>();
     c.folds = j.at("folds").get<int>();
     for (const auto& [name, list] : j.at("stages").items())
       for (const json& e : list) c.stages[name].push_back(EvaluationOf(e));
-    if (!j.contains("fnv1a64"))
-      throw InputError(path +
-                       ": the checkpoint has no checksum (fnv1a64; written by an older talus?): "
-                       "remove it to start afresh");
-    saved_hash = j.at("fnv1a64").get<std::string>();
+    if (!j.contains("sha256"))
+      throw InputError(path + ": the checkpoint has no checksum (\"sha256\"): " + start_afresh);
+    saved_hash = j.at("sha256").get<std::string>();
   } catch (const json::exception& e) {
     throw InputError(path + ": not a calibration checkpoint: " + e.what());
   }
-  if (const std::string hash = Fnv1a64Hex(Body(c).dump()); hash != saved_hash)
-    throw InputError(path + ": what the checkpoint holds does not match its checksum (fnv1a64 " +
+  if (const std::string hash = Sha256Hex(Body(c).dump()); hash != saved_hash)
+    throw InputError(path + ": what the checkpoint holds does not match its checksum (sha256 " +
                      saved_hash + ", the contents give " + hash +
-                     "): the file was edited or damaged; remove it to start afresh");
+                     "): the file was edited or damaged; " + start_afresh);
   return c;
 }
 

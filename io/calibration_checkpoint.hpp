@@ -3,8 +3,9 @@
 // evaluation of each optimisation of the run so far (the fit, and the fit of each fold), with
 // every number as JSON writes it (shortest round-trip form), so that a resumed calibration
 // replays them bit for bit (OptimizerOptions::replay). It names the calibration's inputs hash
-// (CalibrationFile::path_hash) and the held-out runs and folds, and is refused for another
-// calibration.
+// (CalibrationFile::path_hash, as "path_sha256") and the held-out runs and folds, and is refused
+// for another calibration; a SHA-256 checksum over all it holds ("sha256") refuses a file edited
+// or damaged, and a checkpoint of an older talus (FNV-1a checksum) is refused by name.
 
 #include <map>
 #include <string>
@@ -30,8 +31,9 @@ struct EvaluationShape {
 };
 
 std::string CheckpointJson(const CalibrationCheckpoint& checkpoint);
-// Throws InputError naming the file when it cannot be read or parsed, or its checksum does not
-// match what it holds.
+// Throws InputError naming the file when it cannot be read or parsed, has no checksum or an older
+// talus's, or its checksum does not match what it holds; the message says to remove it and start
+// afresh.
 CalibrationCheckpoint ReadCheckpoint(const std::string& path);
 // Throws InputError naming the file `path` and the evaluation ("stages.fit[3]") when the
 // checkpoint has a stage that `shapes` (by stage: "fit", "fold1", ...) lacks, or an evaluation

@@ -3,7 +3,6 @@
 #include <toml++/toml.h>
 
 #include <algorithm>
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -12,6 +11,7 @@
 #include "calibration/holdout.hpp"
 #include "common/closest_name.hpp"
 #include "common/error.hpp"
+#include "common/sha256.hpp"
 #include "io/toml_section.hpp"
 
 namespace talus::io {
@@ -344,18 +344,6 @@ void LoadUncertainty(const Context& context, const toml::table* table, Calibrati
   LoadSeedRefits(s, out);
 }
 
-// 64-bit FNV-1a of `text`, as 16 hex digits.
-std::string Fnv1a(const std::string& text) {
-  std::uint64_t h = 1469598103934665603ULL;
-  for (unsigned char c : text) {
-    h ^= c;
-    h *= 1099511628211ULL;
-  }
-  char hex[17];
-  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
-  return hex;
-}
-
 }  // namespace
 
 CalibrationFile LoadCalibration(const std::string& path) {
@@ -401,8 +389,9 @@ CalibrationFile LoadCalibration(const std::string& path) {
   out.inputs.push_back(path);
   for (const std::string& input : out.event.inputs) out.inputs.push_back(input);
   std::ifstream in(path, std::ios::binary);
-  out.inputs_hash =
-      Fnv1a(std::string(std::istreambuf_iterator<char>(in), {}) + out.event.inputs_hash);
+  Sha256 inputs_hash;
+  inputs_hash.AddStream(in);
+  out.inputs_hash = inputs_hash.Add(out.event.inputs_hash).HexDigest();
 
   std::ostringstream path_text;  // every number at full precision
   path_text.precision(17);
@@ -420,7 +409,7 @@ CalibrationFile LoadCalibration(const std::string& path) {
   path_text << ' ' << o.algorithm << ' ' << o.ftol_rel << ' ' << o.ftol_abs << ' ' << o.xtol_abs
             << ' ' << o.initial_step << ' ' << o.population << ' ' << o.starts << ' '
             << o.start_design << ' ' << o.seed << ' ' << o.fd_step;
-  out.path_hash = Fnv1a(path_text.str());
+  out.path_hash = Sha256Hex(path_text.str());
   return out;
 }
 

@@ -30,10 +30,11 @@ struct CalibrationFile {
   // sets them).
   calibration::CalibrationOptions options;
   std::vector<std::string> inputs;  // the calibration file and the event's inputs
-  std::string inputs_hash;
-  // What decides an optimiser's path -- the event's inputs, rocks and seed, the parameters, the
-  // objective and the optimiser's options -- but not its budget (max_evaluations, max_time_s),
-  // nor the roughness and uncertainty sections: a checkpoint may be resumed with another budget.
+  std::string inputs_hash;          // SHA-256 of the calibration file and the event's hash, hex
+  // SHA-256 (hex) of what decides an optimiser's path -- the event's inputs, rocks and seed, the
+  // parameters, the objective and the optimiser's options -- but not its budget (max_evaluations,
+  // max_time_s), nor the roughness and uncertainty sections: a checkpoint may be resumed with
+  // another budget.
   std::string path_hash;
 };
 

@@ -497,7 +497,7 @@ std::string CalibrationJson(const CalibrationFile& file, const Objective& object
             {"calibration_file", file.path},
             {"event", file.event.path},
             {"inputs", file.inputs},
-            {"inputs_hash", file.inputs_hash},
+            {"inputs_sha256", file.inputs_hash},
             {"runs", release.release_count()},
             {"rocks_per_run", release.rocks_per_release},
             {"seed", release.seed},

@@ -25,9 +25,9 @@ std::string Interval(const Json& pair) {
 
 std::string Head(const Json& c) {
   std::string note = "Talus " + Cell(c["version"]) + ", event " + Cell(c["event"]) +
-                     ", inputs hash " + Cell(c["inputs_hash"]) + "; " + Cell(c["algorithm"]) +
-                     ", " + Cell(c["evaluations"]) + " evaluations, ended by " +
-                     Cell(c["termination"]) +
+                     ", inputs hash (SHA-256) " + Cell(c["inputs_sha256"]) + "; " +
+                     Cell(c["algorithm"]) + ", " + Cell(c["evaluations"]) +
+                     " evaluations, ended by " + Cell(c["termination"]) +
                      ". Everything here is also in calibration.json, history.csv and "
                      "ground_table.toml next to this file (docs/calibration.md).";
   return html::Begin("Talus calibration: " + c.value("calibration_file", std::string()), note) +
@@ -149,7 +149,7 @@ std::string HeldOutSection(const Json& c) {
 std::string WhatRanSection(const Json& c) {
   std::string out = "<h2>What ran</h2>\n";
   out += html::KeyValueTable(c, {"version", "warnings", "parameters", "kinds", "starts",
-                                 "not_scored", "message", "fitted_runs_blocks", "inputs_hash",
+                                 "not_scored", "message", "fitted_runs_blocks", "inputs_sha256",
                                  "holdout", "cross_validation", "roughness", "uncertainty"});
   out += "<h3>Timings</h3>\n" + html::KeyValueTable(c["timings"]);
   return out;

@@ -13,8 +13,8 @@
 #include "common/closest_name.hpp"
 #include "common/csv_table.hpp"
 #include "common/error.hpp"
-#include "common/fnv1a.hpp"
 #include "common/format.hpp"
+#include "common/sha256.hpp"
 #include "ensemble/release.hpp"
 #include "fieldobs/single_impacts.hpp"
 #include "io/toml_section.hpp"
@@ -268,17 +268,15 @@ void CheckDepositsOnTerrain(const EventFile& event) {
                        DemCover(event.scene) + ", so no rock can rest there");
 }
 
-// The hash covers the event file, the observation tables and the scene's own hash.
+// The hash (SHA-256) covers the event file, the observation tables and the scene's own hash.
 std::string InputsHash(const EventFile& event) {
-  std::uint64_t h = kFnv1aStart;
+  Sha256 hash;
   for (std::size_t k = 0; k < event.inputs.size() - event.scene.inputs.size(); ++k) {
     std::ifstream in(event.inputs[k], std::ios::binary);
-    h = Fnv1a64(std::string(std::istreambuf_iterator<char>(in), {}), h);
+    hash.AddStream(in);
   }
-  h = Fnv1a64(event.scene.inputs_hash, h);
-  char hex[17];
-  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
-  return hex;
+  hash.Add(event.scene.inputs_hash);
+  return hash.HexDigest();
 }
 
 }  // namespace

@@ -25,7 +25,7 @@ struct EventFile {
   // line each naming the file and column and saying why: printed and listed in scores.json.
   std::vector<std::string> not_scored;
   std::vector<std::string> inputs;  // the event file, the scene's inputs, the observation tables
-  std::string inputs_hash;
+  std::string inputs_hash;          // SHA-256 of the event file, the tables and the scene's hash
 };
 
 // Throws InputError "<file>:<line>: <key>: <reason>" (or the table's file:line: column).

@@ -41,7 +41,7 @@ const std::map<std::string, std::string>& Labels() {
       {"kappa", "κ (1/m)"},
       {"nu", "ν (1/s)"},
       {"talus_version", "Talus version"},
-      {"inputs_hash_fnv1a64", "inputs hash (FNV-1a 64)"},
+      {"inputs_sha256", "inputs hash (SHA-256)"},
       {"rocks_per_run", "rocks per run"},
       {"rocks_per_release", "rocks per release"},
       {"crs", "coordinate reference system"},

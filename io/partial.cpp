@@ -2,16 +2,16 @@
 
 #include <algorithm>
 #include <charconv>
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "common/bytes.hpp"
 #include "common/csv_table.hpp"
 #include "common/error.hpp"
-#include "common/fnv1a.hpp"
+#include "common/sha256.hpp"
 #include "io/barriers_csv.hpp"
 #include "io/evaluation_lines_csv.hpp"
 #include "io/rocks_csv.hpp"
@@ -22,7 +22,8 @@ namespace {
 
 constexpr const char* kFormat = "talus partial result";
 // 2: the files' sizes and checksums; 3: the ending "barrier", rocks.csv's end_barrier column and
-// barriers.csv; 4: the cell summaries' level (bins capped at ValueSummary::kMaxBins).
+// barriers.csv; 4: SHA-256 for the inputs' hash and the files' checksums instead of FNV-1a 64,
+// and the cell summaries' level (bins capped at ValueSummary::kMaxBins).
 constexpr int kFormatVersion = 4;
 constexpr const char* kStateMagic = "talus partial state 1";
 
@@ -39,21 +40,22 @@ std::string Range(long first, long end) {
   return std::to_string(first) + ":" + std::to_string(end);
 }
 
-// Size and FNV-1a 64 of a file, read in chunks.
-PartialInfo::File FileEntry(const std::string& path) {
+// Size and SHA-256 of a file, read in chunks; `on_bytes`, when given, hears each chunk's size.
+PartialInfo::File FileEntry(const std::string& path,
+                            const std::function<void(std::uint64_t)>& on_bytes = {}) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw std::runtime_error("cannot read " + path);
+  Sha256 hash;
   PartialInfo::File f;
-  std::uint64_t h = kFnv1aStart;
-  char chunk[1 << 16];
-  while (in.read(chunk, sizeof chunk) || in.gcount() > 0) {
-    h = Fnv1a64(std::string_view(chunk, static_cast<std::size_t>(in.gcount())), h);
-    f.bytes += static_cast<std::uint64_t>(in.gcount());
+  std::string chunk(1 << 20, '\0');
+  while (in.read(chunk.data(), static_cast<std::streamsize>(chunk.size())) || in.gcount() > 0) {
+    const auto n = static_cast<std::size_t>(in.gcount());
+    hash.Add(std::string_view(chunk.data(), n));
+    f.bytes += n;
+    if (on_bytes) on_bytes(n);
   }
   if (in.bad()) throw std::runtime_error("cannot read " + path);
-  char hex[17];
-  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
-  f.fnv1a64 = hex;
+  f.sha256 = hash.HexDigest();
   return f;
 }
 
@@ -93,7 +95,7 @@ std::string PartialJson(const SceneFile& scene, const std::string& version, long
   j["scene"] = scene.path;
   j["scene_file"] = std::filesystem::absolute(scene.path).lexically_normal().string();
   j["inputs"] = scene.inputs;
-  j["inputs_hash_fnv1a64"] = scene.inputs_hash;
+  j["inputs_sha256"] = scene.inputs_hash;
   j["seed"] = scene.release.seed;
   // 0 when the releases have rocks of their own (rocks_per_m2): the scene gives them.
   j["rocks_per_release"] =
@@ -116,7 +118,7 @@ std::string PartialJson(const SceneFile& scene, const std::string& version, long
   for (const std::string& path : files) {
     const PartialInfo::File f = FileEntry(path);
     entries[std::filesystem::path(path).filename().string()] = {{"bytes", f.bytes},
-                                                                {"fnv1a64", f.fnv1a64}};
+                                                                {"sha256", f.sha256}};
   }
   j["files"] = entries;
   return j.dump(2) + "\n";
@@ -147,14 +149,31 @@ PartialInfo ReadPartialInfo(const std::string& dir) {
   p.dir = dir;
   try {
     const nlohmann::json j = nlohmann::json::parse(ReadWholeFile(path));
-    if (j.at("format") != kFormat || j.at("format_version") != kFormatVersion)
-      throw InputError(path + ": not a partial result of this version of talus (format " +
-                       j.at("format").dump() + " " + j.at("format_version").dump() + ")");
+    if (j.at("format") != kFormat)
+      throw InputError(path + ": not a partial result of talus simulate --rock-range (format " +
+                       j.at("format").dump() + ")");
+    if (const int version = j.at("format_version"); version != kFormatVersion) {
+      // A part of another talus cannot be checked or merged: it is run again. Version 3 and
+      // before summed the files up with FNV-1a 64, which this talus no longer computes.
+      std::string again = "run the part again with this talus";
+      const auto scene = j.find("scene");
+      const auto first = j.find("first_rock"), end = j.find("end_rock");
+      if (scene != j.end() && scene->is_string() && first != j.end() &&
+          first->is_number_integer() && end != j.end() && end->is_number_integer())
+        again += " (talus simulate " + scene->get<std::string>() + " --rock-range " +
+                 Range(first->get<long>(), end->get<long>()) + " and the options it ran with)";
+      throw InputError(
+          path + ": a part written by " + (version < kFormatVersion ? "an older" : "a newer") +
+          " talus (partial result format " + std::to_string(version) + ", this talus reads " +
+          std::to_string(kFormatVersion) +
+          (version < 4 ? "; its checksums are FNV-1a, this talus checks SHA-256" : "") +
+          "): " + again);
+    }
     p.version = j.at("talus_version");
     p.scene = j.at("scene");
     p.scene_file = j.at("scene_file");
     p.inputs = j.at("inputs").get<std::vector<std::string>>();
-    p.inputs_hash = j.at("inputs_hash_fnv1a64");
+    p.inputs_hash = j.at("inputs_sha256");
     p.seed = j.at("seed");
     p.rocks_per_release = j.at("rocks_per_release");
     p.solver_preset = j.at("solver_preset");
@@ -174,7 +193,7 @@ PartialInfo ReadPartialInfo(const std::string& dir) {
     for (const auto& [name, f] : j.at("files").items()) {
       if (name.empty() || name.find('/') != std::string::npos || name == "." || name == "..")
         throw InputError(path + ": files: '" + name + "' is not a file name");
-      p.files[name] = {f.at("bytes").get<std::uint64_t>(), f.at("fnv1a64").get<std::string>()};
+      p.files[name] = {f.at("bytes").get<std::uint64_t>(), f.at("sha256").get<std::string>()};
     }
   } catch (const nlohmann::json::exception& e) {
     throw InputError(path + ": not a valid partial.json: " + e.what());
@@ -185,7 +204,7 @@ PartialInfo ReadPartialInfo(const std::string& dir) {
   return p;
 }
 
-void CheckPartFiles(const PartialInfo& part) {
+void CheckPartFiles(const PartialInfo& part, const std::function<void(std::uint64_t)>& on_bytes) {
   const std::string json = (std::filesystem::path(part.dir) / "partial.json").string();
   std::vector<std::string> required = {"rocks.csv", "partial.bin"};
   if (part.trajectories) required.push_back("trajectories.h5");
@@ -198,14 +217,14 @@ void CheckPartFiles(const PartialInfo& part) {
       throw InputError(path + ": missing (partial.json lists it)");
     PartialInfo::File have;
     try {
-      have = FileEntry(path);
+      have = FileEntry(path, on_bytes);
     } catch (const std::runtime_error& e) {
       throw InputError(e.what());
     }
-    if (have.bytes != want.bytes || have.fnv1a64 != want.fnv1a64)
-      throw InputError(path + ": " + std::to_string(have.bytes) + " bytes with checksum " +
-                       have.fnv1a64 + ", but partial.json says " + std::to_string(want.bytes) +
-                       " bytes with " + want.fnv1a64 +
+    if (have.bytes != want.bytes || have.sha256 != want.sha256)
+      throw InputError(path + ": " + std::to_string(have.bytes) + " bytes with SHA-256 " +
+                       have.sha256 + ", but partial.json says " + std::to_string(want.bytes) +
+                       " bytes with " + want.sha256 +
                        ": changed or damaged since the part was run");
   }
   // The rows: rocks.csv has each rock of the part once, in order; evaluation_lines.csv and

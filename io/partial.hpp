@@ -7,7 +7,7 @@
 //                    computed from the merged file),
 //   partial.bin      the raster accumulator (per-cell summaries) and the quick-look's sample paths,
 //   partial.json     what the part is (scene, its inputs' hash, seed, range, version, counts)
-//                    and the size and checksum (FNV-1a 64) of each of its other files; written
+//                    and the size and checksum (SHA-256) of each of its other files; written
 //                    last, so that a directory with a partial.json is a complete part.
 // Before merging, each part's files are checked against partial.json (CheckPartFiles): a file
 // changed, swapped with another part's or damaged since the part was run is refused, as are rows
@@ -17,6 +17,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <optional>
 #include <string>
@@ -34,7 +35,7 @@ struct PartialInfo {
   std::string scene;                // the scene path as given to talus simulate
   std::string scene_file;           // the same, absolute
   std::vector<std::string> inputs;  // SceneFile::inputs as given
-  std::string inputs_hash;
+  std::string inputs_hash;          // SceneFile::inputs_hash (SHA-256), "inputs_sha256"
   std::uint64_t seed = 0;
   long rocks_per_release = 0;
   std::string solver_preset;  // "fast", "default", "accurate" (the scene's or --preset)
@@ -43,10 +44,10 @@ struct PartialInfo {
   long first_rock = 0, end_rock = 0;  // rocks [first_rock, end_rock)
   bool trajectories = false;
   ensemble::EnsembleReport counts;  // rocks, ends, raised, steps, threads, wall time
-  // The part's other files (rocks.csv, partial.bin, ...) by name: size and FNV-1a 64 (hex).
+  // The part's other files (rocks.csv, partial.bin, ...) by name: size and SHA-256 (hex).
   struct File {
     std::uint64_t bytes = 0;
-    std::string fnv1a64;
+    std::string sha256;
   };
   std::map<std::string, File> files;
 };
@@ -72,8 +73,11 @@ PartialInfo ReadPartialInfo(const std::string& dir);
 // Checks the files of a part against its partial.json: each listed file is there with its size
 // and checksum, rocks.csv and partial.bin (and trajectories.h5 when the part has trajectories)
 // are listed, rocks.csv holds exactly the part's rocks in order and evaluation_lines.csv only
-// crossings of them. Throws InputError naming the file (and line) and what is wrong.
-void CheckPartFiles(const PartialInfo& part);
+// crossings of them. Throws InputError naming the file (and line) and what is wrong. `on_bytes`,
+// when given, hears how many bytes were checksummed as the files are read (for a progress line:
+// files.bytes of partial.json add up to the total).
+void CheckPartFiles(const PartialInfo& part,
+                    const std::function<void(std::uint64_t)>& on_bytes = {});
 
 // Checks that parts belong to one ensemble (same version, scene inputs, seed, rocks) and that their
 // ranges cover it exactly once; returns them sorted by range. Throws InputError naming the parts

@@ -94,18 +94,17 @@ std::string WhatRanSection(const Json& summary) {
   const std::string scene = get("scene").is_string() ? get("scene").get<std::string>() : "";
   std::string html = html::Begin(
       "Talus run: " + scene,
-      "Talus " + Cell(get("talus_version")) + ", inputs hash (FNV-1a 64) " +
-          Cell(get("inputs_hash_fnv1a64")) +
+      "Talus " + Cell(get("talus_version")) + ", inputs hash (SHA-256) " +
+          Cell(get("inputs_sha256")) +
           ". Everything here is also in summary.json, rocks.csv and the GeoTIFFs next to this "
           "file.");
   html += html::Warnings(get("warnings"));
 
   html += "<h2>What ran</h2>\n";
   html += html::KeyValueTable(
-      summary,
-      {"ends", "raised_at_release", "stayed_at_release", "steps", "unconverged_steps", "threads",
-       "wall_time_s", "trajectories_per_s", "outputs", "blocks", "talus_version",
-       "inputs_hash_fnv1a64", "evaluation_lines", "barriers", "warnings"});
+      summary, {"ends", "raised_at_release", "stayed_at_release", "steps", "unconverged_steps",
+                "threads", "wall_time_s", "trajectories_per_s", "outputs", "blocks",
+                "talus_version", "inputs_sha256", "evaluation_lines", "barriers", "warnings"});
   if (summary.contains("rock") && summary["rock"].is_object()) {
     html += "<h3>Rock</h3>\n";
     html += html::KeyValueTable(summary["rock"]);

@@ -3,13 +3,12 @@
 #include <toml++/toml.h>
 
 #include <algorithm>
-#include <cstdio>
 #include <fstream>
 
 #include "common/format.hpp"
 #include "common/closest_name.hpp"
 #include "common/error.hpp"
-#include "common/fnv1a.hpp"
+#include "common/sha256.hpp"
 #include "io/scene_tables.hpp"
 #include "io/toml_section.hpp"
 
@@ -79,21 +78,15 @@ void LoadGround(const Context& context, const toml::table* ground, GroundTable& 
     context.Fail(ground, "ground", "too many ground categories");
 }
 
-std::string Hex(std::uint64_t v) {
-  char buffer[17];
-  std::snprintf(buffer, sizeof buffer, "%016llx", static_cast<unsigned long long>(v));
-  return buffer;
-}
-
+// SHA-256 of `before` and then of the files' contents, in order.
 std::string HashFiles(const std::vector<std::string>& files, const std::string& before) {
-  std::uint64_t h = Fnv1a64(before);
+  Sha256 hash;
+  hash.Add(before);
   for (const std::string& f : files) {
     std::ifstream in(f, std::ios::binary);
-    char buffer[65536];
-    while (in.read(buffer, sizeof buffer) || in.gcount() > 0)
-      h = Fnv1a64(std::string_view(buffer, static_cast<std::size_t>(in.gcount())), h);
+    hash.AddStream(in);
   }
-  return Hex(h);
+  return hash.HexDigest();
 }
 
 // "unknown <what> 'name' (did you mean '...'?); known: a, b, c".

@@ -74,7 +74,7 @@ struct SceneFile {
   std::optional<PlaneSpec> plane;   // [terrain] plane, when the terrain is the analytic plane
   std::string terrain_description;  // e.g. "dem.tif (270 x 370 cells of 5 m)"
   std::vector<std::string> inputs;  // the scene file and every data file it read
-  std::string inputs_hash;          // FNV-1a 64 over the contents of `inputs`, hex
+  std::string inputs_hash;          // SHA-256 over the contents of `inputs`, hex
   SolverPreset solver_preset = SolverPreset::kDefault;  // [solver] preset, or --preset
   // [solver] self_check: rocks rerun at half the step to measure the run's own step error
   // (ensemble/self_check.hpp); 0: none. talus simulate --self-check N wins over it.

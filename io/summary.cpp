@@ -137,7 +137,7 @@ std::string SummaryJson(const SceneFile& scene, const ensemble::EnsembleReport& 
   j["talus_version"] = version;
   j["scene"] = scene.path;
   j["inputs"] = scene.inputs;
-  j["inputs_hash_fnv1a64"] = scene.inputs_hash;
+  j["inputs_sha256"] = scene.inputs_hash;
   j["terrain"] = scene.terrain_description;
   // The coordinates of every position written (rocks.csv, evaluation lines, trajectories): the
   // DEM's CRS as WKT, null for the plane or a DEM without one.

@@ -63,7 +63,7 @@ std::string ScoresJson(const EventFile& event, const fieldobs::ValidationReport&
   j["event"] = event.path;
   j["scene"] = event.scene.path;
   j["inputs"] = event.inputs;
-  j["inputs_hash_fnv1a64"] = event.inputs_hash;
+  j["inputs_sha256"] = event.inputs_hash;
   j["rocks_per_run"] = run.rocks_per_run;
   j["runs"] = event.scene.release.release_count();
   j["seed"] = run.seed;

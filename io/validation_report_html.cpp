@@ -28,7 +28,7 @@ std::string Head(const Json& scores) {
   const std::string event = scores.value("event", std::string());
   return html::Begin("Talus validation: " + event,
                      "Talus " + Cell(scores["talus_version"]) + ", scene " + Cell(scores["scene"]) +
-                         ", inputs hash (FNV-1a 64) " + Cell(scores["inputs_hash_fnv1a64"]) +
+                         ", inputs hash (SHA-256) " + Cell(scores["inputs_sha256"]) +
                          ". Everything here is also in scores.json and observations.csv next to "
                          "this file (docs/validation.md).") +
          html::WarningsOrNone(scores["warnings"]);
@@ -130,8 +130,8 @@ std::string RunSection(const Json& scores) {
     Add(out, "<tr><th>", Escape(html::HumanLabel(ending)), "</th><td>", Cell(n), "</td></tr>\n");
   out += "</table>\n<h2>What ran</h2>\n";
   out += html::KeyValueTable(
-      scores, {"talus_version", "inputs_hash_fnv1a64", "event", "scene", "warnings", "kinds",
-               "blocks", "ends", "overall", "wall_time_s", "threads", "start_ground_mismatch"});
+      scores, {"talus_version", "inputs_sha256", "event", "scene", "warnings", "kinds", "blocks",
+               "ends", "overall", "wall_time_s", "threads", "start_ground_mismatch"});
   return out;
 }
 

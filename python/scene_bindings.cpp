@@ -497,7 +497,9 @@ void BindScene(py::module_& m) {
       .def_readonly("rock_description", &io::SceneFile::rock_description)
       .def_readonly("warnings", &io::SceneFile::warnings)
       .def_readonly("inputs", &io::SceneFile::inputs)
-      .def_readonly("inputs_hash", &io::SceneFile::inputs_hash)
+      .def_readonly("inputs_hash", &io::SceneFile::inputs_hash,
+                    "SHA-256 (hex) of the scene and every file it read: summary.json's "
+                    "inputs_sha256.")
       .def_property_readonly(
           "ground", [](const io::SceneFile& f) { return FromJson(io::GroundTableJson(f.scene.ground)); },
           "The ground table: {category: {code, model, mu_min, mu_max, beta, kappa, nu, ...}} as "

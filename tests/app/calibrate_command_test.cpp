@@ -430,6 +430,41 @@ TEST(CalibrateCommand, CeresWithAHeldOutRunAndCrossValidation) {
       << output;
 }
 
+// The checkpoint of an older talus (an FNV-1a checksum) in --out is bad input naming the file and
+// saying what to do, with --resume or without, before any rock runs; the directory is left as it
+// was.
+TEST(CalibrateCommand, ResumingACheckpointOfAnOlderTalusIsRefusedSayingWhatToDo) {
+  const fs::path dir = MakeEvent("older_checkpoint");
+  Write(dir / "cal.toml", kGood);
+  fs::create_directories(dir / "out");
+  const std::string older =
+      R"({"fnv1a64":"702b435a4ded976b","folds":0,"holdout":[],"path_hash":"44bda3d473cdc381",)"
+      R"("stages":{"fit":[{"data":0.5,"failed_rocks":0,"feasible":true,"infeasible":"",)"
+      R"("kind_scored":[4],"kind_scores":[0.5],"prior":0.0,"residuals":[0.25,-0.25],"rocks":8,)"
+      R"("u":[0.5],"value":0.5,"values":[0.55],"wall_time_s":0.125}]}})"
+      "\n";
+  Write(dir / "out" / "checkpoint.json", older);
+  std::string output;
+  EXPECT_EQ(Calibrate(dir, "--resume", &output), "2") << output;
+  EXPECT_NE(output.find("talus calibrate: " + (dir / "out" / "checkpoint.json").string() +
+                        ": a checkpoint of an older talus (its checksum is FNV-1a"),
+            std::string::npos)
+      << output;
+  EXPECT_NE(output.find("remove it and run talus calibrate without --resume to start afresh"),
+            std::string::npos)
+      << output;
+  // Without --resume it is refused the same way, not offered for resuming.
+  EXPECT_EQ(Calibrate(dir, "", &output), "2") << output;
+  EXPECT_NE(output.find("checkpoint.json: a checkpoint of an older talus"), std::string::npos)
+      << output;
+  EXPECT_EQ(output.find("resume it with --resume"), std::string::npos) << output;
+  std::vector<std::string> left;
+  for (const auto& entry : fs::directory_iterator(dir / "out"))
+    left.push_back(entry.path().filename().string());
+  EXPECT_EQ(left, std::vector<std::string>{"checkpoint.json"});
+  EXPECT_EQ(Slurp(dir / "out" / "checkpoint.json"), older);
+}
+
 // A calibration stopped by its budget (5 evaluations) and resumed from its checkpoint with a
 // budget of 10 ends exactly where an uninterrupted run with 10 does: the same evaluations, bit
 // for bit (history.csv without its wall times), the same fitted table, the same bootstrap and seed

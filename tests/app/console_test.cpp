@@ -57,6 +57,19 @@ TEST(Console, InformationGoesToStdoutWithoutQuietAndNoProgressOffATerminal) {
   EXPECT_EQ(RunLogText(0).find("3/4 rocks"), std::string::npos);  // progress is not kept
 }
 
+// The progress line of simulate's and validate's rocks and of merge's phases: a bar of 30, the
+// counts, the rate so far and the time left at that rate.
+TEST(Console, ProgressLineShowsBarCountsRateAndTimeLeft) {
+  EXPECT_EQ(ProgressLine("", 3, 10, "rocks", 0, 1.5),
+            "[#########                     ] 3/10 rocks  2.0/s  4 s left");
+  EXPECT_EQ(ProgressLine("Checking the parts", 1.5, 3.0, "MB", 1, 0.5),
+            "Checking the parts [###############               ] 1.5/3.0 MB  3.0/s  1 s left");
+  EXPECT_EQ(ProgressLine("Merging rocks.csv", 0, 4, "parts", 0, 0),
+            "Merging rocks.csv [                              ] 0/4 parts  0.0/s  ? left");
+  EXPECT_EQ(ProgressLine("", 12, 12, "rocks", 0, 2),
+            "[##############################] 12/12 rocks  6.0/s  0 s left");
+}
+
 TEST(Console, RunLogIsWrittenIntoItsDirectoryOnlyWhenTheRunSucceeded) {
   const fs::path dir = talus::testing::TestTmpRoot() / "console_run_log";
   fs::remove_all(dir);

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <filesystem>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -281,6 +282,70 @@ TEST_F(MergeCommand, ASceneChangedSinceThePartsRanIsRefused) {
   talus::app::testing::Write(scene_, edited);
   EXPECT_EQ(Merge({a}, &log), 2);
   EXPECT_NE(log.find("changed since this part was run"), std::string::npos) << log;
+}
+
+// A part that an older talus wrote (partial.json format 3, FNV-1a checksums) is refused as bad
+// input naming its partial.json and the rocks to run again; nothing is written.
+TEST_F(MergeCommand, APartOfAnOlderTalusIsRefusedSayingWhatToRunAgain) {
+  std::string log;
+  const fs::path a = Part("0:5"), b = Part("5:10");
+  nlohmann::ordered_json info = nlohmann::ordered_json::parse(Slurp(b / "partial.json"));
+  info["format_version"] = 3;
+  info["inputs_hash_fnv1a64"] = "cbf29ce484222325";
+  info.erase("inputs_sha256");
+  for (auto& [name, entry] : info["files"].items()) {
+    entry.erase("sha256");
+    entry["fnv1a64"] = "af63bd4c8601b7df";
+  }
+  talus::app::testing::Write(b / "partial.json", info.dump(2) + "\n");
+  EXPECT_EQ(Merge({a, b}, &log), 2);
+  EXPECT_NE(log.find("talus merge: " + (b / "partial.json").string() +
+                     ": a part written by an older talus (partial result format 3, this talus "
+                     "reads 4; its checksums are FNV-1a, this talus checks SHA-256): run the part "
+                     "again with this talus (talus simulate " +
+                     scene_.string() + " --rock-range 5:10 and the options it ran with)"),
+            std::string::npos)
+      << log;
+  EXPECT_FALSE(fs::exists(dir_ / "merged"));
+}
+
+// On a terminal (script(1) gives the program one) merge shows its phases as one status line:
+// checking the parts' bytes, merging each output, writing the rasters and summary; --quiet
+// silences it with the information, and off a terminal there is none. run.log keeps what was
+// said, never the progress.
+TEST_F(MergeCommand, ProgressOnATerminalQuietSilencesItAndRunLogKeepsWhatWasSaid) {
+  if (std::system("command -v script >/dev/null 2>&1") != 0) GTEST_SKIP() << "no script(1)";
+  const fs::path a = Part("0:4"), b = Part("4:10");
+  const auto merge = [&](const std::string& out, const std::string& more, bool terminal) {
+    const std::string command =
+        Talus("merge " + a.string() + " " + b.string() + " --out " + (dir_ / out).string() + more);
+    std::string output;
+    EXPECT_EQ(RunCommand(terminal ? "script -qec '" + command + "' /dev/null" : command, &output),
+              0)
+        << output;
+    return output;
+  };
+  const std::string talkative = merge("out", "", true);
+  for (const char* phase :
+       {"\rChecking the parts [", " MB  ", "\rMerging rocks.csv [", "\rMerging trajectories.h5 [",
+        " 10/10 rocks ", "\rMerging evaluation_lines.csv [",
+        "\rMerging the rasters (partial.bin) [", "\rWriting the outputs [", " files  "})
+    EXPECT_NE(talkative.find(phase), std::string::npos) << phase << "\n" << talkative;
+  EXPECT_NE(talkative.find("Merged 2 parts of "), std::string::npos) << talkative;
+  const std::string quiet = merge("quiet", " --quiet", true);
+  EXPECT_EQ(quiet.find("[#"), std::string::npos) << quiet;
+  EXPECT_EQ(quiet.find("Merging"), std::string::npos) << quiet;
+  EXPECT_EQ(quiet.find("Merged"), std::string::npos) << quiet;
+  const std::string piped = merge("piped", "", false);
+  EXPECT_EQ(piped.find('\r'), std::string::npos) << piped;
+  EXPECT_EQ(piped.find("Checking the parts"), std::string::npos) << piped;
+  EXPECT_NE(piped.find("Merged 2 parts of "), std::string::npos) << piped;
+  const std::string log = Slurp(dir_ / "out" / "run.log");
+  for (const char* line :
+       {"command: ", " merge ", "\nMerged 2 parts of ", "\nWrote ", "finished: exit 0"})
+    EXPECT_NE(log.find(line), std::string::npos) << line << "\n" << log;
+  EXPECT_EQ(log.find("[#"), std::string::npos) << log;  // progress is not kept
+  EXPECT_EQ(log.find("Checking the parts"), std::string::npos) << log;
 }
 
 TEST_F(MergeCommand, BadRockRangesAreRefusedBeforeAnyWork) {

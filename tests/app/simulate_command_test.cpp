@@ -288,8 +288,8 @@ report = false
     const std::string statistic = d->GetMetadataItem("TALUS_STATISTIC");
     const bool count = statistic == "count" || statistic == "fraction";
     EXPECT_EQ(count ? quantity : quantity + "_" + statistic, name.substr(0, name.size() - 4));
-    EXPECT_EQ(d->GetMetadataItem("TALUS_INPUTS_HASH"),
-              summary["inputs_hash_fnv1a64"].get<std::string>());
+    EXPECT_EQ(d->GetMetadataItem("TALUS_INPUTS_SHA256"),
+              summary["inputs_sha256"].get<std::string>());
     EXPECT_EQ(d->GetMetadataItem("TALUS_VERSION"), summary["talus_version"].get<std::string>());
     EXPECT_STREQ(d->GetMetadataItem("TALUS_ROCKS"), "8");
     EXPECT_STREQ(d->GetMetadataItem("TALUS_SEED"), "5");

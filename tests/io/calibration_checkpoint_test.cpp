@@ -11,6 +11,7 @@
 #include <string>
 
 #include "common/error.hpp"
+#include "common/sha256.hpp"
 #include "test_files.hpp"
 
 namespace talus::io {
@@ -137,7 +138,7 @@ TEST(CalibrationCheckpoint, AMissingTruncatedOrForeignFileIsAnInputErrorNamingIt
                 "not a calibration checkpoint");
   ExpectRefused(WriteCheckpoint("foreign", "{\"rocks\": 3}"), "not a calibration checkpoint");
   ExpectRefused(WriteCheckpoint("wrong_type",
-                                "{\"path_hash\": 1, \"holdout\": [], \"folds\": 0, "
+                                "{\"path_sha256\": 1, \"holdout\": [], \"folds\": 0, "
                                 "\"stages\": {}}"),
                 "not a calibration checkpoint");
 }
@@ -164,12 +165,45 @@ TEST(CalibrationCheckpoint, AnEditedValueIsRefusedByTheChecksum) {
   ExpectRefused(
       WriteCheckpoint("edited_u", Edited(j, [](J& e) { e["stages"]["fit"][0]["u"] = J::array(); })),
       "does not match its checksum");
-  ExpectRefused(WriteCheckpoint("edited_hash", Edited(j, [](J& e) { e["path_hash"] = "abc124"; })),
-                "does not match its checksum");
-  ExpectRefused(WriteCheckpoint("no_checksum", Edited(j, [](J& e) { e.erase("fnv1a64"); })),
-                "has no checksum");
+  ExpectRefused(
+      WriteCheckpoint("edited_hash", Edited(j, [](J& e) { e["path_sha256"] = "abc124"; })),
+      "does not match its checksum");
+  ExpectRefused(WriteCheckpoint("no_checksum", Edited(j, [](J& e) { e.erase("sha256"); })),
+                "has no checksum (\"sha256\"): remove it and run talus calibrate without --resume");
   // Unchanged, it reads.
   EXPECT_NO_THROW(ReadCheckpoint(WriteCheckpoint("unchanged", j.dump())));
+}
+
+// The checksum is the SHA-256 of the checkpoint's JSON without it, and the inputs' hash goes in
+// under its algorithm's name too.
+TEST(CalibrationCheckpoint, TheChecksumIsTheSha256OfWhatItHolds) {
+  CalibrationCheckpoint c;
+  c.path_hash = std::string(64, 'a');
+  c.stages["fit"] = {Sample(0)};
+  nlohmann::json j = nlohmann::json::parse(CheckpointJson(c));
+  ASSERT_TRUE(j.contains("sha256"));
+  const std::string checksum = j["sha256"];
+  EXPECT_EQ(checksum.size(), 64u);
+  EXPECT_EQ(j["path_sha256"], c.path_hash);
+  j.erase("sha256");
+  EXPECT_EQ(checksum, Sha256Hex(j.dump()));
+}
+
+// A checkpoint that an older talus wrote (an FNV-1a 64 checksum, "fnv1a64", and its calibration's
+// FNV-1a hash as "path_hash"; this one as that talus wrote it) is refused, naming the file and
+// saying what to do, never replayed and never misread.
+TEST(CalibrationCheckpoint, ACheckpointOfAnOlderTalusIsRefusedSayingWhatToDo) {
+  const std::string older =
+      R"({"fnv1a64":"702b435a4ded976b","folds":0,"holdout":[],"path_hash":"44bda3d473cdc381",)"
+      R"("stages":{"fit":[{"data":0.5,"failed_rocks":0,"feasible":true,"infeasible":"",)"
+      R"("kind_scored":[4],"kind_scores":[0.5],"prior":0.0,"residuals":[0.25,-0.25],"rocks":8,)"
+      R"("u":[0.5],"value":0.5,"values":[0.55],"wall_time_s":0.125}]}})"
+      "\n";
+  const std::string path = WriteCheckpoint("older_talus", older);
+  ExpectRefused(path,
+                "a checkpoint of an older talus (its checksum is FNV-1a, \"fnv1a64\"; this talus "
+                "checks SHA-256), which cannot be resumed: remove it and run talus calibrate "
+                "without --resume to start afresh");
 }
 
 // Every evaluation must have the calibration's shape (Sample's: 2 coordinates, 2 kinds, 3

@@ -11,7 +11,7 @@ namespace talus::io {
 namespace {
 
 const char* kCalibration = R"({"version": "9.9", "calibration_file": "cal.toml",
-  "event": "event.toml", "inputs": ["a"], "inputs_hash": "abc", "runs": 4, "rocks_per_run": 4,
+  "event": "event.toml", "inputs": ["a"], "inputs_sha256": "abc", "runs": 4, "rocks_per_run": 4,
   "seed": 3, "solver": {"tolerance_m_s": 1e-7}, "threads": 2, "algorithm": "bobyqa",
   "termination": "max_evaluations", "message": "m",
   "parameters": [

@@ -68,7 +68,7 @@ file = "impacts.csv"
   EXPECT_EQ(e.reference, "table1");
   // The event, two tables (obs.csv once), the scene and its inputs.
   EXPECT_EQ(e.inputs.size(), 3u + e.scene.inputs.size());
-  EXPECT_EQ(e.inputs_hash.size(), 16u);
+  EXPECT_EQ(e.inputs_hash.size(), 64u);  // SHA-256, hex
 }
 
 TEST(LoadEvent, RestPositionsFromAVectorFileAreReprojectedToTheDem) {

@@ -6,10 +6,12 @@
 #include <fstream>
 #include <functional>
 #include <iterator>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
 #include "common/error.hpp"
+#include "common/sha256.hpp"
 #include "io/rocks_csv.hpp"
 #include "tests/test_tmp.hpp"
 
@@ -148,7 +150,7 @@ TEST(CheckPartFiles, AFileChangedSinceThePartRanIsRefused) {
   const auto bin = std::filesystem::path(b) / "partial.bin";
   for (std::size_t byte = 0; byte < 9; ++byte) {
     FlipBit(bin, byte);
-    EXPECT_NE(FilesMessage(b).find("partial.bin: 9 bytes with checksum"), std::string::npos)
+    EXPECT_NE(FilesMessage(b).find("partial.bin: 9 bytes with SHA-256 "), std::string::npos)
         << byte << ": " << FilesMessage(b);
     FlipBit(bin, byte);
   }
@@ -162,6 +164,56 @@ TEST(CheckPartFiles, AFileChangedSinceThePartRanIsRefused) {
   std::filesystem::remove(std::filesystem::path(b) / "partial.bin");
   EXPECT_NE(FilesMessage(b).find("partial.bin: missing (partial.json lists it)"), std::string::npos)
       << FilesMessage(b);
+}
+
+// partial.json records each file's size and SHA-256, and the scene inputs' hash under its
+// algorithm's name.
+TEST(PartialJson, RecordsEachFilesSizeAndSha256) {
+  const std::string dir = MakePart("recorded", 0, 5);
+  const PartialInfo part = ReadPartialInfo(dir);
+  ASSERT_EQ(part.files.size(), 2u);
+  for (const char* name : {"rocks.csv", "partial.bin"}) {
+    std::ifstream in(std::filesystem::path(dir) / name, std::ios::binary);
+    const std::string bytes(std::istreambuf_iterator<char>(in), {});
+    EXPECT_EQ(part.files.at(name).bytes, bytes.size()) << name;
+    EXPECT_EQ(part.files.at(name).sha256, Sha256Hex(bytes)) << name;
+  }
+  std::ifstream in(std::filesystem::path(dir) / "partial.json");
+  const nlohmann::json j = nlohmann::json::parse(in);
+  EXPECT_TRUE(j.contains("inputs_sha256"));
+  EXPECT_EQ(j["files"]["rocks.csv"]["sha256"], part.files.at("rocks.csv").sha256);
+}
+
+// A part that an older talus wrote (partial result format 3: FNV-1a 64 checksums, the inputs'
+// hash as "inputs_hash_fnv1a64") cannot be checked: it is refused, naming its partial.json and
+// saying how to run it again, never merged.
+TEST(ReadPartialInfo, APartOfAnOlderTalusIsRefusedSayingHowToRunItAgain) {
+  const std::string dir = MakePart("older", 5, 10);
+  const auto json_path = std::filesystem::path(dir) / "partial.json";
+  nlohmann::ordered_json j;
+  {
+    std::ifstream in(json_path);
+    j = nlohmann::ordered_json::parse(in);
+  }
+  j["format_version"] = 3;
+  j["inputs_hash_fnv1a64"] = "cbf29ce484222325";
+  j.erase("inputs_sha256");
+  for (auto& [name, entry] : j["files"].items()) {
+    entry.erase("sha256");
+    entry["fnv1a64"] = "af63bd4c8601b7df";
+  }
+  std::ofstream(json_path) << j.dump(2) << "\n";
+  try {
+    ReadPartialInfo(dir);
+    ADD_FAILURE() << "a part of an older talus was read";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              json_path.string() +
+                  ": a part written by an older talus (partial result format 3, this talus reads "
+                  "4; its checksums are FNV-1a, this talus checks SHA-256): run the part again "
+                  "with this talus (talus simulate scene.toml --rock-range 5:10 and the options "
+                  "it ran with)");
+  }
 }
 
 // Rows must be the part's rocks, each once and in order, even where the checksums agree (a

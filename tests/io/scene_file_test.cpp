@@ -91,7 +91,7 @@ TEST(LoadScene, PlaneSceneWithEveryRelease) {
   EXPECT_TRUE(request.speed && request.reach_probability);
   EXPECT_FALSE(request.energy || request.passages || request.deposits || request.jump_height);
   EXPECT_TRUE(s.crs_wkt.empty());
-  EXPECT_EQ(s.inputs_hash.size(), 16u);
+  EXPECT_EQ(s.inputs_hash.size(), 64u);  // SHA-256, hex
 }
 
 TEST(LoadScene, MinimalSceneUsesDefaults) {

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "common/sha256.hpp"
 #include "test_files.hpp"
 
 namespace talus::io {
@@ -25,7 +26,7 @@ TEST(SummaryJson, CarriesHashVersionCountsAndRate) {
   report.wall_time_s = 2.0;
   const auto j = nlohmann::json::parse(SummaryJson(scene, report, "9.9.9", {"rocks.csv"}));
   EXPECT_EQ(j["talus_version"], "9.9.9");
-  EXPECT_EQ(j["inputs_hash_fnv1a64"], scene.inputs_hash);
+  EXPECT_EQ(j["inputs_sha256"], scene.inputs_hash);
   EXPECT_EQ(j["ends"]["rest"], 7);
   EXPECT_EQ(j["ends"]["left_domain"], 2);
   EXPECT_EQ(j["ends"]["max_time"], 1);
@@ -92,12 +93,17 @@ TEST(SummaryJson, SolverIsTheOptionsTableInItsOrderThenThePreset) {
   EXPECT_EQ(j["solver"]["penetration_tolerance"], 0.01);
 }
 
+// The inputs' hash is the SHA-256 of the inputs' bytes in order: of a scene that reads no other
+// file, what `sha256sum scene.toml` prints.
 TEST(SummaryJson, HashFollowsTheInputs) {
   const auto dir = testing::FreshDir("hash");
   const std::string text =
       "[terrain]\nplane = {}\n[rock]\nshape = { box = [1, 1, 1] }\n[release]\npoints = [[10, 0]]\n";
   testing::WriteText(dir / "scene.toml", text);
-  const std::string a = LoadScene((dir / "scene.toml").string()).inputs_hash;
+  const SceneFile scene = LoadScene((dir / "scene.toml").string());
+  ASSERT_EQ(scene.inputs.size(), 1u);
+  const std::string a = scene.inputs_hash;
+  EXPECT_EQ(a, Sha256Hex(text));
   EXPECT_EQ(LoadScene((dir / "scene.toml").string()).inputs_hash, a);
   testing::WriteText(dir / "scene.toml", text + "# comment\n");
   EXPECT_NE(LoadScene((dir / "scene.toml").string()).inputs_hash, a);

@@ -41,7 +41,7 @@ fieldobs::ValidationReport Report() {
 // scores.json with `warnings` (a JSON array).
 std::string Scores(const std::string& warnings) {
   std::string scores = R"({"talus_version": "9.9", "event": "ev.toml", "scene": "scene.toml",
-  "inputs_hash_fnv1a64": "abc", "rocks_per_run": 6, "runs": 2, "seed": 3,
+  "inputs_sha256": "abc", "rocks_per_run": 6, "runs": 2, "seed": 3,
   "reference": {"parameters": "none", "simulated": false, "note": ""},
   "ends": {"rest": 10, "left_domain": 2, "max_time": 0, "failed": 0},
   "observations": 2, "observations_scored": 2, "not_scored": [],

@@ -6,11 +6,11 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <cstdint>
-#include <cstring>
 #include <limits>
+#include <string_view>
 #include <vector>
 
+#include "common/sha256.hpp"
 #include "scenes/scenes.hpp"
 #include "solver/random.hpp"
 #include "solver/shapes.hpp"
@@ -22,8 +22,9 @@ namespace {
 constexpr double kG = 9.81;
 const GroundParams kHard{0.55, 2.0, 185, 3.0, 0.4};
 
-// Everything an observer sees, step by step, folded into one FNV-1a hash (the StepReport's
-// `clear` aside: a flight step reports clear where the full step may have tested vertices).
+// Everything an observer sees, step by step, folded into one SHA-256 hash of the numbers' bytes
+// (the StepReport's `clear` aside: a flight step reports clear where the full step may have tested
+// vertices).
 class TraceHash : public StepObserver {
  public:
   void OnStep(const RockState& s, const StepReport& r, const TerrainSample& g) override {
@@ -40,16 +41,12 @@ class TraceHash : public StepObserver {
     Add(report, 5);
     ++steps;
   }
-  std::uint64_t hash = 14695981039346656037ull;
+  Sha256 hash;
   long steps = 0;
 
  private:
   void Add(const double* v, int n) {
-    for (int k = 0; k < n; ++k) {
-      std::uint64_t bits;
-      std::memcpy(&bits, &v[k], sizeof bits);
-      hash = (hash ^ bits) * 1099511628211ull;
-    }
+    hash.Add(std::string_view(reinterpret_cast<const char*>(v), sizeof(double) * n));
   }
 };
 
@@ -74,7 +71,8 @@ long ExpectSameBothWays(const Scene& scene, const RockState& start, const char* 
   const RockResult& b = windows.result;
   EXPECT_EQ(a.end, b.end) << what << " rock " << rock;
   EXPECT_EQ(a.steps, b.steps) << what << " rock " << rock;
-  EXPECT_EQ(every.trace.hash, windows.trace.hash) << what << " rock " << rock;
+  EXPECT_EQ(every.trace.hash.HexDigest(), windows.trace.hash.HexDigest())
+      << what << " rock " << rock;
   EXPECT_EQ(a.final_state.position_m, b.final_state.position_m) << what << " rock " << rock;
   EXPECT_EQ(a.final_state.orientation.coeffs(), b.final_state.orientation.coeffs())
       << what << " rock " << rock;
