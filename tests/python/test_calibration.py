@@ -23,6 +23,7 @@ def test_objective_and_calibration_are_the_programs(small_calibration, tmp_path)
 
     calibration = talus.Calibration.load(small_calibration, threads=1)
     assert [p["name"] for p in calibration.parameters] == ["medium.mu_min", "medium.kappa"]
+    assert all(p["prior"] is None for p in calibration.parameters)  # none stated
     # The fit starts at the scene's values: its first evaluation is the objective there.
     assert program[0]["start"] == "0"
     first = calibration.evaluate_unit(calibration.start_unit)
@@ -74,3 +75,18 @@ def test_bad_calibration_input(small_calibration, tmp_path):
     done = run_talus("calibrate", bad, "--out", tmp_path / "out", check=False)
     assert done.returncode == 2
     assert done.stderr.strip() == f"talus calibrate: {raised.value}"
+
+
+def test_a_parameters_prior_is_read_and_priced(small_calibration, tmp_path):
+    text = small_calibration.read_text()
+    text = text.replace('upper = 1.2\n', 'upper = 1.2\nprior = { mean = 0.5, sd = 0.1 }\n', 1)
+    text = text.replace('[objective]\n', '[objective]\nprior_weight = 0.2\n', 1)
+    path = tmp_path / "with_prior.toml"
+    path.write_text(text)
+    calibration = talus.Calibration.load(path, threads=2)
+    assert calibration.parameters[0]["prior"] == {"mean": 0.5, "sd": 0.1}
+    assert calibration.parameters[1]["prior"] is None  # kappa stays free: prior_reference "none"
+    start = calibration.start  # the scene's mu_min (Table 1 medium, 0.35)
+    e = calibration.evaluate_unit(calibration.start_unit)
+    assert e["prior"] == pytest.approx(0.2 * ((start[0] - 0.5) / 0.1) ** 2, rel=1e-12)
+    assert e["value"] == pytest.approx(e["data"] + e["prior"], rel=1e-12)
