@@ -23,6 +23,7 @@ using html::Json;
 using html::kEnergyUnit;
 using html::kJoulesPerEnergyUnit;
 using html::Number;
+using html::NumberOf;
 using svg::Add;
 using svg::Escape;
 
@@ -104,7 +105,8 @@ std::string WhatRanSection(const Json& summary) {
   html += html::KeyValueTable(
       summary, {"ends", "raised_at_release", "stayed_at_release", "steps", "unconverged_steps",
                 "threads", "wall_time_s", "trajectories_per_s", "outputs", "blocks",
-                "talus_version", "inputs_sha256", "evaluation_lines", "barriers", "warnings"});
+                "talus_version", "inputs_sha256", "evaluation_lines", "barriers", "forest",
+                "warnings"});
   if (summary.contains("rock") && summary["rock"].is_object()) {
     html += "<h3>Rock</h3>\n";
     html += html::KeyValueTable(summary["rock"]);
@@ -280,6 +282,50 @@ std::string BarriersSection(const Json& summary) {
   return html;
 }
 
+// "Forest": the model, the stands and trees it was given, and -- explicit trees -- what the
+// rocks did to them (tree_impacts.csv's summary). Absent without a forest.
+std::string ForestSection(const Json& summary) {
+  if (!summary.contains("forest") || !summary["forest"].is_object()) return "";
+  const Json& f = summary["forest"];
+  const bool trees = f.value("model", std::string()) == "trees";
+  std::string html = "<h2>Forest</h2>\n<table>\n";
+  const auto row = [&html](const std::string& label, const std::string& value) {
+    Add(html, "<tr><th>", label, "</th><td>", value, "</td></tr>\n");
+  };
+  row("model", trees ? "explicit trees (stems a rock's hull can hit)"
+                     : "drag layer (a drag from stem density and diameter)");
+  if (trees) row("trees", Cell(f["trees"]));
+  if (f.contains("stands") && f["stands"].is_array() && !f["stands"].empty()) {
+    std::string stands;
+    for (const Json& s : f["stands"])
+      Add(stands, stands.empty() ? "" : "; ", Number(NumberOf(s["stems_per_ha"]), "%.0f"),
+          " stems/ha of DBH ", Number(NumberOf(s["dbh_cm"]), "%.0f"), " cm on ",
+          Number(NumberOf(s["area_m2"]) / 1e4, "%.2f"), " ha");
+    row("stands", stands);
+  }
+  row("stem height (m)", Cell(f["stem_height_m"]));
+  if (f.contains("breaking_energy"))
+    row("energy a stem absorbs before it breaks",
+        Escape(f["breaking_energy"].value("law", std::string())) + ", coefficient " +
+            Cell(f["breaking_energy"]["coefficient_J"]) + " J, exponent " +
+            Cell(f["breaking_energy"]["exponent"]));
+  if (f.contains("impacts")) {
+    const Json& i = f["impacts"];
+    row("rocks that hit a stem", Cell(i["rocks_hitting"]));
+    row("impacts", Cell(i["impacts"]));
+    row("stems hit", Cell(i["stems_hit"]));
+    row("stems broken", Cell(i["breakages"]));
+    row("rocks that broke a stem", Cell(i["rocks_breaking"]));
+    row(std::string("energy the stems absorbed (") + kEnergyUnit + ")",
+        Number(NumberOf(i["absorbed_J"]) / kJoulesPerEnergyUnit));
+  }
+  html += "</table>\n";
+  if (trees)
+    html += "<p class=\"note\">Per rock and stem: tree_impacts.csv; hits per cell: "
+            "tree_hits.tif when asked for (docs/scenes.md, \"[forest]\").</p>\n";
+  return html;
+}
+
 // The ground table, the solver options and the files, as summary.json has them; the page's end.
 std::string SettingsSection(const Json& summary) {
   std::string html;
@@ -305,7 +351,7 @@ std::string RunReportHtml(const RunReportInput& input) {
   const Json summary = Json::parse(input.summary_json);
   return WhatRanSection(summary) + EndingsSection(summary) + MapsSection(input) +
          DistributionsSection(input.rocks) + EvaluationLinesSection(summary) +
-         BarriersSection(summary) + SettingsSection(summary);
+         BarriersSection(summary) + ForestSection(summary) + SettingsSection(summary);
 }
 
 }  // namespace talus::io
