@@ -287,11 +287,15 @@ std::vector<std::string> CalibrationWarnings(const CalibrationSummary& run,
     const bool singular = run.uncertainty && j < run.uncertainty->identified.size() &&
                           !run.uncertainty->identified[j];
     if (flat)
-      out.push_back(Format("%s is unidentified: over its whole range its profile changes the "
-                           "objective's data term by %.3g, less than %.3g (3 x the noise): the "
-                           "observations do not constrain it, and its fitted value is %s",
-                           c.name.c_str(), run.profiles[j].range, run.profiles[j].threshold,
-                           c.prior ? "its prior's" : "where the fit left it"));
+      out.push_back(
+          Format("%s is unidentified: over its whole range its profile changes the "
+                 "objective's data term by %.3g, less than %.3g (3 x the noise): the "
+                 "observations do not constrain it, and its fitted value is %s",
+                 c.name.c_str(), run.profiles[j].range, run.profiles[j].threshold,
+                 c.prior                    ? "its prior's"
+                 : objective.prior_center() ? "where the fit and the pull towards "
+                                              "the reference table left it"
+                                            : "where the fit left it"));
     else if (singular)
       out.push_back(c.name + " is unidentified by the covariance (J^T J is singular in it): the "
                              "observations do not constrain it");
@@ -300,10 +304,10 @@ std::vector<std::string> CalibrationWarnings(const CalibrationSummary& run,
     if (c.prior && jj < u.size()) {
       const double r = c.prior->Residual(c.ToValue(u[jj]));
       if (std::abs(r) > kPriorConflictSds)
-        out.push_back(Format("%s = %g lies %.1f sds from its prior %s: the observations pull "
-                             "away from what was stated; check the prior or the model",
-                             c.name.c_str(), c.ToValue(u[jj]), std::abs(r),
-                             c.prior->Describe().c_str()));
+        out.push_back(
+            Format("%s = %g lies %.1f sds from its prior %s: the observations pull "
+                   "away from what was stated; check the prior or the model",
+                   c.name.c_str(), c.ToValue(u[jj]), std::abs(r), c.prior->Describe().c_str()));
     }
     if (jj < u.size() && (u[jj] <= 1e-3 || u[jj] >= 1 - 1e-3)) {
       const bool low = u[jj] <= 1e-3;

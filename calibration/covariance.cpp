@@ -89,29 +89,32 @@ std::string Sandwich(const Objective& objective, const RowMajor& inverse, Uncert
     if (groups[static_cast<std::size_t>(i)] >= 0)
       gradients.row(groups[static_cast<std::size_t>(i)]) += out.residuals[i] * out.jacobian.row(i);
   for (int g = 0; g < group_count; ++g) out.groups += gradients.row(g).squaredNorm() > 0 ? 1 : 0;
-  // The parameters the runs estimate: identified and moving some run's residuals (one that only
-  // its prior holds takes no degree of freedom from the runs).
+  // The parameters the runs estimate: identified, moving some run's residuals, and with a
+  // profile that is not flat when profiles were measured (one that only its prior holds takes no
+  // degree of freedom from the runs).
   int free = 0;
   for (int j = 0; j < n; ++j) {
-    bool data = false;
-    for (int i = 0; i < m && !data; ++i)
-      data = groups[static_cast<std::size_t>(i)] >= 0 && out.jacobian(i, j) != 0;
-    free += out.identified[static_cast<std::size_t>(j)] && data ? 1 : 0;
+    bool data = out.profiles.size() != static_cast<std::size_t>(n) ||
+                out.profiles[static_cast<std::size_t>(j)].identified;
+    bool moves = false;
+    for (int i = 0; i < m && !moves; ++i)
+      moves = groups[static_cast<std::size_t>(i)] >= 0 && out.jacobian(i, j) != 0;
+    free += out.identified[static_cast<std::size_t>(j)] && data && moves ? 1 : 0;
   }
   if (out.groups <= free)
     return "No covariance: " + std::to_string(out.groups) + " runs with a score gradient for " +
            std::to_string(free) + " parameters.";
   const Eigen::MatrixXd bread = inverse;
-  const Eigen::MatrixXd meat = gradients.transpose() * gradients *
-                               (double(out.groups) / double(out.groups - free));
+  const Eigen::MatrixXd meat =
+      gradients.transpose() * gradients * (double(out.groups) / double(out.groups - free));
   // The prior's rows as pseudo-observations: a residual sqrt(w) (value - mean) / sd whose mean is
   // uncertain by its sd varies with variance w, so its score gradient J_i^T r_i has variance
   // w J_i^T J_i. A coordinate held by its prior alone then gets the prior's sd.
   Eigen::MatrixXd prior_meat = Eigen::MatrixXd::Zero(n, n);
   for (int i = 0; i < m; ++i)
     if (groups[static_cast<std::size_t>(i)] < 0)
-      prior_meat += objective.options().prior_weight * out.jacobian.row(i).transpose() *
-                    out.jacobian.row(i);
+      prior_meat +=
+          objective.options().prior_weight * out.jacobian.row(i).transpose() * out.jacobian.row(i);
   out.covariance_unit = bread * (meat + prior_meat) * bread;
   out.computed = true;
   return "";
@@ -232,11 +235,17 @@ Uncertainty EstimateUncertainty(const Objective& objective, const Eigen::VectorX
 
   const QuietCeresLog quiet;
   RowMajor inverse = RowMajor::Zero(n, n);  // (J^T J)^-1 of the identified coordinates
-  std::vector<int> flat;                    // coordinates whose given profile is flat
+  // A coordinate with a prior term is constrained by its prior rows even where the observations
+  // leave it free (a flat profile): it stays in the covariance, with its prior's uncertainty.
+  const std::vector<int>& with_prior = objective.prior_coordinates();
+  const auto has_prior = [&](int j) {
+    return std::find(with_prior.begin(), with_prior.end(), j) != with_prior.end();
+  };
+  std::vector<int> flat;  // coordinates whose given profile is flat and that no prior holds
   if (static_cast<int>(options.profiles.size()) == n) {
     out.profiles = options.profiles;
     for (int j = 0; j < n; ++j)
-      if (!options.profiles[static_cast<std::size_t>(j)].identified) {
+      if (!options.profiles[static_cast<std::size_t>(j)].identified && !has_prior(j)) {
         out.identified[static_cast<std::size_t>(j)] = false;
         flat.push_back(j);
       }
@@ -253,7 +262,7 @@ Uncertainty EstimateUncertainty(const Objective& objective, const Eigen::VectorX
     std::vector<int> constant;
     for (int j = 0; j < n; ++j) {
       out.identified[static_cast<std::size_t>(j)] =
-          out.profiles[static_cast<std::size_t>(j)].identified;
+          out.profiles[static_cast<std::size_t>(j)].identified || has_prior(j);
       if (!out.identified[static_cast<std::size_t>(j)]) constant.push_back(j);
     }
     ok = InverseOfJtJ(problem, x, constant, options, &inverse);

@@ -12,7 +12,8 @@
 // (J^T J)^-1 at the optimum (dense SVD), and the covariance is (J^T J)^-1 M (J^T J)^-1 with
 // M = sum_g (J_g^T r_g)(J_g^T r_g)^T. A prior (objective.hpp) adds its rows to J^T J and, as
 // pseudo-observations whose stated mean is uncertain by its sd, w J_p^T J_p to M: a coordinate
-// that only its prior holds gets the prior's sd, one the runs hold is unchanged. Where J^T J is rank-deficient, Ceres refuses: each
+// that only its prior holds (its profile flat) is kept, and gets the prior's sd; one the runs
+// hold gets the combination of both. Where J^T J is rank-deficient, Ceres refuses: each
 // parameter is then profiled (ProfileParameters) and those whose profile is flat are held
 // constant (a ceres::SubsetManifold) for the covariance of the others, and reported unidentified.
 // Profiles measured beforehand (UncertaintyOptions::profiles) are used the same way from the

@@ -158,7 +158,8 @@ class Objective {
   Eigen::VectorXd PriorResiduals(const Eigen::VectorXd& u) const;
   // The prior term at u: prior_weight * |PriorResiduals(u)|^2 (0 without a prior).
   double PriorTerm(const Eigen::VectorXd& u) const {
-    return prior_coordinates_.empty() ? 0.0 : options_.prior_weight * PriorResiduals(u).squaredNorm();
+    return prior_coordinates_.empty() ? 0.0
+                                      : options_.prior_weight * PriorResiduals(u).squaredNorm();
   }
   bool needs_episodes() const { return episodes_; }
   // Per residual (Evaluation::residuals): the group of observations it belongs to -- one group

@@ -118,7 +118,8 @@ bool ParameterSpec::IsValid(std::string* why) const {
     msg << "upper = " << upper << " must be <= " << kMaxFriction << " for a friction coefficient";
   else if (roughness && upper > kMaxRoughness)
     msg << "upper = " << upper << " must be <= " << kMaxRoughness << " for a roughness";
-  else if (prior && !std::isfinite(prior->mean + prior->sd + prior->factor))
+  else if (prior && !(std::isfinite(prior->mean) && std::isfinite(prior->sd) &&
+                      std::isfinite(prior->factor)))
     msg << "prior: mean, sd and factor must be finite";
   else if (prior && (prior->sd > 0) == (prior->factor > 0))
     msg << "prior: give sd (> 0, a normal prior) or factor (> 1, a log-normal one), one of them";
@@ -128,9 +129,12 @@ bool ParameterSpec::IsValid(std::string* why) const {
     msg << "prior: sd and factor must be positive";
   else if (prior && prior->IsLogNormal() && !(prior->mean > 0))
     msg << "prior: mean = " << prior->mean << " must be > 0 for a log-normal prior";
+  else if (prior && prior->IsLogNormal() && !(lower > 0))
+    msg << "prior: a log-normal prior needs lower > 0 (at " << lower
+        << " its log would be infinite): raise the lower bound";
   else if (prior && !(prior->mean >= lower && prior->mean <= upper))
-    msg << "prior: mean = " << prior->mean << " lies outside the bounds [" << lower << ", "
-        << upper << "] (the prior would pull against a bound: widen the bounds)";
+    msg << "prior: mean = " << prior->mean << " lies outside the bounds [" << lower << ", " << upper
+        << "] (the prior would pull against a bound: widen the bounds)";
   if (msg.str().empty()) return true;
   if (why) *why = Name() + ": " + msg.str();
   return false;

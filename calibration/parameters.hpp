@@ -104,7 +104,7 @@ struct Coordinate {
   std::vector<int> members;  // indices into ParameterSet::specs()
   double lower = 0, upper = 0;
   bool log = false;
-  std::optional<Prior> prior;  // its members' own prior, if one states it
+  std::optional<Prior> prior;         // its members' own prior, if one states it
   double ToValue(double u) const;     // unit coordinate -> value (u clamped to [0, 1])
   double ToUnit(double value) const;  // value -> unit coordinate (not clamped)
 };

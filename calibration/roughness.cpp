@@ -102,7 +102,8 @@ std::vector<ParameterProfile> ProfileParameters(const Objective& objective,
     ParameterProfile p;
     p.name = objective.parameters().coordinates()[j].name;
     // Identified by the observations: the range of the data term, not of a prior's.
-    double lo = f_u - objective.PriorTerm(u), hi = lo;
+    const double data_u = f_u - objective.PriorTerm(u);
+    double lo = data_u, hi = lo;
     for (int k = 0; k < points; ++k) {
       Eigen::VectorXd v = u;
       v[j] = double(k) / (points - 1);
@@ -115,7 +116,8 @@ std::vector<ParameterProfile> ProfileParameters(const Objective& objective,
       hi = std::max(hi, e.data);
     }
     p.range = hi - lo;
-    p.threshold = std::max(options.noise_multiple * noise, options.relative_floor * std::abs(f_u));
+    p.threshold =
+        std::max(options.noise_multiple * noise, options.relative_floor * std::abs(data_u));
     p.identified = p.range > p.threshold;
     out.push_back(p);
   }

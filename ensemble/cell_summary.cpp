@@ -48,8 +48,8 @@ double ValueSummary::Midpoint(int bin, int level) {
   // The top bin's upper edge may pass the largest float: its bits are taken as an integer.
   const auto edge = [level](std::uint64_t m) {
     const std::uint64_t bits = m << (kShift + level);
-    return bits >= 0x7f800000u ? std::ldexp(1.0, 128) : static_cast<double>(
-                                                            FloatOf(static_cast<std::uint32_t>(bits)));
+    return bits >= 0x7f800000u ? std::ldexp(1.0, 128)
+                               : static_cast<double>(FloatOf(static_cast<std::uint32_t>(bits)));
   };
   const double mid = 0.5 * (edge(static_cast<std::uint64_t>(magnitude)) +
                             edge(static_cast<std::uint64_t>(magnitude) + 1));
@@ -65,7 +65,8 @@ void ValueSummary::CoarsenTo(int level) {
     for (std::size_t k = 0; k < bins_.size(); ++k) {
       const int key = bins_[k].key;
       const int magnitude = key >= 0 ? key : -key - 1;
-      const auto parent = static_cast<std::int16_t>(key >= 0 ? magnitude / 2 : -(magnitude / 2) - 1);
+      const auto parent =
+          static_cast<std::int16_t>(key >= 0 ? magnitude / 2 : -(magnitude / 2) - 1);
       if (out > 0 && bins_[out - 1].key == parent)
         bins_[out - 1].count += bins_[k].count;
       else
@@ -90,6 +91,7 @@ void ValueSummary::Add(float value) {
   else
     bins_.insert(at, Bin{key, 1});
   CoarsenToFit();
+  if (value == 0.0f) value = 0.0f;  // -0 as +0: min and max keep no trace of the order
   const double clamped = std::clamp(static_cast<double>(value), -kLargest, kLargest);
   sum_ += static_cast<Int128>(std::nearbyint(clamped * kQuantum));
   min_ = count_ == 0 ? value : std::min(min_, value);
@@ -150,8 +152,7 @@ float ValueSummary::AtRank(std::int64_t rank) const {
   std::int64_t seen = 0;
   for (const Bin& bin : bins_) {
     seen += bin.count;
-    if (seen >= rank)
-      return std::clamp(static_cast<float>(Midpoint(bin.key, level_)), min_, max_);
+    if (seen >= rank) return std::clamp(static_cast<float>(Midpoint(bin.key, level_)), min_, max_);
   }
   return max_;
 }
@@ -182,13 +183,13 @@ ValueSummary ValueSummary::Deserialize(ByteReader& in) {
   const auto low = in.Get<std::uint64_t>();
   s.sum_ = static_cast<Int128>((static_cast<UInt128>(high) << 64) | low);
   s.level_ = in.Get<std::int32_t>();
-  if (s.level_ < 0 || s.level_ > 31 - kShift) in.Fail();
+  if (s.level_ < 0 || s.level_ > 31 - kShift || (s.count_ > 0 && !(s.min_ <= s.max_))) in.Fail();
   const auto keys = in.GetVector<std::int16_t>();
   const auto counts = in.GetVector<std::uint32_t>();
   if (keys.size() != counts.size()) in.Fail();
   std::int64_t total = 0;
   for (std::size_t k = 0; k < keys.size(); ++k) {
-    if (k > 0 && keys[k] <= keys[k - 1]) in.Fail();
+    if ((k > 0 && keys[k] <= keys[k - 1]) || counts[k] == 0) in.Fail();
     s.bins_.push_back({keys[k], counts[k]});
     total += counts[k];
   }

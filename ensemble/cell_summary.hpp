@@ -81,9 +81,9 @@ class ValueSummary {
     std::int16_t key;
     std::uint32_t count;
   };
-  std::vector<Bin> bins_;    // ascending keys
-  std::int32_t level_ = 0;   // here, in the padding before the 16-byte aligned sum: 64 bytes in all
-  Int128 sum_ = 0;           // sum of round(v * 2^24)
+  std::vector<Bin> bins_;   // ascending keys
+  std::int32_t level_ = 0;  // here, in the padding before the 16-byte aligned sum: 64 bytes in all
+  Int128 sum_ = 0;          // sum of round(v * 2^24)
   std::int64_t count_ = 0;
   float min_ = 0, max_ = 0;
 };

@@ -285,6 +285,7 @@ std::vector<BlockBias> BiasByBlock(const std::vector<ObservationScore>& scores,
       b.block = block;
       b.kind = kind;
       std::vector<double> bias;
+      std::vector<std::string> run_of;  // per observation in `bias`
       double score = 0;
       for (const ObservationScore& s : scores) {
         const auto it = block_of.find(s.run);
@@ -293,16 +294,21 @@ std::vector<BlockBias> BiasByBlock(const std::vector<ObservationScore>& scores,
           continue;
         b.unit = s.unit;
         bias.push_back(s.bias);
+        run_of.push_back(s.run);
         score += s.score;
         ++b.scored;
       }
       if (b.scored == 0) continue;
       b.mean_bias = Mean(bias);
       b.mean_score = score / b.scored;
-      if (b.scored >= 2) {
+      std::map<std::string, double> by_run;  // S_g
+      for (std::size_t i = 0; i < bias.size(); ++i) by_run[run_of[i]] += bias[i] - b.mean_bias;
+      b.runs = static_cast<int>(by_run.size());
+      if (b.runs >= 2) {
         double ss = 0;
-        for (double x : bias) ss += (x - b.mean_bias) * (x - b.mean_bias);
-        b.bias_standard_error = std::sqrt(ss / (b.scored - 1) / b.scored);
+        for (const auto& [run, sum] : by_run) ss += sum * sum;
+        const double g = b.runs, n = b.scored;
+        b.bias_standard_error = std::sqrt(g / (g - 1) * ss / (n * n));
       }
       out.push_back(b);
     }

@@ -86,11 +86,16 @@ struct ValidationOptions {
 struct BlockBias {
   std::string block;  // ensemble::Block::id; "[rock]" for runs without a block
   std::string kind, unit;
-  int scored = 0;
+  int scored = 0;           // observations
+  int runs = 0;             // the runs they belong to
   double mean_bias = kNaN;  // mean over the observations of (simulated mean - observed)
-  // Its standard error over the runs: the sd of the observations' biases / sqrt(scored) (NaN
-  // below 2). Runs of one block scatter (the Tschamut plate's observed run-outs by 25 m), so a
-  // block's bias over 4 runs is uncertain by about 12 m: judge a bias against it.
+  // Its standard error over the runs (NaN below 2 runs), clustered by run as the calibration's
+  // sandwich is: observations of one run (zones, segments, impacts) share its rocks and are not
+  // independent. With b the mean bias and S_g the sum of (bias - b) over run g's observations,
+  //   se^2 = G / (G - 1) * sum_g S_g^2 / scored^2,
+  // which is sd / sqrt(G) for one observation per run. Runs of one block scatter (the Tschamut
+  // plate's observed run-outs by 25 m), so a block's bias over 4 runs is uncertain by about
+  // 12 m: judge a bias against it.
   double bias_standard_error = kNaN;
   double mean_score = kNaN;
 };

@@ -109,10 +109,13 @@ void LoadParameters(const Context& context, const toml::table& root, Calibration
     spec.tie = s.String("tie", "");
     if (const toml::node* prior = s.Node("prior")) {
       if (!prior->is_table())
-        s.Fail("prior", "expected a table { mean = ..., sd = ... } or { mean = ..., factor = ... }");
+        s.Fail("prior",
+               "expected a table { mean = ..., sd = ... } or { mean = ..., factor = ... }");
       const Section p(context, prior->as_table(), name + ".prior", {"mean", "sd", "factor"});
-      if (!p.Has("mean")) p.Fail("mean", std::string("missing: the prior's mean, in ") + spec.Unit());
-      spec.prior = calibration::Prior{p.Number("mean", 0), p.Number("sd", 0), p.Number("factor", 0)};
+      if (!p.Has("mean"))
+        p.Fail("mean", std::string("missing: the prior's mean, in ") + spec.Unit());
+      spec.prior =
+          calibration::Prior{p.Number("mean", 0), p.Number("sd", 0), p.Number("factor", 0)};
     }
     std::string why;
     if (!spec.IsValid(&why))
@@ -172,7 +175,8 @@ void LoadObjective(const Context& context, const toml::table* table, Calibration
   if (own_priors && out.objective.prior_weight == 0 && s.Has("prior_weight"))
     s.Fail("prior_weight", kPriorNeedsWeight);
   if (out.objective.prior_weight > 0 && !own_priors && out.prior_reference == "none")
-    s.Fail("prior_reference", "\"none\" with no parameter's own prior: prior_weight acts on nothing");
+    s.Fail("prior_reference",
+           "\"none\" with no parameter's own prior: prior_weight acts on nothing");
   if (out.objective.prior_weight > 0 && out.prior_reference != "none")
     out.objective.prior_reference = out.prior_reference == "scene"
                                         ? out.event.scene.scene.ground
@@ -399,7 +403,8 @@ CalibrationFile LoadCalibration(const std::string& path) {
   for (const ParameterSpec& p : out.parameters) {
     path_text << ' ' << p.Name() << ' ' << p.lower << ' ' << p.upper << ' ' << p.UsesLog() << ' '
               << p.tie;
-    if (p.prior) path_text << " prior " << p.prior->mean << ' ' << p.prior->sd << ' ' << p.prior->factor;
+    if (p.prior)
+      path_text << " prior " << p.prior->mean << ' ' << p.prior->sd << ' ' << p.prior->factor;
   }
   const calibration::ObjectiveOptions& ob = out.objective;
   for (const auto& [kind, weight] : ob.weights) path_text << ' ' << kind << ' ' << weight;

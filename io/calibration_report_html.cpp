@@ -137,9 +137,10 @@ std::string HeldOutSection(const Json& c) {
            HeldOutKinds(c["cross_validation"]["kinds"]) +
            html::BlockBiasTable(c["cross_validation"].value("blocks", Json()));
   }
+  const bool held_out = !out.empty();
   const std::string fitted = html::BlockBiasTable(c.value("fitted_runs_blocks", Json()));
   if (!fitted.empty()) out += "<h2>Bias per block, fitted runs</h2>\n" + fitted;
-  if (!out.empty())
+  if (held_out)
     out +=
         "<p class=\"note\">Skill = 1 - fitted / reference: below 0 the fitted parameters predict "
         "runs they were not fitted to worse than the reference does.</p>\n";

@@ -153,21 +153,27 @@ std::string Table(const std::vector<std::string>& header,
 }
 
 std::string BlockBiasTable(const Json& blocks) {
-  if (!blocks.is_array() || blocks.empty()) return "";
+  // Nothing to compare without blocks: a scene's single rock ("[rock]") alone is no table.
+  if (!blocks.is_array() || std::none_of(blocks.begin(), blocks.end(), [](const Json& b) {
+        return b.value("block", std::string()) != "[rock]";
+      }))
+    return "";
   std::vector<std::vector<std::string>> rows;
   for (const Json& b : blocks)
     rows.push_back({svg::Escape(b.value("block", std::string())),
                     svg::Escape(HumanLabel(b.value("kind", std::string()))) +
                         UnitSuffix(b.value("unit", std::string())),
-                    Cell(b["scored"]), Number(NumberOf(b["mean_bias"])),
+                    Cell(b.value("runs", Json())), Cell(b.value("scored", Json())),
+                    Number(NumberOf(b.value("mean_bias", Json()))),
                     Number(NumberOf(b.value("bias_standard_error", Json()))),
-                    Number(NumberOf(b["mean_score"]))});
-  return Table({"block", "kind (unit)", "runs scored", "mean bias", "its standard error",
+                    Number(NumberOf(b.value("mean_score", Json())))});
+  return Table({"block", "kind (unit)", "runs", "observations", "mean bias", "its standard error",
                 "mean score"},
                rows) +
-         "<p class=\"note\">Bias = simulated mean - observed, over the block's runs; its standard "
-         "error is the sd of the runs' biases / sqrt(runs). Biases of opposite sign per block "
-         "point at the blocks' shapes (docs/calibration.md, \"Shape parameters\").</p>\n";
+         "<p class=\"note\">Bias = simulated mean - observed, over the block's observations; its "
+         "standard error is over the block's runs (observations of one run share its rocks). "
+         "Biases of opposite sign per block point at the blocks' shapes (docs/calibration.md, "
+         "\"Shape parameters\").</p>\n";
 }
 
 std::string Warnings(const Json& warnings) {

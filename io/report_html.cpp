@@ -103,10 +103,10 @@ std::string WhatRanSection(const Json& summary) {
 
   html += "<h2>What ran</h2>\n";
   html += html::KeyValueTable(
-      summary, {"ends", "raised_at_release", "stayed_at_release", "steps", "unconverged_steps",
-                "threads", "wall_time_s", "trajectories_per_s", "outputs", "blocks",
-                "talus_version", "inputs_sha256", "evaluation_lines", "barriers", "forest",
-                "warnings"});
+      summary,
+      {"ends", "raised_at_release", "stayed_at_release", "steps", "unconverged_steps", "threads",
+       "wall_time_s", "trajectories_per_s", "outputs", "blocks", "talus_version", "inputs_sha256",
+       "evaluation_lines", "barriers", "forest", "warnings"});
   if (summary.contains("rock") && summary["rock"].is_object()) {
     html += "<h3>Rock</h3>\n";
     html += html::KeyValueTable(summary["rock"]);
@@ -321,8 +321,9 @@ std::string ForestSection(const Json& summary) {
   }
   html += "</table>\n";
   if (trees)
-    html += "<p class=\"note\">Per rock and stem: tree_impacts.csv; hits per cell: "
-            "tree_hits.tif when asked for (docs/scenes.md, \"[forest]\").</p>\n";
+    html +=
+        "<p class=\"note\">Per rock and stem: tree_impacts.csv; hits per cell: "
+        "tree_hits.tif when asked for (docs/scenes.md, \"[forest]\").</p>\n";
   return html;
 }
 

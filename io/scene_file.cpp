@@ -5,9 +5,9 @@
 #include <algorithm>
 #include <fstream>
 
-#include "common/format.hpp"
 #include "common/closest_name.hpp"
 #include "common/error.hpp"
+#include "common/format.hpp"
 #include "common/sha256.hpp"
 #include "io/scene_tables.hpp"
 #include "io/toml_section.hpp"

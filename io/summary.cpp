@@ -130,8 +130,7 @@ std::string SummaryJson(const SceneFile& scene, const ensemble::EnsembleReport& 
                         const std::string& version, const std::vector<std::string>& outputs,
                         const std::vector<EvaluationLineSummary>& evaluation_lines,
                         const ensemble::SelfCheckReport* self_check,
-                        const std::vector<BarrierSummary>& barriers,
-                        const TreeImpactSummary* trees,
+                        const std::vector<BarrierSummary>& barriers, const TreeImpactSummary* trees,
                         const std::vector<ensemble::RasterLayer>& rasters) {
   nlohmann::ordered_json j;
   j["talus_version"] = version;

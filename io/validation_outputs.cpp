@@ -36,6 +36,7 @@ nlohmann::ordered_json BlockBiasJson(const std::vector<fieldobs::BlockBias>& bia
                    {"kind", b.kind},
                    {"unit", b.unit},
                    {"scored", b.scored},
+                   {"runs", b.runs},
                    {"mean_bias", Num(b.mean_bias)},
                    {"bias_standard_error", Num(b.bias_standard_error)},
                    {"mean_score", Num(b.mean_score)}});

@@ -113,6 +113,7 @@ py::list Parameters(const Calibration& c) {
     d["log"] = coordinate.log;
     if (coordinate.prior) {
       py::dict prior;
+      prior["kind"] = coordinate.prior->IsLogNormal() ? "log-normal" : "normal";
       prior["mean"] = coordinate.prior->mean;
       if (coordinate.prior->IsLogNormal())
         prior["factor"] = coordinate.prior->factor;
@@ -191,9 +192,11 @@ void BindCalibration(py::module_& m) {
                              "The optimiser's coordinates: name, bounds, unit, log transform, "
                              "the parameter's own prior (mean and sd or factor; None) and the "
                              "parameters a tie joins.")
-      .def_property_readonly("dimension", [](const Calibration& c) { return c.objective().dimension(); })
-      .def_property_readonly("kinds", [](const Calibration& c) { return c.objective().kinds(); },
-                             "The observation kinds the objective scores, in order.")
+      .def_property_readonly("dimension",
+                             [](const Calibration& c) { return c.objective().dimension(); })
+      .def_property_readonly(
+          "kinds", [](const Calibration& c) { return c.objective().kinds(); },
+          "The observation kinds the objective scores, in order.")
       .def_property_readonly("holdout", [](const Calibration& c) { return c.problem->holdout(); })
       .def_property_readonly("fitted_runs",
                              [](const Calibration& c) {

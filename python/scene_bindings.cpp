@@ -489,8 +489,9 @@ void BindScene(py::module_& m) {
           "A scene from Python values: a dict laid out as a scene file's tables (e.g. "
           "{'terrain': {'dem': 'dem.tif'}, 'release': {...}, 'rock': {...}}). `path` names it in "
           "errors, and files it names are found relative to its folder.")
-      .def("copy", [](const io::SceneFile& f) { return std::make_shared<io::SceneFile>(f); },
-           "An independent copy (terrain and shapes are shared, immutable).")
+      .def(
+          "copy", [](const io::SceneFile& f) { return std::make_shared<io::SceneFile>(f); },
+          "An independent copy (terrain and shapes are shared, immutable).")
       .def_readonly("path", &io::SceneFile::path)
       .def_readonly("crs_wkt", &io::SceneFile::crs_wkt, "The DEM's CRS as WKT; '' for none.")
       .def_readonly("terrain_description", &io::SceneFile::terrain_description)
@@ -501,13 +502,15 @@ void BindScene(py::module_& m) {
                     "SHA-256 (hex) of the scene and every file it read: summary.json's "
                     "inputs_sha256.")
       .def_property_readonly(
-          "ground", [](const io::SceneFile& f) { return FromJson(io::GroundTableJson(f.scene.ground)); },
+          "ground",
+          [](const io::SceneFile& f) { return FromJson(io::GroundTableJson(f.scene.ground)); },
           "The ground table: {category: {code, model, mu_min, mu_max, beta, kappa, nu, ...}} as "
           "summary.json lists it.")
       .def("set_ground", &SetGround, py::arg("category"),
            "Sets fields of a ground category by their scene keys, e.g. "
            "set_ground('medium', mu_min=0.3, kappa=2.5).")
-      .def_property_readonly("solver", [](const io::SceneFile& f) { return SolverDict(f.scene.options); })
+      .def_property_readonly("solver",
+                             [](const io::SceneFile& f) { return SolverDict(f.scene.options); })
       .def("set_solver", &SetSolver,
            "Sets dt_s, max_time_s, tolerance_m_s or max_iterations, e.g. set_solver(dt_s=0.001).")
       .def_property(
@@ -524,17 +527,20 @@ void BindScene(py::module_& m) {
             f.release.seed = static_cast<std::uint64_t>(seed);
           },
           "The release's random seed, as talus simulate --seed sets it.")
-      .def_property_readonly("total_rocks", [](const io::SceneFile& f) { return f.release.total_rocks(); })
-      .def_property_readonly("releases",
-                             [](const io::SceneFile& f) {
-                               std::vector<std::string> names;
-                               for (long r = 0; r < f.release.release_count(); ++r)
-                                 names.push_back(f.release.ReleaseName(static_cast<int>(r)));
-                               return names;
-                             },
-                             "The name of every release geometry or run, in order.")
-      .def_property_readonly("geotransform", &GeoTransform,
-                             "GDAL geotransform of the rasters (north-up, DEM nodes at cell centres).")
+      .def_property_readonly("total_rocks",
+                             [](const io::SceneFile& f) { return f.release.total_rocks(); })
+      .def_property_readonly(
+          "releases",
+          [](const io::SceneFile& f) {
+            std::vector<std::string> names;
+            for (long r = 0; r < f.release.release_count(); ++r)
+              names.push_back(f.release.ReleaseName(static_cast<int>(r)));
+            return names;
+          },
+          "The name of every release geometry or run, in order.")
+      .def_property_readonly(
+          "geotransform", &GeoTransform,
+          "GDAL geotransform of the rasters (north-up, DEM nodes at cell centres).")
       .def("simulate", &Simulate, py::arg("threads") = 0, py::arg("rocks") = py::none(),
            py::arg("trajectories") = false, py::arg("trajectory_interval_s") = 0.0,
            py::arg("rasters") = true,

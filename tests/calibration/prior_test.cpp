@@ -70,6 +70,11 @@ TEST(Prior, NonsenseIsRefusedWithTheReason) {
   rough.upper = 0.4;
   EXPECT_NE(Why(WithPrior(rough, {0, 0, 2})).find("must be > 0 for a log-normal prior"),
             std::string::npos);
+  EXPECT_NE(Why(WithPrior(rough, {0.2, 0, 2})).find("a log-normal prior needs lower > 0"),
+            std::string::npos);
+  rough.lower = 0.01;
+  std::string fine;
+  EXPECT_TRUE(WithPrior(rough, {0.2, 0, 2}).IsValid(&fine)) << fine;
   std::string why;
   EXPECT_TRUE(WithPrior(mu, {0.5, 0.1, 0}).IsValid(&why)) << why;
 }
@@ -189,6 +194,20 @@ TEST(Prior, UncertaintyCombinesTheRunsAndThePrior) {
   // Without the priors' pseudo-observation variance the first would be the data's alone,
   // sqrt(ss 6/5) / (6 + precision) -- smaller; the prior-held one would be 0.
   EXPECT_GT(se, std::sqrt(ss * 6 / 5) / (6 + precision) * 1.05);
+
+  // As talus calibrate runs it: with the profiles measured beforehand, the second's flat (the
+  // runs do not see it) -- it stays in the covariance, held by its prior, with the same numbers.
+  const Eigen::Vector2d at((theta - 0.2) / 0.6, 0.5);
+  options.profiles =
+      ProfileParameters(objective, at, objective.Evaluate(at).value, 0.0, ProfileOptions{});
+  ASSERT_EQ(options.profiles.size(), 2u);
+  EXPECT_TRUE(options.profiles[0].identified);
+  EXPECT_FALSE(options.profiles[1].identified);  // the data term does not change along it
+  const Uncertainty pipeline = EstimateUncertainty(objective, at, options);
+  ASSERT_TRUE(pipeline.computed) << pipeline.note;
+  EXPECT_TRUE(pipeline.identified[1]);
+  EXPECT_NEAR(pipeline.standard_error[0], se, 1e-9 * se);
+  EXPECT_NEAR(pipeline.standard_error[1], 0.3, 1e-9);
 }
 
 // A fitted value more than 2 sds from its own prior's mean is a warning (the data and what the

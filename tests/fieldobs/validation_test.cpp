@@ -374,6 +374,7 @@ TEST(BiasByBlock, MeansOverEachBlocksRunsByHand) {
   EXPECT_EQ(biases[0].block, "St. Leonard");
   EXPECT_EQ(biases[0].scored, 2);
   EXPECT_EQ(biases[0].mean_bias, 20);
+  EXPECT_EQ(biases[0].runs, 2);
   EXPECT_DOUBLE_EQ(biases[0].bias_standard_error, 10);  // biases 30, 10: sd 14.14 / sqrt 2
   EXPECT_EQ(biases[0].mean_score, 14);
   EXPECT_EQ(biases[1].block, "Plate");
@@ -384,6 +385,38 @@ TEST(BiasByBlock, MeansOverEachBlocksRunsByHand) {
   EXPECT_EQ(biases[2].mean_bias, 4);
   EXPECT_EQ(biases[2].kind, "runout");
   EXPECT_EQ(biases[2].unit, "m");
+}
+
+// Observations of one run are not independent: the standard error is clustered by run. Run a
+// holds biases 10 and 30, run c 0 and run d -40 (all of one block): mean 0, run sums S = 40, 0,
+// -40, se^2 = 3/2 * (1600 + 0 + 1600) / 16 = 300. Counted as four independent observations it
+// would be sd / 2 = sqrt(1400 / 3) / 2 = 10.8 instead of 17.3.
+TEST(BiasByBlock, StandardErrorIsClusteredByRun) {
+  ensemble::ReleaseSpec release;
+  release.blocks = {{"B", nullptr, {}, {}}};
+  for (const std::string id : {"a", "c", "d"}) {
+    ensemble::ReleaseRun run;
+    run.id = id;
+    run.block = 0;
+    release.runs.push_back(run);
+  }
+  const auto score = [](const std::string& run, double bias) {
+    ObservationScore s;
+    s.run = run;
+    s.kind = "zone_speed";
+    s.unit = "m/s";
+    s.bias = bias;
+    s.score = 1;
+    s.scored = true;
+    return s;
+  };
+  const std::vector<BlockBias> biases =
+      BiasByBlock({score("a", 10), score("a", 30), score("c", 0), score("d", -40)}, release);
+  ASSERT_EQ(biases.size(), 1u);
+  EXPECT_EQ(biases[0].scored, 4);
+  EXPECT_EQ(biases[0].runs, 3);
+  EXPECT_DOUBLE_EQ(biases[0].mean_bias, 0);
+  EXPECT_NEAR(biases[0].bias_standard_error, std::sqrt(300.0), 1e-12);
 }
 
 }  // namespace

@@ -203,8 +203,8 @@ TEST(LoadCalibration, AParametersOwnPriorIsReadAndChecked) {
       MakeCalibration("prior2", "", "prior = { mean = 0.5, sd = 0.2 }\n" + objective));
   EXPECT_NE(normal.path_hash, wider.path_hash);
   const CalibrationFile log_normal = LoadCalibration(MakeCalibration(
-      "prior3", "", "prior = { mean = 0.4, factor = 1.5 }\n" + objective +
-                        "prior_reference = \"table1\"\n"));
+      "prior3", "",
+      "prior = { mean = 0.4, factor = 1.5 }\n" + objective + "prior_reference = \"table1\"\n"));
   EXPECT_EQ(log_normal.parameters[0].prior->factor, 1.5);
   EXPECT_TRUE(log_normal.objective.prior_reference.has_value());
 
@@ -214,7 +214,8 @@ TEST(LoadCalibration, AParametersOwnPriorIsReadAndChecked) {
       {"prior = { mean = 0.5, sd = 0.1 }\n",
        ":7: parameters[0].prior: a parameter's prior acts only with [objective] prior_weight > 0"},
       {"prior = { mean = 0.5, sd = 0.1 }\n[objective]\nprior_weight = 0\n",
-       ":9: objective.prior_weight: a parameter's prior acts only with [objective] prior_weight > 0"},
+       ":9: objective.prior_weight: a parameter's prior acts only with [objective] prior_weight > "
+       "0"},
       {"prior = { mean = 1.5, sd = 0.1 }\n" + objective,
        ":7: parameters[0].prior: medium_soft.mu_min: prior: mean = 1.5 lies outside the bounds "
        "[0.1, 0.9]"},

@@ -31,7 +31,7 @@ const char* kCalibration = R"({"version": "9.9", "calibration_file": "cal.toml",
   "warnings": ["medium.kappa is unidentified"],
   "holdout": {"runs": ["r2"], "kinds": [{"kind": "runout", "unit": "m", "observations": 1,
               "scored": 1, "crps_fitted": 3.0, "crps_reference": 2.0}],
-              "blocks": [{"block": "plate", "kind": "runout", "unit": "m", "scored": 4,
+              "blocks": [{"block": "plate", "kind": "runout", "unit": "m", "scored": 4, "runs": 4,
                           "mean_bias": -19.1, "bias_standard_error": 12.4, "mean_score": 17}]},
   "cross_validation": {"folds": [{"runs": ["r1", "r3"], "objective": 2.2, "evaluations": 5,
                         "termination": "ftol", "fitted": [0.4, 19]}],
@@ -63,7 +63,8 @@ TEST(CalibrationReportHtml, ShowsTheFitWithItsDoubtsPlotsHeldOutRunsAndFolds) {
   EXPECT_NE(html.find("<td>2</td><td>2.5</td><td>0.200</td>"), std::string::npos);
   EXPECT_NE(html.find("<th>1</th><td>r1, r3</td>"), std::string::npos);
   // The held-out runs' bias per block with its standard error.
-  EXPECT_NE(html.find("<th>plate</th><td>run-out (m)</td><td>4</td><td>-19.1</td><td>12.4</td>"),
+  EXPECT_NE(html.find("<th>plate</th><td>run-out (m)</td><td>4</td><td>4</td><td>-19.1</td>"
+                      "<td>12.4</td>"),
             std::string::npos)
       << html;
   EXPECT_EQ(html.find("rocks_per_run"), std::string::npos);

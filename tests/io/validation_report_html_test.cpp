@@ -100,12 +100,16 @@ TEST(ValidationReportHtml, ShowsTheBiasPerBlockWithItsStandardError) {
   const std::string none = ValidationReportHtml({scores, &report, ""});
   EXPECT_EQ(none.find("Bias per block"), std::string::npos);
   const std::string empty_blocks = R"("blocks": [])";
-  scores.replace(scores.find(empty_blocks), empty_blocks.size(),
-                 R"("blocks": [{"block": "plate", "kind": "runout", "unit": "m", "scored": 4,
+  scores.replace(
+      scores.find(empty_blocks), empty_blocks.size(),
+      R"("blocks": [{"block": "plate", "kind": "runout", "unit": "m", "scored": 4, "runs": 4,
                      "mean_bias": -19.1, "bias_standard_error": 12.4, "mean_score": 17}])");
   const std::string html = ValidationReportHtml({scores, &report, ""});
   EXPECT_NE(html.find("<h2>Bias per block</h2>"), std::string::npos);
-  EXPECT_NE(html.find("<th>plate</th><td>run-out (m)</td><td>4</td>"), std::string::npos) << html;
+  EXPECT_NE(html.find("<th>plate</th><td>run-out (m)</td><td>4</td><td>4</td><td>-19.1</td>"
+                      "<td>12.4</td>"),
+            std::string::npos)
+      << html;
   EXPECT_NE(html.find("12.4"), std::string::npos);
 }
 

@@ -84,7 +84,7 @@ def test_a_parameters_prior_is_read_and_priced(small_calibration, tmp_path):
     path = tmp_path / "with_prior.toml"
     path.write_text(text)
     calibration = talus.Calibration.load(path, threads=2)
-    assert calibration.parameters[0]["prior"] == {"mean": 0.5, "sd": 0.1}
+    assert calibration.parameters[0]["prior"] == {"kind": "normal", "mean": 0.5, "sd": 0.1}
     assert calibration.parameters[1]["prior"] is None  # kappa stays free: prior_reference "none"
     start = calibration.start  # the scene's mu_min (Table 1 medium, 0.35)
     e = calibration.evaluate_unit(calibration.start_unit)
