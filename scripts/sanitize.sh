@@ -32,3 +32,23 @@ export LSAN_OPTIONS="suppressions=$supp/lsan.supp:print_suppressions=0"
 # The MPI code of talus is a thin layer (app/mpi_session.cpp) that the ordinary suite runs.
 ctest --test-dir "$build" --output-on-failure --parallel "$(nproc)" --timeout 3600 \
   --exclude-regex '^(SimulateMpi\.|CalibrateMpi\.|MpiSession\.|mpi_session_test_)'
+
+# Every shipped case's scenes (talus simulate) and events (talus validate), two rocks per release or
+# run: the readers of real terrain, point clouds, forests, barriers and observation tables on real
+# inputs, and the writers of every output. A sanitizer report ends talus with a non-zero status.
+talus="${TALUS:-$build/app/talus}"
+cases_out="$(mktemp -d)"
+trap 'rm -rf "$cases_out"' EXIT
+for file in "$root"/cases/*/*.toml; do
+  name="$(basename "$(dirname "$file")")_$(basename "$file" .toml)"
+  if grep -q '^\[\[parameters\]\]' "$file"; then
+    continue   # calibrations: the calibration tests run the same code under the sanitizers
+  elif grep -q '^\[\[observations\]\]' "$file"; then
+    verb=validate
+  else
+    verb=simulate
+  fi
+  echo "sanitize: talus $verb ${file#"$root"/}"
+  "$talus" "$verb" "$file" --rocks 2 --threads 2 --seed 1 --out "$cases_out/$name" --quiet
+done
+echo "sanitize: the suite and every case ran clean"
