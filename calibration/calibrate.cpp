@@ -1,5 +1,6 @@
 #include "calibration/calibrate.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -20,13 +21,25 @@ std::string Format(const char* format, Args... args) {
   return line;
 }
 
+// What the rocks-per-run rule (RocksToIdentify) says of a profile, for people; "" when it says
+// nothing.
+std::string RocksHint(const ParameterProfile& p) {
+  if (!std::isfinite(p.rocks_to_identify)) return "";
+  const double rocks = std::max(2.0, std::ceil(p.rocks_to_identify));  // a run has >= 2 rocks
+  if (p.identified) return Format(" (from about %.0f rocks per run on)", rocks);
+  if (p.within_noise)
+    return "; its range is what noise alone spans, so more rocks per run need not identify it";
+  return Format("; about %.0f rocks per run would (the noise falls as 1/sqrt(rocks))", rocks);
+}
+
 std::string ProfilesReport(const std::vector<ParameterProfile>& profiles) {
   std::string out;
   for (const ParameterProfile& p : profiles)
     out +=
-        Format("  %-28s profile range %-10.3g threshold %-10.3g %s\n", p.name.c_str(), p.range,
+        Format("  %-28s profile range %-10.3g threshold %-10.3g %s%s\n", p.name.c_str(), p.range,
                p.threshold,
-               p.identified ? "identified" : "UNIDENTIFIED: the observations do not constrain it");
+               p.identified ? "identified" : "UNIDENTIFIED: the observations do not constrain it",
+               RocksHint(p).c_str());
   return out;
 }
 
@@ -290,12 +303,13 @@ std::vector<std::string> CalibrationWarnings(const CalibrationSummary& run,
       out.push_back(
           Format("%s is unidentified: over its whole range its profile changes the "
                  "objective's data term by %.3g, less than %.3g (3 x the noise): the "
-                 "observations do not constrain it, and its fitted value is %s",
+                 "observations do not constrain it, and its fitted value is %s%s",
                  c.name.c_str(), run.profiles[j].range, run.profiles[j].threshold,
                  c.prior                    ? "its prior's"
                  : objective.prior_center() ? "where the fit and the pull towards "
                                               "the reference table left it"
-                                            : "where the fit left it"));
+                                            : "where the fit left it",
+                 RocksHint(run.profiles[j]).c_str()));
     else if (singular)
       out.push_back(c.name + " is unidentified by the covariance (J^T J is singular in it): the "
                              "observations do not constrain it");

@@ -119,9 +119,38 @@ std::vector<ParameterProfile> ProfileParameters(const Objective& objective,
     p.threshold =
         std::max(options.noise_multiple * noise, options.relative_floor * std::abs(data_u));
     p.identified = p.range > p.threshold;
+    if (noise > 0 && p.threshold == options.noise_multiple * noise) {
+      p.rocks_to_identify = RocksToIdentify(
+          p.range, p.threshold, static_cast<double>(objective.release().rocks_per_release));
+      p.within_noise = p.range <= NoiseOnlyRange(points, noise);
+    }
     out.push_back(p);
   }
   return out;
+}
+
+double RocksToIdentify(double range, double threshold, double rocks_per_run) {
+  if (!(range > 0 && threshold > 0 && rocks_per_run > 0)) return kNaN;
+  const double ratio = threshold / range;
+  return rocks_per_run * ratio * ratio;
+}
+
+double NoiseOnlyRange(int points, double sd) {
+  if (points < 2) return 0;
+  // d2(n) = E[max - min of n standard normal draws] = integral over x of
+  // 1 - Phi(x)^n - (1 - Phi(x))^n (Tippett 1925), by the trapezoid rule on [-12, 12], where the
+  // integrand of any n below 10^6 has fallen under 1e-25.
+  constexpr int kIntervals = 4800;
+  constexpr double kHalfWidth = 12;
+  const double h = 2 * kHalfWidth / kIntervals;
+  double d2 = 0;
+  for (int k = 0; k <= kIntervals; ++k) {
+    const double x = -kHalfWidth + k * h;
+    const double phi = 0.5 * std::erfc(-x / std::sqrt(2.0));
+    const double f = 1 - std::pow(phi, points) - std::pow(1 - phi, points);
+    d2 += (k == 0 || k == kIntervals ? 0.5 : 1) * f;
+  }
+  return d2 * h * sd;
 }
 
 }  // namespace talus::calibration

@@ -68,7 +68,25 @@ struct ParameterProfile {
   double range = 0;                  // max - min of the data term (f less its prior)
   double threshold = 0;              // what range had to exceed
   bool identified = false;
+  // The rocks per run at which this profile would just reach its threshold (RocksToIdentify);
+  // NaN when the threshold is not the noise's (a noise of 0) or the range is 0.
+  double rocks_to_identify = kNaN;
+  // The range is no larger than the profile's points would span from noise alone
+  // (NoiseOnlyRange): more rocks need not identify it, since its range may fall with the noise.
+  bool within_noise = false;
 };
+
+// The rocks-per-run rule. The noise level an objective is judged against falls as 1/sqrt(rocks)
+// (each run's score is a mean over its rocks; with common random numbers a small step moves a
+// share of them), while a profile's range is the smooth objective's and does not depend on the
+// rocks. A profile of range r judged against a threshold t measured with R rocks per run reaches
+// it at R (t / r)^2 rocks per run. That is a lower bound where r is partly noise.
+double RocksToIdentify(double range, double threshold, double rocks_per_run);
+// The expected range of n independent normal draws of standard deviation `sd`: d2(n) sd, with
+// d2 the range constant of quality control (1.128 for 2 draws, 2.326 for 5). What a profile of n
+// points spans from noise alone, its far points being nearly independent draws of the ensemble's
+// noise.
+double NoiseOnlyRange(int points, double sd);
 
 // Profiles every coordinate through u (f(u) given: it is not re-evaluated), with `noise` the
 // noise level from MeasureRoughness (RoughnessReport::level()).

@@ -222,7 +222,9 @@ json ParametersJson(const Objective& objective, const calibration::CalibrationSu
                       {"values", profile.values},
                       {"objective", profile.f},
                       {"range", Number(profile.range)},
-                      {"threshold", Number(profile.threshold)}};
+                      {"threshold", Number(profile.threshold)},
+                      {"rocks_to_identify", Number(profile.rocks_to_identify)},
+                      {"within_noise", profile.within_noise}};
     } else {
       p["identified"] = nullptr;
     }

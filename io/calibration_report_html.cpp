@@ -1,5 +1,6 @@
 #include "io/calibration_report_html.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "io/calibration_plots.hpp"
@@ -37,7 +38,17 @@ std::string Head(const Json& c) {
 // Why a fitted value is not supported: unidentified, at a bound ("" when it is).
 std::string Doubt(const Json& p) {
   std::string why;
-  if (p["identified"].is_boolean() && !p["identified"].get<bool>()) why = "unidentified";
+  if (p["identified"].is_boolean() && !p["identified"].get<bool>()) {
+    why = "unidentified";
+    // The rocks-per-run rule (docs/calibration.md, "How many rocks per run").
+    const Json& profile = p.contains("profile") ? p["profile"] : Json();
+    const double rocks = profile.is_object() ? NumberOf(profile.value("rocks_to_identify", Json()))
+                                             : std::nan("");
+    if (profile.is_object() && profile.value("within_noise", false))
+      why += " (its profile is within the noise: more rocks per run need not help)";
+    else if (std::isfinite(rocks))
+      why += " (about " + Number(std::max(2.0, std::ceil(rocks))) + " rocks per run would identify it)";
+  }
   const double u = NumberOf(p["final_unit_coordinate"]);
   if (std::isfinite(u) && (u <= 1e-3 || u >= 1 - 1e-3))
     why += std::string(why.empty() ? "" : "; ") + "at its " + (u <= 1e-3 ? "lower" : "upper") +

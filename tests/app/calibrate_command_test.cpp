@@ -123,6 +123,15 @@ TEST(CalibrateCommand, WritesTheGroundTableJsonAndHistory) {
   EXPECT_LE(json["evaluations"].get<int>(), 6);
   EXPECT_TRUE(json["roughness"].is_object());
   EXPECT_TRUE(json["parameters"][0]["identified"].is_boolean());
+  // The rocks-per-run rule with the file's 4 rocks per run: R (threshold / range)^2, or null
+  // for a noise of 0.
+  const auto& profile = json["parameters"][0]["profile"];
+  const double range = profile["range"], threshold = profile["threshold"];
+  if (!profile["rocks_to_identify"].is_null()) {
+    EXPECT_NEAR(profile["rocks_to_identify"].get<double>(),
+                4 * (threshold / range) * (threshold / range), 1e-12 * 4);
+  }
+  EXPECT_TRUE(profile["within_noise"].is_boolean());
   // Every evaluation ran the tight contact solve, whatever the simulations' default.
   EXPECT_EQ(json["solver"]["tolerance_m_s"].get<double>(), 1e-7);
   EXPECT_EQ(json["solver"]["tolerance_source"], "default");

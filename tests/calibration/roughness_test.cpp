@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <utility>
 
 #include "tests/calibration/fixtures.hpp"
 
@@ -136,9 +137,74 @@ TEST(ProfileParameters, WalksEachCoordinateAcrossItsRangeAndJudgesItsRangeAgains
   EXPECT_TRUE(profiles[0].identified);
   EXPECT_NEAR(profiles[0].values.front(), 0.1, 1e-12);
   EXPECT_NEAR(profiles[0].values.back(), 0.9, 1e-12);
-  // A noise level above any change leaves every parameter unidentified.
-  for (const ParameterProfile& p : ProfileParameters(objective, u, f, 1e9, options))
+  // The rocks-per-run rule on each profile: R (t / r)^2 with the release's rocks per run, and
+  // whether the range is within what noise alone spans over 3 points.
+  const double rocks = static_cast<double>(objective.release().rocks_per_release);
+  for (const ParameterProfile& p : profiles) {
+    EXPECT_EQ(p.rocks_to_identify, RocksToIdentify(p.range, p.threshold, rocks)) << p.name;
+    EXPECT_EQ(p.within_noise, p.range <= NoiseOnlyRange(3, noise)) << p.name;
+  }
+  // mu_min's range is far above the threshold: far fewer rocks would do.
+  EXPECT_LT(profiles[0].rocks_to_identify, rocks);
+  EXPECT_FALSE(profiles[0].within_noise);
+  // A noise level above any change leaves every parameter unidentified, its range within noise.
+  for (const ParameterProfile& p : ProfileParameters(objective, u, f, 1e9, options)) {
     EXPECT_FALSE(p.identified) << p.name;
+    EXPECT_TRUE(p.within_noise) << p.name;
+  }
+  // Without a noise (a smooth objective) the threshold is the relative floor: no rule applies.
+  for (const ParameterProfile& p : ProfileParameters(objective, u, f, 0, options)) {
+    EXPECT_TRUE(std::isnan(p.rocks_to_identify)) << p.name;
+    EXPECT_FALSE(p.within_noise) << p.name;
+  }
+}
+
+TEST(RocksToIdentify, ScalesTheRocksByTheSquaredRatioOfThresholdToRange) {
+  EXPECT_DOUBLE_EQ(RocksToIdentify(0.41, 0.99, 8), 8 * (0.99 / 0.41) * (0.99 / 0.41));
+  EXPECT_DOUBLE_EQ(RocksToIdentify(2, 1, 20), 5);  // twice the threshold: a quarter of the rocks
+  EXPECT_TRUE(std::isnan(RocksToIdentify(0, 1, 8)));  // a flat profile: no number of rocks
+  EXPECT_TRUE(std::isnan(RocksToIdentify(1, 0, 8)));
+}
+
+// d2(n), the expected range of n standard normal draws: 2 / sqrt(pi) exactly for n = 2, and the
+// tabulated values of quality control (Tippett 1925; ASTM STP 15D, Table 49), given to 3 decimals,
+// hence the tolerance of half their last digit.
+TEST(NoiseOnlyRange, IsTheExpectedRangeOfNormalDraws) {
+  EXPECT_NEAR(NoiseOnlyRange(2, 1), 2 / std::sqrt(M_PI), 1e-9);
+  const std::pair<int, double> table[] = {{3, 1.693}, {4, 2.059}, {5, 2.326},
+                                          {10, 3.078}, {25, 3.931}};
+  for (const auto& [n, d2] : table) EXPECT_NEAR(NoiseOnlyRange(n, 1), d2, 5e-4) << n;
+  EXPECT_NEAR(NoiseOnlyRange(5, 0.2), 0.2 * NoiseOnlyRange(5, 1), 1e-15);
+  EXPECT_EQ(NoiseOnlyRange(1, 1), 0);
+}
+
+// The premise of the rule: the objective's spread over release seeds falls as 1/sqrt(rocks per
+// run). 32 seeds at 4 and at 16 rocks per run, on the synthetic run-outs: the ratio of the two
+// standard deviations is 2 in expectation. Each sd over 32 seeds has a relative standard error
+// of about 1/sqrt(2 x 31) = 0.127, so the log of the ratio one of 0.18; the band is 3 of them,
+// [2 e^-0.54, 2 e^0.54] = [1.17, 3.43]. It fails if the noise did not fall with the rocks
+// (ratio 1) or fell as 1/rocks (ratio 4).
+TEST(RocksToIdentify, TheObjectivesSpreadOverSeedsFallsAsOneOverTheRootOfTheRocks) {
+  const auto spread = [](long rocks) {
+    ensemble::ReleaseSpec release = Problem().release;
+    release.rocks_per_release = rocks;
+    const Objective objective(Problem().scene, release, Problem().observations,
+                              {testing::Spec("medium_hard", GroundField::kMuMin, 0.1, 0.9)},
+                              ObjectiveOptions{});
+    const Eigen::VectorXd u = Eigen::VectorXd::Constant(1, 0.5);
+    constexpr int kSeeds = 32;
+    double sum = 0, sum2 = 0;
+    for (int k = 1; k <= kSeeds; ++k) {
+      const double f = objective.EvaluateWithSeed(u, release.seed + 100 + k).value;
+      sum += f;
+      sum2 += f * f;
+    }
+    return std::sqrt((sum2 - sum * sum / kSeeds) / (kSeeds - 1));
+  };
+  const double ratio = spread(4) / spread(16);
+  RecordProperty("sd_ratio", std::to_string(ratio));
+  EXPECT_GT(ratio, 1.17);
+  EXPECT_LT(ratio, 3.43);
 }
 
 }  // namespace

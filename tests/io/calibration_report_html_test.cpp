@@ -21,7 +21,8 @@ const char* kCalibration = R"({"version": "9.9", "calibration_file": "cal.toml",
      "standard_error": 0.05},
     {"name": "medium.kappa", "unit": "1/m", "lower": 0.5, "upper": 20, "log": true,
      "initial": 2, "final": 20, "final_unit_coordinate": 1.0, "identified": false,
-     "profile": {"u": [0, 0.5, 1], "values": [0.5, 3.2, 20], "objective": [2.1, 2.0, 2.05]},
+     "profile": {"u": [0, 0.5, 1], "values": [0.5, 3.2, 20], "objective": [2.1, 2.0, 2.05],
+                 "rocks_to_identify": 46.2, "within_noise": false},
      "standard_error": null}],
   "objective": {"before": 3.35, "after": 2.5},
   "kinds": [{"kind": "runout", "unit": "m", "weight": 1, "scale": 1, "score_before": 3.35,
@@ -53,7 +54,17 @@ TEST(CalibrationReportHtml, ShowsTheFitWithItsDoubtsPlotsHeldOutRunsAndFolds) {
             std::string::npos)
       << html;
   EXPECT_NE(html.find("<th>medium.kappa (1/m)</th>"), std::string::npos);
-  EXPECT_NE(html.find("<td>unidentified; at its upper bound</td>"), std::string::npos);
+  // With what the rocks-per-run rule says (docs/calibration.md, "How many rocks per run").
+  EXPECT_NE(html.find("<td>unidentified (about 47 rocks per run would identify it); at its upper "
+                      "bound</td>"),
+            std::string::npos)
+      << html;
+  std::string within = kCalibration;
+  within.replace(within.find("\"within_noise\": false"), 21, "\"within_noise\": true ");
+  EXPECT_NE(CalibrationReportHtml({within, "", {}})
+                .find("<td>unidentified (its profile is within the noise: more rocks per run "
+                      "need not help); at its upper bound</td>"),
+            std::string::npos);
   // The convergence plot as given, and a profile per parameter from calibration.json.
   EXPECT_NE(html.find("<svg id=\"convergence\">"), std::string::npos);
   EXPECT_NE(html.find(">Profile of medium.mu_min</text>"), std::string::npos);
