@@ -27,9 +27,13 @@ std::string RocksHint(const ParameterProfile& p) {
   if (!std::isfinite(p.rocks_to_identify)) return "";
   const double rocks = std::max(2.0, std::ceil(p.rocks_to_identify));  // a run has >= 2 rocks
   if (p.identified) return Format(" (from about %.0f rocks per run on)", rocks);
+  const std::string would =
+      Format("; about %.0f rocks per run would (the noise falls as 1/sqrt(rocks))", rocks);
   if (p.within_noise)
-    return "; its range is what noise alone spans, so more rocks per run need not identify it";
-  return Format("; about %.0f rocks per run would (the noise falls as 1/sqrt(rocks))", rocks);
+    return would +
+           " if its range is real: it is within what noise alone spans, and a range of "
+           "noise falls with the rocks";
+  return would;
 }
 
 std::string ProfilesReport(const std::vector<ParameterProfile>& profiles) {
@@ -135,8 +139,11 @@ void Pipeline::Roughness() {
   const auto t1 = std::chrono::steady_clock::now();
   run_.profiles = ProfileParameters(objective_, best.u, best.value, run_.roughness->level(),
                                     options_.profile_options);
+  // The report's count and time are of both: the roughness' evaluations and the profiles'.
   run_.roughness->wall_time_s +=
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
+  for (const ParameterProfile& p : run_.profiles)
+    run_.roughness->evaluations += static_cast<int>(p.u.size());
   Say(run_.roughness->Report() + ProfilesReport(run_.profiles));
 }
 

@@ -72,7 +72,8 @@ struct ParameterProfile {
   // NaN when the threshold is not the noise's (a noise of 0) or the range is 0.
   double rocks_to_identify = kNaN;
   // The range is no larger than the profile's points would span from noise alone
-  // (NoiseOnlyRange): more rocks need not identify it, since its range may fall with the noise.
+  // (NoiseOnlyRange): it may be noise, which falls with the rocks; then rocks_to_identify is too
+  // few, and no number of rocks identifies it.
   bool within_noise = false;
 };
 

@@ -42,12 +42,14 @@ std::string Doubt(const Json& p) {
     why = "unidentified";
     // The rocks-per-run rule (docs/calibration.md, "How many rocks per run").
     const Json& profile = p.contains("profile") ? p["profile"] : Json();
-    const double rocks = profile.is_object() ? NumberOf(profile.value("rocks_to_identify", Json()))
-                                             : std::nan("");
-    if (profile.is_object() && profile.value("within_noise", false))
-      why += " (its profile is within the noise: more rocks per run need not help)";
-    else if (std::isfinite(rocks))
-      why += " (about " + Number(std::max(2.0, std::ceil(rocks))) + " rocks per run would identify it)";
+    const double rocks =
+        profile.is_object() ? NumberOf(profile.value("rocks_to_identify", Json())) : std::nan("");
+    if (std::isfinite(rocks))
+      why += " (about " + Number(std::max(2.0, std::ceil(rocks))) +
+             " rocks per run would identify it" +
+             (profile.value("within_noise", false) ? " if its profile's range is real, not noise"
+                                                   : "") +
+             ")";
   }
   const double u = NumberOf(p["final_unit_coordinate"]);
   if (std::isfinite(u) && (u <= 1e-3 || u >= 1 - 1e-3))

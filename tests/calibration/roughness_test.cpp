@@ -161,7 +161,7 @@ TEST(ProfileParameters, WalksEachCoordinateAcrossItsRangeAndJudgesItsRangeAgains
 
 TEST(RocksToIdentify, ScalesTheRocksByTheSquaredRatioOfThresholdToRange) {
   EXPECT_DOUBLE_EQ(RocksToIdentify(0.41, 0.99, 8), 8 * (0.99 / 0.41) * (0.99 / 0.41));
-  EXPECT_DOUBLE_EQ(RocksToIdentify(2, 1, 20), 5);  // twice the threshold: a quarter of the rocks
+  EXPECT_DOUBLE_EQ(RocksToIdentify(2, 1, 20), 5);     // twice the threshold: a quarter of the rocks
   EXPECT_TRUE(std::isnan(RocksToIdentify(0, 1, 8)));  // a flat profile: no number of rocks
   EXPECT_TRUE(std::isnan(RocksToIdentify(1, 0, 8)));
 }
@@ -171,8 +171,8 @@ TEST(RocksToIdentify, ScalesTheRocksByTheSquaredRatioOfThresholdToRange) {
 // hence the tolerance of half their last digit.
 TEST(NoiseOnlyRange, IsTheExpectedRangeOfNormalDraws) {
   EXPECT_NEAR(NoiseOnlyRange(2, 1), 2 / std::sqrt(M_PI), 1e-9);
-  const std::pair<int, double> table[] = {{3, 1.693}, {4, 2.059}, {5, 2.326},
-                                          {10, 3.078}, {25, 3.931}};
+  const std::pair<int, double> table[] = {
+      {3, 1.693}, {4, 2.059}, {5, 2.326}, {10, 3.078}, {25, 3.931}};
   for (const auto& [n, d2] : table) EXPECT_NEAR(NoiseOnlyRange(n, 1), d2, 5e-4) << n;
   EXPECT_NEAR(NoiseOnlyRange(5, 0.2), 0.2 * NoiseOnlyRange(5, 1), 1e-15);
   EXPECT_EQ(NoiseOnlyRange(1, 1), 0);

@@ -62,8 +62,8 @@ TEST(CalibrationReportHtml, ShowsTheFitWithItsDoubtsPlotsHeldOutRunsAndFolds) {
   std::string within = kCalibration;
   within.replace(within.find("\"within_noise\": false"), 21, "\"within_noise\": true ");
   EXPECT_NE(CalibrationReportHtml({within, "", {}})
-                .find("<td>unidentified (its profile is within the noise: more rocks per run "
-                      "need not help); at its upper bound</td>"),
+                .find("<td>unidentified (about 47 rocks per run would identify it if its "
+                      "profile's range is real, not noise); at its upper bound</td>"),
             std::string::npos);
   // The convergence plot as given, and a profile per parameter from calibration.json.
   EXPECT_NE(html.find("<svg id=\"convergence\">"), std::string::npos);
