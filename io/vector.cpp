@@ -112,6 +112,14 @@ std::vector<OGRLayer*> SelectLayers(GDALDataset& dataset, const std::string& pat
   return {chosen};
 }
 
+// The names of `feature`'s fields, "a, b, c" ("none").
+std::string FieldNames(OGRFeature& feature) {
+  std::string fields;
+  for (int k = 0; k < feature.GetFieldCount(); ++k)
+    fields += (k ? ", " : "") + std::string(feature.GetFieldDefnRef(k)->GetNameRef());
+  return fields.empty() ? "none" : fields;
+}
+
 // Calls visit(feature, geometry in the target CRS, where) for every feature with a geometry of
 // the layers `select` chooses (null: every layer).
 template <class Visit>
@@ -189,13 +197,9 @@ std::vector<GroundPolygon> ReadGroundPolygons(const std::string& path,
       path, target_crs_wkt, what, "ground polygons", nullptr,
       [&](OGRFeature& feature, const OGRGeometry& geometry, const std::string& where) {
         const int index = feature.GetFieldIndex(field.c_str());
-        if (index < 0) {
-          std::string fields;
-          for (int k = 0; k < feature.GetFieldCount(); ++k)
-            fields += (k ? ", " : "") + std::string(feature.GetFieldDefnRef(k)->GetNameRef());
-          throw InputError(where + ": no field '" + field +
-                           "' (the fields are: " + (fields.empty() ? "none" : fields) + ")");
-        }
+        if (index < 0)
+          throw InputError(where + ": no field '" + field + "' (the fields are: " +
+                           FieldNames(feature) + ")");
         if (!feature.IsFieldSetAndNotNull(index))
           throw InputError(where + ": field '" + field + "' is empty");
         GroundPolygon polygon;
@@ -319,8 +323,21 @@ std::vector<fieldobs::DepositObservation> ReadDepositPoints(const std::string& p
   return out;
 }
 
+namespace {
+
+// The text of `feature`'s attribute `field`: absent when its layer has no such field, "" when null.
+std::optional<std::string> OptionalText(OGRFeature& feature, const std::string& field) {
+  const int index = feature.GetFieldIndex(field.c_str());
+  if (index < 0) return std::nullopt;
+  return feature.IsFieldSetAndNotNull(index) ? feature.GetFieldAsString(index) : "";
+}
+
+}  // namespace
+
 std::vector<TreePoint> ReadTreePoints(const std::string& path, const std::string& target_crs_wkt,
-                                      const std::string& dbh_field, const std::string& what) {
+                                      const std::string& dbh_field,
+                                      const std::string& species_field, bool require_species,
+                                      const std::string& what) {
   std::vector<TreePoint> out;
   ForEachFeature(path, target_crs_wkt, what, "trees", nullptr,
                  [&](OGRFeature& feature, const OGRGeometry& geometry, const std::string& where) {
@@ -338,6 +355,11 @@ std::vector<TreePoint> ReadTreePoints(const std::string& path, const std::string
                    if (!feature.IsFieldSetAndNotNull(field))
                      throw InputError(where + ": " + dbh_field + " is empty");
                    t.dbh_cm = feature.GetFieldAsDouble(field);
+                   t.species = OptionalText(feature, species_field);
+                   if (!t.species && require_species)
+                     throw InputError(where + ": no field '" + species_field +
+                                      "' (species_field: the tree's species; the fields are: " +
+                                      FieldNames(feature) + ")");
                    t.where = where;
                    out.push_back(t);
                  });
@@ -369,6 +391,7 @@ std::vector<StandPolygon> ReadStandPolygons(const std::string& path,
                    stand.stems_per_ha = *number("stems_per_ha", true);
                    stand.dbh_cm = *number("dbh_cm", true);
                    stand.dbh_sd_cm = number("dbh_sd_cm", false).value_or(0.0);
+                   stand.species = OptionalText(feature, "species");
                    std::vector<ReleaseGeometry> parts;
                    Collect(geometry, where, parts);
                    for (ReleaseGeometry& part : parts) {
