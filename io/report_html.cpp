@@ -297,12 +297,13 @@ std::string ForestSection(const Json& summary) {
   if (trees) row("trees", Cell(f["trees"]));
   if (f.contains("stands") && f["stands"].is_array() && !f["stands"].empty()) {
     std::string stands;
-    for (const Json& s : f["stands"])
+    for (const Json& s : f["stands"]) {
       Add(stands, stands.empty() ? "" : "; ", Number(NumberOf(s["stems_per_ha"]), "%.0f"),
           " stems/ha of DBH ", Number(NumberOf(s["dbh_cm"]), "%.0f"), " cm on ",
           Number(NumberOf(s["area_m2"]) / 1e4, "%.2f"), " ha");
       if (const std::string species = s.value("species", std::string()); !species.empty())
         Add(stands, " (", Escape(species), ")");
+    }
     row("stands", stands);
   }
   row("stem height (m)", Cell(f["stem_height_m"]));

@@ -24,9 +24,9 @@ constexpr double kMaxDbh_cm = 300;        // the largest trees of the Alps are ~
 constexpr double kMaxStemsPerHa = 10000;  // one stem per m^2
 constexpr double kMaxStemHeight_m = 100;
 constexpr double kMaxFriction = 10;
-constexpr long kMaxTrees = 10'000'000;  // 40 bytes each
+constexpr long kMaxTrees = 10'000'000;    // 40 bytes each
 constexpr double kMaxEnergyFactor = 100;  // a species' E_max over the forest's law
-constexpr double kMinDrawnDbh_cm = 1;   // a normal draw below it is set to it
+constexpr double kMinDrawnDbh_cm = 1;     // a normal draw below it is set to it
 // The forest's own random streams: the stand index mixed with this, so that they never coincide
 // with a rock's (seed, rock) stream.
 constexpr std::uint64_t kForestStream = 0x666f72657374ULL;  // "forest"
@@ -91,8 +91,9 @@ std::vector<TreeSpecies> ReadSpecies(const Context& context, const Section& fore
     const std::string name = forest.Key("species") + "." + std::string(key.str());
     if (!node.is_table())
       context.Fail(&node, name,
-                   "expected a table [" + name + "] with energy_factor or energy_coefficient_j "
-                   "and/or energy_exponent");
+                   "expected a table [" + name +
+                       "] with energy_factor or energy_coefficient_j "
+                       "and/or energy_exponent");
     const Section s(context, node.as_table(), name,
                     {"energy_factor", "energy_coefficient_j", "energy_exponent"});
     TreeSpecies& t = species.emplace_back();
@@ -127,8 +128,6 @@ class SpeciesNames {
       : species_(species), used_(species.size(), false) {}
 
   bool any() const { return !species_.empty(); }
-  bool used(std::size_t k) const { return used_[k]; }
-  const std::string& ignored() const { return ignored_; }
 
   // -1 for an empty name, else the index of the species `name`. Throws InputError
   // "<where>: species '<name>' is not declared ..." listing the declared ones.
@@ -146,8 +145,8 @@ class SpeciesNames {
                      "(declared: " + (declared.empty() ? "none" : declared) + ")");
   }
   // As Find, for a name from a tree or stand file: without [forest.species] a file's species are
-  // ignored (-1; ignored() says where the first was), so that inventories with a species column
-  // load as before.
+  // ignored (-1, and a warning naming the first), so that inventories with a species column load
+  // as before.
   int FindInFile(const std::string& name, const std::string& where) {
     if (!any()) {
       if (!name.empty() && ignored_.empty()) ignored_ = where;
@@ -156,28 +155,29 @@ class SpeciesNames {
     return Find(name, where);
   }
 
+  // Warnings: species of [forest.species] (the table of `forest`) that no tree or stand named,
+  // and a file's species ignored.
+  void Warn(const Context& context, const Section& forest,
+            std::vector<std::string>* warnings) const {
+    for (std::size_t k = 0; k < species_.size(); ++k)
+      if (!used_[k]) {
+        const std::string& name = species_[k].name;
+        warnings->push_back(context.Where(forest.Node("species")->as_table()->get(name)) + ": " +
+                            forest.Key("species") + "." + name +
+                            ": forest: declared, but no tree or stand names it");
+      }
+    if (!ignored_.empty())
+      warnings->push_back(ignored_ +
+                          ": forest: names a species, but the scene declares none "
+                          "([forest.species]): the file's species are ignored and every stem "
+                          "takes the forest's breaking-energy law");
+  }
+
  private:
   const std::vector<TreeSpecies>& species_;
   std::vector<bool> used_;
   std::string ignored_;
 };
-
-// Warnings: species declared but named by no tree or stand; species in a file ignored.
-void WarnAboutSpecies(const Context& context, const Section& s, const SpeciesNames& names,
-                      const std::vector<TreeSpecies>& species, SceneFile& out) {
-  for (std::size_t k = 0; k < species.size(); ++k)
-    if (!names.used(k)) {
-      const toml::node* node = s.Node("species")->as_table()->get(species[k].name);
-      out.warnings.push_back(context.Where(node) + ": " + s.Key("species") + "." +
-                             species[k].name +
-                             ": forest: declared, but no tree or stand names it");
-    }
-  if (!names.ignored().empty())
-    out.warnings.push_back(names.ignored() +
-                           ": forest: names a species, but the scene declares none "
-                           "([forest.species]): the file's species are ignored and every stem "
-                           "takes the forest's breaking-energy law");
-}
 
 // trees = "file": a CSV file, one tree per row with columns x_m, y_m (the DEM's coordinates),
 // dbh_cm and optionally species; or any point vector file GDAL reads, reprojected to the DEM's
@@ -562,7 +562,7 @@ void LoadForest(const Context& context, const Section& s, bool given, SceneFile&
     out.scene.forest_drag = BuildDragLayer(context, s, stands, model, names, out);
     if (!out.scene.forest_drag.IsValid(&why)) s.Fail("model", why);
     out.forest_drag_model = model;
-    WarnAboutSpecies(context, s, names, model.species, out);
+    names.Warn(context, s, &out.warnings);
     return;
   }
   const long seed = s.Integer("seed", static_cast<long>(out.release.seed));
@@ -578,7 +578,7 @@ void LoadForest(const Context& context, const Section& s, bool given, SceneFile&
   if (stems.empty())
     out.warnings.push_back(context.Where(s.Node(s.Has("stands") ? "stands" : "stands_file")) +
                            ": forest: the stands drew no tree (too small or too sparse)");
-  WarnAboutSpecies(context, s, names, model.species, out);
+  names.Warn(context, s, &out.warnings);
   out.has_forest = true;
   out.scene.forest = Forest(std::move(stems), model);
 }

@@ -112,14 +112,6 @@ std::vector<OGRLayer*> SelectLayers(GDALDataset& dataset, const std::string& pat
   return {chosen};
 }
 
-// The names of `feature`'s fields, "a, b, c" ("none").
-std::string FieldNames(OGRFeature& feature) {
-  std::string fields;
-  for (int k = 0; k < feature.GetFieldCount(); ++k)
-    fields += (k ? ", " : "") + std::string(feature.GetFieldDefnRef(k)->GetNameRef());
-  return fields.empty() ? "none" : fields;
-}
-
 // Calls visit(feature, geometry in the target CRS, where) for every feature with a geometry of
 // the layers `select` chooses (null: every layer).
 template <class Visit>
@@ -197,9 +189,13 @@ std::vector<GroundPolygon> ReadGroundPolygons(const std::string& path,
       path, target_crs_wkt, what, "ground polygons", nullptr,
       [&](OGRFeature& feature, const OGRGeometry& geometry, const std::string& where) {
         const int index = feature.GetFieldIndex(field.c_str());
-        if (index < 0)
-          throw InputError(where + ": no field '" + field + "' (the fields are: " +
-                           FieldNames(feature) + ")");
+        if (index < 0) {
+          std::string fields;
+          for (int k = 0; k < feature.GetFieldCount(); ++k)
+            fields += (k ? ", " : "") + std::string(feature.GetFieldDefnRef(k)->GetNameRef());
+          throw InputError(where + ": no field '" + field +
+                           "' (the fields are: " + (fields.empty() ? "none" : fields) + ")");
+        }
         if (!feature.IsFieldSetAndNotNull(index))
           throw InputError(where + ": field '" + field + "' is empty");
         GroundPolygon polygon;
@@ -324,6 +320,14 @@ std::vector<fieldobs::DepositObservation> ReadDepositPoints(const std::string& p
 }
 
 namespace {
+
+// The names of `feature`'s fields, "a, b, c" ("none").
+std::string FieldNames(OGRFeature& feature) {
+  std::string fields;
+  for (int k = 0; k < feature.GetFieldCount(); ++k)
+    fields += (k ? ", " : "") + std::string(feature.GetFieldDefnRef(k)->GetNameRef());
+  return fields.empty() ? "none" : fields;
+}
 
 // The text of `feature`'s attribute `field`: absent when its layer has no such field, "" when null.
 std::optional<std::string> OptionalText(OGRFeature& feature, const std::string& field) {

@@ -86,8 +86,9 @@ bool TreeSpecies::IsValid(std::string* why) const {
     if (why) *why = what;
     return false;
   };
-  if (name.empty() || std::any_of(name.begin(), name.end(),
-                                  [](char c) { return std::iscntrl(static_cast<unsigned char>(c)); }))
+  if (name.empty() || std::any_of(name.begin(), name.end(), [](char c) {
+        return std::iscntrl(static_cast<unsigned char>(c));
+      }))
     return fail("name '" + name + "' must be non-empty, without control characters");
   if (!(std::isfinite(energy_factor) && energy_factor > 0))
     return fail("energy_factor = " + Number(energy_factor) + " must be finite and > 0");

@@ -337,7 +337,7 @@ TEST(RocksGeoPackage, TreesAreALayerWithTheirDbhHitsAndBreakages) {
   Dataset without(none);
   EXPECT_EQ(without.d->GetLayerByName("trees"), nullptr);
   testing::WriteText(dir / "tree_impacts.csv", std::string(TreeImpactsCsvWriter::Header()) +
-                                                   "\n3,0,0,r,12,22,45,2,1.5,12,22,8,3,2,0\n");
+                                                   "\n3,0,0,r,12,22,45,2,1.5,12,22,8,3,2,0,\n");
   try {
     WriteRocksGeoPackage(
         (dir / "bad.gpkg").string(), (dir / "rocks.csv").string(), "", "", "", "",

@@ -278,11 +278,12 @@ const std::string kSpecies =
     "[forest.species.larch]\nenergy_coefficient_j = 60\n";
 
 TEST(SceneForest, TreesAndStandsOfADeclaredSpeciesBreakByItsLaw) {
-  const SceneFile s = Load("[forest]\ntrees = \"trees.csv\"\n"
-                           "stands = [{ polygon = [[20, -10], [40, -10], [40, 10], [20, 10]], "
-                           "stems_per_ha = 1000, dbh_cm = 25, species = \"larch\" }]\n" +
-                               kSpecies,
-                           "x_m,y_m,dbh_cm,species\n30,0,30,beech\n32,1,30,\n34,2,30,larch\n");
+  const SceneFile s = Load(
+      "[forest]\ntrees = \"trees.csv\"\n"
+      "stands = [{ polygon = [[20, -10], [40, -10], [40, 10], [20, 10]], "
+      "stems_per_ha = 1000, dbh_cm = 25, species = \"larch\" }]\n" +
+          kSpecies,
+      "x_m,y_m,dbh_cm,species\n30,0,30,beech\n32,1,30,\n34,2,30,larch\n");
   const Forest& forest = s.scene.forest;
   ASSERT_EQ(forest.model().species.size(), 2u);
   EXPECT_EQ(forest.model().species[0].name, "beech");
@@ -353,11 +354,12 @@ TEST(SceneForest, BadSpeciesIsAnErrorNamingFileLineAndKey) {
 }
 
 TEST(SceneForest, UnusedSpeciesAndUndeclaredSpeciesInAFileAreWarnings) {
-  const SceneFile s =
-      Load("[forest]\ntrees = \"trees.csv\"\n" + kSpecies, "x_m,y_m,dbh_cm,species\n30,0,30,beech\n");
+  const SceneFile s = Load("[forest]\ntrees = \"trees.csv\"\n" + kSpecies,
+                           "x_m,y_m,dbh_cm,species\n30,0,30,beech\n");
   ASSERT_EQ(s.warnings.size(), 1u);
-  EXPECT_HAS(s.warnings[0],
-             "scene.toml:16: forest.species.larch: forest: declared, but no tree or stand names it");
+  EXPECT_HAS(
+      s.warnings[0],
+      "scene.toml:16: forest.species.larch: forest: declared, but no tree or stand names it");
   // A tree list with a species column in a scene that declares no species (an inventory written
   // before [forest.species]): it loads as before, every stem of the forest's law, with a warning.
   const SceneFile plain =

@@ -82,8 +82,8 @@ TEST(TreeImpactsCsv, TheSpeciesIsTheLastColumn) {
   EXPECT_EQ(text.str(), std::string(TreeImpactsCsvWriter::Header()) + "\n" +
                             "0,0,0,0,10,20,30,2,1.5,0,0,0,5000,1000,0,\"Fagus sylvatica, old\"\n"
                             "1,0,0,0,12,20,20,1,1.5,0,0,0,5000,3000,1,\n");
-  EXPECT_EQ(std::string(TreeImpactsCsvWriter::Header()).substr(
-                std::string(TreeImpactsCsvWriter::Header()).rfind(',')),
+  EXPECT_EQ(std::string(TreeImpactsCsvWriter::Header())
+                .substr(std::string(TreeImpactsCsvWriter::Header()).rfind(',')),
             ",species");
 }
 

@@ -357,7 +357,8 @@ TEST(Forest, SpeciesAreChecked) {
   s.energy_factor = 0;
   model.species = {s};
   EXPECT_FALSE(model.IsValid(&why));
-  EXPECT_NE(why.find("species 'beech': energy_factor = 0 must be finite and > 0"), std::string::npos)
+  EXPECT_NE(why.find("species 'beech': energy_factor = 0 must be finite and > 0"),
+            std::string::npos)
       << why;
   model.species[0].energy_factor = 2;
   model.species[0].energy_coefficient_J = 60;
