@@ -19,11 +19,12 @@
 
 namespace talus {
 
-// A breaking-energy law: E_max = factor * (coefficient * DBH[cm]^exponent) (J).
+// A breaking-energy law: E_max = factor * (coefficient * DBH[cm]^exponent) (J); ForestModel::Law
+// gives a stem's.
 struct BreakingLaw {
   double factor = 1;
-  double coefficient_J = 38.7;
-  double exponent = 2.31;
+  double coefficient_J = 0;
+  double exponent = 0;
 
   double Energy_J(double dbh_m) const;
 };
