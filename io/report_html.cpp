@@ -297,10 +297,13 @@ std::string ForestSection(const Json& summary) {
   if (trees) row("trees", Cell(f["trees"]));
   if (f.contains("stands") && f["stands"].is_array() && !f["stands"].empty()) {
     std::string stands;
-    for (const Json& s : f["stands"])
+    for (const Json& s : f["stands"]) {
       Add(stands, stands.empty() ? "" : "; ", Number(NumberOf(s["stems_per_ha"]), "%.0f"),
           " stems/ha of DBH ", Number(NumberOf(s["dbh_cm"]), "%.0f"), " cm on ",
           Number(NumberOf(s["area_m2"]) / 1e4, "%.2f"), " ha");
+      if (const std::string species = s.value("species", std::string()); !species.empty())
+        Add(stands, " (", Escape(species), ")");
+    }
     row("stands", stands);
   }
   row("stem height (m)", Cell(f["stem_height_m"]));
@@ -309,6 +312,17 @@ std::string ForestSection(const Json& summary) {
         Escape(f["breaking_energy"].value("law", std::string())) + ", coefficient " +
             Cell(f["breaking_energy"]["coefficient_J"]) + " J, exponent " +
             Cell(f["breaking_energy"]["exponent"]));
+  // Each species' law (the user's, docs/model.md "Forest"): factor x coefficient x DBH^exponent.
+  if (f.contains("species") && f["species"].is_array() && !f["species"].empty()) {
+    std::string species;
+    for (const Json& s : f["species"])
+      Add(species, species.empty() ? "" : "; ", Escape(s.value("name", std::string())), ": ",
+          Cell(s["factor"]), " &times; ", Cell(s["coefficient_J"]), " J &times; DBH[cm]<sup>",
+          Cell(s["exponent"]), "</sup>, ",
+          Number(NumberOf(s["e_max_30cm_J"]) / kJoulesPerEnergyUnit, "%.0f"), " ", kEnergyUnit,
+          " at 30 cm");
+    row("breaking energy by species (the scene's laws)", species);
+  }
   if (f.contains("impacts")) {
     const Json& i = f["impacts"];
     row("rocks that hit a stem", Cell(i["rocks_hitting"]));

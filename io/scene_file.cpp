@@ -281,9 +281,10 @@ SceneFile LoadSceneTable(const toml::table& root, const std::string& path,
   scene_tables::LoadBarriers(context, root.get("barriers"), out);
   scene_tables::LoadForest(context,
                            Section(context, SubTable(context, root, "forest"), "forest",
-                                   {"model", "trees", "dbh_field", "stands", "stands_file",
-                                    "stems_per_ha_raster", "dbh_raster", "stem_height_m",
-                                    "friction", "energy_coefficient_j", "energy_exponent", "seed"}),
+                                   {"model", "trees", "dbh_field", "species_field", "stands",
+                                    "stands_file", "stems_per_ha_raster", "dbh_raster",
+                                    "raster_species", "stem_height_m", "friction",
+                                    "energy_coefficient_j", "energy_exponent", "species", "seed"}),
                            root.get("forest") != nullptr, out);
   const Section solver(context, SubTable(context, root, "solver"), "solver", SolverKeys());
   LoadSolver(solver, out.scene.options, out.solver_preset, out.solver_keys_given);

@@ -90,7 +90,8 @@ struct SceneFile {
   // [forest]: where its trees came from (scene.forest holds them); empty without the table.
   struct ForestStand {
     double area_m2 = 0, stems_per_ha = 0, dbh_cm = 0, dbh_sd_cm = 0;
-    long trees = 0;  // drawn
+    long trees = 0;       // drawn
+    std::string species;  // of [forest.species]; "" without
   };
   bool has_forest = false;
   std::string trees_file;  // [forest] trees, resolved; "" without
@@ -102,6 +103,7 @@ struct SceneFile {
   // in scene.forest_drag, with the stands above and the rasters below), "" without [forest].
   std::string forest_model;
   std::string forest_density_raster, forest_dbh_raster;  // model = "drag", resolved; "" without
+  std::string forest_raster_species;  // model = "drag": the rasters' stands' species; "" without
   long forest_drag_cells = 0;                            // model = "drag": DEM nodes in a stand
   ForestModel forest_drag_model;  // model = "drag": its breaking energy and height
 };

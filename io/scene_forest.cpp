@@ -24,8 +24,9 @@ constexpr double kMaxDbh_cm = 300;        // the largest trees of the Alps are ~
 constexpr double kMaxStemsPerHa = 10000;  // one stem per m^2
 constexpr double kMaxStemHeight_m = 100;
 constexpr double kMaxFriction = 10;
-constexpr long kMaxTrees = 10'000'000;  // 24 bytes each
-constexpr double kMinDrawnDbh_cm = 1;   // a normal draw below it is set to it
+constexpr long kMaxTrees = 10'000'000;    // 40 bytes each
+constexpr double kMaxEnergyFactor = 100;  // a species' E_max over the forest's law
+constexpr double kMinDrawnDbh_cm = 1;     // a normal draw below it is set to it
 // The forest's own random streams: the stand index mixed with this, so that they never coincide
 // with a rock's (seed, rock) stream.
 constexpr std::uint64_t kForestStream = 0x666f72657374ULL;  // "forest"
@@ -77,11 +78,113 @@ std::string DbhBounds(double dbh_cm) {
   return TenDigits(dbh_cm) + " cm must be > 0 and <= " + TenDigits(kMaxDbh_cm) + " cm";
 }
 
-// trees = "file": a CSV file, one tree per row with columns x_m, y_m (the DEM's coordinates) and
-// dbh_cm; or any point vector file GDAL reads, reprojected to the DEM's CRS, its DBH (cm) in the
-// attribute dbh_field.
+// [forest.species.<name>]: each species' breaking-energy law, in name order (toml++'s order).
+std::vector<TreeSpecies> ReadSpecies(const Context& context, const Section& forest) {
+  std::vector<TreeSpecies> species;
+  if (!forest.Has("species")) return species;
+  const toml::table* table = forest.Node("species")->as_table();
+  if (!table)
+    forest.Fail("species",
+                "expected tables [forest.species.<name>], each with energy_factor or "
+                "energy_coefficient_j and/or energy_exponent");
+  for (const auto& [key, node] : *table) {
+    const std::string name = forest.Key("species") + "." + std::string(key.str());
+    if (!node.is_table())
+      context.Fail(&node, name,
+                   "expected a table [" + name +
+                       "] with energy_factor or energy_coefficient_j "
+                       "and/or energy_exponent");
+    const Section s(context, node.as_table(), name,
+                    {"energy_factor", "energy_coefficient_j", "energy_exponent"});
+    TreeSpecies& t = species.emplace_back();
+    t.name = key.str();
+    const bool own_law = s.Has("energy_coefficient_j") || s.Has("energy_exponent");
+    if (s.Has("energy_factor") && own_law)
+      s.Fail("energy_factor",
+             "a species gives energy_factor (E_max = factor x the forest's law) or a law of its "
+             "own (energy_coefficient_j and/or energy_exponent), not both");
+    if (!s.Has("energy_factor") && !own_law)
+      s.Fail("energy_factor",
+             "missing: give energy_factor (E_max = factor x the forest's law) or "
+             "energy_coefficient_j and/or energy_exponent (a law of its own)");
+    t.energy_factor = s.Number("energy_factor", t.energy_factor);
+    RequireWithin(s, "energy_factor", t.energy_factor, 0, kMaxEnergyFactor, "");
+    if (s.Has("energy_coefficient_j")) t.energy_coefficient_J = s.Number("energy_coefficient_j", 0);
+    if (s.Has("energy_exponent")) {
+      t.energy_exponent = s.Number("energy_exponent", 0);
+      RequireWithin(s, "energy_exponent", *t.energy_exponent, 0, 5, "");
+    }
+    std::string why;
+    if (!t.IsValid(&why)) s.FailCheck(why);
+  }
+  return species;
+}
+
+// The species that trees and stands name, looked up in [forest.species]; remembers which were
+// named, and where a file named species that the scene does not declare.
+class SpeciesNames {
+ public:
+  explicit SpeciesNames(const std::vector<TreeSpecies>& species)
+      : species_(species), used_(species.size(), false) {}
+
+  bool any() const { return !species_.empty(); }
+
+  // -1 for an empty name, else the index of the species `name`. Throws InputError
+  // "<where>: species '<name>' is not declared ..." listing the declared ones.
+  int Find(const std::string& name, const std::string& where) {
+    if (name.empty()) return -1;
+    std::string declared;
+    for (std::size_t k = 0; k < species_.size(); ++k) {
+      if (species_[k].name == name) {
+        used_[k] = true;
+        return static_cast<int>(k);
+      }
+      declared += (k ? ", '" : "'") + species_[k].name + "'";
+    }
+    throw InputError(where + ": species '" + name + "' is not declared in [forest.species] " +
+                     "(declared: " + (declared.empty() ? "none" : declared) + ")");
+  }
+  // As Find, for a name from a tree or stand file: without [forest.species] a file's species are
+  // ignored (-1, and a warning naming the first), so that inventories with a species column load
+  // as before.
+  int FindInFile(const std::string& name, const std::string& where) {
+    if (!any()) {
+      if (!name.empty() && ignored_.empty()) ignored_ = where;
+      return -1;
+    }
+    return Find(name, where);
+  }
+
+  // Warnings: species of [forest.species] (the table of `forest`) that no tree or stand named,
+  // and a file's species ignored.
+  void Warn(const Context& context, const Section& forest,
+            std::vector<std::string>* warnings) const {
+    for (std::size_t k = 0; k < species_.size(); ++k)
+      if (!used_[k]) {
+        const std::string& name = species_[k].name;
+        warnings->push_back(context.Where(forest.Node("species")->as_table()->get(name)) + ": " +
+                            forest.Key("species") + "." + name +
+                            ": forest: declared, but no tree or stand names it");
+      }
+    if (!ignored_.empty())
+      warnings->push_back(ignored_ +
+                          ": forest: names a species, but the scene declares none "
+                          "([forest.species]): the file's species are ignored and every stem "
+                          "takes the forest's breaking-energy law");
+  }
+
+ private:
+  const std::vector<TreeSpecies>& species_;
+  std::vector<bool> used_;
+  std::string ignored_;
+};
+
+// trees = "file": a CSV file, one tree per row with columns x_m, y_m (the DEM's coordinates),
+// dbh_cm and optionally species; or any point vector file GDAL reads, reprojected to the DEM's
+// CRS, its DBH (cm) in the attribute dbh_field and its species in species_field.
 void ReadTrees(const Context& context, const Section& s, const Terrain& terrain,
-               const std::string& crs_wkt, std::vector<Stem>* stems, SceneFile& out) {
+               const std::string& crs_wkt, SpeciesNames& names, std::vector<Stem>* stems,
+               SceneFile& out) {
   const std::string path = context.Resolve(s.String("trees", ""));
   const std::string key = context.Where(s.Node("trees")) + ": " + s.Key("trees");
   const std::size_t first = stems->size();
@@ -89,6 +192,10 @@ void ReadTrees(const Context& context, const Section& s, const Terrain& terrain,
     if (s.Has("dbh_field"))
       s.Fail("dbh_field",
              "a CSV tree list has its DBH in the column dbh_cm; dbh_field names the "
+             "attribute of a vector file");
+    if (s.Has("species_field"))
+      s.Fail("species_field",
+             "a CSV tree list has its species in the column species; species_field names the "
              "attribute of a vector file");
     CsvTable table = [&] {
       try {
@@ -110,17 +217,25 @@ void ReadTrees(const Context& context, const Section& s, const Terrain& terrain,
         throw InputError(table.Where(row, "dbh_cm") + ": " + DbhBounds(dbh_cm));
       stem.dbh_m = dbh_cm / 100;
       stem.ground_m = FootOf(terrain, stem.position_m, table.Where(row, "x_m"));
+      stem.species = names.FindInFile(table.Empty(row, "species") ? "" : table.Text(row, "species"),
+                                      table.Where(row, "species"));
       stems->push_back(stem);
     }
   } else {
     const std::string field = s.String("dbh_field", "dbh_cm");
-    for (const TreePoint& t : ReadTreePoints(path, crs_wkt, field, key)) {
+    const std::string species_field = s.String("species_field", "species");
+    if (s.Has("species_field") && !names.any())
+      s.Fail("species_field", "the scene declares no species ([forest.species.<name>])");
+    for (const TreePoint& t :
+         ReadTreePoints(path, crs_wkt, field, species_field, s.Has("species_field"), key)) {
       if (!(std::isfinite(t.dbh_cm) && t.dbh_cm > 0 && t.dbh_cm <= kMaxDbh_cm))
         throw InputError(t.where + ": " + field + " = " + DbhBounds(t.dbh_cm));
       if (static_cast<long>(stems->size() - first) >= kMaxTrees)
         throw InputError(key + ": " + path + " has more than " + std::to_string(kMaxTrees) +
                          " trees");
-      stems->push_back(Stem{t.xy_m, t.dbh_cm / 100, FootOf(terrain, t.xy_m, t.where)});
+      stems->push_back(
+          Stem{t.xy_m, t.dbh_cm / 100, FootOf(terrain, t.xy_m, t.where),
+               names.FindInFile(t.species.value_or(""), t.where + ": " + species_field)});
     }
   }
   out.inputs.push_back(path);
@@ -162,10 +277,11 @@ bool InsideRings(const std::vector<std::vector<Eigen::Vector2d>>& rings, const E
 // A stand's trees: a homogeneous Poisson process in the polygon -- the count Poisson with mean
 // density * area, counted as the arrivals of a unit-rate process before that mean; each tree
 // uniform in the polygon (rejection from its bounding box) -- with a normal DBH (mean, spread),
-// clamped to kMinDrawnDbh_cm .. kMaxDbh_cm. From its own stream (seed, kForestStream + stream).
-void DrawStand(const std::vector<std::vector<Eigen::Vector2d>>& rings, std::uint64_t seed,
-               std::uint64_t stream, const Terrain& terrain, const std::string& where,
-               SceneFile::ForestStand* stand, std::vector<Stem>* stems) {
+// clamped to kMinDrawnDbh_cm .. kMaxDbh_cm, and the stand's species. From its own stream (seed,
+// kForestStream + stream).
+void DrawStand(const std::vector<std::vector<Eigen::Vector2d>>& rings, int species,
+               std::uint64_t seed, std::uint64_t stream, const Terrain& terrain,
+               const std::string& where, SceneFile::ForestStand* stand, std::vector<Stem>* stems) {
   RockRandom random(seed, kForestStream + stream);
   const double mean = stand->stems_per_ha / 1e4 * stand->area_m2;
   long count = 0;
@@ -189,23 +305,26 @@ void DrawStand(const std::vector<std::vector<Eigen::Vector2d>>& rings, std::uint
     }
     stem.dbh_m = std::clamp(dbh_cm, kMinDrawnDbh_cm, kMaxDbh_cm) / 100;
     stem.ground_m = FootOf(terrain, stem.position_m, where);
+    stem.species = species;
     stems->push_back(stem);
   }
   stand->trees = count;
 }
 
-// One stand as given: its rings (outer, then holes; in the DEM's CRS), its numbers and where it
-// was given (for errors).
+// One stand as given: its rings (outer, then holes; in the DEM's CRS), its numbers, its species
+// (an index into ForestModel::species, -1: none) and where it was given (for errors).
 struct StandInput {
   std::vector<std::vector<Eigen::Vector2d>> rings;
   SceneFile::ForestStand stand;
+  int species = -1;
   std::string where;
 };
 
-// stands = [{ polygon = [[x, y], ...], stems_per_ha, dbh_cm, dbh_sd_cm }] (or [[forest.stands]]
-// tables), then the polygons of stands_file, each checked.
+// stands = [{ polygon = [[x, y], ...], stems_per_ha, dbh_cm, dbh_sd_cm, species }] (or
+// [[forest.stands]] tables), then the polygons of stands_file, each checked.
 std::vector<StandInput> ReadStands(const Context& context, const Section& forest,
-                                   const std::string& crs_wkt, SceneFile& out) {
+                                   const std::string& crs_wkt, SpeciesNames& names,
+                                   SceneFile& out) {
   std::vector<StandInput> stands;
   if (forest.Has("stands")) {
     const toml::array* list = forest.Node("stands")->as_array();
@@ -215,7 +334,7 @@ std::vector<StandInput> ReadStands(const Context& context, const Section& forest
                   "stems_per_ha = ..., dbh_cm = ... }");
     for (std::size_t k = 0; k < list->size(); ++k) {
       const Section s(context, list->get(k)->as_table(), "forest.stands[" + std::to_string(k) + "]",
-                      {"polygon", "stems_per_ha", "dbh_cm", "dbh_sd_cm"});
+                      {"polygon", "stems_per_ha", "dbh_cm", "dbh_sd_cm", "species"});
       for (const char* required : {"polygon", "stems_per_ha", "dbh_cm"})
         if (!s.Has(required)) s.Fail(required, "missing");
       StandInput& input = stands.emplace_back();
@@ -227,6 +346,10 @@ std::vector<StandInput> ReadStands(const Context& context, const Section& forest
       if (input.rings.front().size() < 3) s.Fail("polygon", "a stand needs at least 3 points");
       stand.area_m2 = AreaOf(input.rings);
       if (const auto [key, why] = StandProblem(stand); !key.empty()) s.Fail(key, why);
+      const std::string species = s.String("species", "");
+      input.species =
+          names.Find(species, context.Where(s.Node("species")) + ": " + s.Key("species"));
+      if (input.species >= 0) stand.species = species;
       input.where = context.Where(s.Node("polygon")) + ": " + s.Key("polygon");
     }
   }
@@ -246,6 +369,8 @@ std::vector<StandInput> ReadStands(const Context& context, const Section& forest
       stand.area_m2 = AreaOf(polygon.rings);
       if (const auto [field, why] = StandProblem(stand); !field.empty())
         throw InputError(polygon.where + ": " + field + ": " + why);
+      input.species = names.FindInFile(polygon.species.value_or(""), polygon.where + ": species");
+      if (input.species >= 0) stand.species = *polygon.species;
       input.where = polygon.where;
     }
     out.inputs.push_back(path);
@@ -259,7 +384,7 @@ void DrawStands(std::vector<StandInput>& stands, const Terrain& terrain, std::ui
                 std::vector<Stem>* stems, SceneFile& out) {
   for (std::size_t k = 0; k < stands.size(); ++k) {
     StandInput& input = stands[k];
-    DrawStand(input.rings, seed, k, terrain, input.where, &input.stand, stems);
+    DrawStand(input.rings, input.species, seed, k, terrain, input.where, &input.stand, stems);
     out.stands.push_back(input.stand);
   }
 }
@@ -313,12 +438,13 @@ std::string NodeAt(const GridGeometry& g, std::size_t k) {
 }
 
 // model = "drag": the stands on the DEM's nodes (a node takes the stand of the last polygon holding
-// it, over the rasters' stand there) as a ForestDrag of the model's breaking energy and height.
-// The rasters: stems_per_ha_raster (nodata or 0: no forest) and dbh_raster (cm, where there are
-// stems); each distinct pair of values is a stand.
+// it, over the rasters' stand there) as a ForestDrag of the model's breaking energy (each stand's
+// species' law) and height. The rasters: stems_per_ha_raster (nodata or 0: no forest) and
+// dbh_raster (cm, where there are stems), their stands of the species raster_species; each
+// distinct pair of values is a stand.
 ForestDrag BuildDragLayer(const Context& context, const Section& s,
                           const std::vector<StandInput>& stands, const ForestModel& model,
-                          SceneFile& out) {
+                          SpeciesNames& names, SceneFile& out) {
   const GridGeometry& dem = out.scene.terrain.heights().grid;
   std::vector<DragStand> list;
   std::vector<int> cells(static_cast<std::size_t>(dem.nx) * dem.ny, -1);
@@ -326,7 +452,15 @@ ForestDrag BuildDragLayer(const Context& context, const Section& s,
     s.Fail(s.Has("dbh_raster") ? "dbh_raster" : "stems_per_ha_raster",
            "stems_per_ha_raster and dbh_raster go together: a stand needs both its density and "
            "its DBH");
+  if (s.Has("raster_species") && !s.Has("stems_per_ha_raster"))
+    s.Fail("raster_species",
+           "names the species of the stands of stems_per_ha_raster and dbh_raster, which the "
+           "scene does not give");
   if (s.Has("stems_per_ha_raster")) {
+    out.forest_raster_species = s.String("raster_species", "");
+    const int species =
+        names.Find(out.forest_raster_species,
+                   context.Where(s.Node("raster_species")) + ": " + s.Key("raster_species"));
     const std::vector<double> density =
         RasterOnDem(context, s, "stems_per_ha_raster", dem, out, &out.forest_density_raster);
     const std::vector<double> dbh =
@@ -346,7 +480,8 @@ ForestDrag BuildDragLayer(const Context& context, const Section& s,
                                  " has stems, must be > 0 and <= " + TenDigits(kMaxDbh_cm) + " cm");
       auto [it, added] = index.try_emplace({n, dbh[k]}, static_cast<int>(list.size()));
       if (added)
-        list.push_back(DragStand{n / 1e4, dbh[k] / 100, model.BreakingEnergy_J(dbh[k] / 100)});
+        list.push_back(
+            DragStand{n / 1e4, dbh[k] / 100, model.BreakingEnergy_J(dbh[k] / 100, species)});
       cells[k] = it->second;
     }
   }
@@ -357,8 +492,8 @@ ForestDrag BuildDragLayer(const Context& context, const Section& s,
       rings.push_back(input.rings);
       burn.push_back(static_cast<int>(list.size()));
       const double dbh_m = input.stand.dbh_cm / 100;
-      list.push_back(
-          DragStand{input.stand.stems_per_ha / 1e4, dbh_m, model.BreakingEnergy_J(dbh_m)});
+      list.push_back(DragStand{input.stand.stems_per_ha / 1e4, dbh_m,
+                               model.BreakingEnergy_J(dbh_m, input.species)});
       out.stands.push_back(input.stand);
       if (input.stand.dbh_sd_cm > 0)
         out.warnings.push_back(input.where +
@@ -388,7 +523,7 @@ void LoadForest(const Context& context, const Section& s, bool given, SceneFile&
                         "from the stands' density and DBH)");
   const bool drag = model_name == "drag";
   if (drag) {
-    for (const char* key : {"trees", "dbh_field", "friction", "seed"})
+    for (const char* key : {"trees", "dbh_field", "species_field", "friction", "seed"})
       if (s.Has(key))
         s.Fail(key, std::string("model = \"drag\" has no explicit trees: ") + key +
                         " is for model = \"trees\"");
@@ -398,7 +533,7 @@ void LoadForest(const Context& context, const Section& s, bool given, SceneFile&
              "}], stands_file = \"stands.gpkg\" or stems_per_ha_raster and dbh_raster (or "
              "several)");
   } else {
-    for (const char* key : {"stems_per_ha_raster", "dbh_raster"})
+    for (const char* key : {"stems_per_ha_raster", "dbh_raster", "raster_species"})
       if (s.Has(key))
         s.Fail(key, std::string(key) +
                         " is for model = \"drag\"; explicit trees come from trees, "
@@ -419,12 +554,15 @@ void LoadForest(const Context& context, const Section& s, bool given, SceneFile&
   RequireWithin(s, "energy_exponent", model.energy_exponent, 0, 5, "");
   std::string why;
   if (!model.IsValid(&why)) s.FailCheck(why);
+  model.species = ReadSpecies(context, s);
+  SpeciesNames names(model.species);
   out.forest_model = model_name;
-  std::vector<StandInput> stands = ReadStands(context, s, out.crs_wkt, out);
+  std::vector<StandInput> stands = ReadStands(context, s, out.crs_wkt, names, out);
   if (drag) {
-    out.scene.forest_drag = BuildDragLayer(context, s, stands, model, out);
+    out.scene.forest_drag = BuildDragLayer(context, s, stands, model, names, out);
     if (!out.scene.forest_drag.IsValid(&why)) s.Fail("model", why);
     out.forest_drag_model = model;
+    names.Warn(context, s, &out.warnings);
     return;
   }
   const long seed = s.Integer("seed", static_cast<long>(out.release.seed));
@@ -432,7 +570,7 @@ void LoadForest(const Context& context, const Section& s, bool given, SceneFile&
   out.forest_seed = static_cast<std::uint64_t>(seed);
 
   std::vector<Stem> stems;
-  if (s.Has("trees")) ReadTrees(context, s, out.scene.terrain, out.crs_wkt, &stems, out);
+  if (s.Has("trees")) ReadTrees(context, s, out.scene.terrain, out.crs_wkt, names, &stems, out);
   DrawStands(stands, out.scene.terrain, out.forest_seed, &stems, out);
   if (static_cast<long>(stems.size()) > kMaxTrees)
     s.Fail("stands",
@@ -440,6 +578,7 @@ void LoadForest(const Context& context, const Section& s, bool given, SceneFile&
   if (stems.empty())
     out.warnings.push_back(context.Where(s.Node(s.Has("stands") ? "stands" : "stands_file")) +
                            ": forest: the stands drew no tree (too small or too sparse)");
+  names.Warn(context, s, &out.warnings);
   out.has_forest = true;
   out.scene.forest = Forest(std::move(stems), model);
 }

@@ -95,6 +95,24 @@ nlohmann::ordered_json BarrierJson(const BarrierSummary& s) {
   return j;
 }
 
+// The forest's breaking-energy laws: its own and, per species of [forest.species], the species'
+// (the forest's filled in), each with E_max at a DBH of 30 cm.
+void BreakingEnergyJson(const ForestModel& model, nlohmann::ordered_json& f) {
+  f["breaking_energy"] = {{"coefficient_J", model.energy_coefficient_J},
+                          {"exponent", model.energy_exponent},
+                          {"law", "E_max = coefficient * DBH[cm]^exponent"}};
+  nlohmann::ordered_json species = nlohmann::ordered_json::array();
+  for (std::size_t k = 0; k < model.species.size(); ++k) {
+    const BreakingLaw law = model.Law(static_cast<int>(k));
+    species.push_back({{"name", model.species[k].name},
+                       {"coefficient_J", law.coefficient_J},
+                       {"exponent", law.exponent},
+                       {"factor", law.factor},
+                       {"e_max_30cm_J", law.Energy_J(0.30)}});
+  }
+  f["species"] = species;
+}
+
 }  // namespace
 
 std::string GroundTableJson(const GroundTable& table) { return GroundJson(table).dump(); }
@@ -249,15 +267,14 @@ std::string SummaryJson(const SceneFile& scene, const ensemble::EnsembleReport& 
                         {"stems_per_ha", s.stems_per_ha},
                         {"dbh_cm", s.dbh_cm},
                         {"dbh_sd_cm", s.dbh_sd_cm},
-                        {"trees", s.trees}});
+                        {"trees", s.trees},
+                        {"species", s.species}});
     f["stands_file"] = scene.stands_file;
     f["stands"] = stands;
     f["seed"] = scene.forest_seed;
     f["stem_height_m"] = model.stem_height_m;
     f["friction"] = model.friction;
-    f["breaking_energy"] = {{"coefficient_J", model.energy_coefficient_J},
-                            {"exponent", model.energy_exponent},
-                            {"law", "E_max = coefficient * DBH[cm]^exponent"}};
+    BreakingEnergyJson(model, f);
     if (trees)
       f["impacts"] = {
           {"rock_stem_pairs", trees->rows},        {"impacts", trees->impacts},
@@ -272,17 +289,18 @@ std::string SummaryJson(const SceneFile& scene, const ensemble::EnsembleReport& 
     f["model"] = "drag";
     nlohmann::ordered_json stands = nlohmann::ordered_json::array();
     for (const SceneFile::ForestStand& s : scene.stands)
-      stands.push_back(
-          {{"area_m2", s.area_m2}, {"stems_per_ha", s.stems_per_ha}, {"dbh_cm", s.dbh_cm}});
+      stands.push_back({{"area_m2", s.area_m2},
+                        {"stems_per_ha", s.stems_per_ha},
+                        {"dbh_cm", s.dbh_cm},
+                        {"species", s.species}});
     f["stands_file"] = scene.stands_file;
     f["stands"] = stands;
     f["stems_per_ha_raster"] = scene.forest_density_raster;
     f["dbh_raster"] = scene.forest_dbh_raster;
+    f["raster_species"] = scene.forest_raster_species;
     f["dem_nodes_in_forest"] = scene.forest_drag_cells;
     f["stem_height_m"] = model.stem_height_m;
-    f["breaking_energy"] = {{"coefficient_J", model.energy_coefficient_J},
-                            {"exponent", model.energy_exponent},
-                            {"law", "E_max = coefficient * DBH[cm]^exponent"}};
+    BreakingEnergyJson(model, f);
     f["rate"] = "c = n (DBH + w) |v_h| min(E_max, 2/3 E) / (2 E) on v and Omega (docs/model.md)";
     j["forest"] = f;
   }

@@ -9,7 +9,7 @@ namespace talus::io {
 
 const char* TreeImpactsCsvWriter::Header() {
   return "tree,rock,release,run,tree_x_m,tree_y_m,dbh_cm,impacts,t_s,x_m,y_m,z_m,energy_J,"
-         "absorbed_J,broken";
+         "absorbed_J,broken,species";
 }
 
 TreeImpactsCsvWriter::TreeImpactsCsvWriter(const std::string& path, const Forest& forest,
@@ -22,11 +22,16 @@ void TreeImpactsCsvWriter::Write(const ensemble::RockOutcome& rock) {
   const std::string run = CsvField(release_.ReleaseName(rock.release));
   for (const StemHit& h : hits) {
     const Stem& stem = forest_.stems()[static_cast<std::size_t>(h.stem)];
+    const std::string species =
+        stem.species >= 0
+            ? CsvField(forest_.model().species[static_cast<std::size_t>(stem.species)].name)
+            : "";
     std::fprintf(file_.get(),
-                 "%d,%ld,%d,%s,%.10g,%.10g,%.10g,%d,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%d\n",
+                 "%d,%ld,%d,%s,%.10g,%.10g,%.10g,%d,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%d,%s\n",
                  h.stem, rock.rock, rock.release, run.c_str(), stem.position_m.x(),
                  stem.position_m.y(), 100 * stem.dbh_m, h.impacts, h.t_s, h.position_m.x(),
-                 h.position_m.y(), h.position_m.z(), h.energy_J, h.absorbed_J, h.broken ? 1 : 0);
+                 h.position_m.y(), h.position_m.z(), h.energy_J, h.absorbed_J, h.broken ? 1 : 0,
+                 species.c_str());
   }
 }
 

@@ -319,8 +319,29 @@ std::vector<fieldobs::DepositObservation> ReadDepositPoints(const std::string& p
   return out;
 }
 
+namespace {
+
+// The names of `feature`'s fields, "a, b, c" ("none").
+std::string FieldNames(OGRFeature& feature) {
+  std::string fields;
+  for (int k = 0; k < feature.GetFieldCount(); ++k)
+    fields += (k ? ", " : "") + std::string(feature.GetFieldDefnRef(k)->GetNameRef());
+  return fields.empty() ? "none" : fields;
+}
+
+// The text of `feature`'s attribute `field`: absent when its layer has no such field, "" when null.
+std::optional<std::string> OptionalText(OGRFeature& feature, const std::string& field) {
+  const int index = feature.GetFieldIndex(field.c_str());
+  if (index < 0) return std::nullopt;
+  return feature.IsFieldSetAndNotNull(index) ? feature.GetFieldAsString(index) : "";
+}
+
+}  // namespace
+
 std::vector<TreePoint> ReadTreePoints(const std::string& path, const std::string& target_crs_wkt,
-                                      const std::string& dbh_field, const std::string& what) {
+                                      const std::string& dbh_field,
+                                      const std::string& species_field, bool require_species,
+                                      const std::string& what) {
   std::vector<TreePoint> out;
   ForEachFeature(path, target_crs_wkt, what, "trees", nullptr,
                  [&](OGRFeature& feature, const OGRGeometry& geometry, const std::string& where) {
@@ -338,6 +359,11 @@ std::vector<TreePoint> ReadTreePoints(const std::string& path, const std::string
                    if (!feature.IsFieldSetAndNotNull(field))
                      throw InputError(where + ": " + dbh_field + " is empty");
                    t.dbh_cm = feature.GetFieldAsDouble(field);
+                   t.species = OptionalText(feature, species_field);
+                   if (!t.species && require_species)
+                     throw InputError(where + ": no field '" + species_field +
+                                      "' (species_field: the tree's species; the fields are: " +
+                                      FieldNames(feature) + ")");
                    t.where = where;
                    out.push_back(t);
                  });
@@ -369,6 +395,7 @@ std::vector<StandPolygon> ReadStandPolygons(const std::string& path,
                    stand.stems_per_ha = *number("stems_per_ha", true);
                    stand.dbh_cm = *number("dbh_cm", true);
                    stand.dbh_sd_cm = number("dbh_sd_cm", false).value_or(0.0);
+                   stand.species = OptionalText(feature, "species");
                    std::vector<ReleaseGeometry> parts;
                    Collect(geometry, where, parts);
                    for (ReleaseGeometry& part : parts) {

@@ -1,6 +1,7 @@
 #pragma once
 // Release geometries from vector files GDAL/OGR reads (GeoJSON, GeoPackage, Shapefile, ...).
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -80,28 +81,34 @@ std::vector<fieldobs::DepositObservation> ReadDepositPoints(const std::string& p
 struct TreePoint {
   Eigen::Vector2d xy_m = Eigen::Vector2d::Zero();  // in the DEM's CRS
   double dbh_cm = 0;                               // as stored, unchecked
-  std::string where;                               // "<what> (<file>, feature <fid>)"
+  // The species attribute as text: absent when the layer has no such field, "" when null.
+  std::optional<std::string> species;
+  std::string where;  // "<what> (<file>, feature <fid>)"
 };
 
 // The trees of a vector file of points (a [forest] trees file other than CSV): every point
 // feature of every layer, reprojected to the DEM's CRS as for ReadReleaseGeometries (an error when
-// the file has a CRS and the DEM none), each with the number in its `dbh_field` attribute. Throws
-// InputError naming `what`, the file and the feature: not a point, no such field, an empty value,
-// no point at all.
+// the file has a CRS and the DEM none), each with the number in its `dbh_field` attribute and the
+// text of its `species_field` attribute where the layer has one. Throws InputError naming `what`,
+// the file and the feature: not a point, no DBH field (or, with `require_species`, no species
+// field), an empty DBH, no point at all.
 std::vector<TreePoint> ReadTreePoints(const std::string& path, const std::string& target_crs_wkt,
-                                      const std::string& dbh_field, const std::string& what);
+                                      const std::string& dbh_field,
+                                      const std::string& species_field, bool require_species,
+                                      const std::string& what);
 
 // One forest stand of a polygon vector file (ReadStandPolygons).
 struct StandPolygon {
   std::vector<std::vector<Eigen::Vector2d>> rings;     // outer ring, then holes; in the DEM's CRS
   double stems_per_ha = 0, dbh_cm = 0, dbh_sd_cm = 0;  // as stored, unchecked
-  std::string where;                                   // "<what> (<file>, feature <fid>)"
+  std::optional<std::string> species;  // as TreePoint's, from the attribute `species`
+  std::string where;                   // "<what> (<file>, feature <fid>)"
 };
 
 // The stands of a vector file of polygons ([forest] stands_file): every polygon feature of every
 // layer (multi-polygons split), reprojected to the DEM's CRS as for ReadReleaseGeometries, with
-// the numeric attributes stems_per_ha and dbh_cm and the optional dbh_sd_cm (0 when absent).
-// Throws InputError naming `what`, the file and the feature.
+// the numeric attributes stems_per_ha and dbh_cm, the optional dbh_sd_cm (0 when absent) and the
+// optional text attribute species. Throws InputError naming `what`, the file and the feature.
 std::vector<StandPolygon> ReadStandPolygons(const std::string& path,
                                             const std::string& target_crs_wkt,
                                             const std::string& what);

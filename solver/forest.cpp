@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <Eigen/LU>
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -76,8 +77,38 @@ Eigen::Vector2d ProjectOnDisk(const Eigen::Vector2d& p, double radius) {
 
 }  // namespace
 
-double ForestModel::BreakingEnergy_J(double dbh_m) const {
-  return energy_coefficient_J * std::pow(100 * dbh_m, energy_exponent);
+double BreakingLaw::Energy_J(double dbh_m) const {
+  return factor * (coefficient_J * std::pow(100 * dbh_m, exponent));
+}
+
+bool TreeSpecies::IsValid(std::string* why) const {
+  auto fail = [&](const std::string& what) {
+    if (why) *why = what;
+    return false;
+  };
+  if (name.empty() || std::any_of(name.begin(), name.end(), [](char c) {
+        return std::iscntrl(static_cast<unsigned char>(c));
+      }))
+    return fail("name '" + name + "' must be non-empty, without control characters");
+  if (!(std::isfinite(energy_factor) && energy_factor > 0))
+    return fail("energy_factor = " + Number(energy_factor) + " must be finite and > 0");
+  if (energy_coefficient_J && !(std::isfinite(*energy_coefficient_J) && *energy_coefficient_J > 0))
+    return fail("energy_coefficient_j = " + Number(*energy_coefficient_J) +
+                " must be finite and > 0 J");
+  if (energy_exponent && !(std::isfinite(*energy_exponent) && *energy_exponent > 0))
+    return fail("energy_exponent = " + Number(*energy_exponent) + " must be finite and > 0");
+  if (energy_factor != 1 && (energy_coefficient_J || energy_exponent))
+    return fail("energy_factor = " + Number(energy_factor) +
+                " with a law of its own: a species scales the forest's law or has its own "
+                "coefficient and exponent, not both");
+  return true;
+}
+
+BreakingLaw ForestModel::Law(int k) const {
+  if (k < 0) return BreakingLaw{1, energy_coefficient_J, energy_exponent};
+  const TreeSpecies& s = species[static_cast<std::size_t>(k)];
+  return BreakingLaw{s.energy_factor, s.energy_coefficient_J.value_or(energy_coefficient_J),
+                     s.energy_exponent.value_or(energy_exponent)};
 }
 
 bool ForestModel::IsValid(std::string* why) const {
@@ -94,6 +125,13 @@ bool ForestModel::IsValid(std::string* why) const {
                 " must be finite and > 0 J");
   if (!(std::isfinite(energy_exponent) && energy_exponent > 0))
     return fail("energy_exponent = " + Number(energy_exponent) + " must be finite and > 0");
+  for (const TreeSpecies& s : species) {
+    std::string reason;
+    if (!s.IsValid(&reason)) return fail("species '" + s.name + "': " + reason);
+    if (std::count_if(species.begin(), species.end(),
+                      [&](const TreeSpecies& t) { return t.name == s.name; }) > 1)
+      return fail("species '" + s.name + "' is declared twice");
+  }
   return true;
 }
 
@@ -104,7 +142,10 @@ Forest::Forest(std::vector<Stem> stems, const ForestModel& model)
   x0_m_ = x1;
   y0_m_ = y1;
   for (const Stem& s : stems_) {
-    capacity_J_.push_back(model_.BreakingEnergy_J(s.dbh_m));
+    // A species the model lacks (IsValid says so) breaks at NaN rather than reading past the list.
+    capacity_J_.push_back(s.species < static_cast<int>(model_.species.size())
+                              ? model_.BreakingEnergy_J(s.dbh_m, s.species)
+                              : std::numeric_limits<double>::quiet_NaN());
     max_radius_m_ = std::max(max_radius_m_, 0.5 * s.dbh_m);
     x0_m_ = std::min(x0_m_, s.position_m.x());
     y0_m_ = std::min(y0_m_, s.position_m.y());
@@ -140,6 +181,12 @@ bool Forest::IsValid(std::string* why) const {
     }
     if (!(std::isfinite(s.dbh_m) && s.dbh_m > 0)) {
       if (why) *why = "tree " + std::to_string(k) + ": dbh = " + Number(s.dbh_m) + " m must be > 0";
+      return false;
+    }
+    if (s.species < -1 || s.species >= static_cast<int>(model_.species.size())) {
+      if (why)
+        *why = "tree " + std::to_string(k) + ": species " + std::to_string(s.species) +
+               " is not one of the model's " + std::to_string(model_.species.size());
       return false;
     }
   }

@@ -9,6 +9,7 @@
 // rest of this rock, not for the other rocks. A scene without trees does no forest work.
 
 #include <Eigen/Core>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -18,17 +19,44 @@
 
 namespace talus {
 
+// A breaking-energy law: E_max = factor * (coefficient * DBH[cm]^exponent) (J); ForestModel::Law
+// gives a stem's.
+struct BreakingLaw {
+  double factor = 1;
+  double coefficient_J = 0;
+  double exponent = 0;
+
+  double Energy_J(double dbh_m) const;
+};
+
+// A tree species whose stems break by a law of their own ([forest.species.<name>]; docs/model.md
+// "Forest"): the forest's law times energy_factor, or (factor 1) its own coefficient and/or
+// exponent, the other taken from the forest's. The user states it, from the source they trust.
+struct TreeSpecies {
+  std::string name;                            // non-empty, no control characters
+  double energy_factor = 1;                    // > 0; 1 when the species has a law of its own
+  std::optional<double> energy_coefficient_J;  // J, > 0; absent: the forest's
+  std::optional<double> energy_exponent;       // > 0; absent: the forest's
+  // Checks the fields; *why names the field (as the scene key), the value and the bound.
+  bool IsValid(std::string* why) const;
+};
+
 // The mechanics shared by all stems of a scene.
 struct ForestModel {
   double stem_height_m = 10;  // stems reach this high above the terrain at their axis (m), > 0
   double friction = 0.5;      // Coulomb coefficient between rock and stem, >= 0
-  // Breaking energy E_max = coefficient * DBH[cm]^exponent (J); defaults: Dorren & Berger 2006
-  // as docs/model.md "Forest" states (and what of it could be checked).
+  // Breaking energy E_max = coefficient * DBH[cm]^exponent (J) of stems without a species;
+  // defaults: Dorren & Berger 2006 as docs/model.md "Forest" states (and what of it could be
+  // checked).
   double energy_coefficient_J = 38.7;
   double energy_exponent = 2.31;
+  // The species a stem or stand may name (Stem::species indexes it); empty: one law for all.
+  std::vector<TreeSpecies> species;
 
-  double BreakingEnergy_J(double dbh_m) const;
-  // Checks the fields; *why names the field, the value and the bound.
+  // The law of species k (an index into `species`; -1: none, the forest's own law, factor 1).
+  BreakingLaw Law(int k = -1) const;
+  double BreakingEnergy_J(double dbh_m, int k = -1) const { return Law(k).Energy_J(dbh_m); }
+  // Checks the fields and every species; *why names the field, the value and the bound.
   bool IsValid(std::string* why) const;
 };
 
@@ -37,13 +65,15 @@ struct Stem {
   Eigen::Vector2d position_m = Eigen::Vector2d::Zero();  // axis, map coordinates (m)
   double dbh_m = 0;                                      // stem diameter (m), > 0
   double ground_m = 0;  // terrain height at the axis (m): the stem's foot
+  int species = -1;     // index into ForestModel::species; -1: none (the forest's law)
 };
 
 // The trees of a scene and a uniform grid of them for cheap look-ups.
 class Forest {
  public:
   Forest() = default;
-  // Requires model.IsValid() and finite stems of positive DBH.
+  // Requires model.IsValid() and finite stems of positive DBH, each of a species of the model or
+  // none.
   Forest(std::vector<Stem> stems, const ForestModel& model);
 
   bool empty() const { return stems_.empty(); }
@@ -81,7 +111,7 @@ class Forest {
  private:
   std::vector<Stem> stems_;
   ForestModel model_;
-  std::vector<double> capacity_J_;  // per stem, model_.BreakingEnergy_J(dbh)
+  std::vector<double> capacity_J_;  // per stem, model_.BreakingEnergy_J(dbh, species)
   double max_radius_m_ = 0;
   double x0_m_ = 0, y0_m_ = 0, cell_m_ = kCell_m;
   int nx_ = 0, ny_ = 0;
@@ -104,7 +134,7 @@ class Forest {
 struct DragStand {
   double stems_per_m2 = 0;       // n, > 0
   double dbh_m = 0;              // D, > 0
-  double breaking_energy_J = 0;  // E_max(D) of the ForestModel, > 0
+  double breaking_energy_J = 0;  // E_max(D) of the ForestModel and the stand's species, > 0
 };
 
 class ForestDrag {

@@ -292,9 +292,9 @@ TEST(RocksGeoPackage, TreesAreALayerWithTheirDbhHitsAndBreakages) {
   // Header of the writer; tree 2 hit by rocks 0 (twice, held) and 1 (broken), tree 0 by rock 2.
   testing::WriteText(dir / "tree_impacts.csv",
                      std::string(TreeImpactsCsvWriter::Header()) +
-                         "\n2,0,0,r,12,22,45,2,1.5,12,22,8,300000,250000,0"
-                         "\n2,1,0,r,12,22,45,1,1.7,12,22,8,900000,150000,1"
-                         "\n0,2,0,r,10,20,30,1,2.0,10,20,6,50000,50000,0\n");
+                         "\n2,0,0,r,12,22,45,2,1.5,12,22,8,300000,250000,0,"
+                         "\n2,1,0,r,12,22,45,1,1.7,12,22,8,900000,150000,1,"
+                         "\n0,2,0,r,10,20,30,1,2.0,10,20,6,50000,50000,0,\n");
   const std::string path = (dir / "rocks.gpkg").string();
   WriteRocksGeoPackage(
       path, (dir / "rocks.csv").string(), "", testing::Wkt(31287), "", "",
@@ -337,7 +337,7 @@ TEST(RocksGeoPackage, TreesAreALayerWithTheirDbhHitsAndBreakages) {
   Dataset without(none);
   EXPECT_EQ(without.d->GetLayerByName("trees"), nullptr);
   testing::WriteText(dir / "tree_impacts.csv", std::string(TreeImpactsCsvWriter::Header()) +
-                                                   "\n3,0,0,r,12,22,45,2,1.5,12,22,8,3,2,0\n");
+                                                   "\n3,0,0,r,12,22,45,2,1.5,12,22,8,3,2,0,\n");
   try {
     WriteRocksGeoPackage(
         (dir / "bad.gpkg").string(), (dir / "rocks.csv").string(), "", "", "", "",

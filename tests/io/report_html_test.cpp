@@ -136,16 +136,22 @@ TEST(ReportHtml, ShowsTheForestSummary) {
   RunReportInput input;
   input.summary_json = R"({"rocks": 10, "forest": {"model": "trees", "trees": 120,
       "stands": [{"area_m2": 20000, "stems_per_ha": 300, "dbh_cm": 30, "dbh_sd_cm": 5,
-                  "trees": 120}],
+                  "trees": 120, "species": "beech"}],
       "stem_height_m": 10, "friction": 0.5,
       "breaking_energy": {"coefficient_J": 38.7, "exponent": 2.31,
                           "law": "E_max = coefficient * DBH[cm]^exponent"},
+      "species": [{"name": "beech", "coefficient_J": 38.7, "exponent": 2.31, "factor": 1.6,
+                   "e_max_30cm_J": 159936}],
       "impacts": {"rock_stem_pairs": 9, "impacts": 11, "rocks_hitting": 6, "rocks_breaking": 2,
                   "breakages": 3, "stems_hit": 8, "absorbed_J": 250000}}})";
   const std::string html = RunReportHtml(input);
   EXPECT_NE(html.find("<h2>Forest</h2>"), std::string::npos);
   EXPECT_NE(html.find("<tr><th>trees</th><td>120</td></tr>"), std::string::npos) << html;
-  EXPECT_NE(html.find("300 stems/ha of DBH 30 cm on 2.00 ha"), std::string::npos) << html;
+  EXPECT_NE(html.find("300 stems/ha of DBH 30 cm on 2.00 ha (beech)"), std::string::npos) << html;
+  EXPECT_NE(html.find("<tr><th>breaking energy by species (the scene's laws)</th><td>beech: 1.6 "
+                      "&times; 38.7 J &times; DBH[cm]<sup>2.31</sup>, 160 kJ at 30 cm</td></tr>"),
+            std::string::npos)
+      << html;
   EXPECT_NE(html.find("<tr><th>stems broken</th><td>3</td></tr>"), std::string::npos);
   EXPECT_NE(html.find("<tr><th>energy the stems absorbed (kJ)</th><td>250</td></tr>"),
             std::string::npos)

@@ -6,13 +6,17 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <fstream>
+#include <iterator>
 #include <mutex>
 #include <string>
 
 #include "common/error.hpp"
 #include "ensemble/runner.hpp"
+#include "io/rocks_csv.hpp"
 #include "io/scene_file.hpp"
 #include "test_files.hpp"
 
@@ -264,6 +268,228 @@ TEST(SceneForest, BadInputIsAnErrorNamingFileLineAndKey) {
   EXPECT_HAS(ErrorOf(kStand + "dbh = 3\n"), "forest.dbh: unknown key");
   EXPECT_HAS(ErrorOf("[output]\nrasters = [\"tree_hits\"]\n"),
              "output.rasters: tree_hits counts the impacts on stems: the scene has no [forest]");
+}
+
+// Two species as a scene declares them after its [forest] keys: beech by a factor of the forest's
+// law, larch by a coefficient of its own (the forest's exponent). The numbers are the test's, not
+// published ones.
+const std::string kSpecies =
+    "[forest.species.beech]\nenergy_factor = 1.6\n"
+    "[forest.species.larch]\nenergy_coefficient_j = 60\n";
+
+TEST(SceneForest, TreesAndStandsOfADeclaredSpeciesBreakByItsLaw) {
+  const SceneFile s = Load(
+      "[forest]\ntrees = \"trees.csv\"\n"
+      "stands = [{ polygon = [[20, -10], [40, -10], [40, 10], [20, 10]], "
+      "stems_per_ha = 1000, dbh_cm = 25, species = \"larch\" }]\n" +
+          kSpecies,
+      "x_m,y_m,dbh_cm,species\n30,0,30,beech\n32,1,30,\n34,2,30,larch\n");
+  const Forest& forest = s.scene.forest;
+  ASSERT_EQ(forest.model().species.size(), 2u);
+  EXPECT_EQ(forest.model().species[0].name, "beech");
+  EXPECT_EQ(forest.model().species[1].name, "larch");
+  const double e30 = ForestModel{}.BreakingEnergy_J(0.30);
+  ASSERT_GT(forest.stems().size(), 3u);
+  EXPECT_EQ(forest.stems()[0].species, 0);
+  EXPECT_EQ(forest.capacity_J(0), 1.6 * e30);
+  EXPECT_EQ(forest.stems()[1].species, -1);  // an empty cell: the forest's law
+  EXPECT_EQ(forest.capacity_J(1), e30);
+  EXPECT_EQ(forest.stems()[2].species, 1);
+  EXPECT_NEAR(forest.capacity_J(2), 60 * std::pow(30.0, 2.31), 1e-9 * forest.capacity_J(2));
+  for (std::size_t k = 3; k < forest.stems().size(); ++k) {
+    EXPECT_EQ(forest.stems()[k].species, 1);  // the stand's
+    EXPECT_EQ(forest.capacity_J(static_cast<int>(k)),
+              forest.model().BreakingEnergy_J(forest.stems()[k].dbh_m, 1));
+  }
+  ASSERT_EQ(s.stands.size(), 1u);
+  EXPECT_EQ(s.stands[0].species, "larch");
+  EXPECT_TRUE(s.warnings.empty()) << s.warnings.front();
+}
+
+TEST(SceneForest, BadSpeciesIsAnErrorNamingFileLineAndKey) {
+  // Lines: 12 [forest], 13 trees, 14 [forest.species.beech], 15 its first key.
+  const std::string trees = "[forest]\ntrees = \"trees.csv\"\n";
+  const std::string beech = trees + "[forest.species.beech]\n";
+  const std::string csv = "x_m,y_m,dbh_cm,species\n30,0,30,beech\n";
+  EXPECT_HAS(ErrorOf(trees + kSpecies, csv + "32,0,30,oak\n"),
+             "trees.csv:3: column 'species': species 'oak' is not declared in [forest.species] "
+             "(declared: 'beech', 'larch')");
+  EXPECT_HAS(ErrorOf(beech + "energy_factor = 2\nenergy_coefficient_j = 60\n", csv),
+             "scene.toml:15: forest.species.beech.energy_factor: a species gives energy_factor "
+             "(E_max = factor x the forest's law) or a law of its own");
+  EXPECT_HAS(ErrorOf(beech + "energy_exponent = 2\nenergy_factor = 2\n", csv),
+             "scene.toml:16: forest.species.beech.energy_factor: a species gives energy_factor");
+  EXPECT_HAS(ErrorOf(beech + "energy_factor = 0\n", csv),
+             "scene.toml:15: forest.species.beech.energy_factor: energy_factor = 0 must be finite "
+             "and > 0");
+  EXPECT_HAS(ErrorOf(beech + "energy_factor = -1\n", csv),
+             "scene.toml:15: forest.species.beech.energy_factor: -1 is outside 0 .. 100");
+  EXPECT_HAS(ErrorOf(beech + "energy_factor = 500\n", csv), "500 is outside 0 .. 100");
+  EXPECT_HAS(ErrorOf(beech + "energy_coefficient_j = -60\n", csv),
+             "forest.species.beech.energy_coefficient_j: energy_coefficient_j = -60 must be");
+  EXPECT_HAS(ErrorOf(beech + "energy_factr = 2\n", csv),
+             "scene.toml:15: forest.species.beech.energy_factr: unknown key (did you mean "
+             "'energy_factor'?)");
+  EXPECT_HAS(ErrorOf(beech + "height_m = 2\n", csv),
+             "scene.toml:15: forest.species.beech.height_m: unknown key");
+  EXPECT_HAS(ErrorOf(beech, csv), "forest.species.beech.energy_factor: missing");
+  EXPECT_HAS(ErrorOf(trees + "species = 3\n", csv), "forest.species: expected tables");
+  EXPECT_HAS(ErrorOf(trees + "[forest.species.\"a\\tb\"]\nenergy_factor = 2\n", csv),
+             "without control characters");
+  // An inline stand naming an undeclared species.
+  EXPECT_HAS(ErrorOf("[forest]\nstands = [{ polygon = [[20, -10], [40, -10], [40, 10]], "
+                     "stems_per_ha = 400, dbh_cm = 30, species = \"oak\" }]\n" +
+                     kSpecies),
+             "scene.toml:13: forest.stands[0].species: species 'oak' is not declared in "
+             "[forest.species] (declared: 'beech', 'larch')");
+  // Keys for another kind of input.
+  EXPECT_HAS(ErrorOf(trees + "species_field = \"art\"\n" + kSpecies, csv),
+             "forest.species_field: a CSV tree list has its species in the column species");
+  EXPECT_HAS(ErrorOf(kStand + "raster_species = \"beech\"\n" + kSpecies),
+             "forest.raster_species: raster_species is for model = \"drag\"");
+  EXPECT_HAS(ErrorOf(kStand + "model = \"drag\"\nraster_species = \"beech\"\n" + kSpecies),
+             "forest.raster_species: names the species of the stands of stems_per_ha_raster");
+  EXPECT_HAS(ErrorOf(kStand + "model = \"drag\"\nspecies_field = \"art\"\n" + kSpecies),
+             "forest.species_field: model = \"drag\" has no explicit trees");
+}
+
+TEST(SceneForest, UnusedSpeciesAndUndeclaredSpeciesInAFileAreWarnings) {
+  const SceneFile s = Load("[forest]\ntrees = \"trees.csv\"\n" + kSpecies,
+                           "x_m,y_m,dbh_cm,species\n30,0,30,beech\n");
+  ASSERT_EQ(s.warnings.size(), 1u);
+  EXPECT_HAS(
+      s.warnings[0],
+      "scene.toml:16: forest.species.larch: forest: declared, but no tree or stand names it");
+  // A tree list with a species column in a scene that declares no species (an inventory written
+  // before [forest.species]): it loads as before, every stem of the forest's law, with a warning.
+  const SceneFile plain =
+      Load("[forest]\ntrees = \"trees.csv\"\n", "x_m,y_m,dbh_cm,species\n30,0,30,Picea abies\n");
+  EXPECT_EQ(plain.scene.forest.stems().at(0).species, -1);
+  EXPECT_EQ(plain.scene.forest.capacity_J(0), ForestModel{}.BreakingEnergy_J(0.30));
+  ASSERT_EQ(plain.warnings.size(), 1u);
+  EXPECT_HAS(plain.warnings[0],
+             "trees.csv:2: column 'species': forest: names a species, but the scene declares none");
+}
+
+// A point vector file of trees: the species in the attribute species_field ("species" by default,
+// read when the layer has it; a null value is no species); a species_field the layer lacks is an
+// error when the scene names it.
+TEST(SceneForest, AVectorTreeFileGivesEachTreeTheSpeciesOfItsSpeciesField) {
+  const auto dir = testing::FreshDir("scene");
+  testing::WriteText(dir / "trees.geojson", R"({"type": "FeatureCollection", "features": [
+{"type": "Feature", "properties": {"dbh_cm": 30, "species": "beech", "art": "larch"}, "geometry": {"type": "Point", "coordinates": [30, 1]}},
+{"type": "Feature", "properties": {"dbh_cm": 30, "species": null, "art": "larch"}, "geometry": {"type": "Point", "coordinates": [33, -2]}}]})");
+  const auto load = [&](const std::string& keys) {
+    testing::WriteText(dir / "scene.toml",
+                       kScene + "[forest]\ntrees = \"trees.geojson\"\n" + keys + kSpecies);
+    return LoadScene((dir / "scene.toml").string());
+  };
+  SceneFile s = load("");
+  ASSERT_EQ(s.scene.forest.stems().size(), 2u);
+  EXPECT_EQ(s.scene.forest.stems()[0].species, 0);
+  EXPECT_EQ(s.scene.forest.stems()[1].species, -1);
+  ASSERT_EQ(s.warnings.size(), 1u);  // larch
+  s = load("species_field = \"art\"\n");
+  EXPECT_EQ(s.scene.forest.stems()[0].species, 1);
+  EXPECT_EQ(s.scene.forest.stems()[1].species, 1);
+  try {
+    load("species_field = \"sorte\"\n");
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_HAS(e.what(), "trees.geojson, feature 0): no field 'sorte' (species_field");
+    EXPECT_HAS(e.what(), "the fields are: dbh_cm, species, art");
+  }
+}
+
+// stands_file: a polygon's attribute species (when the layer has it) is the stand's species.
+TEST(SceneForest, StandsOfAFileTakeTheSpeciesOfTheirAttribute) {
+  const auto dir = testing::FreshDir("scene");
+  testing::WriteText(dir / "stands.geojson", R"({"type": "FeatureCollection", "features": [
+{"type": "Feature", "properties": {"stems_per_ha": 2000, "dbh_cm": 20, "species": "beech"},
+ "geometry": {"type": "Polygon", "coordinates": [[[20, -10], [30, -10], [30, 10], [20, 10], [20, -10]]]}},
+{"type": "Feature", "properties": {"stems_per_ha": 2000, "dbh_cm": 20, "species": null},
+ "geometry": {"type": "Polygon", "coordinates": [[[30, -10], [40, -10], [40, 10], [30, 10], [30, -10]]]}}]})");
+  testing::WriteText(dir / "scene.toml", kScene + "[forest]\nstands_file = \"stands.geojson\"\n" +
+                                             "[forest.species.beech]\nenergy_factor = 1.6\n");
+  const SceneFile s = LoadScene((dir / "scene.toml").string());
+  ASSERT_EQ(s.stands.size(), 2u);
+  EXPECT_EQ(s.stands[0].species, "beech");
+  EXPECT_EQ(s.stands[1].species, "");
+  ASSERT_FALSE(s.scene.forest.empty());
+  for (const Stem& stem : s.scene.forest.stems())
+    EXPECT_EQ(stem.species, stem.position_m.x() < 30 ? 0 : -1) << stem.position_m.x();
+  EXPECT_TRUE(s.warnings.empty());
+}
+
+// model = "drag": a stand's species sets its DragStand's breaking energy; raster_species that of
+// the rasters' stands.
+TEST(SceneForest, TheDragStandsBreakByTheirSpeciesLaw) {
+  const auto dir = testing::FreshDir("scene");
+  // 2 x 2 cells of 5 m from (20, -5) to (30, 5): 800 stems/ha of DBH 25 cm, 300 of 40 cm.
+  const std::array<double, 6> gt = {20, 5, 0, 5, 0, -5};
+  testing::WriteGdalRaster(dir / "density.tif", {{800, 300}, {800, 300}}, gt, 0, -1);
+  testing::WriteGdalRaster(dir / "dbh.tif", {{25, 40}, {25, 40}}, gt, 0, -1);
+  testing::WriteText(
+      dir / "scene.toml",
+      kScene +
+          "[forest]\nmodel = \"drag\"\nstems_per_ha_raster = \"density.tif\"\n"
+          "dbh_raster = \"dbh.tif\"\nraster_species = \"larch\"\n"
+          "stands = [{ polygon = [[30, -10], [35, -10], [35, 10], [30, 10]], stems_per_ha = 400, "
+          "dbh_cm = 30, species = \"beech\" }, { polygon = [[35, -10], [40, -10], [40, 10], [35, "
+          "10]], stems_per_ha = 400, dbh_cm = 30 }]\n" +
+          kSpecies);
+  const SceneFile s = LoadScene((dir / "scene.toml").string());
+  const ForestDrag& drag = s.scene.forest_drag;
+  const double e30 = ForestModel{}.BreakingEnergy_J(0.30);
+  ASSERT_NE(drag.StandAt(32, 0), nullptr);
+  EXPECT_EQ(drag.StandAt(32, 0)->breaking_energy_J, 1.6 * e30);  // beech
+  ASSERT_NE(drag.StandAt(38, 0), nullptr);
+  EXPECT_EQ(drag.StandAt(38, 0)->breaking_energy_J, e30);  // no species
+  ASSERT_NE(drag.StandAt(22, 0), nullptr);
+  EXPECT_NEAR(drag.StandAt(22, 0)->breaking_energy_J, 60 * std::pow(25.0, 2.31),
+              1e-9 * drag.StandAt(22, 0)->breaking_energy_J);  // larch, the rasters'
+  EXPECT_EQ(s.forest_raster_species, "larch");
+  ASSERT_EQ(s.stands.size(), 2u);
+  EXPECT_EQ(s.stands[0].species, "beech");
+  EXPECT_TRUE(s.warnings.empty());
+}
+
+// The rocks.csv of a run (as talus simulate writes it), `threads` 1.
+std::string RocksCsvOf(const SceneFile& s, const std::string& name) {
+  ensemble::EnsembleOptions options;
+  options.threads = 1;
+  Collect sink;
+  ensemble::RunEnsemble(s.scene, s.release, options, &sink);
+  std::sort(sink.rocks.begin(), sink.rocks.end(),
+            [](const auto& a, const auto& b) { return a.rock < b.rock; });
+  const auto path = testing::FreshDir(name) / "rocks.csv";
+  RocksCsvWriter csv(path.string(), s.scene, s.release);
+  long broken = 0;
+  for (const ensemble::RockOutcome& rock : sink.rocks) {
+    csv.Write(rock);
+    for (const StemHit& h : rock.result.stem_hits) broken += h.broken;
+  }
+  csv.Commit();
+  EXPECT_GT(broken, 0) << "the rocks break stems";
+  std::ifstream in(path);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+// A species of factor 1 is the forest's law: a scene whose one stand is of that species gives the
+// bytes of rocks.csv of the same scene without species.
+TEST(SceneForest, ASpeciesOfFactorOneGivesTheRocksOfTheSceneWithoutSpecies) {
+  std::string scene = kScene;
+  scene.replace(scene.find("seed = 4\n"), 9,
+                "seed = 4\nvelocity_m_s = [6, 0, 0]\norientation = \"random\"\n");
+  std::string thin = kStand;  // 5 cm stems, which the rocks break
+  thin.replace(thin.find("dbh_cm = 30, dbh_sd_cm = 5"), 26, "dbh_cm = 5, dbh_sd_cm = 1");
+  std::string of_species = thin;
+  of_species.replace(of_species.find(" }]"), 3, ", species = \"spruce\" }]");
+  const SceneFile plain = Load(thin, "", scene);
+  const SceneFile spruce =
+      Load(of_species + "[forest.species.spruce]\nenergy_factor = 1\n", "", scene);
+  ASSERT_EQ(spruce.scene.forest.stems().front().species, 0);
+  EXPECT_EQ(RocksCsvOf(spruce, "spruce"), RocksCsvOf(plain, "plain"));
 }
 
 // model = "drag": the stands on the DEM's nodes (1 m here) as ForestDrag stands of density

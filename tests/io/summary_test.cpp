@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -55,6 +56,38 @@ TEST(SummaryJson, CarriesHashVersionCountsAndRate) {
   EXPECT_DOUBLE_EQ(j["trajectories_per_s"].get<double>(), 5.0);
   EXPECT_DOUBLE_EQ(j["wall_time_s"].get<double>(), 2.0);
   EXPECT_TRUE(j["crs_wkt"].is_null());  // the plane has no CRS
+}
+
+// "forest": the species of [forest.species] with their laws (the forest's coefficient and exponent
+// filled in) and E_max at 30 cm; each stand's species ("" without).
+TEST(SummaryJson, ForestListsTheSpeciesLawsAndEachStandsSpecies) {
+  const auto dir = testing::FreshDir("summary_forest");
+  testing::WriteText(
+      dir / "scene.toml",
+      "[terrain]\nplane = {}\n[rock]\nshape = { box = [1, 1, 1] }\n[release]\npoints = [[10, "
+      "0]]\n[forest]\nstands = [{ polygon = [[20, -5], [30, -5], [30, 5]], stems_per_ha = 400, "
+      "dbh_cm = 30, species = \"beech\" }, { polygon = [[20, -5], [30, 5], [20, 5]], "
+      "stems_per_ha = 400, dbh_cm = 30 }]\n[forest.species.beech]\nenergy_factor = 1.6\n"
+      "[forest.species.larch]\nenergy_coefficient_j = 60\n");
+  const SceneFile scene = LoadScene((dir / "scene.toml").string());
+  const auto j =
+      nlohmann::json::parse(SummaryJson(scene, ensemble::EnsembleReport{}, "9.9.9", {}));
+  const auto& f = j.at("forest");
+  ASSERT_EQ(f.at("species").size(), 2u);
+  const auto& beech = f["species"][0];
+  EXPECT_EQ(beech["name"], "beech");
+  EXPECT_EQ(beech["factor"], 1.6);
+  EXPECT_EQ(beech["coefficient_J"], 38.7);
+  EXPECT_EQ(beech["exponent"], 2.31);
+  EXPECT_EQ(beech["e_max_30cm_J"], 1.6 * (38.7 * std::pow(30.0, 2.31)));
+  const auto& larch = f["species"][1];
+  EXPECT_EQ(larch["factor"], 1);
+  EXPECT_EQ(larch["coefficient_J"], 60);
+  EXPECT_EQ(larch["exponent"], 2.31);
+  EXPECT_EQ(f["stands"][0]["species"], "beech");
+  EXPECT_EQ(f["stands"][1]["species"], "");
+  // The unused larch is a warning.
+  ASSERT_EQ(j["warnings"].size(), 1u);
 }
 
 // The DEM's CRS, as WKT, for the positions every output holds.

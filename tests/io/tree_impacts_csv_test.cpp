@@ -46,9 +46,9 @@ TEST(TreeImpactsCsv, RowsPerRockAndStemAndTheirSummary) {
   std::stringstream text;
   text << in.rdbuf();
   EXPECT_EQ(text.str(), std::string(TreeImpactsCsvWriter::Header()) + "\n" +
-                            "0,0,0,0,10,20,30,2,1.5,0,0,0,5000,1000,0\n"
-                            "1,0,0,0,12,20,20,1,1.5,0,0,0,5000,3000,1\n"
-                            "0,2,0,0,10,20,30,1,1.5,0,0,0,5000,3000,1\n");
+                            "0,0,0,0,10,20,30,2,1.5,0,0,0,5000,1000,0,\n"
+                            "1,0,0,0,12,20,20,1,1.5,0,0,0,5000,3000,1,\n"
+                            "0,2,0,0,10,20,30,1,1.5,0,0,0,5000,3000,1,\n");
   const TreeImpactSummary s = SummarizeTreeImpacts(path);
   EXPECT_EQ(s.rows, 3);
   EXPECT_EQ(s.impacts, 4);
@@ -57,6 +57,34 @@ TEST(TreeImpactsCsv, RowsPerRockAndStemAndTheirSummary) {
   EXPECT_EQ(s.breakages, 2);
   EXPECT_EQ(s.stems_hit, 2);
   EXPECT_EQ(s.absorbed_J, 7000);
+}
+
+// A stem of a species: its name in the last column (quoted as text fields are), empty for none.
+TEST(TreeImpactsCsv, TheSpeciesIsTheLastColumn) {
+  const auto dir = testing::FreshDir("trees");
+  const auto path = (dir / "tree_impacts.csv").string();
+  ForestModel model;
+  TreeSpecies beech;
+  beech.name = "Fagus sylvatica, old";
+  beech.energy_factor = 1.6;
+  model.species = {beech};
+  const Forest forest({Stem{{10, 20}, 0.3, 0, 0}, Stem{{12, 20}, 0.2, 0, -1}}, model);
+  ensemble::ReleaseSpec release;
+  release.releases.push_back({ensemble::ReleaseGeometry::Kind::kPoint, {{{0, 0}}}});
+  {
+    TreeImpactsCsvWriter csv(path, forest, release);
+    csv.Write(Rock(0, {{0, false}, {1, true}}));
+    csv.Commit();
+  }
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  EXPECT_EQ(text.str(), std::string(TreeImpactsCsvWriter::Header()) + "\n" +
+                            "0,0,0,0,10,20,30,2,1.5,0,0,0,5000,1000,0,\"Fagus sylvatica, old\"\n"
+                            "1,0,0,0,12,20,20,1,1.5,0,0,0,5000,3000,1,\n");
+  EXPECT_EQ(std::string(TreeImpactsCsvWriter::Header())
+                .substr(std::string(TreeImpactsCsvWriter::Header()).rfind(',')),
+            ",species");
 }
 
 }  // namespace
