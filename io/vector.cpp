@@ -63,6 +63,14 @@ void Collect(const OGRGeometry& geometry, const std::string& where,
   }
 }
 
+// The names of `feature`'s fields, "a, b, c" ("none").
+std::string FieldNames(OGRFeature& feature) {
+  std::string fields;
+  for (int k = 0; k < feature.GetFieldCount(); ++k)
+    fields += (k ? ", " : "") + std::string(feature.GetFieldDefnRef(k)->GetNameRef());
+  return fields.empty() ? "none" : fields;
+}
+
 }  // namespace
 
 namespace {
@@ -185,43 +193,40 @@ std::vector<GroundPolygon> ReadGroundPolygons(const std::string& path,
                                               const std::string& target_crs_wkt,
                                               const std::string& field, const std::string& what) {
   std::vector<GroundPolygon> out;
-  ForEachFeature(
-      path, target_crs_wkt, what, "ground polygons", nullptr,
-      [&](OGRFeature& feature, const OGRGeometry& geometry, const std::string& where) {
-        const int index = feature.GetFieldIndex(field.c_str());
-        if (index < 0) {
-          std::string fields;
-          for (int k = 0; k < feature.GetFieldCount(); ++k)
-            fields += (k ? ", " : "") + std::string(feature.GetFieldDefnRef(k)->GetNameRef());
-          throw InputError(where + ": no field '" + field +
-                           "' (the fields are: " + (fields.empty() ? "none" : fields) + ")");
-        }
-        if (!feature.IsFieldSetAndNotNull(index))
-          throw InputError(where + ": field '" + field + "' is empty");
-        GroundPolygon polygon;
-        polygon.where = where;
-        const OGRFieldType type = feature.GetFieldDefnRef(index)->GetType();
-        if (type == OFTInteger || type == OFTInteger64 || type == OFTReal) {
-          const double v = feature.GetFieldAsDouble(index);
-          if (v != std::floor(v) || std::abs(v) > 1e9)
-            throw InputError(where + ": field '" + field + "' is " +
-                             feature.GetFieldAsString(index) + ", not an integer category code");
-          polygon.value = std::to_string(static_cast<long>(v));
-          polygon.numeric = true;
-        } else {
-          polygon.value = feature.GetFieldAsString(index);
-          if (polygon.value.empty()) throw InputError(where + ": field '" + field + "' is empty");
-        }
-        std::vector<ReleaseGeometry> parts;
-        Collect(geometry, where, parts);
-        for (ReleaseGeometry& part : parts) {
-          if (part.kind != ReleaseGeometry::Kind::kPolygon)
-            throw InputError(where + ": a ground polygon must be a polygon, not a " +
-                             std::string(geometry.getGeometryName()));
-          polygon.rings = std::move(part.rings);
-          out.push_back(polygon);
-        }
-      });
+  ForEachFeature(path, target_crs_wkt, what, "ground polygons", nullptr,
+                 [&](OGRFeature& feature, const OGRGeometry& geometry, const std::string& where) {
+                   const int index = feature.GetFieldIndex(field.c_str());
+                   if (index < 0)
+                     throw InputError(where + ": no field '" + field +
+                                      "' (the fields are: " + FieldNames(feature) + ")");
+                   if (!feature.IsFieldSetAndNotNull(index))
+                     throw InputError(where + ": field '" + field + "' is empty");
+                   GroundPolygon polygon;
+                   polygon.where = where;
+                   const OGRFieldType type = feature.GetFieldDefnRef(index)->GetType();
+                   if (type == OFTInteger || type == OFTInteger64 || type == OFTReal) {
+                     const double v = feature.GetFieldAsDouble(index);
+                     if (v != std::floor(v) || std::abs(v) > 1e9)
+                       throw InputError(where + ": field '" + field + "' is " +
+                                        feature.GetFieldAsString(index) +
+                                        ", not an integer category code");
+                     polygon.value = std::to_string(static_cast<long>(v));
+                     polygon.numeric = true;
+                   } else {
+                     polygon.value = feature.GetFieldAsString(index);
+                     if (polygon.value.empty())
+                       throw InputError(where + ": field '" + field + "' is empty");
+                   }
+                   std::vector<ReleaseGeometry> parts;
+                   Collect(geometry, where, parts);
+                   for (ReleaseGeometry& part : parts) {
+                     if (part.kind != ReleaseGeometry::Kind::kPolygon)
+                       throw InputError(where + ": a ground polygon must be a polygon, not a " +
+                                        std::string(geometry.getGeometryName()));
+                     polygon.rings = std::move(part.rings);
+                     out.push_back(polygon);
+                   }
+                 });
   if (out.empty()) throw InputError(what + ": " + path + " has no polygon");
   return out;
 }
@@ -264,10 +269,7 @@ std::vector<ensemble::EvaluationLine> ReadLineFeatures(
                      FeatureValue& v = feature_values[k];
                      const int index = feature.GetFieldIndex(fields[k].c_str());
                      if (index < 0) {
-                       for (int f = 0; f < feature.GetFieldCount(); ++f)
-                         v.fields += (f ? ", " : "") +
-                                     std::string(feature.GetFieldDefnRef(f)->GetNameRef());
-                       if (v.fields.empty()) v.fields = "none";
+                       v.fields = FieldNames(feature);
                        continue;
                      }
                      if (!feature.IsFieldSetAndNotNull(index)) {
@@ -320,14 +322,6 @@ std::vector<fieldobs::DepositObservation> ReadDepositPoints(const std::string& p
 }
 
 namespace {
-
-// The names of `feature`'s fields, "a, b, c" ("none").
-std::string FieldNames(OGRFeature& feature) {
-  std::string fields;
-  for (int k = 0; k < feature.GetFieldCount(); ++k)
-    fields += (k ? ", " : "") + std::string(feature.GetFieldDefnRef(k)->GetNameRef());
-  return fields.empty() ? "none" : fields;
-}
 
 // The text of `feature`'s attribute `field`: absent when its layer has no such field, "" when null.
 std::optional<std::string> OptionalText(OGRFeature& feature, const std::string& field) {
