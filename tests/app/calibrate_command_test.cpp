@@ -560,11 +560,12 @@ TEST(CalibrateCommand, SigintKeepsEveryEvaluationForResume) {
       ++n;
     return n;
   };
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  const auto deadline = std::chrono::steady_clock::now() +
+                        std::chrono::duration<double>(talus::app::testing::kHangSeconds);
   while (printed() < 3 && std::chrono::steady_clock::now() < deadline)
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   ::kill(pid, SIGINT);
-  const int status = talus::app::testing::WaitFor(pid, 60);
+  const int status = talus::app::testing::WaitFor(pid, talus::app::testing::kHangSeconds);
   const std::string text = Slurp(log);
   ASSERT_EQ(status, 130) << text;
   const int before = printed();

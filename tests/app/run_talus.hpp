@@ -63,6 +63,12 @@ inline pid_t StartProgram(const std::string& binary, const std::vector<std::stri
   return error == 0 ? pid : -1;
 }
 
+// How long a test waits for a run it started to reach a point or to end before it calls it hung:
+// a bound on a hang, never a timing (the waits end as soon as the run gets there). Generous,
+// because the sanitizer build (scripts/sanitize.sh) on a busy machine runs 10-50 x slower than a
+// release build.
+inline constexpr double kHangSeconds = 900;
+
 // Waits up to `seconds` for `pid` to end; its exit code, 256 + the signal if a signal killed it
 // (not an exit code), or -1 if it did not end (it is then killed).
 inline int WaitFor(pid_t pid, double seconds) {

@@ -45,6 +45,7 @@ pid_t StartTalus(const std::vector<std::string>& arguments, const fs::path& log)
   return talus::app::testing::StartProgram(TALUS_BINARY, arguments, log);
 }
 
+using talus::app::testing::kHangSeconds;
 using talus::app::testing::WaitFor;
 
 using talus::app::testing::Slurp;
@@ -592,12 +593,13 @@ void InterruptARun(int signal, const std::string& name) {
     std::error_code error;
     return fs::exists(trajectories, error) && fs::file_size(trajectories, error) > 0 && !error;
   };
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  const auto deadline =
+      std::chrono::steady_clock::now() + std::chrono::duration<double>(kHangSeconds);
   while (!writing() && std::chrono::steady_clock::now() < deadline)
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   const bool was_writing = writing();
   ::kill(pid, signal);
-  const int status = WaitFor(pid, 30);
+  const int status = WaitFor(pid, kHangSeconds);
   log = Slurp(dir / "log.txt");
   EXPECT_TRUE(was_writing) << "the run did not get to write its trajectories\n" << log;
   EXPECT_EQ(status, 128 + signal) << log;
@@ -650,9 +652,11 @@ TEST(SimulateCommand, AFullDiskIsOneErrorAndLeavesTheEarlierRunAsItWas) {
   ASSERT_GT(pid, 0);
   const fs::path trajectories = out / (".talus-run.talus-tmp-" + std::to_string(pid)) /
                                 (".trajectories.h5.talus-tmp-" + std::to_string(pid));
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  const auto deadline =
+      std::chrono::steady_clock::now() + std::chrono::duration<double>(kHangSeconds);
   while (!fs::exists(trajectories) && std::chrono::steady_clock::now() < deadline)
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  ASSERT_TRUE(fs::exists(trajectories)) << "the run did not get to write its trajectories";
   {  // Fill the disk.
     std::FILE* ballast = std::fopen((disk / "ballast").c_str(), "wb");
     ASSERT_NE(ballast, nullptr);
@@ -661,7 +665,7 @@ TEST(SimulateCommand, AFullDiskIsOneErrorAndLeavesTheEarlierRunAsItWas) {
     }
     std::fclose(ballast);
   }
-  EXPECT_EQ(WaitFor(pid, 60), 1);
+  EXPECT_EQ(WaitFor(pid, kHangSeconds), 1);
   fs::remove(disk / "ballast");
   log = Slurp(dir / "log.txt");
   EXPECT_NE(log.find("talus simulate: cannot write rock "), std::string::npos) << log;
