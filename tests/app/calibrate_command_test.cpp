@@ -18,6 +18,7 @@
 #include <thread>
 
 #include "run_talus.hpp"
+#include "tests/io/older_checkpoint.hpp"
 
 namespace {
 
@@ -446,12 +447,7 @@ TEST(CalibrateCommand, ResumingACheckpointOfAnOlderTalusIsRefusedSayingWhatToDo)
   const fs::path dir = MakeEvent("older_checkpoint");
   Write(dir / "cal.toml", kGood);
   fs::create_directories(dir / "out");
-  const std::string older =
-      R"({"fnv1a64":"702b435a4ded976b","folds":0,"holdout":[],"path_hash":"44bda3d473cdc381",)"
-      R"("stages":{"fit":[{"data":0.5,"failed_rocks":0,"feasible":true,"infeasible":"",)"
-      R"("kind_scored":[4],"kind_scores":[0.5],"prior":0.0,"residuals":[0.25,-0.25],"rocks":8,)"
-      R"("u":[0.5],"value":0.5,"values":[0.55],"wall_time_s":0.125}]}})"
-      "\n";
+  const std::string older = talus::testing::kOlderTalusCheckpoint;
   Write(dir / "out" / "checkpoint.json", older);
   std::string output;
   EXPECT_EQ(Calibrate(dir, "--resume", &output), "2") << output;

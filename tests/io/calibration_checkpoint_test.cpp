@@ -13,6 +13,7 @@
 #include "common/error.hpp"
 #include "common/sha256.hpp"
 #include "test_files.hpp"
+#include "tests/io/older_checkpoint.hpp"
 
 namespace talus::io {
 namespace {
@@ -193,12 +194,7 @@ TEST(CalibrationCheckpoint, TheChecksumIsTheSha256OfWhatItHolds) {
 // FNV-1a hash as "path_hash"; this one as that talus wrote it) is refused, naming the file and
 // saying what to do, never replayed and never misread.
 TEST(CalibrationCheckpoint, ACheckpointOfAnOlderTalusIsRefusedSayingWhatToDo) {
-  const std::string older =
-      R"({"fnv1a64":"702b435a4ded976b","folds":0,"holdout":[],"path_hash":"44bda3d473cdc381",)"
-      R"("stages":{"fit":[{"data":0.5,"failed_rocks":0,"feasible":true,"infeasible":"",)"
-      R"("kind_scored":[4],"kind_scores":[0.5],"prior":0.0,"residuals":[0.25,-0.25],"rocks":8,)"
-      R"("u":[0.5],"value":0.5,"values":[0.55],"wall_time_s":0.125}]}})"
-      "\n";
+  const std::string older = talus::testing::kOlderTalusCheckpoint;
   const std::string path = WriteCheckpoint("older_talus", older);
   ExpectRefused(path,
                 "a checkpoint of an older talus (its checksum is FNV-1a, \"fnv1a64\"; this talus "
