@@ -13,11 +13,12 @@
 namespace talus::calibration {
 namespace {
 
-// printf into a string (the stages' lines for people).
+// printf into a string (the stages' lines for people), whatever its length.
 template <class... Args>
 std::string Format(const char* format, Args... args) {
-  char line[512];
-  std::snprintf(line, sizeof line, format, args...);
+  const int length = std::snprintf(nullptr, 0, format, args...);
+  std::string line(static_cast<std::size_t>(std::max(length, 0)), '\0');
+  std::snprintf(line.data(), line.size() + 1, format, args...);
   return line;
 }
 
@@ -27,6 +28,10 @@ std::string RocksHint(const ParameterProfile& p) {
   if (!std::isfinite(p.rocks_to_identify)) return "";
   const double rocks = std::max(2.0, std::ceil(p.rocks_to_identify));  // a run has >= 2 rocks
   if (p.identified) return Format(" (from about %.0f rocks per run on)", rocks);
+  if (rocks > kMostRocksPerRun)
+    return Format("; no practical number of rocks per run would (its range is %.2g of its "
+                  "threshold)",
+                  p.range / p.threshold);
   const std::string would =
       Format("; about %.0f rocks per run would (the noise falls as 1/sqrt(rocks))", rocks);
   if (p.within_noise)
@@ -144,7 +149,17 @@ void Pipeline::Roughness() {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
   for (const ParameterProfile& p : run_.profiles)
     run_.roughness->evaluations += static_cast<int>(p.u.size());
-  Say(run_.roughness->Report() + ProfilesReport(run_.profiles));
+  // The rocks-per-run rule holds for sampling noise only (docs/calibration.md).
+  std::string rule;
+  if (!run_.roughness->LevelIsSamplingNoise()) {
+    for (ParameterProfile& p : run_.profiles) p.rocks_to_identify = kNaN;
+    rule = Format(
+        "  rocks per run to identify: not estimated: at the roughness' smallest step, %.2g, the "
+        "objective's smooth change is part of it, and more rocks do not lower that; add a step "
+        "of 1e-4 to [roughness] steps\n",
+        run_.roughness->steps.front());
+  }
+  Say(run_.roughness->Report() + ProfilesReport(run_.profiles) + rule);
 }
 
 void Pipeline::Uncertainty() {
@@ -309,7 +324,8 @@ std::vector<std::string> CalibrationWarnings(const CalibrationSummary& run,
     if (flat)
       out.push_back(
           Format("%s is unidentified: over its whole range its profile changes the "
-                 "objective's data term by %.3g, less than %.3g (3 x the noise): the "
+                 "objective's data term by %.3g, not more than %.3g (3 x the noise level, or "
+                 "what noise alone spans over its points): the "
                  "observations do not constrain it, and its fitted value is %s%s",
                  c.name.c_str(), run.profiles[j].range, run.profiles[j].threshold,
                  c.prior                    ? "its prior's"

@@ -104,6 +104,7 @@ std::vector<ParameterProfile> ProfileParameters(const Objective& objective,
     // Identified by the observations: the range of the data term, not of a prior's.
     const double data_u = f_u - objective.PriorTerm(u);
     double lo = data_u, hi = lo;
+    int spanned = 1;  // the values the range spans: f(u)'s and each feasible point's
     for (int k = 0; k < points; ++k) {
       Eigen::VectorXd v = u;
       v[j] = double(k) / (points - 1);
@@ -114,15 +115,19 @@ std::vector<ParameterProfile> ProfileParameters(const Objective& objective,
       if (!e.feasible) continue;  // a crossing of mu_min and mu_max is not information
       lo = std::min(lo, e.data);
       hi = std::max(hi, e.data);
+      if (v[j] != u[j]) ++spanned;  // at u itself the same rocks give the same value again
     }
     p.range = hi - lo;
-    p.threshold =
-        std::max(options.noise_multiple * noise, options.relative_floor * std::abs(data_u));
+    // Above a few times the noise, and above what the noise alone spans over these values (more
+    // than 3 x from about 10 of them on): a range within that may be all noise.
+    const double noise_only = NoiseOnlyRange(spanned, noise);
+    const double noise_threshold = std::max(options.noise_multiple * noise, noise_only);
+    p.threshold = std::max(noise_threshold, options.relative_floor * std::abs(data_u));
     p.identified = p.range > p.threshold;
-    if (noise > 0 && p.threshold == options.noise_multiple * noise) {
+    if (noise > 0 && p.threshold == noise_threshold) {
       p.rocks_to_identify = RocksToIdentify(
           p.range, p.threshold, static_cast<double>(objective.release().rocks_per_release));
-      p.within_noise = p.range <= NoiseOnlyRange(points, noise);
+      p.within_noise = p.range <= noise_only;
     }
     out.push_back(p);
   }

@@ -46,6 +46,17 @@ struct RoughnessReport {
   double seed_sd = kNaN;
   // The noise level identifiability is judged against: max(noise, seed_sd).
   double level() const { return std::isnan(seed_sd) ? noise : std::max(noise, seed_sd); }
+  // Whether the level is sampling noise, which falls as 1/sqrt(rocks) (RocksToIdentify's
+  // premise): the seeds' spread, or the roughness at a step of at most kSamplingNoiseStep. The
+  // smooth objective changes by its slope x the step, about a profile's range x the step, so
+  // there by a thousandth of the range; at a step of 1e-2 by a hundredth of it (a tenth where the
+  // objective is ten times as steep as on average), which is of the order of a threshold that
+  // matters and does not fall with the rocks.
+  bool LevelIsSamplingNoise() const {
+    return (!std::isnan(seed_sd) && seed_sd >= noise) ||
+           (!steps.empty() && steps.front() <= kSamplingNoiseStep);
+  }
+  static constexpr double kSamplingNoiseStep = 1e-3;
   double fd_step = kNaN;   // recommended finite-difference step (unit coordinates)
   double ftol_abs = kNaN;  // recommended absolute tolerance on f: 2 x noise
   int evaluations = 0;
@@ -58,7 +69,9 @@ RoughnessReport MeasureRoughness(const Objective& objective, const Eigen::Vector
 
 struct ProfileOptions {
   int points = 5;                // evaluations along each coordinate, 0 .. 1 evenly
-  double noise_multiple = 3;     // identified when the profile's range exceeds this x noise
+  // Identified when the profile's range exceeds this x noise, and what the noise alone spans over
+  // the profile's values (NoiseOnlyRange; the larger from about 10 values on).
+  double noise_multiple = 3;
   double relative_floor = 1e-6;  // ... and this x |f(u)| (for a noise of 0)
 };
 
@@ -66,14 +79,16 @@ struct ParameterProfile {
   std::string name;
   std::vector<double> u, values, f;  // along the coordinate
   double range = 0;                  // max - min of the data term (f less its prior)
-  double threshold = 0;              // what range had to exceed
+  // What range had to exceed: the larger of noise_multiple x noise and NoiseOnlyRange over the
+  // values it spans (f(u)'s and each feasible point's other than u), or the relative floor.
+  double threshold = 0;
   bool identified = false;
   // The rocks per run at which this profile would just reach its threshold (RocksToIdentify);
   // NaN when the threshold is not the noise's (a noise of 0) or the range is 0.
   double rocks_to_identify = kNaN;
-  // The range is no larger than the profile's points would span from noise alone
+  // The range is no larger than the profile's values would span from noise alone
   // (NoiseOnlyRange): it may be noise, which falls with the rocks; then rocks_to_identify is too
-  // few, and no number of rocks identifies it.
+  // few, and no number of rocks identifies it. Such a profile is never identified.
   bool within_noise = false;
 };
 
@@ -83,6 +98,9 @@ struct ParameterProfile {
 // rocks. A profile of range r judged against a threshold t measured with R rocks per run reaches
 // it at R (t / r)^2 rocks per run. That is a lower bound where r is partly noise.
 double RocksToIdentify(double range, double threshold, double rocks_per_run);
+// Beyond this many rocks per run the rule's answer is "none that a calibration can afford" (a
+// range that is a rounding residue would otherwise ask for 10^30 rocks).
+constexpr double kMostRocksPerRun = 1e6;
 // The expected range of n independent normal draws of standard deviation `sd`: d2(n) sd, with
 // d2 the range constant of quality control (1.128 for 2 draws, 2.326 for 5). What a profile of n
 // points spans from noise alone, its far points being nearly independent draws of the ensemble's

@@ -346,6 +346,7 @@ json RoughnessJson(const std::optional<calibration::RoughnessReport>& roughness)
           {"seed_values", r.seed_values},
           {"seed_sd", Number(r.seed_sd)},
           {"level", Number(r.level())},
+          {"level_is_sampling_noise", r.LevelIsSamplingNoise()},
           {"finite_difference_step", Number(r.fd_step)},
           {"ftol_abs", Number(r.ftol_abs)},
           {"evaluations", r.evaluations}};

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "calibration/roughness.hpp"
 #include "io/calibration_plots.hpp"
 #include "io/html_page.hpp"
 #include "io/svg_plot.hpp"
@@ -44,7 +45,9 @@ std::string Doubt(const Json& p) {
     const Json& profile = p.contains("profile") ? p["profile"] : Json();
     const double rocks =
         profile.is_object() ? NumberOf(profile.value("rocks_to_identify", Json())) : std::nan("");
-    if (std::isfinite(rocks))
+    if (std::isfinite(rocks) && rocks > calibration::kMostRocksPerRun)
+      why += " (no practical number of rocks per run would identify it)";
+    else if (std::isfinite(rocks))
       why += " (about " + Number(std::max(2.0, std::ceil(rocks))) +
              " rocks per run would identify it" +
              (profile.value("within_noise", false) ? " if its profile's range is real, not noise"

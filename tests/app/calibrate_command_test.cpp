@@ -78,10 +78,14 @@ profile_points = 3
 )";
 
 // A small calibration completes, writes its four files and prints the summary. Budget: 6
-// evaluations plus 1 + 1 + 1 for the roughness and 3 for the profile, of 16 rocks each.
+// evaluations plus 1 + 1 + 1 for the roughness and 3 for the profile, of 16 rocks each. The
+// roughness at a step of 1e-4, where it is sampling noise (the rocks-per-run rule applies).
 TEST(CalibrateCommand, WritesTheGroundTableJsonAndHistory) {
   const fs::path dir = MakeEvent("good");
-  Write(dir / "cal.toml", kGood);
+  std::string cal = kGood;
+  const std::string step = "steps = [1e-2]";
+  cal.replace(cal.find(step), step.size(), "steps = [1e-4]");
+  Write(dir / "cal.toml", cal);
   std::string output;
   const int code =
       RunCommand(std::string(TALUS_BINARY) + " calibrate " + (dir / "cal.toml").string() +
@@ -124,15 +128,19 @@ TEST(CalibrateCommand, WritesTheGroundTableJsonAndHistory) {
   EXPECT_LE(json["evaluations"].get<int>(), 6);
   EXPECT_TRUE(json["roughness"].is_object());
   EXPECT_TRUE(json["parameters"][0]["identified"].is_boolean());
-  // The rocks-per-run rule with the file's 4 rocks per run: R (threshold / range)^2, or null
-  // for a noise of 0.
+  // The rocks-per-run rule with the file's 4 rocks per run: R (threshold / range)^2, the level
+  // being sampling noise at a step of 1e-4 (and the seed's spread above 0).
+  EXPECT_EQ(json["roughness"]["level_is_sampling_noise"], true);
+  ASSERT_GT(json["roughness"]["level"].get<double>(), 0);
   const auto& profile = json["parameters"][0]["profile"];
   const double range = profile["range"], threshold = profile["threshold"];
-  if (!profile["rocks_to_identify"].is_null()) {
-    EXPECT_NEAR(profile["rocks_to_identify"].get<double>(),
-                4 * (threshold / range) * (threshold / range), 1e-12 * 4);
-  }
-  EXPECT_TRUE(profile["within_noise"].is_boolean());
+  ASSERT_GT(range, 0);
+  ASSERT_TRUE(profile["rocks_to_identify"].is_number()) << profile;
+  EXPECT_NEAR(profile["rocks_to_identify"].get<double>(),
+              4 * (threshold / range) * (threshold / range), 1e-12 * 4);
+  // A range within what noise alone spans is never taken for identification.
+  EXPECT_FALSE(profile["within_noise"].get<bool>() &&
+               json["parameters"][0]["identified"].get<bool>());
   // Every evaluation ran the tight contact solve, whatever the simulations' default.
   EXPECT_EQ(json["solver"]["tolerance_m_s"].get<double>(), 1e-7);
   EXPECT_EQ(json["solver"]["tolerance_source"], "default");
@@ -154,6 +162,34 @@ TEST(CalibrateCommand, WritesTheGroundTableJsonAndHistory) {
                  &output),
       0)
       << output;
+}
+
+// The rocks-per-run rule needs the level to be sampling noise: with no other seeds and the
+// roughness at a step of 1e-2 alone, talus does not give it and says why (docs/calibration.md,
+// "How many rocks per run").
+TEST(CalibrateCommand, TheRocksPerRunRuleIsNotGivenAgainstTheRoughnessAtALargeStep) {
+  const fs::path dir = MakeEvent("large_step");
+  std::string cal = kGood;
+  cal.replace(cal.find("max_evaluations = 6"), 19, "max_evaluations = 2");
+  cal.replace(cal.find("seeds = 1"), 9, "seeds = 0");
+  cal += "[uncertainty]\nenabled = false\n";
+  Write(dir / "cal.toml", cal);
+  std::string output;
+  ASSERT_EQ(RunCommand(std::string(TALUS_BINARY) + " calibrate " + (dir / "cal.toml").string() +
+                           " --out " + (dir / "out").string() + " --threads 2",
+                       &output),
+            0)
+      << output;
+  EXPECT_NE(output.find("  rocks per run to identify: not estimated: at the roughness' smallest "
+                        "step, 0.01, the objective's smooth change is part of it"),
+            std::string::npos)
+      << output;
+  EXPECT_EQ(output.find("rocks per run on)"), std::string::npos) << output;
+  EXPECT_EQ(output.find("rocks per run would"), std::string::npos) << output;
+  const auto json = nlohmann::json::parse(Slurp(dir / "out" / "calibration.json"));
+  EXPECT_EQ(json["roughness"]["level_is_sampling_noise"], false);
+  EXPECT_TRUE(json["roughness"]["seed_values"].empty());
+  EXPECT_TRUE(json["parameters"][0]["profile"]["rocks_to_identify"].is_null());
 }
 
 // On a terminal (script(1) gives the program one) the phases show their progress as one status

@@ -181,7 +181,7 @@ TEST(CalibrationWarnings, EachWeakOrCensoredResultIsSaid) {
   const std::vector<std::string> w = CalibrationWarnings(run, problem.objective());
   ASSERT_EQ(w.size(), 5u);
   EXPECT_EQ(w[0].rfind("medium_hard.mu_min is unidentified: over its whole range its profile "
-                       "changes the objective's data term by 0.7, less than 0.9",
+                       "changes the objective's data term by 0.7, not more than 0.9",
                        0),
             0u)
       << w[0];
@@ -198,6 +198,17 @@ TEST(CalibrationWarnings, EachWeakOrCensoredResultIsSaid) {
             0u)
       << w[3];
   EXPECT_EQ(w[4].rfind("the cross-validated runs score deposit worse", 0), 0u) << w[4];
+
+  // The rocks-per-run rule: its number, or none where it is beyond any calibration's means.
+  run.profiles[0].rocks_to_identify = 46.2;
+  EXPECT_NE(CalibrationWarnings(run, problem.objective())[0].find(
+                "; about 47 rocks per run would (the noise falls as 1/sqrt(rocks))"),
+            std::string::npos);
+  run.profiles[0].rocks_to_identify = 2e7;
+  EXPECT_NE(CalibrationWarnings(run, problem.objective())[0].find(
+                "; no practical number of rocks per run would (its range is 0.78 of its "
+                "threshold)"),
+            std::string::npos);
 
   // Within the noise, inside the bounds, identified, better fitted: nothing to say.
   run.fit.best.u[0] = 0.5;

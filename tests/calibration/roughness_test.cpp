@@ -138,7 +138,8 @@ TEST(ProfileParameters, WalksEachCoordinateAcrossItsRangeAndJudgesItsRangeAgains
   EXPECT_NEAR(profiles[0].values.front(), 0.1, 1e-12);
   EXPECT_NEAR(profiles[0].values.back(), 0.9, 1e-12);
   // The rocks-per-run rule on each profile: R (t / r)^2 with the release's rocks per run, and
-  // whether the range is within what noise alone spans over 3 points.
+  // whether the range is within what noise alone spans over 3 values (f(u) and the points 0 and
+  // 1; the point 0.5 is u itself, the same rocks, the same value).
   const double rocks = static_cast<double>(objective.release().rocks_per_release);
   for (const ParameterProfile& p : profiles) {
     EXPECT_EQ(p.rocks_to_identify, RocksToIdentify(p.range, p.threshold, rocks)) << p.name;
@@ -157,6 +158,48 @@ TEST(ProfileParameters, WalksEachCoordinateAcrossItsRangeAndJudgesItsRangeAgains
     EXPECT_TRUE(std::isnan(p.rocks_to_identify)) << p.name;
     EXPECT_FALSE(p.within_noise) << p.name;
   }
+}
+
+// With many points, what noise alone spans exceeds 3 x the noise (d2(10) = 3.08): a range above
+// 3 x the noise but within that span is not identified, and its rule is hedged.
+TEST(ProfileParameters, ARangeWithinWhatNoiseSpansOverManyPointsIsNotIdentified) {
+  const Objective& objective = TwoParameterObjective();
+  const Eigen::Vector2d u(0.5, 0.5);
+  const double f = objective.Evaluate(u).value;
+  ProfileOptions options;
+  options.points = 20;  // at k / 19, never u: 21 values with f(u)
+  const double range = ProfileParameters(objective, u, f, 1e-9, options)[0].range;
+  ASSERT_GT(range, 0);
+  const double noise = range / 3.4;  // 3 x noise < range < d2(21) x noise = 3.78 x noise
+  ASSERT_GT(range, options.noise_multiple * noise);
+  ASSERT_LT(range, NoiseOnlyRange(21, noise));
+  const ParameterProfile p = ProfileParameters(objective, u, f, noise, options)[0];
+  EXPECT_EQ(p.range, range);
+  EXPECT_EQ(p.threshold, NoiseOnlyRange(21, noise));
+  EXPECT_FALSE(p.identified);
+  EXPECT_TRUE(p.within_noise);
+  EXPECT_EQ(p.rocks_to_identify,
+            RocksToIdentify(range, p.threshold,
+                            static_cast<double>(objective.release().rocks_per_release)));
+}
+
+// The rule's premise, that the level falls with the rocks, holds for the seeds' spread and for
+// the roughness at a small step, not for the roughness at a step where the objective's smooth
+// change is part of it.
+TEST(RoughnessReport, TheLevelIsSamplingNoiseFromTheSeedsOrAtASmallStep) {
+  RoughnessReport r;
+  r.steps = {1e-2, 1e-1};
+  r.noise = 0.12;
+  EXPECT_FALSE(r.LevelIsSamplingNoise());  // no seeds, a large step
+  r.seed_sd = 0.03;
+  EXPECT_FALSE(r.LevelIsSamplingNoise());  // the level is the roughness at 1e-2
+  r.seed_sd = 0.2;
+  EXPECT_TRUE(r.LevelIsSamplingNoise());  // the level is the seeds' spread
+  r.seed_sd = 0.03;
+  r.steps = {1e-3, 1e-2};
+  EXPECT_TRUE(r.LevelIsSamplingNoise());
+  r.steps = {1.5e-3};
+  EXPECT_FALSE(r.LevelIsSamplingNoise());
 }
 
 TEST(RocksToIdentify, ScalesTheRocksByTheSquaredRatioOfThresholdToRange) {

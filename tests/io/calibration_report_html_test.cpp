@@ -65,6 +65,12 @@ TEST(CalibrationReportHtml, ShowsTheFitWithItsDoubtsPlotsHeldOutRunsAndFolds) {
                 .find("<td>unidentified (about 47 rocks per run would identify it if its "
                       "profile's range is real, not noise); at its upper bound</td>"),
             std::string::npos);
+  std::string beyond = kCalibration;
+  beyond.replace(beyond.find("\"rocks_to_identify\": 46.2"), 25, "\"rocks_to_identify\": 3e9 ");
+  EXPECT_NE(CalibrationReportHtml({beyond, "", {}})
+                .find("<td>unidentified (no practical number of rocks per run would identify "
+                      "it); at its upper bound</td>"),
+            std::string::npos);
   // The convergence plot as given, and a profile per parameter from calibration.json.
   EXPECT_NE(html.find("<svg id=\"convergence\">"), std::string::npos);
   EXPECT_NE(html.find(">Profile of medium.mu_min</text>"), std::string::npos);
