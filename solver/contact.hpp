@@ -16,7 +16,7 @@ struct Contact {
   // The second contact of a closed vertex heading across a concave change of the terrain: the
   // face ahead, as a predicted contact (DetectContacts). Not warm-started.
   bool corner = false;
-  int ground = 0;    // ground index at the contact point
+  int ground = 0;  // ground index at the contact point
   // Body frame: where the percussion acts; the vertex itself, or for a predicted contact with
   // SolverOptions::predicted_lever = kTouch the vertex turned to where it touches.
   Eigen::Vector3d lever_m = Eigen::Vector3d::Zero();
@@ -40,9 +40,9 @@ struct Contact {
 
 // The scarring soil as contact detection leaves it for the rest of the step.
 struct SoilContact {
-  int ground = -1;          // soil category of the episode; -1: no vertex in a soil layer
-  double depth_m = 0;       // rebound plane below the surface (eq. 11), m
-  bool submerged = false;   // a vertex over soil is below the surface at the midpoint
+  int ground = -1;         // soil category of the episode; -1: no vertex in a soil layer
+  double depth_m = 0;      // rebound plane below the surface (eq. 11), m
+  bool submerged = false;  // a vertex over soil is below the surface at the midpoint
 };
 
 // Scratch space reused across steps; one per thread. Reset() before each new rock.
@@ -54,9 +54,15 @@ struct StepWorkspace {
   std::vector<Eigen::Vector3d> last_percussion;
   std::vector<char> last_closed;
   std::vector<int> last_closed_list;
+  // What the scene holds, looked up once per rock (SimulateRock) instead of in every step: some
+  // ground category with the scarring soil, and some drag layer (a category's or the forest's).
+  // True, i.e. looked for in every step, until set; Reset makes them true again.
+  bool scene_has_soil = true;
+  bool scene_has_drag = true;
 
   void Reset(std::size_t vertex_count) {
     contacts.clear();
+    scene_has_soil = scene_has_drag = true;
     last_percussion.assign(vertex_count, Eigen::Vector3d::Zero());
     last_closed.assign(vertex_count, 0);
     last_closed_list.clear();

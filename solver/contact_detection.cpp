@@ -7,11 +7,32 @@
 namespace talus {
 namespace {
 
+// The friction coefficient mu(s) of the step's scar on a ground category: the contacts of a step
+// share the scar and mostly one category, so its arctangent is taken once per category met in a
+// row.
+class FrictionOfScar {
+ public:
+  FrictionOfScar(const GroundTable& table, double scar_m) : table_(table), scar_m_(scar_m) {}
+  double operator()(int ground) {
+    if (ground != ground_) {
+      ground_ = ground;
+      mu_ = table_.params(ground).Friction(scar_m_);
+    }
+    return mu_;
+  }
+
+ private:
+  const GroundTable& table_;
+  double scar_m_;
+  int ground_ = -1;
+  double mu_ = 0;
+};
+
 // Friction, ground and contact frame (n, t1, t2) of a contact at the terrain point (x, y).
-void SetFrame(const Scene& scene, const RockState& mid, const Eigen::Vector3d& x,
+void SetFrame(const Scene& scene, FrictionOfScar& friction, const Eigen::Vector3d& x,
               const Eigen::Vector3d& n, Contact& c) {
   c.ground = scene.terrain.GroundAt(x.x(), x.y());
-  c.mu = scene.ground.params(c.ground).Friction(mid.scar_m);
+  c.mu = friction(c.ground);
   // Tangent basis: e_y x n never vanishes for an upward normal.
   const Eigen::Vector3d t1 = Eigen::Vector3d(n.z(), 0.0, -n.x()).normalized();
   c.directions.col(0) = n;
@@ -38,7 +59,7 @@ Eigen::Vector3d PredictedLeverArm(PredictedLever lever, const Eigen::Vector3d& b
 // vertex go at worst), lies on a face of another normal and deeper than allowed_depth_m below it,
 // the vertex gets a second contact with that face, as a predicted contact (gap to its plane plus
 // the allowed depth, never negative).
-void AddCornerContact(const Scene& scene, const RockState& mid, const Eigen::Matrix3d& rotation,
+void AddCornerContact(const Scene& scene, FrictionOfScar& friction, const Eigen::Matrix3d& rotation,
                       const Eigen::Vector3d& velocity_m_s, const Eigen::Vector3d& omega_rad_s,
                       double horizon_s, double allowed_depth_m, int vertex,
                       const Eigen::Vector3d& b, const Eigen::Vector3d& x,
@@ -56,7 +77,7 @@ void AddCornerContact(const Scene& scene, const RockState& mid, const Eigen::Mat
   c.corner = true;
   c.lever_m = b;
   c.gap_m = std::max(0.0, n.dot(x - on_plane) + allowed_depth_m);
-  SetFrame(scene, mid, x_end, n, c);
+  SetFrame(scene, friction, x_end, n, c);
 }
 
 }  // namespace
@@ -87,7 +108,7 @@ DetectResult DetectContacts(const Scene& scene, const RockShape& rock, const Roc
   SoilContact& soil = workspace.soil;
   soil = SoilContact{mid.soil_ground, mid.soil_depth_m, false};
   bool in_soil = false;
-  const bool any_soil = scene.ground.AnySoil();
+  const bool any_soil = workspace.scene_has_soil;
   const Terrain& terrain = scene.terrain;
   const Eigen::Vector3d& r = mid.position_m;
   const double radius = rock.bounding_radius_m;
@@ -108,6 +129,7 @@ DetectResult DetectContacts(const Scene& scene, const RockShape& rock, const Roc
     soil = SoilContact{};
     return DetectResult::kClear;
   }
+  FrictionOfScar friction(scene.ground, mid.scar_m);
   const Eigen::Vector3d m_body = rotation.transpose() * m;
   const Eigen::Vector3d rate_lever = m_body.cross(omega_rad_s);
 
@@ -135,8 +157,10 @@ DetectResult DetectContacts(const Scene& scene, const RockShape& rock, const Roc
       const Eigen::Vector3d arm = rotation * b;
       const Eigen::Vector3d x = r + arm;
       // The gap (x_z - h) n_z has the sign of x_z - h: the normal is needed only for contacts.
-      double height;
-      if (!terrain.Height(x.x(), x.y(), &height)) return DetectResult::kOutsideDomain;
+      Terrain::Cell cell;
+      if (!terrain.Locate(x.x(), x.y(), &cell)) return DetectResult::kOutsideDomain;
+      const double height = Terrain::HeightIn(cell);
+      if (std::isnan(height)) return DetectResult::kOutsideDomain;  // a nodata corner
       // Over soil, the contact is with the rebound plane below the surface.
       double depth = 0;
       if (any_soil && x.z() <= height &&
@@ -146,16 +170,15 @@ DetectResult DetectContacts(const Scene& scene, const RockShape& rock, const Roc
       }
       if (x.z() <= height - depth) {
         // Closed at the midpoint.
-        TerrainSample sample;
-        terrain.Sample(x.x(), x.y(), &sample);
+        const Eigen::Vector3d normal = terrain.NormalIn(cell);
         Contact& c = workspace.contacts.emplace_back();
         c.vertex = k;
         c.lever_m = b;
         c.gap_m = 0;
-        SetFrame(scene, mid, x, sample.normal, c);
+        SetFrame(scene, friction, x, normal, c);
         if (horizon_s > 0 && depth == 0)
-          AddCornerContact(scene, mid, rotation, velocity_m_s, omega_rad_s, horizon_s,
-                           allowed_depth_m, k, b, x, sample.normal, workspace);
+          AddCornerContact(scene, friction, rotation, velocity_m_s, omega_rad_s, horizon_s,
+                           allowed_depth_m, k, b, x, normal, workspace);
         continue;
       }
       if (horizon_s == 0) continue;
@@ -182,7 +205,7 @@ DetectResult DetectContacts(const Scene& scene, const RockShape& rock, const Roc
       c.gap_m = std::max(0.0, gap_mid + allowed_depth_m);  // never a push out
       c.lever_m = PredictedLeverArm(scene.options.predicted_lever, b, omega_rad_s, horizon_s,
                                     gap_mid, n.dot(x_end - on_plane));
-      SetFrame(scene, mid, x_end, n, c);
+      SetFrame(scene, friction, x_end, n, c);
     }
   }
   if (!in_soil) soil = SoilContact{};

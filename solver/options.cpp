@@ -8,7 +8,8 @@ namespace talus {
 namespace {
 
 constexpr std::array<const char*, 2> kViscousReadings = {"centre_of_mass", "contact_friction"};
-constexpr std::array<const char*, 2> kContactSolveMethods = {"gauss_seidel", "block"};
+constexpr std::array<const char*, 3> kContactSolveMethods = {"gauss_seidel", "block",
+                                                             "block_on_stall"};
 constexpr std::array<const char*, 2> kPredictedLevers = {"midpoint", "touch"};
 constexpr std::array<const char*, 2> kSoilDragPoints = {"centre_of_mass", "submerged_centroid"};
 constexpr std::array<const char*, 3> kSolverPresets = {"fast", "default", "accurate"};

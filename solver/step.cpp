@@ -197,7 +197,7 @@ StepReport StepOnce(const Scene& scene, const RockShape& rock, double dt, bool m
   // 3. Free end velocities: gravity, and the drag layer where the centre of mass is inside one.
   Eigen::Vector3d velocity = FreeVelocity(opt, dt, begin.velocity_m_s);
   EffectiveInertia inertia{rock.mass_kg, 1.0};
-  if (scene.ground.AnyDragLayer() || !scene.forest_drag.empty())
+  if (workspace.scene_has_drag)
     DragLayer(scene, dt, rock, state.position_m, begin, velocity, omega, inertia);
 
   // 4. Contact set at the midpoint: closed contacts and the vertices that the free motion (no

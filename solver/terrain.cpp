@@ -62,8 +62,8 @@ PlanePyramid PlanePyramid::Build(const Heightfield& heights) {
         double residual = 0;
         for (int j = j0; j <= j1 && !std::isnan(residual); ++j)
           for (int i = i0; i <= i1; ++i) {
-            const double d = z(i, j) - (b.z_m + b.slope_x * (i - ic) * g.dx_m +
-                                        b.slope_y * (j - jc) * g.dy_m);
+            const double d =
+                z(i, j) - (b.z_m + b.slope_x * (i - ic) * g.dx_m + b.slope_y * (j - jc) * g.dy_m);
             if (std::isnan(d)) {
               residual = std::numeric_limits<double>::quiet_NaN();
               break;
@@ -111,24 +111,26 @@ bool Terrain::Locate(double x_m, double y_m, Cell* cell) const {
 bool Terrain::Height(double x_m, double y_m, double* height_m) const {
   Cell c;
   if (!Locate(x_m, y_m, &c)) return false;
-  const double lower = c.row0[0] + c.u * (c.row0[1] - c.row0[0]);
-  const double upper = c.row1[0] + c.u * (c.row1[1] - c.row1[0]);
-  *height_m = lower + c.w * (upper - lower);
+  *height_m = HeightIn(c);
   return !std::isnan(*height_m);  // a nodata corner
+}
+
+Eigen::Vector3d Terrain::NormalIn(const Cell& c) const {
+  const double z00 = c.row0[0], z10 = c.row0[1], z01 = c.row1[0], z11 = c.row1[1];
+  const double lower = z00 + c.u * (z10 - z00);
+  const double upper = z01 + c.u * (z11 - z01);
+  const double hx = ((z10 - z00) * (1 - c.w) + (z11 - z01) * c.w) * inv_dx_;
+  const double hy = (upper - lower) * inv_dy_;
+  return Eigen::Vector3d(-hx, -hy, 1.0) / std::sqrt(hx * hx + hy * hy + 1.0);
 }
 
 bool Terrain::Sample(double x_m, double y_m, TerrainSample* out) const {
   Cell c;
   if (!Locate(x_m, y_m, &c)) return false;
-  const double z00 = c.row0[0], z10 = c.row0[1], z01 = c.row1[0], z11 = c.row1[1];
-  const double lower = z00 + c.u * (z10 - z00);
-  const double upper = z01 + c.u * (z11 - z01);
-  const double h = lower + c.w * (upper - lower);
+  const double h = HeightIn(c);
   if (std::isnan(h)) return false;  // a nodata corner
-  const double hx = ((z10 - z00) * (1 - c.w) + (z11 - z01) * c.w) * inv_dx_;
-  const double hy = (upper - lower) * inv_dy_;
   out->height_m = h;
-  out->normal = Eigen::Vector3d(-hx, -hy, 1.0) / std::sqrt(hx * hx + hy * hy + 1.0);
+  out->normal = NormalIn(c);
   return true;
 }
 
@@ -167,17 +169,17 @@ bool Terrain::PlaneAround(double x_m, double y_m, double r_m, LocalPlane* out) c
         const double j0 = bj * level.cells, j1 = std::min(j0 + level.cells, g.ny - 1.0);
         const double w_corners[2] = {std::max(fy_lo, j0), std::min(fy_hi, j1)};
         for (int bi = bi_lo; bi <= bi_hi; ++bi) {
-          const PlanePyramid::Block& b = level.blocks[static_cast<std::size_t>(bj) * level.nbx + bi];
+          const PlanePyramid::Block& b =
+              level.blocks[static_cast<std::size_t>(bj) * level.nbx + bi];
           if (std::isnan(b.residual_m)) return false;  // a nodata node: no bound
           const double i0 = bi * level.cells, i1 = std::min(i0 + level.cells, g.nx - 1.0);
           const double u_corners[2] = {std::max(fx_lo, i0), std::min(fx_hi, i1)};
           const double ic = 0.5 * (i0 + i1), jc = 0.5 * (j0 + j1);
           for (double fy : w_corners)
             for (double fx : u_corners) {
-              const double block = b.z_m + b.slope_x * (fx - ic) * g.dx_m +
-                                   b.slope_y * (fy - jc) * g.dy_m;
-              const double plane = out->at.height_m +
-                                   out->slope_x * (g.x0_m + fx * g.dx_m - x_m) +
+              const double block =
+                  b.z_m + b.slope_x * (fx - ic) * g.dx_m + b.slope_y * (fy - jc) * g.dy_m;
+              const double plane = out->at.height_m + out->slope_x * (g.x0_m + fx * g.dx_m - x_m) +
                                    out->slope_y * (g.y0_m + fy * g.dy_m - y_m);
               deviation = std::max(deviation, b.residual_m + std::abs(block - plane));
             }

@@ -47,22 +47,23 @@ struct TerrainSample {
 };
 
 // A hierarchy of square blocks of the DEM's cells, 2^k x 2^k cells for k = kFirstLevel ..
-// kLastLevel (fewer at the grid's far edges), each with a plane and the largest vertical departure of
-// the block's nodes from it (NaN when one is nodata). The bilinear terrain less a plane is bilinear
-// in each cell, so it departs from the block's plane nowhere in the block by more than at a node:
-// Terrain::PlaneAround bounds a large box by the few blocks that cover it instead of every cell.
+// kLastLevel (fewer at the grid's far edges), each with a plane and the largest vertical departure
+// of the block's nodes from it (NaN when one is nodata). The bilinear terrain less a plane is
+// bilinear in each cell, so it departs from the block's plane nowhere in the block by more than at
+// a node: Terrain::PlaneAround bounds a large box by the few blocks that cover it instead of every
+// cell.
 struct PlanePyramid {
   static constexpr int kFirstLevel = 2;  // blocks of 4 x 4 cells
   static constexpr int kLastLevel = 8;   // blocks of 256 x 256 cells
   struct Block {
-    double z_m = 0;        // the plane's height at the block's centre
-    double slope_x = 0;    // dz/dx
-    double slope_y = 0;    // dz/dy
-    double residual_m = 0; // largest |node height - plane| over the block's nodes; NaN: nodata
+    double z_m = 0;         // the plane's height at the block's centre
+    double slope_x = 0;     // dz/dx
+    double slope_y = 0;     // dz/dy
+    double residual_m = 0;  // largest |node height - plane| over the block's nodes; NaN: nodata
   };
   struct Level {
-    int cells = 0;      // block side, cells
-    int nbx = 0, nby = 0;  // blocks along x and y
+    int cells = 0;              // block side, cells
+    int nbx = 0, nby = 0;       // blocks along x and y
     std::vector<Block> blocks;  // row after row along y
   };
   std::vector<Level> levels;  // levels[k - kFirstLevel]; only those the grid can hold
@@ -87,6 +88,25 @@ class Terrain {
   // The height alone (the contact test's fast path); false as for Sample.
   bool Height(double x_m, double y_m, double* height_m) const;
 
+  // The cell holding a point: its lower and upper rows of node heights (corners [0] and [1] of
+  // each) and the point's local coordinates (u, w) in [0, 1]^2. For a height that may need its
+  // normal afterwards (a vertex found closed) without locating the point twice: Height and Sample
+  // are HeightIn and NormalIn of the located cell, so the values are the same bits.
+  struct Cell {
+    const double* row0;
+    const double* row1;
+    double u, w;
+  };
+  // False outside the grid.
+  bool Locate(double x_m, double y_m, Cell* cell) const;
+  // The bilinear height in a located cell (NaN at a nodata corner) and the unit upward normal.
+  static double HeightIn(const Cell& c) {
+    const double lower = c.row0[0] + c.u * (c.row0[1] - c.row0[0]);
+    const double upper = c.row1[0] + c.u * (c.row1[1] - c.row1[0]);
+    return lower + c.w * (upper - lower);
+  }
+  Eigen::Vector3d NormalIn(const Cell& c) const;
+
   // Ground index at a horizontal position (the default where the ground grid has none).
   int GroundAt(double x_m, double y_m) const;
 
@@ -94,12 +114,12 @@ class Terrain {
   // anywhere in the box [x - r, x + r] x [y - r, y + r]: |h(p) - plane(p)| <= deviation_m there.
   // A box over at most kExactCells cells per side: in each cell that holds a point of the box,
   // h - plane is bilinear, so its extremes over the part of the box in that cell are at that part's
-  // corners: deviation_m is the largest of those, the tightest such bound. A larger box (a fine DEM):
-  // the at most 2 x 2 blocks of the smallest PlanePyramid level whose blocks are as wide as the box,
-  // each adding its residual to the largest departure of its plane from the tangent plane at the
-  // corners of the box's part in it; a bound whose cost does not grow with the DEM's resolution.
-  // Plus 1e-6 m for rounding. False when the box reaches beyond the grid or a cell that holds a
-  // point of it (a block, for the pyramid's bound) has a nodata corner.
+  // corners: deviation_m is the largest of those, the tightest such bound. A larger box (a fine
+  // DEM): the at most 2 x 2 blocks of the smallest PlanePyramid level whose blocks are as wide as
+  // the box, each adding its residual to the largest departure of its plane from the tangent plane
+  // at the corners of the box's part in it; a bound whose cost does not grow with the DEM's
+  // resolution. Plus 1e-6 m for rounding. False when the box reaches beyond the grid or a cell that
+  // holds a point of it (a block, for the pyramid's bound) has a nodata corner.
   struct LocalPlane {
     TerrainSample at;    // height and normal at (x, y)
     double slope_x = 0;  // dh/dx
@@ -134,16 +154,6 @@ class Terrain {
   bool IsValid(std::string* why) const;
 
  private:
-  // The cell holding a point: its lower and upper rows of node heights (corners [0] and [1] of
-  // each) and the point's local coordinates (u, w) in [0, 1]^2.
-  struct Cell {
-    const double* row0;
-    const double* row1;
-    double u, w;
-  };
-  // False outside the grid.
-  bool Locate(double x_m, double y_m, Cell* cell) const;
-
   // Shared, immutable. The hot path reads the cached grid and pointers below, not through these.
   std::shared_ptr<const Heightfield> heights_;
   std::shared_ptr<const GroundGrid> ground_;

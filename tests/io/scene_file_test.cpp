@@ -286,6 +286,11 @@ TEST(LoadScene, ContactSolveMethodIsChosenByNameWithDidYouMean) {
   testing::WriteText(dir / "scene.toml", kPlaneScene);
   EXPECT_EQ(LoadScene((dir / "scene.toml").string()).scene.options.contact_solve,
             ContactSolveMethod::kGaussSeidel);  // the default
+  testing::WriteText(dir / "scene.toml",
+                     Replace(kPlaneScene, "max_time_s = 20",
+                             "max_time_s = 20\ncontact_solve = \"block_on_stall\""));
+  EXPECT_EQ(LoadScene((dir / "scene.toml").string()).scene.options.contact_solve,
+            ContactSolveMethod::kBlockOnStall);
   testing::WriteText(dir / "scene.toml", Replace(kPlaneScene, "max_time_s = 20",
                                                  "max_time_s = 20\ncontact_solve = \"block\""));
   EXPECT_EQ(LoadScene((dir / "scene.toml").string()).scene.options.contact_solve,

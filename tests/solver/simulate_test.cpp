@@ -134,6 +134,7 @@ TEST(Simulate, CentreOfMassReadingIsBitIdenticalToWave1) {
   scene.options.viscous = ViscousReading::kCentreOfMass;
   scene.options.tolerance_m_s = 1e-7;
   scene.options.impact_substeps = 1;  // the whole steps of then
+  scene.options.contact_solve = ContactSolveMethod::kGaussSeidel;  // the sweeps alone of then
   SimulationWorkspace ws;
   for (const Golden& g : golden) {
     const RockResult r = SimulateRock(scene, scenes::Ramp40Release(scene, 1, g.rock), ws);
@@ -145,6 +146,32 @@ TEST(Simulate, CentreOfMassReadingIsBitIdenticalToWave1) {
     EXPECT_EQ(r.max_kinetic_energy_j, g.max_kinetic_energy) << "rock " << g.rock;
     EXPECT_EQ(r.max_angular_speed_rad_s, g.max_angular_speed) << "rock " << g.rock;
   }
+}
+
+TEST(Simulate, BlockOnStallConvergesTheRampStepsWhereGaussSeidelStalls) {
+  // The benchmark ramp's first 8 rocks of seed 1 under Gauss-Seidel alone and with the block on
+  // stall (ContactSolveMethod::kBlockOnStall), default tolerance (1e-3 m/s) and max_iterations
+  // (200): Gauss-Seidel leaves steps unconverged (the premise), the block on stall at most a
+  // tenth as many, and it sweeps less in all. Measured: 45 unconverged steps and 61 714 sweeps
+  // against 1 and 61 061.
+  long unconverged[2] = {0, 0}, sweeps[2] = {0, 0};
+  const ContactSolveMethod methods[2] = {ContactSolveMethod::kGaussSeidel,
+                                         ContactSolveMethod::kBlockOnStall};
+  for (int m = 0; m < 2; ++m) {
+    Scene scene = scenes::Ramp40();
+    scene.options.contact_solve = methods[m];
+    SimulationWorkspace ws;
+    for (int rock = 0; rock < 8; ++rock) {
+      const RockResult r = SimulateRock(scene, scenes::Ramp40Release(scene, 1, rock), ws);
+      unconverged[m] += r.unconverged_steps;
+      sweeps[m] += r.solver_iterations;
+    }
+  }
+  std::printf("unconverged steps %ld / %ld, sweeps %ld / %ld (gauss_seidel / block_on_stall)\n",
+              unconverged[0], unconverged[1], sweeps[0], sweeps[1]);
+  EXPECT_GT(unconverged[0], 0);
+  EXPECT_LE(unconverged[1], unconverged[0] / 10);
+  EXPECT_LT(sweeps[1], sweeps[0]);
 }
 
 TEST(Random, StreamsDependOnSeedAndRockOnlyAndOrientationsAreUniform) {
