@@ -2,9 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <limits>
 #include <utility>
+
+#include "common/format.hpp"
 
 namespace talus {
 namespace {
@@ -22,12 +23,6 @@ double SegmentCrossing(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const
   const double u = (d.x() * r.y() - d.y() * r.x()) / denominator;
   const bool on_segment = u >= 0 && (open_end ? u < 1 : u <= 1);
   return t > 0 && t <= 1 && on_segment ? t : -1;
-}
-
-std::string Number(double v) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.10g", v);
-  return text;
 }
 
 double RotationalEnergy(const RockShape& shape, const RockState& s) {
@@ -131,9 +126,9 @@ bool Barrier::IsValid(std::string* why) const {
     if (!v.allFinite()) return fail("vertices: a vertex is not finite");
   if (!(length_m() > 0)) return fail("vertices: the polyline has zero length");
   if (!(std::isfinite(height_m) && height_m >= 0))
-    return fail("height_m = " + Number(height_m) + " must be finite and >= 0 m");
+    return fail("height_m = " + TenDigits(height_m) + " must be finite and >= 0 m");
   if (!(std::isfinite(capacity_J) && capacity_J > 0))
-    return fail("capacity_J = " + Number(capacity_J) + " must be finite and > 0 J");
+    return fail("capacity_J = " + TenDigits(capacity_J) + " must be finite and > 0 J");
   return true;
 }
 

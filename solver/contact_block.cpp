@@ -14,11 +14,6 @@ using Eigen::Vector3d;
 
 double Cross(const Vector2d& u, const Vector2d& v) { return u.x() * v.y() - u.y() * v.x(); }
 
-Vector2d ProjectDisk(const Vector2d& p, double bound) {
-  const double norm = p.norm();
-  return norm > bound ? Vector2d(p * (bound / norm)) : p;
-}
-
 // Every law at both contacts, for the statuses the solution claims (tolerance in m/s).
 bool Verify(const PairProblem& pr, const std::array<ContactStatus, 2>& status,
             const std::array<Vector2d, 2>& d, const Vector6d& p, const Vector6d& xi,

@@ -24,6 +24,13 @@ struct PairProblem {
 
 enum class ContactStatus : unsigned char { kSeparated, kSticking, kSlipping };
 
+// A tangential percussion projected onto the friction disk of radius bound (the one contact's
+// solve and the pair's share it).
+inline Eigen::Vector2d ProjectDisk(const Eigen::Vector2d& p, double bound) {
+  const double norm = p.norm();
+  return norm > bound ? Eigen::Vector2d(p * (bound / norm)) : p;
+}
+
 // Solves Signorini (xi_N >= 0, P_N >= 0, xi_N P_N = 0) and Coulomb (|P_T| <= mu P_N; sticking:
 // xi_T = 0; slipping: xi_N = 0 and P_T = mu P_N d with d = -xi_T / |xi_T|) at both contacts. The
 // nine active-set cases (each contact separated, sticking or slipping) are tried, the one that

@@ -9,12 +9,6 @@
 namespace talus {
 namespace {
 
-// Projects the tangential percussion onto the friction disk of radius bound.
-Eigen::Vector2d ProjectDisk(const Eigen::Vector2d& p, double bound) {
-  const double norm = p.norm();
-  return norm > bound ? Eigen::Vector2d(p * (bound / norm)) : p;
-}
-
 // Slip branch of one contact: P = P_N (1, mu d) with d a unit vector opposite to the tangential
 // velocity of gamma = xi0 + G P, and gamma_N = 0. Newton's method on the angle of d for
 // F = d x gamma_T = 0 (analytic derivative; d is turned without trigonometric calls), started

@@ -5,18 +5,13 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
-#include <cstdio>
 #include <limits>
 #include <numbers>
 
+#include "common/format.hpp"
+
 namespace talus {
 namespace {
-
-std::string Number(double v) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.10g", v);
-  return text;
-}
 
 double KineticEnergy(const RockShape& rock, const Eigen::Vector3d& v, const Eigen::Vector3d& w) {
   return 0.5 * rock.mass_kg * v.squaredNorm() + 0.5 * w.dot(rock.inertia_kg_m2.cwiseProduct(w));
@@ -91,14 +86,14 @@ bool TreeSpecies::IsValid(std::string* why) const {
       }))
     return fail("name '" + name + "' must be non-empty, without control characters");
   if (!(std::isfinite(energy_factor) && energy_factor > 0))
-    return fail("energy_factor = " + Number(energy_factor) + " must be finite and > 0");
+    return fail("energy_factor = " + TenDigits(energy_factor) + " must be finite and > 0");
   if (energy_coefficient_J && !(std::isfinite(*energy_coefficient_J) && *energy_coefficient_J > 0))
-    return fail("energy_coefficient_j = " + Number(*energy_coefficient_J) +
+    return fail("energy_coefficient_j = " + TenDigits(*energy_coefficient_J) +
                 " must be finite and > 0 J");
   if (energy_exponent && !(std::isfinite(*energy_exponent) && *energy_exponent > 0))
-    return fail("energy_exponent = " + Number(*energy_exponent) + " must be finite and > 0");
+    return fail("energy_exponent = " + TenDigits(*energy_exponent) + " must be finite and > 0");
   if (energy_factor != 1 && (energy_coefficient_J || energy_exponent))
-    return fail("energy_factor = " + Number(energy_factor) +
+    return fail("energy_factor = " + TenDigits(energy_factor) +
                 " with a law of its own: a species scales the forest's law or has its own "
                 "coefficient and exponent, not both");
   return true;
@@ -117,14 +112,14 @@ bool ForestModel::IsValid(std::string* why) const {
     return false;
   };
   if (!(std::isfinite(stem_height_m) && stem_height_m > 0))
-    return fail("stem_height_m = " + Number(stem_height_m) + " must be finite and > 0 m");
+    return fail("stem_height_m = " + TenDigits(stem_height_m) + " must be finite and > 0 m");
   if (!(std::isfinite(friction) && friction >= 0))
-    return fail("friction = " + Number(friction) + " must be finite and >= 0");
+    return fail("friction = " + TenDigits(friction) + " must be finite and >= 0");
   if (!(std::isfinite(energy_coefficient_J) && energy_coefficient_J > 0))
-    return fail("energy_coefficient_j = " + Number(energy_coefficient_J) +
+    return fail("energy_coefficient_j = " + TenDigits(energy_coefficient_J) +
                 " must be finite and > 0 J");
   if (!(std::isfinite(energy_exponent) && energy_exponent > 0))
-    return fail("energy_exponent = " + Number(energy_exponent) + " must be finite and > 0");
+    return fail("energy_exponent = " + TenDigits(energy_exponent) + " must be finite and > 0");
   for (const TreeSpecies& s : species) {
     std::string reason;
     if (!s.IsValid(&reason)) return fail("species '" + s.name + "': " + reason);
@@ -180,7 +175,7 @@ bool Forest::IsValid(std::string* why) const {
       return false;
     }
     if (!(std::isfinite(s.dbh_m) && s.dbh_m > 0)) {
-      if (why) *why = "tree " + std::to_string(k) + ": dbh = " + Number(s.dbh_m) + " m must be > 0";
+      if (why) *why = "tree " + std::to_string(k) + ": dbh = " + TenDigits(s.dbh_m) + " m must be > 0";
       return false;
     }
     if (s.species < -1 || s.species >= static_cast<int>(model_.species.size())) {
@@ -364,7 +359,7 @@ bool ForestDrag::IsValid(std::string* why) const {
   if (cells_.size() != static_cast<std::size_t>(grid_.nx) * static_cast<std::size_t>(grid_.ny))
     return fail("the grid has " + std::to_string(cells_.size()) + " cells, expected nx * ny");
   if (!(std::isfinite(height_m_) && height_m_ > 0))
-    return fail("height_m = " + Number(height_m_) + " must be finite and > 0 m");
+    return fail("height_m = " + TenDigits(height_m_) + " must be finite and > 0 m");
   for (int k : cells_)
     if (k < -1 || k >= static_cast<int>(stands_.size()))
       return fail("a cell refers to stand " + std::to_string(k) + ", not in the list");
@@ -372,9 +367,9 @@ bool ForestDrag::IsValid(std::string* why) const {
     const DragStand& s = stands_[k];
     if (!(std::isfinite(s.stems_per_m2) && s.stems_per_m2 > 0 && std::isfinite(s.dbh_m) &&
           s.dbh_m > 0 && std::isfinite(s.breaking_energy_J) && s.breaking_energy_J > 0))
-      return fail("stand " + std::to_string(k) + ": density " + Number(s.stems_per_m2) +
-                  " /m^2, dbh " + Number(s.dbh_m) + " m and breaking energy " +
-                  Number(s.breaking_energy_J) + " J must be finite and > 0");
+      return fail("stand " + std::to_string(k) + ": density " + TenDigits(s.stems_per_m2) +
+                  " /m^2, dbh " + TenDigits(s.dbh_m) + " m and breaking energy " +
+                  TenDigits(s.breaking_energy_J) + " J must be finite and > 0");
   }
   return true;
 }
