@@ -16,6 +16,10 @@ struct Contact {
   // The second contact of a closed vertex heading across a concave change of the terrain: the
   // face ahead, as a predicted contact (DetectContacts). Not warm-started.
   bool corner = false;
+  // A held contact (ContactHold::kHeld): a contact of the step before, open at the midpoint, that
+  // the free motion carries below the terrain by the next midpoint but not below the tolerance;
+  // gap_m is its own gap. It never splits a step.
+  bool held = false;
   int ground = 0;  // ground index at the contact point
   // Body frame: where the percussion acts; the vertex itself, or for a predicted contact with
   // SolverOptions::predicted_lever = kTouch the vertex turned to where it touches.

@@ -130,6 +130,10 @@ DetectResult DetectContacts(const Scene& scene, const RockShape& rock, const Roc
     return DetectResult::kClear;
   }
   FrictionOfScar friction(scene.ground, mid.scar_m);
+  // Held contacts: the plastic law's only (Newton's law takes the begin velocities of closed
+  // contacts; a held one's would rebound it from above the terrain).
+  const bool hold =
+      scene.options.contact_hold == ContactHold::kHeld && scene.options.normal_restitution == 0;
   const Eigen::Vector3d m_body = rotation.transpose() * m;
   const Eigen::Vector3d rate_lever = m_body.cross(omega_rad_s);
 
@@ -191,7 +195,24 @@ DetectResult DetectContacts(const Scene& scene, const RockShape& rock, const Roc
       TerrainSample end;
       if (!terrain.Sample(x_end.x(), x_end.y(), &end)) continue;  // leaving: the next step says so
       const Eigen::Vector3d& n = end.normal;
-      if ((x_end.z() - end.height_m) * n.z() >= -allowed_depth_m) continue;
+      const double end_gap = (x_end.z() - end.height_m) * n.z();
+      if (end_gap >= -allowed_depth_m) {
+        // Not predicted; held if it was a contact in the step before and reaches the terrain by
+        // the next midpoint (ContactHold::kHeld), outside the soil, whose contacts sink by design.
+        if (!hold || end_gap >= 0 || static_cast<std::size_t>(k) >= workspace.last_closed.size() ||
+            !workspace.last_closed[k])
+          continue;
+        if (any_soil && scene.ground.params(terrain.GroundAt(x_end.x(), x_end.y())).IsSoil())
+          continue;
+        const Eigen::Vector3d on_plane(x_end.x(), x_end.y(), end.height_m);
+        Contact& c = workspace.contacts.emplace_back();
+        c.vertex = k;
+        c.gap_m = std::max(0.0, n.dot(x - on_plane));
+        c.held = true;
+        c.lever_m = b;
+        SetFrame(scene, friction, x_end, n, c);
+        continue;
+      }
       double depth_end = 0;
       if (any_soil &&
           SoilDepthAt(scene, rock, x_end.x(), x_end.y(), velocity_m_s.z(), soil, &depth_end)) {

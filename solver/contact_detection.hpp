@@ -27,7 +27,11 @@ inline double PredictionHorizon(const SolverOptions& options) { return options.d
 //   mass's world velocity and the body angular velocity given); frame of the terrain at that end
 //   point, gap_m = the midpoint vertex's distance to the terrain's tangent plane there plus
 //   allowed_depth_m (>= 0), so that the solver's law gap_m + horizon gamma_N,E >= 0 lets the
-//   vertex sink no deeper than allowed_depth_m by the next midpoint.
+//   vertex sink no deeper than allowed_depth_m by the next midpoint;
+// - held (SolverOptions::contact_hold, plastic law, outside soil): open at the midpoint, a contact
+//   of the step before (workspace.last_closed), below the terrain after the horizon but not
+//   deeper than allowed_depth_m; frame as predicted, gap_m its own distance to that plane
+//   (>= 0): the vertex reaches the terrain by the next midpoint and goes no deeper.
 // A rock whose bounding sphere clears the terrain's local plane, over the horizon, by more than
 // the terrain departs from that plane (Terrain::PlaneAround, over the box that the sphere reaches
 // within the horizon) costs one test (kClear); otherwise only the vertices within that departure

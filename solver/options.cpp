@@ -11,6 +11,7 @@ constexpr std::array<const char*, 2> kViscousReadings = {"centre_of_mass", "cont
 constexpr std::array<const char*, 3> kContactSolveMethods = {"gauss_seidel", "block",
                                                              "block_on_stall"};
 constexpr std::array<const char*, 2> kPredictedLevers = {"midpoint", "touch"};
+constexpr std::array<const char*, 2> kContactHolds = {"midpoint", "held"};
 constexpr std::array<const char*, 2> kSoilDragPoints = {"centre_of_mass", "submerged_centroid"};
 constexpr std::array<const char*, 3> kSolverPresets = {"fast", "default", "accurate"};
 
@@ -19,6 +20,7 @@ constexpr std::array<const char*, 3> kSolverPresets = {"fast", "default", "accur
 constinit const EnumNames kViscousReadingNames{"reading", kViscousReadings};
 constinit const EnumNames kContactSolveMethodNames{"method", kContactSolveMethods};
 constinit const EnumNames kPredictedLeverNames{"lever", kPredictedLevers};
+constinit const EnumNames kContactHoldNames{"contact hold", kContactHolds};
 constinit const EnumNames kSoilDragPointNames{"drag point", kSoilDragPoints};
 constinit const EnumNames kSolverPresetNames{"preset", kSolverPresets};
 
@@ -35,6 +37,11 @@ bool ParseContactSolveMethod(std::string_view name, ContactSolveMethod* method) 
 const char* ToString(PredictedLever lever) { return kPredictedLeverNames.NameOf(lever); }
 bool ParsePredictedLever(std::string_view name, PredictedLever* lever) {
   return kPredictedLeverNames.Parse(name, lever);
+}
+
+const char* ToString(ContactHold hold) { return kContactHoldNames.NameOf(hold); }
+bool ParseContactHold(std::string_view name, ContactHold* hold) {
+  return kContactHoldNames.Parse(name, hold);
 }
 
 const char* ToString(SoilDragPoint point) { return kSoilDragPointNames.NameOf(point); }
@@ -74,7 +81,7 @@ constexpr Bounds Choices(const std::array<const char*, N>& /*names*/) {
 }  // namespace
 
 // In the order of summary.json's "solver".
-constinit const std::array<SolverOptionInfo, 17> kSolverOptions = {{
+constinit const std::array<SolverOptionInfo, 18> kSolverOptions = {{
     {.key = "dt_s",
      .type = Type::kNumber,
      .member = MemberOf<&O::dt_s>(),
@@ -156,6 +163,13 @@ constinit const std::array<SolverOptionInfo, 17> kSolverOptions = {{
      .valid = Choices(kPredictedLevers),
      .choices = &kPredictedLeverNames,
      .doc = "where a predicted contact's percussion acts (below)"},
+    {.key = "contact_hold",
+     .type = Type::kChoice,
+     .member = MemberOf<&O::contact_hold>(),
+     .unit = "1",
+     .valid = Choices(kContactHolds),
+     .choices = &kContactHoldNames,
+     .doc = "whether a contact of the step before that gravity brings back is held (below)"},
     {.key = "impact_substeps",
      .type = Type::kInteger,
      .member = MemberOf<&O::impact_substeps>(),

@@ -159,6 +159,7 @@ bool NeedsSubsteps(const Scene& scene, const RockShape& rock, const RockState& b
                    const RockState& mid, const Eigen::Matrix3d& rotation, double allowed_depth,
                    const StepWorkspace& workspace) {
   for (const Contact& c : workspace.contacts) {
+    if (c.held) continue;
     if (c.gap_m > 0) return true;
     if (c.corner || scene.ground.params(c.ground).IsSoil()) continue;
     const Eigen::Vector3d& b = rock.vertices_m[c.vertex];

@@ -316,6 +316,22 @@ TEST(LoadScene, PredictedLeverIsChosenByNameWithDidYouMean) {
              "scene.toml:23: solver.predicted_lever: unknown lever 'tuch' (did you mean 'touch'?)");
 }
 
+TEST(LoadScene, ContactHoldIsChosenByNameWithDidYouMean) {
+  const auto dir = testing::FreshDir("contact_hold");
+  testing::WriteText(dir / "scene.toml", kPlaneScene);
+  EXPECT_EQ(LoadScene((dir / "scene.toml").string()).scene.options.contact_hold,
+            ContactHold::kMidpoint);  // the default
+  testing::WriteText(dir / "scene.toml", Replace(kPlaneScene, "max_time_s = 20",
+                                                 "max_time_s = 20\ncontact_hold = \"held\""));
+  EXPECT_EQ(LoadScene((dir / "scene.toml").string()).scene.options.contact_hold,
+            ContactHold::kHeld);
+  EXPECT_HAS(ErrorOf(Replace(kPlaneScene, "max_time_s = 20",
+                             "max_time_s = 20\ncontact_hold = \"hold\""),
+                     dir),
+             "scene.toml:23: solver.contact_hold: unknown contact hold 'hold' (did you mean "
+             "'held'?)");
+}
+
 // [solver] preset sets the accuracy knobs (solver/options.hpp) and keys the scene gives win over
 // it; talus simulate --preset (UseSolverPreset) wins over both and names the values it changed.
 TEST(LoadScene, SolverPresetSetsTheKnobsTheSceneDoesNotGive) {

@@ -104,6 +104,17 @@ TEST(Options, ViscousReadingNamesRoundTrip) {
   EXPECT_FALSE(ParseViscousReading("drag", &parsed));
 }
 
+TEST(Options, ContactHoldNamesRoundTrip) {
+  EXPECT_EQ(SolverOptions{}.contact_hold, ContactHold::kMidpoint);
+  for (ContactHold h : {ContactHold::kMidpoint, ContactHold::kHeld}) {
+    ContactHold parsed = ContactHold::kMidpoint;
+    EXPECT_TRUE(ParseContactHold(ToString(h), &parsed));
+    EXPECT_EQ(parsed, h);
+  }
+  ContactHold parsed = ContactHold::kHeld;
+  EXPECT_FALSE(ParseContactHold("hold", &parsed));
+}
+
 TEST(Options, PredictedLeverNamesRoundTrip) {
   EXPECT_EQ(SolverOptions{}.predicted_lever, PredictedLever::kMidpoint);
   for (PredictedLever l : {PredictedLever::kMidpoint, PredictedLever::kTouch}) {
