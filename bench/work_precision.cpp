@@ -9,7 +9,6 @@
 
 #include <gdal_priv.h>
 #include <gdal_utils.h>
-#include <sys/utsname.h>
 #include <toml++/toml.h>
 
 #include <CLI/CLI.hpp>
@@ -18,12 +17,10 @@
 #include <cstdio>
 #include <ctime>
 #include <exception>
-#include <fstream>
 #include <memory>
 #include <optional>
 #include <random>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "bench/bench_main.hpp"
@@ -695,26 +692,6 @@ void ReportRocks(const Context& c, int base) {
 }
 
 // ---- Machine and study inputs -------------------------------------------------------------------
-
-std::string FirstLine(const std::string& path, const std::string& prefix) {
-  std::ifstream in(path);
-  for (std::string line; std::getline(in, line);)
-    if (line.rfind(prefix, 0) == 0) return line;
-  return "unknown";
-}
-
-void PrintMachine(int argc, char** argv) {
-  utsname host{};
-  uname(&host);
-  std::string model = FirstLine("/proc/cpuinfo", "model name");
-  model = model.substr(model.find(':') + 2);
-  std::printf("machine: %s, nproc %u, %s %s; load average (1, 5, 15 min) at start: %s\n",
-              model.c_str(), std::thread::hardware_concurrency(), host.sysname, host.release,
-              FirstLine("/proc/loadavg", "").c_str());
-  std::printf("command:");
-  for (int k = 0; k < argc; ++k) std::printf(" %s", argv[k]);
-  std::printf("\n");
-}
 
 // For a plane without evaluation lines: two lines across it, at mid-slope and at the foot.
 std::vector<EvaluationLine> LinesOf(const talus::io::SceneFile& file) {
