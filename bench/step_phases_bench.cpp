@@ -8,6 +8,7 @@
 // A class where the coarse step loses less energy than the fine one is where its rocks run further.
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>

@@ -156,6 +156,12 @@ void LoadSolver(const Section& s, SolverOptions& o, SolverPreset& preset,
                   "whole step; it is " +
                   RoundTrip(o.normal_restitution) + ")");
     o.impact_substeps = 1;
+    // Nor does it hold contacts: it would rebound a held vertex from above the terrain.
+    if (s.Has("contact_hold") && o.contact_hold == ContactHold::kHeld)
+      s.FailCheck("contact_hold = \"held\" needs normal_restitution = 0 (Newton's law would "
+                  "rebound a held vertex from above the terrain; it is " +
+                  RoundTrip(o.normal_restitution) + ")");
+    o.contact_hold = ContactHold::kMidpoint;
   }
   std::string why;
   if (!o.IsValid(&why)) s.FailCheck(why);

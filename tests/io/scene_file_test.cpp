@@ -279,6 +279,10 @@ TEST(LoadScene, RestitutionIsOneCoefficient) {
              "velocities of a whole step; it is 0.4)");
   testing::WriteText(dir / "scene.toml", with("normal_restitution = 0.4\nimpact_substeps = 1"));
   EXPECT_EQ(LoadScene((dir / "scene.toml").string()).scene.options.impact_substeps, 1);
+  // Nor does it hold contacts (SolverOptions::contact_hold).
+  EXPECT_HAS(ErrorOf(with("normal_restitution = 0.4\ncontact_hold = \"held\""), dir),
+             "contact_hold = \"held\" needs normal_restitution = 0 (Newton's law would rebound a "
+             "held vertex from above the terrain; it is 0.4)");
 }
 
 TEST(LoadScene, ContactSolveMethodIsChosenByNameWithDidYouMean) {
