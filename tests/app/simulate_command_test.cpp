@@ -793,7 +793,7 @@ const std::string kAddressSpaceCap = "ulimit -v 16000000 && ";
 // A run whose estimated memory or disk exceeds what the machine has is refused before any rock
 // runs (exit 2, nothing written), with the estimate, what is available and the knob to turn. The
 // run's address space is capped at 16 GB (ulimit -v, which the estimate honours), so the memory
-// case is refused on a node with more than the estimate's 28 GB too (not under AddressSanitizer:
+// case is refused on a node with more than the estimate's 96 GB too (not under AddressSanitizer:
 // there the machine's own memory decides).
 TEST(SimulateCommand, ARunTooLargeForTheMachineIsRefusedBeforeAnyRock) {
   const fs::path dir = FreshDir("too_large");
@@ -822,10 +822,12 @@ rasters = ["speed", "energy", "jump_height"]
       {raster_scene, "",
        {"of disk, but ", "values behind the percentile rasters", "(fewer rocks (--rocks)",
         "nothing was run"}},
-      // 2000 threads, each with a footprint grid of an int per cell: 28 GB.
-      {raster_scene, " --threads 2000",
-       {"of memory besides the ", " is available (", "raster footprint grids of 2000 threads",
-        "(fewer threads (--threads)", "nothing was run"}},
+      // Two evaluation lines: the summary reads four doubles per rock and line back, 96 GB.
+      {raster_scene +
+           "[evaluation_lines]\nlines = [[[50, -10], [50, 10]], [[60, -10], [60, 10]]]\n",
+       "",
+       {"of memory besides the ", " is available (", "evaluation line values behind the summary",
+        "(fewer rocks (--rocks)", "nothing was run"}},
       {disk_scene, "",
        {"the outputs need about ", " PB of disk, but ", "trajectories.h5 (10002 samples per rock",
         "(trajectories = false", "rocks.gpkg (geopackage = false", "nothing was run"}},
