@@ -261,6 +261,9 @@ std::vector<std::string> RunIntoStaging(const io::SceneFile& scene, int threads,
   }
   options.rasters = scene.output.Request(scene.scene.terrain.heights().grid);
   options.keep_raster_state = part;
+  // The values behind the percentile rasters, in the staging directory: never committed, removed
+  // with the accumulator or, at the latest, with the staging directory.
+  options.raster_spill.dir = staging.path("raster_spill");
   options.progress = std::move(progress);
   if (!scene.evaluation_lines.empty())
     options.evaluation_lines =
@@ -304,7 +307,8 @@ std::vector<std::string> RunIntoStaging(const io::SceneFile& scene, int threads,
   if (!part)
     return WriteSummaryOutputs(scene, *report, report->rasters, sink.paths, staging, outputs,
                                self_check);
-  WriteFileAtomically(staging.path("partial.bin"), io::PartialState(*report, sink.paths));
+  io::WritePartialState(staging.path("partial.bin"), *report, sink.paths);
+  report->raster_state.reset();  // its spill is in partial.bin now
   outputs.push_back("partial.bin");
   std::vector<std::string> files;  // sizes and checksums in partial.json
   for (const std::string& name : outputs) files.push_back(staging.path(name));
@@ -360,11 +364,13 @@ std::vector<std::string> MergeIntoStaging(const io::SceneFile& scene,
   if (scene.has_forest) merge_csv("tree_impacts.csv", io::TreeImpactsCsvWriter::Header());
   const ensemble::RasterRequest request = scene.output.Request(scene.scene.terrain.heights().grid);
   std::optional<ensemble::RasterAccumulator> rasters;
+  ensemble::RasterSpillOptions spill;
+  spill.dir = staging.path("raster_spill");
   std::vector<io::SamplePath> paths;
   for (long k = 0; k < n_parts; ++k) {
     ThrowIfInterrupted();
     show("Merging the rasters (partial.bin)", k, n_parts, "parts");
-    io::ReadPartialState(parts[k], request, &rasters, &paths);
+    io::ReadPartialState(parts[k], request, spill, &rasters, &paths);
     report->AddCounts(parts[k].counts);
   }
   show("Merging the rasters (partial.bin)", n_parts, n_parts, "parts");

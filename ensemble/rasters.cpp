@@ -4,6 +4,8 @@
 #include <array>
 #include <cassert>
 #include <cmath>
+#include <istream>
+#include <ostream>
 #include <utility>
 
 namespace talus::ensemble {
@@ -114,9 +116,12 @@ void FootprintRecorder::Finish(RockOutcome& outcome) {
     }
 }
 
-RasterAccumulator::RasterAccumulator(const RasterRequest& request) : request_(request) {
+RasterAccumulator::RasterAccumulator(const RasterRequest& request, RasterSpillOptions spill)
+    : request_(request) {
   const auto cells = static_cast<std::size_t>(request.grid.nx) * request.grid.ny;
-  if (request.passages || request.reach_probability) passages_.assign(cells, 0);
+  if (quantities() > 0 && !request.percentiles.empty())
+    spill_.emplace(request.grid, quantities(), std::move(spill));
+  if (request.passages || request.reach_probability || spill_) passages_.assign(cells, 0);
   if (request.deposits) deposits_.assign(cells, 0);
   if (request.tree_hits) tree_hits_.assign(cells, 0);
   if (quantities() > 0) slot_.assign(cells, -1);
@@ -141,10 +146,14 @@ void RasterAccumulator::Add(const Footprint& footprint) {
     const int cell = footprint.cells[k];
     if (!passages_.empty()) ++passages_[static_cast<std::size_t>(cell)];
     if (slot_.empty()) continue;
+    std::array<float, 3> values{};
+    int q = 0;
+    if (request_.speed) values[static_cast<std::size_t>(q++)] = footprint.speed_m_s[k];
+    if (request_.energy) values[static_cast<std::size_t>(q++)] = footprint.energy_j[k];
+    if (request_.jump_height) values[static_cast<std::size_t>(q++)] = footprint.jump_height_m[k];
     ValueSummary* s = Summaries(cell);
-    if (request_.speed) (s++)->Add(footprint.speed_m_s[k]);
-    if (request_.energy) (s++)->Add(footprint.energy_j[k]);
-    if (request_.jump_height) s->Add(footprint.jump_height_m[k]);
+    for (int v = 0; v < q; ++v) s[v].Add(values[static_cast<std::size_t>(v)]);
+    if (spill_) spill_->Append(cell, values.data());
   }
   if (!deposits_.empty() && footprint.deposit_cell >= 0)
     ++deposits_[static_cast<std::size_t>(footprint.deposit_cell)];
@@ -164,6 +173,7 @@ void RasterAccumulator::Merge(const RasterAccumulator& other) {
     const ValueSummary* theirs = &other.summaries_[static_cast<std::size_t>(other.slot_[c])];
     for (std::size_t k = 0; k < q; ++k) mine[k].Merge(theirs[k]);
   }
+  if (spill_) spill_->Append(*other.spill_);
 }
 
 namespace {
@@ -195,7 +205,7 @@ bool RasterRequest::IsValid(std::string* why) const {
   return true;
 }
 
-std::vector<RasterLayer> RasterAccumulator::Finish(const Heightfield& dem) const {
+std::vector<RasterLayer> RasterAccumulator::Finish(const Heightfield& dem) {
   const std::size_t cells = static_cast<std::size_t>(request_.grid.nx) * request_.grid.ny;
   assert(dem.grid.nx == request_.grid.nx && dem.grid.ny == request_.grid.ny &&
          dem.z_m.size() == cells);
@@ -207,6 +217,14 @@ std::vector<RasterLayer> RasterAccumulator::Finish(const Heightfield& dem) const
     return RasterLayer{name,     unit,      std::vector<float>(cells, fill),
                        quantity, statistic, description};
   };
+  // The percentiles of every quantity from the spill: [quantity * percentiles + k][cell].
+  const std::size_t percentiles = request_.percentiles.size();
+  std::vector<std::vector<float>> spilled;
+  if (spill_) {
+    spilled.assign(static_cast<std::size_t>(quantities()) * percentiles,
+                   std::vector<float>(cells, RasterLayer::kNoData));
+    spill_->Percentiles(passages_, request_.percentiles, spilled);
+  }
   int quantity = 0;
   for (auto [kind, unit] :
        {std::pair{RasterKind::kSpeed, "m/s"}, std::pair{RasterKind::kEnergy, "J"},
@@ -219,10 +237,14 @@ std::vector<RasterLayer> RasterAccumulator::Finish(const Heightfield& dem) const
         layer(what, "max", unit, shown + ", largest over passing rocks", RasterLayer::kNoData));
     out.push_back(
         layer(what, "mean", unit, shown + ", mean over passing rocks", RasterLayer::kNoData));
-    for (int p : request_.percentiles) {
+    for (std::size_t k = 0; k < percentiles; ++k) {
+      const int p = request_.percentiles[k];
       const std::string statistic = std::string("p").append(std::to_string(p));
       const std::string description = shown + ", " + Ordinal(p) + " percentile over passing rocks";
-      out.push_back(layer(what, statistic, unit, description, RasterLayer::kNoData));
+      out.push_back(RasterLayer{what + "_" + statistic, unit,
+                                std::move(spilled[static_cast<std::size_t>(quantity) *
+                                                      percentiles + k]),
+                                what, statistic, description});
     }
     for (std::size_t c = 0; c < cells; ++c) {
       if (slot_[c] < 0) continue;
@@ -231,11 +253,6 @@ std::vector<RasterLayer> RasterAccumulator::Finish(const Heightfield& dem) const
       if (s.count() == 0) continue;
       out[first].values[c] = s.max();
       out[first + 1].values[c] = static_cast<float>(s.mean());
-      for (std::size_t k = 0; k < request_.percentiles.size(); ++k) {
-        RasterLayer& percentile = out[first + 2 + k];
-        percentile.values[c] = s.Percentile(request_.percentiles[k]);
-        percentile.relative_error = std::max(percentile.relative_error, s.relative_error());
-      }
     }
     ++quantity;
   }
@@ -275,17 +292,15 @@ std::vector<RasterLayer> RasterAccumulator::Finish(const Heightfield& dem) const
 }
 
 std::size_t RasterAccumulator::MemoryBytes() const {
-  std::size_t bytes = sizeof(int) * (passages_.capacity() + deposits_.capacity() +
-                                     tree_hits_.capacity() + slot_.capacity()) +
-                      sizeof(ValueSummary) * summaries_.capacity();
-  for (const ValueSummary& s : summaries_) bytes += 8 * s.bins();
-  return bytes;
+  return sizeof(int) * (passages_.capacity() + deposits_.capacity() + tree_hits_.capacity() +
+                        slot_.capacity()) +
+         sizeof(ValueSummary) * summaries_.capacity() + (spill_ ? spill_->MemoryBytes() : 0);
 }
 
 namespace {
 
 // Format of RasterAccumulator::Serialize; a change of layout changes the number.
-constexpr std::uint32_t kStateFormat = 3;
+constexpr std::uint32_t kStateFormat = 4;
 
 std::string PercentileList(const std::vector<std::int32_t>& percentiles) {
   std::string text;
@@ -345,9 +360,18 @@ void RasterAccumulator::Serialize(ByteWriter& out) const {
       summaries_[static_cast<std::size_t>(slot_[static_cast<std::size_t>(c)]) +
                  static_cast<std::size_t>(k)]
           .Serialize(out);
+  // The records WriteSpill writes, per band.
+  std::vector<std::int64_t> records;
+  for (int b = 0; spill_ && b < spill_->bands(); ++b) records.push_back(spill_->records(b));
+  out.PutVector(records);
 }
 
-RasterAccumulator RasterAccumulator::Deserialize(const RasterRequest& request, ByteReader& in) {
+void RasterAccumulator::WriteSpill(std::ostream& spill) const {
+  if (spill_) spill_->WriteBands(spill);
+}
+
+void RasterAccumulator::MergeSerialized(ByteReader& in, std::istream& spill) {
+  const RasterRequest& request = request_;
   if (in.Get<std::uint32_t>() != kStateFormat) in.Fail("was written by another version of talus");
   if (in.Get<std::uint32_t>() != RequestBits(request))
     in.Fail("holds other rasters than the scene asks for");
@@ -361,26 +385,33 @@ RasterAccumulator RasterAccumulator::Deserialize(const RasterRequest& request, B
       grid.y0_m != request.grid.y0_m || grid.dx_m != request.grid.dx_m ||
       grid.dy_m != request.grid.dy_m)
     in.Fail("is on another grid than the scene's DEM");
-  RasterAccumulator acc(request);
-  acc.rocks_ = static_cast<long>(in.Get<std::int64_t>());
+  const auto rocks = in.Get<std::int64_t>();
+  if (rocks < 0) in.Fail();
+  rocks_ += static_cast<long>(rocks);
   std::vector<int> passages(static_cast<std::size_t>(grid.nx) * grid.ny, 0);
   std::vector<int> deposits(passages.size(), 0), tree_hits(passages.size(), 0);
   GetCounts(in, passages);
   GetCounts(in, deposits);
   GetCounts(in, tree_hits);
-  if (!acc.passages_.empty()) acc.passages_ = std::move(passages);
-  if (!acc.deposits_.empty()) acc.deposits_ = std::move(deposits);
-  if (!acc.tree_hits_.empty()) acc.tree_hits_ = std::move(tree_hits);
+  for (std::size_t c = 0; c < passages_.size(); ++c) passages_[c] += passages[c];
+  for (std::size_t c = 0; c < deposits_.size(); ++c) deposits_[c] += deposits[c];
+  for (std::size_t c = 0; c < tree_hits_.size(); ++c) tree_hits_[c] += tree_hits[c];
   const auto passed = in.GetVector<std::int32_t>();
-  if (!passed.empty() && acc.slot_.empty()) in.Fail();
-  for (std::int32_t c : passed) {
-    if (c < 0 || static_cast<std::size_t>(c) >= acc.slot_.size() ||
-        acc.slot_[static_cast<std::size_t>(c)] >= 0)
+  if (!passed.empty() && slot_.empty()) in.Fail();
+  for (std::size_t k = 0; k < passed.size(); ++k) {
+    const std::int32_t c = passed[k];
+    if (c < 0 || static_cast<std::size_t>(c) >= slot_.size() || (k > 0 && c <= passed[k - 1]))
       in.Fail();
-    ValueSummary* s = acc.Summaries(c);
-    for (int k = 0; k < acc.quantities(); ++k) s[k] = ValueSummary::Deserialize(in);
+    ValueSummary* s = Summaries(c);
+    for (int q = 0; q < quantities(); ++q) s[q].Merge(ValueSummary::Deserialize(in));
   }
-  return acc;
+  const auto records = in.GetVector<std::int64_t>();
+  if (!spill_) {
+    if (!records.empty()) in.Fail();
+    return;
+  }
+  if (const std::string wrong = spill_->ReadBands(spill, records); !wrong.empty())
+    in.Fail("is truncated or damaged: its spilled values (" + wrong + ")");
 }
 
 }  // namespace talus::ensemble

@@ -5,12 +5,15 @@
 // partial runs.
 
 #include <cstdint>
+#include <iosfwd>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "common/bytes.hpp"
 #include "ensemble/cell_summary.hpp"
 #include "ensemble/outcome.hpp"
+#include "ensemble/raster_spill.hpp"
 #include "ensemble/recorders.hpp"
 #include "solver/option_table.hpp"
 #include "solver/simulate.hpp"
@@ -99,39 +102,41 @@ struct RasterLayer {
   // The counts of a count layer (passages, deposits) exactly, kNoData where the DEM has no height;
   // empty for the others. `values` holds them too, as float (exact up to 2^24).
   std::vector<std::int32_t> counts = {};
-  // A percentile layer's bound on |value - exact| / |exact|: the largest over its cells
-  // (ValueSummary::relative_error, which coarsens where a cell's values span many octaves); 0 for
-  // the others.
-  double relative_error = 0;
   static constexpr float kNoData = -9999.0f;
 };
 
-// Merges footprints into per-cell summaries (cell_summary.hpp): counts, maxima, means and
-// percentiles whose result does not depend on the order of the rocks or on how they were split
-// between accumulators (Merge), to the bit. Memory: 4 bytes per cell for each of the slot,
-// passage and deposit grids in use, plus, per passed cell and requested quantity, one
-// ValueSummary (64 bytes) and 8 bytes per histogram bin it holds (at most
-// ValueSummary::kMaxBins, 2 kB); it does not grow with the number of rocks beyond the bins.
+// Merges footprints into per-cell summaries (cell_summary.hpp) and spills the values behind the
+// percentiles to disk (raster_spill.hpp): counts, maxima, means and percentiles whose result does
+// not depend on the order of the rocks or on how they were split between accumulators (Merge), to
+// the bit; the percentiles are exact. Memory: 4 bytes per cell for each of the slot, passage and
+// deposit grids in use, per passed cell and requested quantity one ValueSummary (32 bytes), and
+// the spill's write buffers; none of it grows with the number of rocks. Disk: 4 + 4 q bytes per
+// cell passage (q: the quantities requested) when percentiles are asked for.
 class RasterAccumulator {
  public:
-  explicit RasterAccumulator(const RasterRequest& request);
+  explicit RasterAccumulator(const RasterRequest& request, RasterSpillOptions spill = {});
   void Add(const Footprint& footprint);
-  // Adds the rocks of `other`, which must have the same request.
+  // Adds the rocks of `other`, which must have the same request (its spilled values are copied).
   void Merge(const RasterAccumulator& other);
   // The rasters, in the order speed, energy, jump height (each max, mean, then the percentiles
   // ascending), passages, deposits, reach probability, tree hits; `dem` is the DEM on the request's
-  // grid, whose nodata cells (NaN) are nodata in every raster.
-  std::vector<RasterLayer> Finish(const Heightfield& dem) const;
+  // grid, whose nodata cells (NaN) are nodata in every raster. Reads the spill back (in at most
+  // RasterSpillOptions::memory_bytes of values at a time).
+  std::vector<RasterLayer> Finish(const Heightfield& dem);
   long rocks() const { return rocks_; }
   const RasterRequest& request() const { return request_; }
-  // Bytes held now (grids, summaries and their bins), for memory reports.
+  // Bytes held now (grids, summaries, the spill's buffers), for memory reports, and bytes spilled.
   std::size_t MemoryBytes() const;
+  std::uint64_t SpillBytes() const { return spill_ ? spill_->DiskBytes() : 0; }
 
-  // The state, for merging in another process; Deserialize checks that it was made for the same
-  // request (rasters and percentiles) and grid, and throws std::runtime_error otherwise or when the
-  // bytes are damaged.
+  // The state, for merging in another process: Serialize writes the counts and summaries,
+  // WriteSpill the spilled values (raster_spill.hpp; none when no percentile is asked for).
+  // MergeSerialized adds such a state (Serialize's bytes from `in`, WriteSpill's from `spill`) to
+  // this accumulator; it checks that it was made for the same request (rasters and percentiles)
+  // and grid, and throws std::runtime_error (naming `in`) otherwise or when the bytes are damaged.
   void Serialize(ByteWriter& out) const;
-  static RasterAccumulator Deserialize(const RasterRequest& request, ByteReader& in);
+  void WriteSpill(std::ostream& spill) const;
+  void MergeSerialized(ByteReader& in, std::istream& spill);
 
  private:
   // The summaries of a passed cell, created on its first passage.
@@ -140,9 +145,10 @@ class RasterAccumulator {
 
   RasterRequest request_;
   long rocks_ = 0;
-  std::vector<int> passages_, deposits_, tree_hits_;
+  std::vector<int> passages_, deposits_, tree_hits_;  // passages_ also for the spill's counts
   std::vector<int> slot_;  // per cell: index of its first summary in summaries_, or -1
   std::vector<ValueSummary> summaries_;  // per passed cell: speed, energy, jump height as requested
+  std::optional<RasterSpill> spill_;     // with a quantity and a percentile requested
 };
 
 }  // namespace talus::ensemble

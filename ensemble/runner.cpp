@@ -131,7 +131,7 @@ EnsembleReport RunEnsemble(const Scene& scene, const ReleaseSpec& release,
   EnsembleReport report;
   report.threads = threads;
   std::optional<RasterAccumulator> rasters;
-  if (options.rasters.any()) rasters.emplace(options.rasters);
+  if (options.rasters.any()) rasters.emplace(options.rasters, options.raster_spill);
   auto merge = [&](RockOutcome&& out) {
     ++report.rocks;
     ++report.by_end[static_cast<std::size_t>(out.result.end)];
@@ -149,7 +149,7 @@ EnsembleReport RunEnsemble(const Scene& scene, const ReleaseSpec& release,
 
   if (options.progress) options.progress(report.rocks, total);
   if (rasters && options.keep_raster_state)
-    report.raster_state = std::move(rasters);
+    report.raster_state = std::make_shared<RasterAccumulator>(std::move(*rasters));
   else if (rasters)
     report.rasters = rasters->Finish(scene.terrain.heights());
   report.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -34,6 +34,10 @@ struct EnsembleOptions {
   std::function<bool(long rock)> sample_trajectories;
   double trajectory_interval_s = 0.01;  // samples at t = 0, every interval, and the end
   RasterRequest rasters;                // nothing requested: no raster work
+  // Where the values behind the percentile rasters are spilled during the run (a directory inside
+  // the run's staging directory: removed on success and on failure) and the memory to read them
+  // back in (raster_spill.hpp).
+  RasterSpillOptions raster_spill;
   // Keep the raster accumulator in the report (EnsembleReport::raster_state) for merging with other
   // runs' instead of finishing the rasters.
   bool keep_raster_state = false;
@@ -68,7 +72,9 @@ struct EnsembleReport {
   int threads = 1;
   double wall_time_s = 0;
   std::vector<RasterLayer> rasters;
-  std::optional<RasterAccumulator> raster_state;  // with EnsembleOptions::keep_raster_state
+  // With EnsembleOptions::keep_raster_state; shared by copies of the report (it owns the spill's
+  // files, which are not copied).
+  std::shared_ptr<RasterAccumulator> raster_state;
 
   // Adds the counts of another part of the same ensemble (rasters are merged by the caller).
   void AddCounts(const EnsembleReport& other);

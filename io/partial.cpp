@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "common/atomic_file.hpp"
 #include "common/bytes.hpp"
 #include "common/csv_table.hpp"
 #include "common/error.hpp"
@@ -23,9 +24,11 @@ namespace {
 constexpr const char* kFormat = "talus partial result";
 // 2: the files' sizes and checksums; 3: the ending "barrier", rocks.csv's end_barrier column and
 // barriers.csv; 4: SHA-256 for the inputs' hash and the files' checksums instead of FNV-1a 64,
-// and the cell summaries' level (bins capped at ValueSummary::kMaxBins).
-constexpr int kFormatVersion = 4;
-constexpr const char* kStateMagic = "talus partial state 1";
+// and the cell summaries' level (bins capped at ValueSummary::kMaxBins); 5: partial.bin's head
+// length first and the values behind the percentile rasters after it (raster_spill.hpp), the
+// cell summaries without histograms.
+constexpr int kFormatVersion = 5;
+constexpr const char* kStateMagic = "talus partial state 2";
 
 std::string ReadWholeFile(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
@@ -124,20 +127,28 @@ std::string PartialJson(const SceneFile& scene, const std::string& version, long
   return j.dump(2) + "\n";
 }
 
-std::string PartialState(const ensemble::EnsembleReport& report,
-                         const std::vector<SamplePath>& paths) {
-  ByteWriter out;
-  out.PutString(kStateMagic);
-  out.Put<std::uint8_t>(report.raster_state ? 1 : 0);
-  if (report.raster_state) report.raster_state->Serialize(out);
-  out.Put<std::uint64_t>(paths.size());
+void WritePartialState(const std::string& path, const ensemble::EnsembleReport& report,
+                       const std::vector<SamplePath>& paths) {
+  ByteWriter head;
+  head.PutString(kStateMagic);
+  head.Put<std::uint8_t>(report.raster_state ? 1 : 0);
+  if (report.raster_state) report.raster_state->Serialize(head);
+  head.Put<std::uint64_t>(paths.size());
   for (const SamplePath& p : paths) {
-    out.Put<std::int64_t>(p.rock);
+    head.Put<std::int64_t>(p.rock);
     std::vector<double> xy;
     for (const Eigen::Vector2d& v : p.xy_m) xy.insert(xy.end(), {v.x(), v.y()});
-    out.PutVector(xy);
+    head.PutVector(xy);
   }
-  return out.Take();
+  AtomicFile file(path);
+  std::ofstream out(file.temp_path(), std::ios::binary);
+  const std::uint64_t head_bytes = head.bytes().size();
+  out.write(reinterpret_cast<const char*>(&head_bytes), sizeof head_bytes);
+  out.write(head.bytes().data(), static_cast<std::streamsize>(head_bytes));
+  if (report.raster_state) report.raster_state->WriteSpill(out);
+  out.close();
+  if (!out) throw std::runtime_error("cannot write " + path);
+  file.Commit();
 }
 
 PartialInfo ReadPartialInfo(const std::string& dir) {
@@ -304,22 +315,31 @@ std::vector<PartialInfo> CheckPartials(std::vector<PartialInfo> parts) {
 }
 
 void ReadPartialState(const PartialInfo& part, const ensemble::RasterRequest& request,
+                      const ensemble::RasterSpillOptions& spill,
                       std::optional<ensemble::RasterAccumulator>* rasters,
                       std::vector<SamplePath>* paths) {
   const std::string path = (std::filesystem::path(part.dir) / "partial.bin").string();
-  const std::string bytes = ReadWholeFile(path);
-  ByteReader in(bytes, path);
+  // The head in memory; the spilled values streamed into the accumulator's spill.
+  std::ifstream file(path, std::ios::binary);
+  if (!file) throw std::runtime_error("cannot read " + path);
+  std::uint64_t head_bytes = 0;
+  std::string head;
+  if (file.read(reinterpret_cast<char*>(&head_bytes), sizeof head_bytes) &&
+      head_bytes <= std::filesystem::file_size(path)) {
+    head.resize(head_bytes);
+    file.read(head.data(), static_cast<std::streamsize>(head_bytes));
+  }
+  if (!file) throw std::runtime_error(path + " is truncated or damaged");
+  ByteReader in(head, path);
   if (in.GetString() != kStateMagic) in.Fail("is not a partial state of this version of talus");
   const bool has_rasters = in.Get<std::uint8_t>() != 0;
   if (has_rasters != request.any()) in.Fail("holds other rasters than the scene asks for");
   if (has_rasters) {
-    ensemble::RasterAccumulator acc = ensemble::RasterAccumulator::Deserialize(request, in);
-    if (acc.rocks() != part.counts.rocks)
+    if (!rasters->has_value()) rasters->emplace(request, spill);
+    const long before = (*rasters)->rocks();
+    (*rasters)->MergeSerialized(in, file);
+    if ((*rasters)->rocks() - before != part.counts.rocks)
       in.Fail("holds another number of rocks than partial.json");
-    if (rasters->has_value())
-      (*rasters)->Merge(acc);
-    else
-      rasters->emplace(std::move(acc));
   }
   const auto n = in.Get<std::uint64_t>();
   for (std::uint64_t k = 0; k < n; ++k) {
@@ -328,7 +348,7 @@ void ReadPartialState(const PartialInfo& part, const ensemble::RasterRequest& re
     const auto xy = in.GetVector<double>();
     for (std::size_t i = 0; i + 1 < xy.size(); i += 2) p.xy_m.emplace_back(xy[i], xy[i + 1]);
   }
-  if (!in.at_end()) in.Fail();
+  if (!in.at_end() || file.peek() != std::ifstream::traits_type::eof()) in.Fail();
 }
 
 }  // namespace talus::io

@@ -5,7 +5,8 @@
 //   trajectories.h5  their rows, when the scene asks for trajectories,
 //   evaluation_lines.csv  their crossings, when the scene has evaluation lines (the summary is
 //                    computed from the merged file),
-//   partial.bin      the raster accumulator (per-cell summaries) and the quick-look's sample paths,
+//   partial.bin      the raster accumulator (per-cell summaries and the values spilled for the
+//                    percentiles, raster_spill.hpp) and the quick-look's sample paths,
 //   partial.json     what the part is (scene, its inputs' hash, seed, range, version, counts)
 //                    and the size and checksum (SHA-256) of each of its other files; written
 //                    last, so that a directory with a partial.json is a complete part.
@@ -58,14 +59,17 @@ struct SamplePath {
   std::vector<Eigen::Vector2d> xy_m;
 };
 
-// partial.json and partial.bin of a part. `files`: the paths of the part's other files, written
-// already (their names, sizes and checksums go into partial.json). Throws std::runtime_error when
-// one cannot be read.
+// partial.json of a part. `files`: the paths of the part's other files, written already (their
+// names, sizes and checksums go into partial.json). Throws std::runtime_error when one cannot be
+// read.
 std::string PartialJson(const SceneFile& scene, const std::string& version, long first_rock,
                         long end_rock, const ensemble::EnsembleReport& report,
                         const std::vector<std::string>& files);
-std::string PartialState(const ensemble::EnsembleReport& report,
-                         const std::vector<SamplePath>& paths);
+// Writes partial.bin to `path` (atomically, streaming the spilled values: its size in memory does
+// not grow with the rocks): the length of its head, the head (the raster accumulator's state and
+// the sample paths), then the raster accumulator's spill. Throws std::runtime_error.
+void WritePartialState(const std::string& path, const ensemble::EnsembleReport& report,
+                       const std::vector<SamplePath>& paths);
 
 // Reads <dir>/partial.json. Throws InputError naming the directory and the problem.
 PartialInfo ReadPartialInfo(const std::string& dir);
@@ -85,8 +89,10 @@ void CheckPartFiles(const PartialInfo& part,
 std::vector<PartialInfo> CheckPartials(std::vector<PartialInfo> parts);
 
 // Reads <dir>/partial.bin: adds its raster state to *rasters (when the scene asks for rasters;
-// created on the first part) and appends its paths. Throws std::runtime_error.
+// created on the first part, spilling as `spill` says) and appends its paths. Throws
+// std::runtime_error.
 void ReadPartialState(const PartialInfo& part, const ensemble::RasterRequest& request,
+                      const ensemble::RasterSpillOptions& spill,
                       std::optional<ensemble::RasterAccumulator>* rasters,
                       std::vector<SamplePath>* paths);
 

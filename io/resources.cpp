@@ -16,6 +16,7 @@
 #include "ensemble/cell_summary.hpp"
 #include "ensemble/ordered_pool.hpp"
 #include "ensemble/outcome.hpp"
+#include "ensemble/raster_spill.hpp"
 
 namespace talus::io {
 namespace {
@@ -49,7 +50,6 @@ constexpr double kGeoTiffBytesPerCell = 4;
 // spare capacity of a std::vector grown by push_back (capacity doubles: 1.5 on average).
 constexpr double kHeapBlockOverhead = 16;
 constexpr double kVectorGrowth = 1.5;
-constexpr double kHistogramBinBytes = 8;  // ValueSummary's bin: key and count
 
 // The quick-look image per pixel: an RGB triple of doubles, a byte band and GDAL's 3-band canvas.
 constexpr double kQuickLookBytesPerPixel = 3 * sizeof(double) + 1 + 3;
@@ -61,17 +61,20 @@ std::string Cells(const GridGeometry& g) {
 }  // namespace
 
 double PercentileStorageBytes(int stats, double cells, double passes) {
-  // RasterAccumulator: a ValueSummary per passed cell and statistic (ensemble/cell_summary.hpp),
-  // with a histogram bin per distinct bin of its values: at most one per value, and at most 64 per
-  // octave of the cell's range (counted here as 16 octaves, far wider than any cell's spread),
-  // plus a slot per DEM cell pointing at the cell's summaries.
+  // RasterAccumulator: a ValueSummary per passed cell and statistic (ensemble/cell_summary.hpp) in
+  // one growing vector, a slot per DEM cell pointing at the cell's summaries and a passage count
+  // per DEM cell; the spill's write buffers and, at the end, the values it reads back at a time
+  // (ensemble/raster_spill.hpp). None of it grows with the rocks beyond one summary per cell.
   if (stats == 0) return 0;
   const double touched = std::min(cells, passes);  // cells with at least one value
-  const double bins = std::min(passes, touched * 64 * 16);
-  return cells * sizeof(int) +
-         stats * (touched * sizeof(ensemble::ValueSummary) * kVectorGrowth +
-                  bins * kHistogramBinBytes * kVectorGrowth + touched * kHeapBlockOverhead);
+  const ensemble::RasterSpillOptions spill;
+  return cells * 2 * sizeof(int) +
+         stats * touched * sizeof(ensemble::ValueSummary) * kVectorGrowth +
+         double(ensemble::RasterSpill::kMaxBands) * ensemble::RasterSpill::kBufferBytes +
+         double(spill.memory_bytes);
 }
+
+double RasterSpillBytes(int stats, double passes) { return passes * (4.0 + 4.0 * stats); }
 
 double ResourceEstimate::memory_bytes() const {
   return std::accumulate(memory.begin(), memory.end(), 0.0,
@@ -123,8 +126,12 @@ ResourceEstimate EstimateResources(const SceneFile& scene, int threads) {
           {"per-cell summaries behind the speed, energy or jump_height rasters (" +
                std::to_string(stats) + " of them)",
            PercentileStorageBytes(stats, cells, rocks * footprint),
-           "fewer rocks (--rocks), a coarser DEM, or leave speed, energy and jump_height "
-           "out of [output] rasters"});
+           "a coarser DEM, or leave speed, energy and jump_height out of [output] rasters"});
+    if (stats > 0 && !rasters.percentiles.empty())
+      e.disk.push_back({"values behind the percentile rasters (spilled during the run, removed "
+                        "at its end)",
+                        RasterSpillBytes(stats, rocks * footprint),
+                        "fewer rocks (--rocks), or no percentiles in [output]"});
     const double layers = (2 + double(rasters.percentiles.size())) * stats + int(rasters.passages) +
                           int(rasters.deposits) + int(rasters.reach_probability);
     e.memory.push_back({"output rasters", cells * layers * sizeof(float), fewer_rasters});

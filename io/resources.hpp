@@ -31,7 +31,8 @@ struct ResourceEstimate {
 // Estimates the run of `scene` on `threads` worker threads (resolved: >= 1), with the outputs
 // its [output] table asks for. Counts the DEM and ground grid, each thread's raster footprint
 // grid, the raster accumulators, the per-cell storage of the percentile rasters, the finished rocks
-// waiting to be written, the quick-look image, and trajectories.h5, rocks.csv and the GeoTIFFs.
+// waiting to be written, the quick-look image, and trajectories.h5, rocks.csv, the GeoTIFFs and
+// the values spilled for the percentile rasters.
 // Where the size depends on how far and long rocks travel, it assumes that each rock crosses the
 // DEM along its diagonal and travels kAssumedTravelTime_s (or max_time_s when shorter).
 ResourceEstimate EstimateResources(const SceneFile& scene, int threads);
@@ -40,10 +41,12 @@ ResourceEstimate EstimateResources(const SceneFile& scene, int threads);
 // average with max_time_s = 120; io/resources.cpp has the measured sizes behind the estimate).
 inline constexpr double kAssumedTravelTime_s = 100;
 
-// Bytes of the per-cell storage behind the percentile rasters for `stats` statistics (speed,
-// energy, jump height: 0 to 3) on `cells` raster cells, holding `passes` (rock, cell) values in
-// all. The one place that knows how RasterAccumulator keeps them.
+// Bytes of memory behind the speed, energy and jump height rasters for `stats` statistics (0 to
+// 3) on `cells` raster cells, holding `passes` (rock, cell) values in all: bounded by the cells,
+// whatever the rocks. RasterSpillBytes: the disk the values behind their percentiles take during
+// the run. The one place that knows how RasterAccumulator keeps them.
 double PercentileStorageBytes(int stats, double cells, double passes);
+double RasterSpillBytes(int stats, double passes);
 
 // What the machine offers the run.
 struct MachineCapacity {

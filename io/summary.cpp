@@ -1,5 +1,6 @@
 #include "io/summary.hpp"
 
+#include <cctype>
 #include <cmath>
 #include <nlohmann/json.hpp>
 
@@ -237,11 +238,13 @@ std::string SummaryJson(const SceneFile& scene, const ensemble::EnsembleReport& 
   j["raster_output"] = {{"rasters", RasterNames(scene.output.rasters)},
                         {"percentiles", scene.output.percentiles},
                         {"format", ToString(scene.output.raster_format)}};
-  // Per percentile raster, the bound on its values' relative error (cells whose values span
-  // many octaves hold coarser bins: ensemble/cell_summary.hpp).
+  // Per percentile raster, the bound on |value - exact nearest-rank percentile| / |exact|: 0, the
+  // percentiles are taken exactly from every passing rock's value (ensemble/raster_spill.hpp).
   nlohmann::ordered_json bounds = nlohmann::ordered_json::object();
   for (const ensemble::RasterLayer& layer : rasters)
-    if (layer.relative_error > 0) bounds[layer.name] = layer.relative_error;
+    if (layer.statistic.size() > 1 && layer.statistic[0] == 'p' &&
+        std::isdigit(static_cast<unsigned char>(layer.statistic[1])))
+      bounds[layer.name] = 0;
   j["raster_output"]["percentile_relative_error"] = bounds;
   if (!scene.evaluation_lines.empty()) {
     nlohmann::ordered_json lines = nlohmann::ordered_json::array();

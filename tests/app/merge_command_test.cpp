@@ -301,7 +301,7 @@ TEST_F(MergeCommand, APartOfAnOlderTalusIsRefusedSayingWhatToRunAgain) {
   EXPECT_EQ(Merge({a, b}, &log), 2);
   EXPECT_NE(log.find("talus merge: " + (b / "partial.json").string() +
                      ": a part written by an older talus (partial result format 3, this talus "
-                     "reads 4; its checksums are FNV-1a, this talus checks SHA-256): run the part "
+                     "reads 5; its checksums are FNV-1a, this talus checks SHA-256): run the part "
                      "again with this talus (talus simulate " +
                      scene_.string() + " --rock-range 5:10 and the options it ran with)"),
             std::string::npos)

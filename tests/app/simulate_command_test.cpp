@@ -793,13 +793,14 @@ const std::string kAddressSpaceCap = "ulimit -v 16000000 && ";
 // A run whose estimated memory or disk exceeds what the machine has is refused before any rock
 // runs (exit 2, nothing written), with the estimate, what is available and the knob to turn. The
 // run's address space is capped at 16 GB (ulimit -v, which the estimate honours), so the memory
-// case is refused on a node with more than the estimate's 130 GB too (not under AddressSanitizer:
+// case is refused on a node with more than the estimate's 96 GB too (not under AddressSanitizer:
 // there the machine's own memory decides).
 TEST(SimulateCommand, ARunTooLargeForTheMachineIsRefusedBeforeAnyRock) {
   const fs::path dir = FreshDir("too_large");
-  // 3500 x 1000 cells; 10^9 rocks, each assumed to cross the diagonal: a full histogram in every
-  // cell, about 130 GB of per-cell summaries.
-  const std::string memory_scene = R"([terrain]
+  // 3500 x 1000 cells; 10^9 rocks, each assumed to cross the diagonal: the values behind the
+  // percentile rasters, spilled to disk, about 58 TB (the per-cell summaries in memory are
+  // bounded by the cells, 0.5 GB here).
+  const std::string raster_scene = R"([terrain]
 plane = { slope_deg = 35, slope_length_m = 300, runout_m = 50, width_m = 100, cell_m = 0.1 }
 [rock]
 shape = { box = [0.4, 0.4, 0.3] }
@@ -810,23 +811,33 @@ rocks = 500000000
 rasters = ["speed", "energy", "jump_height"]
 )";
   // 10^9 rocks' trajectories of 100 s every 0.01 s, and their paths in rocks.gpkg: over a PB.
-  std::string disk_scene = memory_scene;
+  std::string disk_scene = raster_scene;
   disk_scene.replace(disk_scene.find("rasters = "), std::string::npos,
                      "trajectories = true\nquicklook = false\n");
-  const std::vector<std::pair<std::string, std::vector<std::string>>> cases = {
-      {memory_scene,
-       {"of memory besides the ", " is available (", "per-cell summaries behind the speed",
+  struct Case {
+    std::string scene, options;
+    std::vector<std::string> parts;
+  };
+  const std::vector<Case> cases = {
+      {raster_scene, "",
+       {"of disk, but ", "values behind the percentile rasters", "(fewer rocks (--rocks)",
+        "nothing was run"}},
+      // Two evaluation lines: the summary reads four doubles per rock and line back, 96 GB.
+      {raster_scene +
+           "[evaluation_lines]\nlines = [[[50, -10], [50, 10]], [[60, -10], [60, 10]]]\n",
+       "",
+       {"of memory besides the ", " is available (", "evaluation line values behind the summary",
         "(fewer rocks (--rocks)", "nothing was run"}},
-      {disk_scene,
+      {disk_scene, "",
        {"the outputs need about ", " PB of disk, but ", "trajectories.h5 (10002 samples per rock",
         "(trajectories = false", "rocks.gpkg (geopackage = false", "nothing was run"}},
   };
-  for (const auto& [text, parts] : cases) {
+  for (const auto& [text, options, parts] : cases) {
     std::ofstream(dir / "scene.toml") << text;
     const fs::path out = dir / "out";
     std::string log;
     EXPECT_EQ(RunCommand(kAddressSpaceCap + Talus("simulate " + (dir / "scene.toml").string() +
-                                                  " --out " + out.string()),
+                                                  " --out " + out.string() + options),
                          &log),
               2)
         << log;

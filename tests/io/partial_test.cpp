@@ -210,7 +210,7 @@ TEST(ReadPartialInfo, APartOfAnOlderTalusIsRefusedSayingHowToRunItAgain) {
     EXPECT_EQ(std::string(e.what()),
               json_path.string() +
                   ": a part written by an older talus (partial result format 3, this talus reads "
-                  "4; its checksums are FNV-1a, this talus checks SHA-256): run the part again "
+                  "5; its checksums are FNV-1a, this talus checks SHA-256): run the part again "
                   "with this talus (talus simulate scene.toml --rock-range 5:10 and the options "
                   "it ran with)");
   }

@@ -12,6 +12,7 @@
 #include <string>
 
 #include "ensemble/cell_summary.hpp"
+#include "ensemble/raster_spill.hpp"
 #include "test_files.hpp"
 
 namespace talus::io {
@@ -49,19 +50,22 @@ const ResourceTerm* Find(const std::vector<ResourceTerm>& terms, const std::stri
 
 #define EXPECT_HAS(text, part) EXPECT_NE(std::string(text).find(part), std::string::npos) << (text)
 
-TEST(PercentileStorageBytes, ASummaryPerPassedCellAndABinPerValueAtMost) {
-  // A slot (4 bytes) per DEM cell; per statistic and passed cell a ValueSummary with half again of
-  // spare capacity and a heap block (16 bytes), and an 8-byte histogram bin per value, at most
-  // 64 x 16 per cell, again with half of spare capacity.
-  const double summary = sizeof(ensemble::ValueSummary) * 1.5 + 16;
-  EXPECT_DOUBLE_EQ(PercentileStorageBytes(1, 100, 1000), 100 * 4 + 100 * summary + 1000 * 8 * 1.5);
-  EXPECT_DOUBLE_EQ(PercentileStorageBytes(1, 100, 10), 100 * 4 + 10 * summary + 10 * 8 * 1.5);
-  // However many rocks pass, a cell's histogram is bounded: 1e9 passes over 100 cells cost as
-  // much as 100 x 1024 values.
-  EXPECT_DOUBLE_EQ(PercentileStorageBytes(1, 100, 1e9), PercentileStorageBytes(1, 100, 102400));
-  EXPECT_DOUBLE_EQ(PercentileStorageBytes(3, 100, 1000) - 100 * 4,
-                   3 * (PercentileStorageBytes(1, 100, 1000) - 100 * 4));
+TEST(PercentileStorageBytes, ASummaryPerPassedCellAndAFixedSpillWhateverTheRocks) {
+  // A slot and a passage count (4 bytes each) per DEM cell; per statistic and passed cell a
+  // ValueSummary with half again of spare capacity; the spill's write buffers and the values it
+  // reads back at a time.
+  const double summary = sizeof(ensemble::ValueSummary) * 1.5;
+  const double spill = ensemble::RasterSpill::kMaxBands * ensemble::RasterSpill::kBufferBytes +
+                       ensemble::RasterSpillOptions{}.memory_bytes;
+  EXPECT_DOUBLE_EQ(PercentileStorageBytes(1, 100, 1000), 100 * 8 + 100 * summary + spill);
+  EXPECT_DOUBLE_EQ(PercentileStorageBytes(1, 100, 10), 100 * 8 + 10 * summary + spill);
+  // However many rocks pass, the memory is that of every cell passed.
+  EXPECT_DOUBLE_EQ(PercentileStorageBytes(1, 100, 1e9), PercentileStorageBytes(1, 100, 100));
+  EXPECT_DOUBLE_EQ(PercentileStorageBytes(3, 100, 1000) - 100 * 8 - spill,
+                   3 * (PercentileStorageBytes(1, 100, 1000) - 100 * 8 - spill));
   EXPECT_DOUBLE_EQ(PercentileStorageBytes(0, 100, 1000), 0);
+  // On disk: a cell index and a float per statistic for every passage.
+  EXPECT_DOUBLE_EQ(RasterSpillBytes(3, 1000), 1000 * 16.0);
 }
 
 TEST(EstimateResources, CountsEachPartFromTheScene) {
@@ -78,7 +82,12 @@ TEST(EstimateResources, CountsEachPartFromTheScene) {
       Find(one.memory, "per-cell summaries behind the speed, energy or jump_height rasters");
   ASSERT_NE(p95, nullptr);
   EXPECT_DOUBLE_EQ(p95->bytes, PercentileStorageBytes(2, cells, rocks * std::hypot(61.0, 31.0)));
-  EXPECT_HAS(p95->knob, "fewer rocks (--rocks)");
+  EXPECT_HAS(p95->knob, "a coarser DEM");
+  // Their percentiles' values spilled to disk: a cell index and two floats per passage.
+  const ResourceTerm* spill = Find(one.disk, "values behind the percentile rasters");
+  ASSERT_NE(spill, nullptr);
+  EXPECT_DOUBLE_EQ(spill->bytes, RasterSpillBytes(2, rocks * std::hypot(61.0, 31.0)));
+  EXPECT_HAS(spill->knob, "fewer rocks (--rocks)");
   // Each thread keeps a footprint grid of an int per cell.
   const ResourceEstimate four = EstimateResources(scene, 4);
   EXPECT_DOUBLE_EQ(Find(four.memory, "raster footprint grids of 4 threads")->bytes, 4 * cells * 4);
@@ -142,7 +151,10 @@ TEST(CheckResources, RefusesARunLargerThanTheMemoryOrDiskWithTheKnob) {
                          " of the loaded scene, but " + FormatBytes(e.run_bytes() - 1) +
                          " is available (MemAvailable)");
   EXPECT_HAS(memory, "largest parts: ");
-  EXPECT_HAS(memory, "(fewer rocks (--rocks)");
+  // The rasters' summaries are bounded by the DEM, whatever the rocks.
+  EXPECT_HAS(memory, "per-cell summaries behind the speed, energy or jump_height rasters (2 of "
+                     "them) (a coarser DEM");
+  EXPECT_EQ(memory.find("(fewer rocks (--rocks)"), std::string::npos);
   EXPECT_HAS(memory, "nothing was run");
   EXPECT_EQ(memory.find('\n'), std::string::npos);
 

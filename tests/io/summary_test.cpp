@@ -40,13 +40,16 @@ TEST(SummaryJson, CarriesHashVersionCountsAndRate) {
   EXPECT_EQ(j["solver"]["preset"], "default");
   EXPECT_EQ(j["raster_output"]["percentiles"], nlohmann::json::array({95}));
   EXPECT_EQ(j["raster_output"]["format"], "gtiff");
-  // No rasters given: no bounds. With a percentile layer: its stated bound, by name.
+  // No rasters given: no bounds. Each percentile layer by name with its bound, 0: exact; the
+  // other layers have none.
   EXPECT_TRUE(j["raster_output"]["percentile_relative_error"].empty());
-  ensemble::RasterLayer p95{"energy_p95", "J", {}, "energy", "p95"};
-  p95.relative_error = 1.0 / 64;
-  const auto with = nlohmann::json::parse(
-      SummaryJson(scene, report, "9.9.9", {"rocks.csv"}, {}, nullptr, {}, nullptr, {p95}));
-  EXPECT_EQ(with["raster_output"]["percentile_relative_error"]["energy_p95"], 1.0 / 64);
+  const ensemble::RasterLayer p95{"energy_p95", "J", {}, "energy", "p95"};
+  const ensemble::RasterLayer max{"energy_max", "J", {}, "energy", "max"};
+  const ensemble::RasterLayer passages{"passages", "count", {}, "passages", "count"};
+  const auto with = nlohmann::json::parse(SummaryJson(scene, report, "9.9.9", {"rocks.csv"}, {},
+                                                      nullptr, {}, nullptr, {max, p95, passages}));
+  EXPECT_EQ(with["raster_output"]["percentile_relative_error"],
+            nlohmann::json::parse(R"({"energy_p95": 0})"));
   EXPECT_EQ(j["raster_output"]["rasters"], nlohmann::json::array());
   EXPECT_EQ(j["ground"].size(), 8u);  // Table 1
   EXPECT_EQ(j["ground"]["medium"]["code"], 4);
