@@ -69,8 +69,8 @@ double MechanicalEnergy(const talus::Scene& scene, const talus::RockShape& rock,
 }
 
 double RotationalEnergy(const talus::RockShape& rock, const talus::RockState& s) {
-  return 0.5 * s.angular_velocity_rad_s.dot(
-                   rock.inertia_kg_m2.cwiseProduct(s.angular_velocity_rad_s));
+  return 0.5 *
+         s.angular_velocity_rad_s.dot(rock.inertia_kg_m2.cwiseProduct(s.angular_velocity_rad_s));
 }
 
 // What a run has done since its start, per kg, read at the end of every coarse step.
@@ -246,7 +246,8 @@ struct Landing {
         "| k | windows | energy change, fine (J/kg) | coarse - fine (J/kg) | rotational | "
         "normal work | tangential work | rest | loaded time, fine / coarse (ms) | scar, fine / "
         "coarse (m) |\n|---|---|---|---|---|---|---|---|---|---|\n",
-        landing_speed, same_mark ? ", and whose fine run first carries load in the same coarse step" : "",
+        landing_speed,
+        same_mark ? ", and whose fine run first carries load in the same coarse step" : "",
         later_n ? static_cast<double>(later_sum) / later_n : NAN);
     for (std::size_t i = 0; i < kOffsets.size(); ++i) {
       const Row& row = rows[i];
