@@ -178,7 +178,7 @@ std::vector<std::string> WriteSummaryOutputs(
     page.layers = &layers;
     page.paths = std::move(xy);
     page.lines = std::move(map_lines);
-    page.rocks = io::ReadRockColumns(staging.path("rocks.csv"));
+    page.rocks = io::RockColumns(staging.path("rocks.csv"));
     WriteFileAtomically(staging.path("report.html"), io::RunReportHtml(page));
     wrote(1);
   }

@@ -20,13 +20,16 @@ double SortedQuantile(const std::vector<double>& sorted, double p) {
   return sorted[lo] + (h - static_cast<double>(lo)) * (sorted[lo + 1] - sorted[lo]);
 }
 
+std::size_t NearestRank(double p, std::size_t n) {
+  return static_cast<std::size_t>(std::max(1.0, std::ceil(p / 100 * static_cast<double>(n))));
+}
+
 double NearestRankPercentile(std::vector<double> values, double p) {
   values.erase(
       std::remove_if(values.begin(), values.end(), [](double v) { return !std::isfinite(v); }),
       values.end());
   if (values.empty()) return std::numeric_limits<double>::quiet_NaN();
-  const auto n = static_cast<double>(values.size());
-  const auto rank = static_cast<std::size_t>(std::max(1.0, std::ceil(p / 100 * n)));
+  const std::size_t rank = NearestRank(p, values.size());
   std::nth_element(values.begin(), values.begin() + static_cast<long>(rank - 1), values.end());
   return values[rank - 1];
 }

@@ -49,45 +49,49 @@ void BarriersCsvWriter::Write(const ensemble::RockOutcome& rock) {
 void BarriersCsvWriter::Commit() { file_.Commit(); }
 
 std::vector<BarrierSummary> SummarizeBarriers(const std::string& csv_path,
-                                              const std::vector<Barrier>& barriers, long rocks) {
+                                              const std::vector<Barrier>& barriers, long rocks,
+                                              std::size_t budget_bytes) {
   std::map<std::string, std::size_t> index;
   for (std::size_t b = 0; b < barriers.size(); ++b) index[barriers[b].name] = b;
   std::vector<BarrierSummary> out(barriers.size());
-  // Per barrier: impact energy and passing height of each rock that reached it, energy after of
-  // each that passed.
-  std::vector<std::array<std::vector<double>, 3>> values(barriers.size());
-
-  CsvReader in(csv_path);
-  const std::size_t barrier_column = in.Column("barrier"), outcome_column = in.Column("outcome");
-  const std::array<std::size_t, 3> columns = {in.Column("energy_J"), in.Column("passing_height_m"),
-                                              in.Column("energy_after_J")};
-  std::vector<std::string> fields;
-  while (in.Next(&fields)) {
-    const std::string where = csv_path + ":" + std::to_string(in.line());
-    const auto at = index.find(fields[barrier_column]);
-    if (at == index.end())
-      throw InputError(where + ": column 'barrier': '" + fields[barrier_column] +
-                       "' is not a barrier of the scene");
-    BarrierSummary& s = out[at->second];
-    std::array<double, 3> v{};
-    for (std::size_t q = 0; q < 3; ++q)
-      v[q] = CsvFieldNumber(fields[columns[q]], where, in.header()[columns[q]]);
-    const std::string& outcome = fields[outcome_column];
-    ++s.reached;
-    if (outcome == ToString(BarrierOutcome::kStopped)) {
-      ++s.stopped;
-    } else if (outcome == ToString(BarrierOutcome::kOvertopped)) {
-      ++s.overtopped;
-    } else if (outcome == ToString(BarrierOutcome::kBrokeThrough)) {
-      ++s.broke_through;
-    } else {
-      throw InputError(where + ": column 'outcome': '" + outcome +
-                       "': expected stopped, overtopped or broke_through");
+  // Column 3 b + q: impact energy and passing height (q = 0, 1) of each rock that reached barrier
+  // b, energy after (q = 2) of each that passed. Each reading counts the outcomes afresh.
+  const ColumnSource source = [&](const ColumnSink& emit) {
+    for (BarrierSummary& s : out) s.reached = s.stopped = s.overtopped = s.broke_through = 0;
+    CsvReader in(csv_path);
+    const std::size_t barrier_column = in.Column("barrier"), outcome_column = in.Column("outcome");
+    const std::array<std::size_t, 3> columns = {
+        in.Column("energy_J"), in.Column("passing_height_m"), in.Column("energy_after_J")};
+    std::vector<std::string> fields;
+    while (in.Next(&fields)) {
+      const std::string where = csv_path + ":" + std::to_string(in.line());
+      const auto at = index.find(fields[barrier_column]);
+      if (at == index.end())
+        throw InputError(where + ": column 'barrier': '" + fields[barrier_column] +
+                         "' is not a barrier of the scene");
+      BarrierSummary& s = out[at->second];
+      std::array<double, 3> v{};
+      for (std::size_t q = 0; q < 3; ++q)
+        v[q] = CsvFieldNumber(fields[columns[q]], where, in.header()[columns[q]]);
+      const std::string& outcome = fields[outcome_column];
+      ++s.reached;
+      if (outcome == ToString(BarrierOutcome::kStopped)) {
+        ++s.stopped;
+      } else if (outcome == ToString(BarrierOutcome::kOvertopped)) {
+        ++s.overtopped;
+      } else if (outcome == ToString(BarrierOutcome::kBrokeThrough)) {
+        ++s.broke_through;
+      } else {
+        throw InputError(where + ": column 'outcome': '" + outcome +
+                         "': expected stopped, overtopped or broke_through");
+      }
+      emit(3 * at->second, v[0]);
+      emit(3 * at->second + 1, v[1]);
+      if (outcome != ToString(BarrierOutcome::kStopped)) emit(3 * at->second + 2, v[2]);
     }
-    values[at->second][0].push_back(v[0]);
-    values[at->second][1].push_back(v[1]);
-    if (outcome != ToString(BarrierOutcome::kStopped)) values[at->second][2].push_back(v[2]);
-  }
+  };
+  const std::vector<ColumnStatistics> statistics =
+      SummarizeColumns(source, 3 * barriers.size(), kCrossingPercents, budget_bytes);
 
   for (std::size_t b = 0; b < barriers.size(); ++b) {
     BarrierSummary& s = out[b];
@@ -100,10 +104,9 @@ std::vector<BarrierSummary> SummarizeBarriers(const std::string& csv_path,
     s.reach_probability = rocks > 0 ? double(s.reached) / double(rocks) : kNaN;
     s.passing_probability =
         rocks > 0 ? double(s.overtopped + s.broke_through) / double(rocks) : kNaN;
-    s.impact_energy_J = StatisticsOf(values[b][0]);
-    s.passing_height_m = StatisticsOf(values[b][1]);
-    s.passing_energy_J = StatisticsOf(values[b][2]);
-    values[b] = {};
+    s.impact_energy_J = CrossingStatisticsOf(statistics[3 * b]);
+    s.passing_height_m = CrossingStatisticsOf(statistics[3 * b + 1]);
+    s.passing_energy_J = CrossingStatisticsOf(statistics[3 * b + 2]);
   }
   return out;
 }

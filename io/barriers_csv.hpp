@@ -57,9 +57,12 @@ struct BarrierSummary {
 };
 
 // The summary of every barrier from a complete barriers.csv of a run of `rocks` rocks, read row by
-// row. Throws InputError naming the file and line when a row is not one the writer writes.
-std::vector<BarrierSummary> SummarizeBarriers(const std::string& csv_path,
-                                              const std::vector<Barrier>& barriers, long rocks);
+// row, and again as SummarizeColumns (common/column_statistics.hpp) needs: memory is bounded by
+// `budget_bytes`, not by the rows. Throws InputError naming the file and line when a row is not one
+// the writer writes.
+std::vector<BarrierSummary> SummarizeBarriers(
+    const std::string& csv_path, const std::vector<Barrier>& barriers, long rocks,
+    std::size_t budget_bytes = kColumnStatisticsBudgetBytes);
 
 // barriers_summary.csv: a header and one row per barrier.
 std::string BarriersSummaryCsv(const std::vector<BarrierSummary>& summary);

@@ -8,7 +8,6 @@
 #include "common/csv_table.hpp"
 #include "common/error.hpp"
 #include "common/format.hpp"
-#include "common/statistics.hpp"
 #include "io/rocks_csv.hpp"
 
 namespace talus::io {
@@ -47,39 +46,48 @@ void EvaluationLinesCsvWriter::Write(const ensemble::RockOutcome& rock) {
 
 void EvaluationLinesCsvWriter::Commit() { file_.Commit(); }
 
-CrossingStatistics StatisticsOf(const std::vector<double>& values) {
+CrossingStatistics CrossingStatisticsOf(const ColumnStatistics& column) {
   CrossingStatistics s;
-  double sum = 0;
-  for (double v : values) sum += v;
-  s.values[0] = values.empty() ? kNaN : sum / static_cast<double>(values.size());
-  const double percent[] = {50, 90, 95, 99, 100};
-  for (std::size_t k = 0; k < 5; ++k) s.values[k + 1] = NearestRankPercentile(values, percent[k]);
+  s.values[0] = column.mean();
+  for (std::size_t k = 0; k < kCrossingPercents.size(); ++k)
+    s.values[k + 1] = column.percentiles[k];
   return s;
 }
 
+CrossingStatistics StatisticsOf(const std::vector<double>& values) {
+  const ColumnSource source = [&values](const ColumnSink& emit) {
+    for (double v : values) emit(0, v);
+  };
+  return CrossingStatisticsOf(SummarizeColumns(source, 1, kCrossingPercents)[0]);
+}
+
 std::vector<EvaluationLineSummary> SummarizeEvaluationLines(
-    const std::string& csv_path, const std::vector<ensemble::EvaluationLine>& lines, long rocks) {
+    const std::string& csv_path, const std::vector<ensemble::EvaluationLine>& lines, long rocks,
+    std::size_t budget_bytes) {
   std::map<std::string, std::size_t> index;
   for (std::size_t l = 0; l < lines.size(); ++l) index[lines[l].name] = l;
-  // Per line: speed, energy, centre-of-mass height and bounce height of each crossing rock.
-  std::vector<std::array<std::vector<double>, 4>> values(lines.size());
-
-  CsvReader in(csv_path);
-  const std::size_t line_column = in.Column("line");
-  const std::array<std::size_t, 4> columns = {in.Column("speed_m_s"), in.Column("energy_J"),
-                                              in.Column("com_height_m"),
-                                              in.Column("bounce_height_m")};
-  std::vector<std::string> fields;
-  while (in.Next(&fields)) {
-    const auto at = index.find(fields[line_column]);
-    if (at == index.end())
-      throw InputError(csv_path + ":" + std::to_string(in.line()) + ": column 'line': '" +
-                       fields[line_column] + "' is not an evaluation line of the scene");
-    for (std::size_t q = 0; q < 4; ++q)
-      values[at->second][q].push_back(
-          CsvFieldNumber(fields[columns[q]], csv_path + ":" + std::to_string(in.line()),
-                         in.header()[columns[q]]));
-  }
+  // Column 4 l + q: speed, energy, centre-of-mass height and bounce height (q) of each rock that
+  // crossed line l.
+  const ColumnSource source = [&](const ColumnSink& emit) {
+    CsvReader in(csv_path);
+    const std::size_t line_column = in.Column("line");
+    const std::array<std::size_t, 4> columns = {in.Column("speed_m_s"), in.Column("energy_J"),
+                                                in.Column("com_height_m"),
+                                                in.Column("bounce_height_m")};
+    std::vector<std::string> fields;
+    while (in.Next(&fields)) {
+      const auto at = index.find(fields[line_column]);
+      if (at == index.end())
+        throw InputError(csv_path + ":" + std::to_string(in.line()) + ": column 'line': '" +
+                         fields[line_column] + "' is not an evaluation line of the scene");
+      for (std::size_t q = 0; q < 4; ++q)
+        emit(4 * at->second + q,
+             CsvFieldNumber(fields[columns[q]], csv_path + ":" + std::to_string(in.line()),
+                            in.header()[columns[q]]));
+    }
+  };
+  const std::vector<ColumnStatistics> statistics =
+      SummarizeColumns(source, 4 * lines.size(), kCrossingPercents, budget_bytes);
 
   std::vector<EvaluationLineSummary> out;
   for (std::size_t l = 0; l < lines.size(); ++l) {
@@ -87,13 +95,12 @@ std::vector<EvaluationLineSummary> SummarizeEvaluationLines(
     s.name = lines[l].name;
     s.length_m = lines[l].length_m();
     s.rocks = rocks;
-    s.crossed = static_cast<long>(values[l][0].size());
+    s.crossed = statistics[4 * l].count;
     s.passing_probability = rocks > 0 ? double(s.crossed) / double(rocks) : kNaN;
-    s.speed_m_s = StatisticsOf(values[l][0]);
-    s.energy_J = StatisticsOf(values[l][1]);
-    s.com_height_m = StatisticsOf(values[l][2]);
-    s.bounce_height_m = StatisticsOf(values[l][3]);
-    values[l] = {};  // release the line's values before the next line's statistics
+    s.speed_m_s = CrossingStatisticsOf(statistics[4 * l]);
+    s.energy_J = CrossingStatisticsOf(statistics[4 * l + 1]);
+    s.com_height_m = CrossingStatisticsOf(statistics[4 * l + 2]);
+    s.bounce_height_m = CrossingStatisticsOf(statistics[4 * l + 3]);
   }
   return out;
 }

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "common/atomic_file.hpp"
+#include "common/column_statistics.hpp"
 #include "ensemble/evaluation_lines.hpp"
 #include "ensemble/outcome.hpp"
 #include "ensemble/release.hpp"
@@ -38,6 +39,9 @@ class EvaluationLinesCsvWriter {
   const ensemble::ReleaseSpec& release_;
 };
 
+// The percentiles of CrossingStatistics after its mean: median, 90 %, 95 %, 99 % and largest.
+inline const std::vector<double> kCrossingPercents = {50, 90, 95, 99, 100};
+
 // Mean, nearest-rank percentiles (common/statistics.hpp NearestRankPercentile) and largest value of
 // one quantity over the rocks that crossed a line; NaN when none did.
 struct CrossingStatistics {
@@ -57,12 +61,15 @@ struct EvaluationLineSummary {
 
 // The statistics of `values` (in any order; the mean is summed in the order given).
 CrossingStatistics StatisticsOf(const std::vector<double>& values);
+// The same from a column summarised at kCrossingPercents (common/column_statistics.hpp).
+CrossingStatistics CrossingStatisticsOf(const ColumnStatistics& column);
 
 // The summary of every line from a complete evaluation_lines.csv of a run of `rocks` rocks, read
-// record by record; memory is four numbers per row. Throws InputError naming the file and line
-// when a row is not one the writer writes.
+// record by record, and again as SummarizeColumns needs: memory is bounded by `budget_bytes`, not
+// by the rows. Throws InputError naming the file and line when a row is not one the writer writes.
 std::vector<EvaluationLineSummary> SummarizeEvaluationLines(
-    const std::string& csv_path, const std::vector<ensemble::EvaluationLine>& lines, long rocks);
+    const std::string& csv_path, const std::vector<ensemble::EvaluationLine>& lines, long rocks,
+    std::size_t budget_bytes = kColumnStatisticsBudgetBytes);
 
 // evaluation_lines_summary.csv: a header and one row per line.
 std::string EvaluationLinesSummaryCsv(const std::vector<EvaluationLineSummary>& summary);

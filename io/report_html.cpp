@@ -1,6 +1,7 @@
 #include "io/report_html.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -29,62 +30,100 @@ using svg::Escape;
 
 }  // namespace
 
-RockColumns ReadRockColumns(const std::string& rocks_csv) {
-  CsvReader in(rocks_csv);
-  const std::size_t runout = in.Column("runout_m"), energy = in.Column("max_kinetic_energy_j"),
-                    jump = in.Column("max_jump_height_m"), speed = in.Column("max_speed_m_s"),
-                    angle = in.Column("travel_angle_deg");
-  RockColumns out;
-  std::vector<std::string> fields;
-  while (in.Next(&fields)) {
-    const auto value = [&](std::size_t c) {
-      const std::string& text = fields[c];
-      if (text.empty()) return std::numeric_limits<double>::quiet_NaN();
-      return CsvFieldNumber(text, rocks_csv + ":" + std::to_string(in.line()), in.header()[c]);
-    };
-    out.runout_m.push_back(value(runout));
-    out.max_kinetic_energy_j.push_back(value(energy));
-    out.max_jump_height_m.push_back(value(jump));
-    out.max_speed_m_s.push_back(value(speed));
-    out.travel_angle_deg.push_back(value(angle));
+ColumnSource RockColumns(const std::string& rocks_csv) {
+  std::array<std::size_t, kRockColumnCount> at{};
+  {
+    const CsvReader in(rocks_csv);
+    at[kRunoutColumn] = in.Column("runout_m");
+    at[kEnergyColumn] = in.Column("max_kinetic_energy_j");
+    at[kJumpHeightColumn] = in.Column("max_jump_height_m");
+    at[kSpeedColumn] = in.Column("max_speed_m_s");
+    at[kTravelAngleColumn] = in.Column("travel_angle_deg");
   }
+  return [rocks_csv, at](const ColumnSink& emit) {
+    CsvReader in(rocks_csv);
+    std::vector<std::string> fields;
+    while (in.Next(&fields)) {
+      for (std::size_t k = 0; k < kRockColumnCount; ++k) {
+        const std::string& text = fields[at[k]];
+        double v = std::numeric_limits<double>::quiet_NaN();
+        if (!text.empty())
+          v = CsvFieldNumber(text, rocks_csv + ":" + std::to_string(in.line()), in.header()[at[k]]);
+        emit(k, k == kEnergyColumn ? v / kJoulesPerEnergyUnit : v);
+      }
+    }
+  };
+}
+
+namespace {
+
+// Percentiles the report shows; the histograms' median and 95 % are among them.
+const std::vector<double> kPercents = {50, 90, 95, 99, 100};
+constexpr std::size_t kMedian = 0, kP95 = 2;
+
+// A histogram of one column's finite values: `count` in equal bins from `lo` to `hi`.
+struct Histogram {
+  double lo = 0, hi = 1;
+  std::vector<long> count;
+};
+
+// Histograms of the columns `which` of `source`, in `bins` bins from 0 (or the smallest value,
+// when negative) to the largest, in one reading of the source.
+std::vector<Histogram> HistogramsOf(const ColumnSource& source,
+                                    const std::vector<ColumnStatistics>& statistics,
+                                    const std::vector<std::size_t>& which, int bins) {
+  std::vector<Histogram> out(which.size());
+  std::vector<int> slot(statistics.size(), -1);
+  for (std::size_t k = 0; k < which.size(); ++k) {
+    const ColumnStatistics& s = statistics[which[k]];
+    Histogram& h = out[k];
+    h.lo = s.finite > 0 ? std::min(0.0, s.min) : 0;
+    h.hi = s.finite > 0 ? std::max(0.0, s.max) : 0;
+    if (!(h.hi > h.lo)) h.hi = h.lo + 1;
+    h.count.assign(static_cast<std::size_t>(bins), 0);
+    slot[which[k]] = static_cast<int>(k);
+  }
+  source([&](std::size_t column, double v) {
+    if (column >= slot.size() || slot[column] < 0 || !std::isfinite(v)) return;
+    Histogram& h = out[static_cast<std::size_t>(slot[column])];
+    const int b = std::min(bins - 1, static_cast<int>((v - h.lo) / (h.hi - h.lo) * bins));
+    ++h.count[static_cast<std::size_t>(b)];
+  });
   return out;
 }
 
-std::string HistogramSvg(const std::string& title, const std::string& x_label,
-                         const std::vector<double>& values, int bins) {
-  std::vector<double> finite;
-  for (double v : values)
-    if (std::isfinite(v)) finite.push_back(v);
-  double lo = 0, hi = 0;
-  for (double v : finite) {
-    lo = std::min(lo, v);
-    hi = std::max(hi, v);
-  }
-  if (!(hi > lo)) hi = lo + 1;
-  std::vector<long> count(static_cast<std::size_t>(bins), 0);
-  for (double v : finite) {
-    const int b = std::min(bins - 1, static_cast<int>((v - lo) / (hi - lo) * bins));
-    ++count[static_cast<std::size_t>(b)];
-  }
-  const long top = std::max<long>(1, *std::max_element(count.begin(), count.end()));
-  const svg::Axis x{lo, hi, svg::kLeft, svg::kWidth - svg::kRight};
+std::string HistogramSvg(const std::string& title, const std::string& x_label, const Histogram& h,
+                         const ColumnStatistics& s) {
+  const int bins = static_cast<int>(h.count.size());
+  const long top = std::max<long>(1, *std::max_element(h.count.begin(), h.count.end()));
+  const svg::Axis x{h.lo, h.hi, svg::kLeft, svg::kWidth - svg::kRight};
   const svg::Axis y{0, static_cast<double>(top) * 1.1, svg::kHeight - svg::kBottom, svg::kTop};
   std::string out = svg::Frame(title, x_label, "rocks", x, y);
   for (int b = 0; b < bins; ++b) {
-    const double left = lo + (hi - lo) * b / bins, right = lo + (hi - lo) * (b + 1) / bins;
-    const double h = static_cast<double>(count[static_cast<std::size_t>(b)]);
-    Add(out, "<rect x=\"", svg::F(x(left)), "\" y=\"", svg::F(y(h)), "\" width=\"",
-        svg::F(x(right) - x(left)), "\" height=\"", svg::F(y(0) - y(h)),
+    const double left = h.lo + (h.hi - h.lo) * b / bins,
+                 right = h.lo + (h.hi - h.lo) * (b + 1) / bins;
+    const double height = static_cast<double>(h.count[static_cast<std::size_t>(b)]);
+    Add(out, "<rect x=\"", svg::F(x(left)), "\" y=\"", svg::F(y(height)), "\" width=\"",
+        svg::F(x(right) - x(left)), "\" height=\"", svg::F(y(0) - y(height)),
         "\" fill=\"#1f5fbf\" fill-opacity=\"0.75\" stroke=\"white\"/>\n");
   }
-  const std::string stats = "n = " + std::to_string(finite.size()) + ", median " +
-                            Number(NearestRankPercentile(finite, 50)) + ", 95 % " +
-                            Number(NearestRankPercentile(finite, 95)) + ", largest " +
-                            Number(finite.empty() ? NAN : hi);
+  const std::string stats = "n = " + std::to_string(s.finite) + ", median " +
+                            Number(s.percentiles[kMedian]) + ", 95 % " +
+                            Number(s.percentiles[kP95]) + ", largest " + Number(s.max);
   Add(out, "<text x=\"", svg::F(svg::kWidth - svg::kRight - 6), "\" y=\"", svg::F(svg::kTop + 14),
       "\" text-anchor=\"end\">", stats, "</text>\n");
   return out + "</svg>\n";
+}
+
+}  // namespace
+
+std::string HistogramSvg(const std::string& title, const std::string& x_label,
+                         const std::vector<double>& values, int bins) {
+  const ColumnSource source = [&values](const ColumnSink& emit) {
+    for (double v : values) emit(0, v);
+  };
+  const std::vector<ColumnStatistics> s = SummarizeColumns(source, 1, kPercents);
+  return HistogramSvg(title, x_label, HistogramsOf(source, s, {0}, bins)[0], s[0]);
 }
 
 namespace {
@@ -156,29 +195,32 @@ std::string MapsSection(const RunReportInput& input) {
 }
 
 // "Distributions over the rocks": histograms and a table of statistics.
-std::string DistributionsSection(const RockColumns& r) {
-  std::vector<double> energy_kj;
-  for (double e : r.max_kinetic_energy_j) energy_kj.push_back(e / kJoulesPerEnergyUnit);
+std::string DistributionsSection(const ColumnSource& rocks, std::size_t budget_bytes) {
+  const ColumnSource none = [](const ColumnSink&) {};
+  const ColumnSource& source = rocks ? rocks : none;
+  const std::vector<ColumnStatistics> s =
+      SummarizeColumns(source, kRockColumnCount, kPercents, budget_bytes);
+  const std::vector<Histogram> h =
+      HistogramsOf(source, s, {kRunoutColumn, kEnergyColumn, kJumpHeightColumn}, 20);
   std::string html = "<h2>Distributions over the rocks</h2>\n<div class=\"plots\">\n";
-  html += HistogramSvg("Runout", "runout (m)", r.runout_m);
-  html += HistogramSvg("Largest kinetic energy", std::string("energy (") + kEnergyUnit + ")",
-                       energy_kj);
+  html += HistogramSvg("Runout", "runout (m)", h[0], s[kRunoutColumn]);
+  html += HistogramSvg("Largest kinetic energy", std::string("energy (") + kEnergyUnit + ")", h[1],
+                       s[kEnergyColumn]);
   html += HistogramSvg("Largest jump height", "jump height: centre of mass, along the normal (m)",
-                       r.max_jump_height_m);
+                       h[2], s[kJumpHeightColumn]);
   html +=
       "</div>\n<table>\n<tr><th></th><th>mean</th><th>median</th><th>90 %</th><th>95 %</th>"
       "<th>99 %</th><th>largest</th></tr>\n";
-  const auto stats_row = [&](const char* label, const std::vector<double>& values) {
-    Add(html, "<tr><th>", label, "</th><td>", Number(Mean(values)), "</td>");
-    for (double p : {50.0, 90.0, 95.0, 99.0, 100.0})
-      Add(html, "<td>", Number(NearestRankPercentile(values, p)), "</td>");
+  const auto stats_row = [&](const std::string& label, const ColumnStatistics& c) {
+    Add(html, "<tr><th>", label, "</th><td>", Number(c.mean()), "</td>");
+    for (double p : c.percentiles) Add(html, "<td>", Number(p), "</td>");
     html += "</tr>\n";
   };
-  stats_row("runout (m)", r.runout_m);
-  stats_row("largest speed (m/s)", r.max_speed_m_s);
-  stats_row((std::string("largest kinetic energy (") + kEnergyUnit + ")").c_str(), energy_kj);
-  stats_row("largest jump height, along the normal (m)", r.max_jump_height_m);
-  stats_row("travel angle (&deg;)", r.travel_angle_deg);
+  stats_row("runout (m)", s[kRunoutColumn]);
+  stats_row("largest speed (m/s)", s[kSpeedColumn]);
+  stats_row(std::string("largest kinetic energy (") + kEnergyUnit + ")", s[kEnergyColumn]);
+  stats_row("largest jump height, along the normal (m)", s[kJumpHeightColumn]);
+  stats_row("travel angle (&deg;)", s[kTravelAngleColumn]);
   html +=
       "</table>\n<p class=\"note\">Percentiles are nearest-rank, over the rocks (one value per "
       "rock).</p>\n";
@@ -365,8 +407,9 @@ std::string SettingsSection(const Json& summary) {
 std::string RunReportHtml(const RunReportInput& input) {
   const Json summary = Json::parse(input.summary_json);
   return WhatRanSection(summary) + EndingsSection(summary) + MapsSection(input) +
-         DistributionsSection(input.rocks) + EvaluationLinesSection(summary) +
-         BarriersSection(summary) + ForestSection(summary) + SettingsSection(summary);
+         DistributionsSection(input.rocks, input.statistics_budget_bytes) +
+         EvaluationLinesSection(summary) + BarriersSection(summary) + ForestSection(summary) +
+         SettingsSection(summary);
 }
 
 }  // namespace talus::io

@@ -117,6 +117,8 @@ TEST(SummarizeEvaluationLines, NearestRankStatisticsAndPassingProbability) {
       << table;
   EXPECT_NE(table.find("\n\"net, lower\",3,25,0,0,,,,,,,,,,,,,,,,,,,,,,,,\n"), std::string::npos)
       << table;
+  // Read again as often as a budget of one value needs (common/column_statistics.hpp): the same.
+  EXPECT_EQ(EvaluationLinesSummaryCsv(SummarizeEvaluationLines(path, TwoLines(), 25, 8)), table);
 }
 
 TEST(SummarizeEvaluationLines, RowsOfUnknownLinesOrWithoutNumbersAreErrors) {
