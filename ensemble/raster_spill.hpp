@@ -25,8 +25,10 @@ struct RasterSpillOptions {
   // a run's staging directory; empty: a new directory under the system's temporary directory.
   // Removed with the spill.
   std::string dir;
-  // Memory for the values of one group of cells at Percentiles() (bytes, > 0).
-  std::size_t memory_bytes = std::size_t{16} << 20;
+  // Memory for the values of one group of cells at Percentiles() (bytes, > 0). Percentiles()
+  // holds about twice this at most; 4 MiB took 1.75 s against 1.17 s with 16 MiB for the 33
+  // million records of 10^5 tirol rocks, and kept 18 MB less.
+  std::size_t memory_bytes = std::size_t{4} << 20;
 };
 
 class RasterSpill {

@@ -47,13 +47,26 @@ OGRFieldType FieldType(const std::string& column) {
   return OFTReal;
 }
 
-// Sets GDAL's clock for the GeoPackage's last_change while alive (this thread only).
-class FixedGpkgDate {
+// GDAL's settings for writing the GeoPackage, while alive (this thread only):
+// - its clock, fixed for the GeoPackage's last_change;
+// - the spatial indexes built by SQLite as the features go in, not in a background thread from an
+//   in-memory R-tree that grows with the features (GDAL >= 3.6). That kept about 3 MB more per
+//   10^5 rocks, and took longer on the clock (5 s against 9 s for 10^5 rocks' end points);
+// - SQLite's page cache at 1 MB.
+class GpkgWriteSettings {
  public:
-  FixedGpkgDate() { CPLSetThreadLocalConfigOption("OGR_CURRENT_DATE", "2000-01-01T00:00:00.000Z"); }
-  ~FixedGpkgDate() { CPLSetThreadLocalConfigOption("OGR_CURRENT_DATE", nullptr); }
-  FixedGpkgDate(const FixedGpkgDate&) = delete;
-  FixedGpkgDate& operator=(const FixedGpkgDate&) = delete;
+  GpkgWriteSettings() {
+    CPLSetThreadLocalConfigOption("OGR_CURRENT_DATE", "2000-01-01T00:00:00.000Z");
+    CPLSetThreadLocalConfigOption("OGR_GPKG_ALLOW_THREADED_RTREE", "NO");
+    CPLSetThreadLocalConfigOption("OGR_SQLITE_CACHE", "1");
+  }
+  ~GpkgWriteSettings() {
+    for (const char* key :
+         {"OGR_CURRENT_DATE", "OGR_GPKG_ALLOW_THREADED_RTREE", "OGR_SQLITE_CACHE"})
+      CPLSetThreadLocalConfigOption(key, nullptr);
+  }
+  GpkgWriteSettings(const GpkgWriteSettings&) = delete;
+  GpkgWriteSettings& operator=(const GpkgWriteSettings&) = delete;
 };
 
 struct DatasetCloser {
@@ -348,7 +361,7 @@ void WriteRocksGeoPackage(const std::string& path, const std::string& rocks_csv,
                           const std::string& trajectories_h5, const std::string& crs_wkt,
                           const std::string& evaluation_lines_csv, const std::string& barriers_csv,
                           const GeoPackageScene& scene) {
-  const FixedGpkgDate fixed_date;
+  const GpkgWriteSettings settings;
   AtomicFile file(path);
   Writer out(path, file.temp_path(), crs_wkt);
 
