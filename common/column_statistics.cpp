@@ -4,6 +4,8 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <numeric>
+#include <stdexcept>
 
 #include "common/statistics.hpp"
 
@@ -68,6 +70,11 @@ void NarrowBatch(const ColumnSource& source, std::vector<Target*>& batch,
   });
   for (std::size_t b = 0; b < batch.size(); ++b) {
     Target& t = *batch[b];
+    const std::uint64_t found =
+        collect[b] ? values[b].size()
+                   : std::accumulate(histogram[b].begin(), histogram[b].end(), std::uint64_t{0});
+    if (found != t.candidates)
+      throw std::runtime_error("a file read again for its statistics changed in between");
     if (collect[b]) {
       std::vector<double>& v = values[b];
       std::nth_element(v.begin(), v.begin() + static_cast<long>(t.rank - 1), v.end());

@@ -40,7 +40,8 @@ inline constexpr std::size_t kColumnStatisticsBudgetBytes = std::size_t{1} << 20
 // bit patterns narrow it to a range that fits the budget, and that range is read and selected. Both
 // give the same values (a zero is returned as +0 from the second). Memory is at most twice the
 // budget (vectors grow by doubling) and at least one 32 KiB histogram, whatever the number of
-// values. Throws what the source throws.
+// values. Throws what the source throws, and std::runtime_error when the source gives other values
+// when read again.
 std::vector<ColumnStatistics> SummarizeColumns(
     const ColumnSource& source, std::size_t columns, const std::vector<double>& percents,
     std::size_t budget_bytes = kColumnStatisticsBudgetBytes);

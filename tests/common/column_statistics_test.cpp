@@ -139,5 +139,16 @@ TEST(SummarizeColumns, ValuesOfOtherColumnsAreIgnoredAndErrorsPropagate) {
   EXPECT_THROW(SummarizeColumns(failing, 1, {50}), std::runtime_error);
 }
 
+// A file that changes between its readings (not one of a run) is an error, not a wrong value.
+TEST(SummarizeColumns, ASourceThatChangesWhenReadAgainIsAnError) {
+  int reads = 0;
+  const ColumnSource changing = [&reads](const ColumnSink& emit) {
+    const int n = 1000 + 10 * reads++;
+    for (int i = 0; i < n; ++i) emit(0, i);
+  };
+  EXPECT_THROW(SummarizeColumns(changing, 1, {50}, 64), std::runtime_error);
+  EXPECT_GT(reads, 1);
+}
+
 }  // namespace
 }  // namespace talus
