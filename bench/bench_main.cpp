@@ -3,6 +3,7 @@
 
 #include "bench/bench_main.hpp"
 
+#include <sys/resource.h>
 #include <sys/utsname.h>
 
 #include <cstdio>
@@ -15,6 +16,12 @@ std::string FirstLine(const std::string& path, const std::string& prefix) {
   for (std::string line; std::getline(in, line);)
     if (line.rfind(prefix, 0) == 0) return line;
   return "unknown";
+}
+
+double PeakRssMiB() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return static_cast<double>(usage.ru_maxrss) / 1024.0;  // kB on Linux
 }
 
 void PrintMachine(int argc, char** argv) {

@@ -11,3 +11,6 @@ std::string FirstLine(const std::string& path, const std::string& prefix);
 
 // Prints the machine (CPU model, hardware threads, kernel, load average) and the command line.
 void PrintMachine(int argc, char** argv);
+
+// The process's peak resident memory so far (getrusage ru_maxrss), MiB.
+double PeakRssMiB();

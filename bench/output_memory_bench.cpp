@@ -10,7 +10,6 @@
 //     (SummarizeColumns within --budget-mib).
 
 #include <cpl_error.h>
-#include <sys/resource.h>
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
@@ -28,12 +27,6 @@
 #include "io/report_html.hpp"
 
 namespace {
-
-double PeakRssMiB() {
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
-  return static_cast<double>(usage.ru_maxrss) / 1024.0;  // kB on Linux
-}
 
 void Spill(long records, int nx, int ny, std::size_t budget_bytes) {
   talus::GridGeometry grid;

@@ -7,8 +7,6 @@
 // not for the memory figures) and compares every percentile raster with the brute-force
 // nearest-rank percentile of each cell.
 
-#include <sys/resource.h>
-
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <array>
@@ -25,12 +23,6 @@
 #include "io/scene_file.hpp"
 
 namespace {
-
-double PeakRssMiB() {
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
-  return static_cast<double>(usage.ru_maxrss) / 1024.0;  // kB on Linux
-}
 
 // Counts passages (all quantities share them) and, with `keep`, keeps every passage's values
 // per cell and quantity.
@@ -75,8 +67,7 @@ long CheckPercentiles(const PassageCounter& counter, const talus::Heightfield& d
       const float got = layer.values[static_cast<std::size_t>(cell)];
       ++compared;
       if (got != exact && differ++ < 5)
-        std::printf("  %s cell %d: %.9g, brute force %.9g\n", layer.name.c_str(), cell, got,
-                    exact);
+        std::printf("  %s cell %d: %.9g, brute force %.9g\n", layer.name.c_str(), cell, got, exact);
     }
   }
   std::printf("  check: %ld cell percentiles compared with brute force, %ld differ\n", compared,
@@ -102,8 +93,8 @@ int RunBenchmark(int argc, char** argv) {
   const talus::GridGeometry& grid = scene.scene.terrain.heights().grid;
   std::printf("scene %s: %s, %d x %d cells\n", scene_path.c_str(),
               scene.terrain_description.c_str(), grid.nx, grid.ny);
-  std::printf("%8s %9s %12s %14s %10s %9s %13s\n", "rocks", "wall_s", "passages",
-              "summaries_MiB", "spill_MiB", "finish_s", "peak_rss_MiB");
+  std::printf("%8s %9s %12s %14s %10s %9s %13s\n", "rocks", "wall_s", "passages", "summaries_MiB",
+              "spill_MiB", "finish_s", "peak_rss_MiB");
   for (long rocks : counts) {
     scene.release.rocks_per_release = rocks;
     talus::ensemble::EnsembleOptions options;
