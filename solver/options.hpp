@@ -120,10 +120,10 @@ struct SolverOptions {
   // the contact solve itself set theirs.
   double tolerance_m_s = 1e-3;
   int max_iterations = 200;
-  // Two-contact steps: Gauss-Seidel sweeps (the default), one coupled block solve, or sweeps and
+  // Two-contact steps: Gauss-Seidel sweeps, one coupled block solve, or (the default) sweeps and
   // the block solve for a pair whose sweeps stall (bench/README.md, "A block solve for stalled
-  // pairs").
-  ContactSolveMethod contact_solve = ContactSolveMethod::kGaussSeidel;
+  // pairs", and "Block on stall as the default").
+  ContactSolveMethod contact_solve = ContactSolveMethod::kBlockOnStall;
   double prox_alpha = 1.0;  // step length r = alpha / diag(W' M^-1 W), in (0, 2)
   // Contact prediction (plastic normal law only): a vertex that would sink deeper than this
   // fraction of the rock's thickness by the next midpoint joins the contact set early and is

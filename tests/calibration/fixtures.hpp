@@ -80,12 +80,14 @@ struct PlaneRuns {
   ensemble::ReleaseSpec release;
 
   PlaneRuns(int runs, long rocks, double height_m = 0.5,
-            ViscousReading reading = ViscousReading::kContactFriction) {
+            ViscousReading reading = ViscousReading::kContactFriction,
+            ContactSolveMethod contact_solve = SolverOptions().contact_solve) {
     PlaneSpec plane{35, 30, 40, 80, 1};
     scene.terrain = Terrain(MakePlaneHeightfield(plane), scene.ground.IndexOfName("medium_hard"));
     scene.rock = MakeRockShape(MakeBox(0.4, 0.4, 0.3), 2700);
     scene.options.max_time_s = 4;
     scene.options.viscous = reading;
+    scene.options.contact_solve = contact_solve;
     for (int r = 0; r < runs; ++r) {
       ensemble::ReleaseRun run;
       char id[32];
@@ -115,8 +117,9 @@ struct SyntheticRunouts : PlaneRuns {
   // Under the default reading of the viscous term (contact friction), as every calibration test
   // runs unless it says otherwise.
   SyntheticRunouts(int runs, long rocks, double truth_mu_min, double height_m = 0.5,
-                   ViscousReading reading = ViscousReading::kContactFriction)
-      : PlaneRuns(runs, rocks, height_m, reading) {
+                   ViscousReading reading = ViscousReading::kContactFriction,
+                   ContactSolveMethod contact_solve = SolverOptions().contact_solve)
+      : PlaneRuns(runs, rocks, height_m, reading, contact_solve) {
     medium_hard().kappa_1_m = 0.05;
     Scene truth = scene;
     truth.ground.mutable_params(truth.ground.IndexOfName("medium_hard")).mu_min = truth_mu_min;

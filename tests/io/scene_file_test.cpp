@@ -289,12 +289,12 @@ TEST(LoadScene, ContactSolveMethodIsChosenByNameWithDidYouMean) {
   const auto dir = testing::FreshDir("contact_solve");
   testing::WriteText(dir / "scene.toml", kPlaneScene);
   EXPECT_EQ(LoadScene((dir / "scene.toml").string()).scene.options.contact_solve,
-            ContactSolveMethod::kGaussSeidel);  // the default
-  testing::WriteText(dir / "scene.toml",
-                     Replace(kPlaneScene, "max_time_s = 20",
-                             "max_time_s = 20\ncontact_solve = \"block_on_stall\""));
+            ContactSolveMethod::kBlockOnStall);  // the default
+  testing::WriteText(
+      dir / "scene.toml",
+      Replace(kPlaneScene, "max_time_s = 20", "max_time_s = 20\ncontact_solve = \"gauss_seidel\""));
   EXPECT_EQ(LoadScene((dir / "scene.toml").string()).scene.options.contact_solve,
-            ContactSolveMethod::kBlockOnStall);
+            ContactSolveMethod::kGaussSeidel);
   testing::WriteText(dir / "scene.toml", Replace(kPlaneScene, "max_time_s = 20",
                                                  "max_time_s = 20\ncontact_solve = \"block\""));
   EXPECT_EQ(LoadScene((dir / "scene.toml").string()).scene.options.contact_solve,
@@ -329,11 +329,11 @@ TEST(LoadScene, ContactHoldIsChosenByNameWithDidYouMean) {
                                                  "max_time_s = 20\ncontact_hold = \"held\""));
   EXPECT_EQ(LoadScene((dir / "scene.toml").string()).scene.options.contact_hold,
             ContactHold::kHeld);
-  EXPECT_HAS(ErrorOf(Replace(kPlaneScene, "max_time_s = 20",
-                             "max_time_s = 20\ncontact_hold = \"hold\""),
-                     dir),
-             "scene.toml:23: solver.contact_hold: unknown contact hold 'hold' (did you mean "
-             "'held'?)");
+  EXPECT_HAS(
+      ErrorOf(Replace(kPlaneScene, "max_time_s = 20", "max_time_s = 20\ncontact_hold = \"hold\""),
+              dir),
+      "scene.toml:23: solver.contact_hold: unknown contact hold 'hold' (did you mean "
+      "'held'?)");
 }
 
 // [solver] preset sets the accuracy knobs (solver/options.hpp) and keys the scene gives win over
@@ -364,7 +364,8 @@ TEST(LoadScene, SolverPresetSetsTheKnobsTheSceneDoesNotGive) {
   EXPECT_EQ(scene.scene.options.dt_s, defaults.dt_s);
   EXPECT_EQ(scene.scene.options.max_iterations, defaults.max_iterations);
   EXPECT_EQ(scene.scene.options.tolerance_m_s, 1e-2);  // the scene's own 1e-6 overridden
-  EXPECT_EQ(scene.solver_keys_overridden, std::vector<std::string>{"tolerance_m_s = 1e-06 -> 0.01"});
+  EXPECT_EQ(scene.solver_keys_overridden,
+            std::vector<std::string>{"tolerance_m_s = 1e-06 -> 0.01"});
   // The shipped scenes' case: dt_s = 0.002 given, --preset accurate halves it.
   scene = load("dt_s = 0.002");
   UseSolverPreset(scene, SolverPreset::kAccurate);
@@ -1207,7 +1208,8 @@ TEST(LoadScene, ShapePerRockNeedsRockShapes) {
                                                  "shape = \"rock\"\nshape_per_rock = true"));
   const SceneFile s = LoadScene((dir / "scene.toml").string());
   ASSERT_TRUE(static_cast<bool>(s.release.shape_per_rock));
-  const RockShape a = s.release.shape_per_rock(&s.release.blocks[0], 1), b = s.release.shape_per_rock(&s.release.blocks[0], 2);
+  const RockShape a = s.release.shape_per_rock(&s.release.blocks[0], 1),
+                  b = s.release.shape_per_rock(&s.release.blocks[0], 2);
   EXPECT_NEAR(a.mass_kg, 69, 1e-9);  // size and mass kept, whatever the seed
   EXPECT_NEAR(b.mass_kg, 69, 1e-9);
   EXPECT_NE(a.vertices_m.size() == b.vertices_m.size() && a.vertices_m[0] == b.vertices_m[0], true);
@@ -1218,11 +1220,12 @@ TEST(LoadScene, ShapePerRockNeedsRockShapes) {
 // calibration may change recorded with a maker that rebuilds the block from them.
 TEST(LoadScene, EachBlockHasAShapeOfItsOwn) {
   const auto dir = testing::FreshDir("block_shapes");
-  testing::WriteText(dir / "blocks.csv",
-                     "block_id,mass_kg,size_x_m,size_y_m,size_z_m,roughness,points,shape_seed,file\n"
-                     "1,69,0.37,0.32,0.37,0.3,40,7,\n"
-                     "4,40,0.46,0.30,0.20,,,,\n"
-                     "scan,,,,,,,,cube.xyz\n");
+  testing::WriteText(
+      dir / "blocks.csv",
+      "block_id,mass_kg,size_x_m,size_y_m,size_z_m,roughness,points,shape_seed,file\n"
+      "1,69,0.37,0.32,0.37,0.3,40,7,\n"
+      "4,40,0.46,0.30,0.20,,,,\n"
+      "scan,,,,,,,,cube.xyz\n");
   // The corners of a 0.4 m cube and its centre: the hull is the cube.
   std::string cube;
   for (int i = 0; i < 8; ++i)
@@ -1276,14 +1279,15 @@ TEST(LoadScene, BlockShapeKnobsAreChecked) {
                              "mass_kg = 250", "mass_kg = 250\nroughness = 0.7"),
                      dir),
              "block 'slab': roughness: 0.7 must be in 0 .. 0.5");
-  EXPECT_HAS(ErrorOf(Replace(kRunScene, "size_m = [1.0, 0.5, 0.2]", "file = \"cube.xyz\"\nsize_m = [1, 1, 1]"),
+  EXPECT_HAS(ErrorOf(Replace(kRunScene, "size_m = [1.0, 0.5, 0.2]",
+                             "file = \"cube.xyz\"\nsize_m = [1, 1, 1]"),
                      dir),
              "blocks.slab.size_m: a point cloud block takes its shape and size from its file");
   EXPECT_HAS(ErrorOf(Replace(kRunScene, "size_m = [1.0, 0.5, 0.2]", "file = \"missing.xyz\""), dir),
              "file not found");
-  EXPECT_HAS(ErrorOf(Replace(kRunScene, "shape = \"box\"", "shape = \"rock\"\nsize_variation = 0.1"),
-                     dir),
-             "blocks.size_variation: varies the shape per rock: needs shape_per_rock = true");
+  EXPECT_HAS(
+      ErrorOf(Replace(kRunScene, "shape = \"box\"", "shape = \"rock\"\nsize_variation = 0.1"), dir),
+      "blocks.size_variation: varies the shape per rock: needs shape_per_rock = true");
   testing::WriteText(dir / "blocks.csv",
                      "block_id,size_x_m,size_y_m,size_z_m,file\n1,0.3,0.3,0.3,cube.xyz\n");
   EXPECT_HAS(ErrorOf(kRunScene, dir),
