@@ -179,6 +179,7 @@ void Pipeline::Uncertainty() {
     const StepChoice choice = ChooseFiniteDifferenceStep(objective_, best.u);
     Say(choice.Report());
     uncertainty.fd_step = choice.step;
+    uncertainty.gradient_resolved = !choice.noise_dominated;
   }
   uncertainty.noise = run_.roughness ? run_.roughness->level() : 0;
   uncertainty.profiles = run_.profiles;

@@ -43,6 +43,8 @@ Uncertainty Unestimated(const Objective& objective, const Eigen::VectorXd& u) {
   out.weak.assign(static_cast<std::size_t>(n), false);
   out.standard_error = Eigen::VectorXd::Constant(n, kNaN);
   out.standard_error_unit = Eigen::VectorXd::Constant(n, kNaN);
+  out.offset_unit = Eigen::VectorXd::Zero(n);
+  out.stationary_values = Eigen::VectorXd::Constant(n, kNaN);
   out.covariance_unit = Eigen::MatrixXd::Zero(n, n);
   out.covariance = Eigen::MatrixXd::Zero(n, n);
   out.correlation = Eigen::MatrixXd::Constant(n, n, kNaN);
@@ -118,6 +120,34 @@ std::string Sandwich(const Objective& objective, const RowMajor& inverse, Uncert
   out.covariance_unit = bread * (meat + prior_meat) * bread;
   out.computed = true;
   return "";
+}
+
+// The Gauss-Newton step at the covariance's step, d = -(J^T J)^-1 f'_h / 2, from the objective's
+// central differences at the Jacobian's points (answered from the cache), kept inside the box,
+// into out.offset_unit and out.stationary_values; d d^T is added to out.covariance_unit.
+// Coordinates held constant have zero rows in `inverse` and get no step.
+void Stationarity(const Objective& objective, const EvaluateFn& evaluate, const RowMajor& inverse,
+                  double h, Uncertainty& out) {
+  const int n = objective.dimension();
+  const std::optional<Evaluation> at = evaluate(out.u);
+  if (!at || !at->feasible) return;
+  Eigen::VectorXd slope = Eigen::VectorXd::Zero(n);
+  for (int j = 0; j < n; ++j) {
+    if (!out.identified[static_cast<std::size_t>(j)]) continue;
+    // As ResidualCost: u itself where a side is infeasible.
+    auto [lo, hi] = CentralPair(out.u, j, h);
+    std::optional<Evaluation> a = evaluate(lo), b = evaluate(hi);
+    if (a && !a->feasible) a = at, lo = out.u;
+    if (b && !b->feasible) b = at, hi = out.u;
+    if (!a || !b || hi[j] == lo[j]) return;
+    slope[j] = (b->value - a->value) / (hi[j] - lo[j]);
+  }
+  const Eigen::VectorXd target =
+      (out.u - 0.5 * Eigen::MatrixXd(inverse) * slope).cwiseMax(0.0).cwiseMin(1.0);
+  out.stationary_located = true;
+  out.offset_unit = target - out.u;
+  out.stationary_values = objective.parameters().Values(target);
+  out.covariance_unit += out.offset_unit * out.offset_unit.transpose();
 }
 
 // The covariance in physical units (through the transforms' Jacobian), the standard errors, which
@@ -280,6 +310,10 @@ Uncertainty EstimateUncertainty(const Objective& objective, const Eigen::VectorX
                   (none > 0 ? " even without the unconstrained parameters." : "."));
   if (const std::string no = Sandwich(objective, inverse, out); !no.empty())
     return finish(note + no);
+  if (options.gradient_resolved) {
+    Stationarity(objective, evaluate, inverse, options.fd_step, out);
+    evaluator.Rethrow();
+  }
   InPhysicalUnits(objective, options, out);
   return finish(ConstraintNote(note, u, options, out));
 }
@@ -313,6 +347,22 @@ std::string Uncertainty::Report() const {
             Num(correlation(static_cast<Eigen::Index>(j), static_cast<Eigen::Index>(k)), "%6.2f") +
             " ";
       out += "\n";
+    }
+  }
+  if (computed && !stationary_located)
+    out +=
+        "  the smoothed objective's stationary point is not located: the differences at this "
+        "step are noise-dominated\n";
+  if (stationary_located) {
+    out +=
+        "  the smoothed objective's stationary point, one Gauss-Newton step at the step above "
+        "(its distance is in the standard errors):\n";
+    for (std::size_t j = 0; j < names.size(); ++j) {
+      const auto k = static_cast<Eigen::Index>(j);
+      if (!identified[j]) continue;
+      std::snprintf(line, sizeof line, "    %-26s %14s  (%+.3f of range)\n", names[j].c_str(),
+                    Num(stationary_values[k], "%.6g").c_str(), offset_unit[k]);
+      out += line;
     }
   }
   return out + "  " + note + "\n";

@@ -18,6 +18,23 @@
 // constant (a ceres::SubsetManifold) for the covariance of the others, and reported unidentified.
 // Profiles measured beforehand (UncertaintyOptions::profiles) are used the same way from the
 // start: a flat profile overrules a finite-difference Jacobian of noise.
+//
+// Stationarity. The sandwich linearises about a stationary point, but on a rough objective the
+// optimiser stops in a dip of the rocks' noise, where the objective smoothed over the
+// covariance's step still has a slope: Levenberg-Marquardt's and BOBYQA's trial steps out of the
+// dip are rejected on the rough values. The Gauss-Newton step at that step,
+// d = -(J^T J)^-1 J^T rbar = -H^-1 f'_h (f'_h the objective's central difference over +-h,
+// rbar the mean of the residuals there, so J^T rbar = f'_h / 2; the same evaluations as J),
+// points from the fit to the stationary point of the smoothed model. Its distance is an error the
+// sandwich cannot see, and is added to the covariance as d d^T. Only where the differences
+// resolve the gradient (UncertaintyOptions::gradient_resolved): where they are noise-dominated, d
+// is the noise's too (measured on two correlated parameters: steps of 0.13 and 0.20 of the ranges
+// from a fit 0.005 from the truth; docs/calibration.md, "Stationarity"), and the stationary point
+// is not located. (The sandwich's
+// uncentred meat already holds d d^T / G of it: at most a factor 1 + 1/G too wide in that term.)
+// Measured on 24 runs of 5 rocks, whose fit moves by sd 0.043 with the model's seed: the offsets
+// were -0.057 and -0.078 where the fit lay 0.11 from the truth (docs/calibration.md,
+// "Stationarity").
 
 #include <Eigen/Core>
 #include <string>
@@ -42,6 +59,10 @@ struct UncertaintyOptions {
   // profiles' options.
   double noise = 0;
   ProfileOptions profile;
+  // Whether the difference quotients at fd_step resolve the gradient (StepChoice::noise_dominated
+  // false, least_squares.hpp). Where they do not, the Gauss-Newton step below is the noise's, and
+  // the stationary point is not located (no d d^T).
+  bool gradient_resolved = true;
   // Profiles already measured at this point (ProfileParameters, one per coordinate), or empty.
   // A coordinate whose profile is flat is unidentified whatever J says -- on a rough objective
   // the differences of a parameter that only reshuffles which way rocks turn are noise, which a
@@ -56,7 +77,7 @@ struct Uncertainty {
   std::vector<std::string> names;
   Eigen::VectorXd u;         // where (unit coordinates)
   Eigen::VectorXd values;    // the parameters there
-  double fd_step = 0;         // the central-difference step it used, unit coordinates
+  double fd_step = 0;        // the central-difference step it used, unit coordinates
   Eigen::MatrixXd jacobian;  // residuals x coordinates, unit coordinates
   Eigen::VectorXd residuals;
   int groups = 0;                   // independent groups (runs) in the sandwich
@@ -64,7 +85,14 @@ struct Uncertainty {
   Eigen::MatrixXd covariance;       // n x n, physical units (through the transforms' Jacobian)
   Eigen::VectorXd standard_error;   // physical units; NaN where unidentified
   Eigen::VectorXd standard_error_unit;
-  Eigen::MatrixXd correlation;             // NaN where unidentified
+  Eigen::MatrixXd correlation;  // NaN where unidentified
+  // d, the Gauss-Newton step at fd_step from u to the smoothed model's stationary point (unit
+  // coordinates, kept inside the box; 0 where unidentified), and the parameters at u + d. Its
+  // d d^T is part of covariance_unit. Only where `stationary_located` (a covariance computed with
+  // a resolved gradient); else d = 0 and the values NaN.
+  bool stationary_located = false;
+  Eigen::VectorXd offset_unit;
+  Eigen::VectorXd stationary_values;
   std::vector<bool> identified;            // per coordinate
   std::vector<bool> weak;                  // identified but standard_error_unit > weak_fraction
   std::vector<ParameterProfile> profiles;  // when rank-deficient

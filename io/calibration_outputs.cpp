@@ -10,8 +10,8 @@
 
 #include "common/format.hpp"
 #include "io/rocks_csv.hpp"
-#include "pointclouds/rock_source.hpp"
 #include "io/validation_outputs.hpp"
+#include "pointclouds/rock_source.hpp"
 
 namespace talus::io {
 namespace {
@@ -309,6 +309,9 @@ json UncertaintyJson(const calibration::CalibrationSummary& run) {
           {"weak", weak},
           {"runs", u.groups},
           {"finite_difference_step", Number(u.fd_step)},
+          {"stationary_located", u.stationary_located},
+          {"offset_unit", Vector(u.offset_unit)},
+          {"stationary_values", Vector(u.stationary_values)},
           {"note", u.note},
           {"evaluations", u.evaluations},
           {"wall_time_s", u.wall_time_s},

@@ -32,9 +32,9 @@ TEST(EstimateUncertainty, MeanOfObservationsHasTheStandardErrorOfTheMean) {
   for (double v : y) ss += (v - mean) * (v - mean);
   const double se = std::sqrt(ss / 9 / 10);
   LinearProblem problem(10);
-  const Objective objective = problem.Make(
-      {Free(GroundField::kMuMin, 0.2, 0.8)},
-      [&](const GroundValues& v, int g) { return v.mu_min - y[g]; });
+  const Objective objective =
+      problem.Make({Free(GroundField::kMuMin, 0.2, 0.8)},
+                   [&](const GroundValues& v, int g) { return v.mu_min - y[g]; });
   const Eigen::VectorXd u = Eigen::VectorXd::Constant(1, (mean - 0.2) / 0.6);
   const Uncertainty out = EstimateUncertainty(objective, u, UncertaintyOptions{});
   ASSERT_TRUE(out.computed) << out.note;
@@ -55,6 +55,54 @@ TEST(EstimateUncertainty, MeanOfObservationsHasTheStandardErrorOfTheMean) {
   EXPECT_NE(out.Report().find("medium_hard.mu_min"), std::string::npos);
 }
 
+// Away from the optimum (a fit stopped in a dip of a rough objective) the objective's slope is
+// not zero. For the mean of G observations at mu = mean + d the residuals are linear, so the
+// Gauss-Newton step at any step is exact: it goes back to the mean (offset -d / 0.6 in unit
+// coordinates), and the covariance is the sandwich with the residuals at mu,
+// sum_g (mu - y_g)^2 / (G (G - 1)), plus the offset's square d^2.
+TEST(EstimateUncertainty, AFitOffItsStationaryPointHasTheOffsetInItsStandardError) {
+  const double y[10] = {0.41, 0.55, 0.47, 0.62, 0.38, 0.51, 0.58, 0.44, 0.49, 0.60};
+  double mean = 0;
+  for (double v : y) mean += v / 10;
+  const double d = 0.04;
+  double ss = 0;
+  for (double v : y) ss += (mean + d - v) * (mean + d - v);
+  const double variance = ss / 9 / 10 + d * d;
+  LinearProblem problem(10);
+  const Objective objective =
+      problem.Make({Free(GroundField::kMuMin, 0.2, 0.8)},
+                   [&](const GroundValues& v, int g) { return v.mu_min - y[g]; });
+  const Eigen::VectorXd u = Eigen::VectorXd::Constant(1, (mean + d - 0.2) / 0.6);
+  const Uncertainty out = EstimateUncertainty(objective, u, UncertaintyOptions{});
+  ASSERT_TRUE(out.computed) << out.note;
+  EXPECT_TRUE(out.stationary_located);
+  EXPECT_NEAR(out.offset_unit[0], -d / 0.6, 1e-9);
+  EXPECT_NEAR(out.stationary_values[0], mean, 1e-9);
+  EXPECT_NEAR(out.values[0], mean + d, 1e-15);
+  EXPECT_NEAR(out.covariance(0, 0), variance, 1e-9 * variance);
+  EXPECT_NEAR(out.standard_error[0], std::sqrt(variance), 1e-9);
+  EXPECT_EQ(out.evaluations, 3);  // the slope reuses the Jacobian's points
+  EXPECT_NE(out.Report().find("stationary point"), std::string::npos) << out.Report();
+
+  // At the optimum itself there is no offset.
+  const Uncertainty at = EstimateUncertainty(
+      objective, Eigen::VectorXd::Constant(1, (mean - 0.2) / 0.6), UncertaintyOptions{});
+  EXPECT_TRUE(at.stationary_located);
+  EXPECT_NEAR(at.offset_unit[0], 0, 1e-12);
+
+  // Where the differences do not resolve the gradient (noise-dominated), the step is not taken:
+  // the plain sandwich, and the report says why.
+  UncertaintyOptions unresolved;
+  unresolved.gradient_resolved = false;
+  const Uncertainty noisy = EstimateUncertainty(objective, u, unresolved);
+  ASSERT_TRUE(noisy.computed) << noisy.note;
+  EXPECT_FALSE(noisy.stationary_located);
+  EXPECT_EQ(noisy.offset_unit[0], 0);
+  EXPECT_TRUE(std::isnan(noisy.stationary_values[0]));
+  EXPECT_NEAR(noisy.covariance(0, 0), ss / 9 / 10, 1e-9 * variance);
+  EXPECT_NE(noisy.Report().find("not located"), std::string::npos) << noisy.Report();
+}
+
 // A straight-line fit r_g = mu_min + mu_max t_g - y_g with unequal scatter: the sandwich is HC1,
 // computed here from the design matrix X = [1, t] and the residuals e at the least-squares fit;
 // covariance, standard errors and the correlation agree to 1e-9 relative.
@@ -63,9 +111,9 @@ TEST(EstimateUncertainty, StraightLineFitGivesTheHeteroscedasticityConsistentCov
   const double t[g_count] = {-1, -0.75, -0.5, -0.25, 0, 0.25, 0.5, 0.75, 1};
   const double y[g_count] = {-1.45, -1.1, -0.4, 0.05, 0.55, 0.95, 1.6, 1.85, 2.7};
   LinearProblem problem(g_count);
-  const Objective objective = problem.Make(
-      {Free(GroundField::kMuMin, 0.2, 0.8), Free(GroundField::kMuMax, 1.0, 3.0)},
-      [&](const GroundValues& v, int g) { return v.mu_min + v.mu_max * t[g] - y[g]; });
+  const Objective objective =
+      problem.Make({Free(GroundField::kMuMin, 0.2, 0.8), Free(GroundField::kMuMax, 1.0, 3.0)},
+                   [&](const GroundValues& v, int g) { return v.mu_min + v.mu_max * t[g] - y[g]; });
   Eigen::MatrixXd x(g_count, 2);
   Eigen::VectorXd yy(g_count);
   for (int g = 0; g < g_count; ++g) {
@@ -102,9 +150,9 @@ TEST(EstimateUncertainty, AParameterWithoutEffectIsUnidentifiedAndNamed) {
   double ss = 0;
   for (double v : y) ss += (v - mean) * (v - mean);
   LinearProblem problem(6);
-  const Objective objective = problem.Make(
-      {Free(GroundField::kMuMin, 0.2, 0.8), Free(GroundField::kBeta, 50, 500)},
-      [&](const GroundValues& v, int g) { return v.mu_min - y[g]; });
+  const Objective objective =
+      problem.Make({Free(GroundField::kMuMin, 0.2, 0.8), Free(GroundField::kBeta, 50, 500)},
+                   [&](const GroundValues& v, int g) { return v.mu_min - y[g]; });
   const Eigen::Vector2d u((mean - 0.2) / 0.6, 0.5);
   const Uncertainty out = EstimateUncertainty(objective, u, UncertaintyOptions{});
   EXPECT_TRUE(out.rank_deficient);
@@ -150,9 +198,9 @@ TEST(EstimateUncertainty, NotesStateTooFewRunsWeakParametersAndBounds) {
     // Observations spread over 1.2 around 0.5: s / sqrt(G) = 0.35 of the range 0.6 > 0.25.
     const double y[4] = {-0.1, 0.3, 0.7, 1.1};
     LinearProblem problem(4);
-    const Objective objective = problem.Make(
-        {Free(GroundField::kMuMin, 0.2, 0.8)},
-        [&](const GroundValues& v, int g) { return v.mu_min - y[g]; });
+    const Objective objective =
+        problem.Make({Free(GroundField::kMuMin, 0.2, 0.8)},
+                     [&](const GroundValues& v, int g) { return v.mu_min - y[g]; });
     const Uncertainty out =
         EstimateUncertainty(objective, Eigen::VectorXd::Constant(1, 0.5), UncertaintyOptions{});
     ASSERT_TRUE(out.computed);
@@ -176,13 +224,14 @@ TEST(EstimateUncertainty, NotesStateTooFewRunsWeakParametersAndBounds) {
 // known, no point is run again and the result is the same.
 TEST(EstimateUncertainty, KnownEvaluationsAreNotRunAgain) {
   LinearProblem problem(5);
-  const Objective objective = problem.Make(
-      {Free(GroundField::kMuMin, 0.2, 0.8)},
-      [](const GroundValues& v, int g) { return v.mu_min - 0.4 - 0.05 * g; });
+  const Objective objective =
+      problem.Make({Free(GroundField::kMuMin, 0.2, 0.8)},
+                   [](const GroundValues& v, int g) { return v.mu_min - 0.4 - 0.05 * g; });
   const Eigen::VectorXd u = Eigen::VectorXd::Constant(1, 0.5);
   const Uncertainty fresh = EstimateUncertainty(objective, u, UncertaintyOptions{});
   std::vector<Evaluation> known;
-  for (double v : {0.5, 0.49, 0.51}) known.push_back(objective.Evaluate(Eigen::VectorXd::Constant(1, v)));
+  for (double v : {0.5, 0.49, 0.51})
+    known.push_back(objective.Evaluate(Eigen::VectorXd::Constant(1, v)));
   const int before = *problem.runs;
   const Uncertainty reused = EstimateUncertainty(objective, u, UncertaintyOptions{}, known);
   EXPECT_EQ(*problem.runs, before);
@@ -193,8 +242,8 @@ TEST(EstimateUncertainty, KnownEvaluationsAreNotRunAgain) {
 // Invalid options throw std::invalid_argument naming the option and its bound.
 TEST(EstimateUncertainty, InvalidOptionsAreNamed) {
   LinearProblem problem(3);
-  const Objective objective = problem.Make(
-      {Free(GroundField::kMuMin, 0.2, 0.8)}, [](const GroundValues& v, int) { return v.mu_min; });
+  const Objective objective = problem.Make({Free(GroundField::kMuMin, 0.2, 0.8)},
+                                           [](const GroundValues& v, int) { return v.mu_min; });
   const auto message = [&](UncertaintyOptions o) {
     try {
       EstimateUncertainty(objective, Eigen::VectorXd::Constant(1, 0.5), o);
