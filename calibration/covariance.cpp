@@ -123,7 +123,8 @@ std::string Sandwich(const Objective& objective, const RowMajor& inverse, Uncert
 }
 
 // The Gauss-Newton step at the covariance's step, d = -(J^T J)^-1 f'_h / 2, from the objective's
-// central differences at the Jacobian's points (answered from the cache), kept inside the box,
+// central differences at the Jacobian's points (answered from the cache), shortened to the
+// stencil (no coordinate beyond h) and kept inside the box,
 // into out.offset_unit and out.stationary_values; d d^T is added to out.covariance_unit.
 // Coordinates held constant have zero rows in `inverse` and get no step.
 void Stationarity(const Objective& objective, const EvaluateFn& evaluate, const RowMajor& inverse,
@@ -142,8 +143,14 @@ void Stationarity(const Objective& objective, const EvaluateFn& evaluate, const 
     if (!a || !b || hi[j] == lo[j]) return;
     slope[j] = (b->value - a->value) / (hi[j] - lo[j]);
   }
-  const Eigen::VectorXd target =
-      (out.u - 0.5 * Eigen::MatrixXd(inverse) * slope).cwiseMax(0.0).cwiseMin(1.0);
+  // The slope was measured over u -+ h: a longer step extrapolates the smoothed model beyond
+  // where it was measured (along a valley of correlated parameters, to a corner of the box), so
+  // the step is shortened to the stencil, its direction kept.
+  Eigen::VectorXd step = -0.5 * Eigen::MatrixXd(inverse) * slope;
+  const double longest = step.cwiseAbs().maxCoeff();
+  out.offset_limited = longest > h;
+  if (out.offset_limited) step *= h / longest;
+  const Eigen::VectorXd target = (out.u + step).cwiseMax(0.0).cwiseMin(1.0);
   out.stationary_located = true;
   out.offset_unit = target - out.u;
   out.stationary_values = objective.parameters().Values(target);
@@ -322,8 +329,7 @@ std::string Uncertainty::Report() const {
   char step[32];
   std::snprintf(step, sizeof step, "%.3g", fd_step);
   std::string out = "Uncertainty (sandwich covariance from Ceres, " + std::to_string(groups) +
-                    " runs, step " + step + ", " + std::to_string(evaluations) +
-                    " evaluations):\n";
+                    " runs, step " + step + ", " + std::to_string(evaluations) + " evaluations):\n";
   char line[256];
   std::snprintf(line, sizeof line, "  %-28s %14s %14s %10s  %s\n", "parameter", "value",
                 "std. error", "(of range)", "");
@@ -354,9 +360,11 @@ std::string Uncertainty::Report() const {
         "  the smoothed objective's stationary point is not located: the differences at this "
         "step are noise-dominated\n";
   if (stationary_located) {
-    out +=
-        "  the smoothed objective's stationary point, one Gauss-Newton step at the step above "
-        "(its distance is in the standard errors):\n";
+    out += std::string(
+               "  the smoothed objective's stationary point, one Gauss-Newton step at the "
+               "step above") +
+           (offset_limited ? ", shortened to it" : "") +
+           " (its distance is in the standard errors):\n";
     for (std::size_t j = 0; j < names.size(); ++j) {
       const auto k = static_cast<Eigen::Index>(j);
       if (!identified[j]) continue;

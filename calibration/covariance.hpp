@@ -25,7 +25,11 @@
 // dip are rejected on the rough values. The Gauss-Newton step at that step,
 // d = -(J^T J)^-1 J^T rbar = -H^-1 f'_h (f'_h the objective's central difference over +-h,
 // rbar the mean of the residuals there, so J^T rbar = f'_h / 2; the same evaluations as J),
-// points from the fit to the stationary point of the smoothed model. Its distance is an error the
+// points from the fit to the stationary point of the smoothed model. The slope was measured over
+// u -+ h only: a longer step is shortened to that stencil (its largest coordinate h, its
+// direction kept) rather than extrapolated, which along a valley of correlated parameters runs
+// to a corner of the box (measured on Tschamut's four parameters, correlations 0.73-0.97: steps
+// of up to 0.55 of a range at h = 0.163). Its distance is an error the
 // sandwich cannot see, and is added to the covariance as d d^T. Only where the differences
 // resolve the gradient (UncertaintyOptions::gradient_resolved): where they are noise-dominated, d
 // is the noise's too (measured on two correlated parameters: steps of 0.13 and 0.20 of the ranges
@@ -91,6 +95,7 @@ struct Uncertainty {
   // d d^T is part of covariance_unit. Only where `stationary_located` (a covariance computed with
   // a resolved gradient); else d = 0 and the values NaN.
   bool stationary_located = false;
+  bool offset_limited = false;  // d was shortened to the stencil (its largest coordinate fd_step)
   Eigen::VectorXd offset_unit;
   Eigen::VectorXd stationary_values;
   std::vector<bool> identified;            // per coordinate

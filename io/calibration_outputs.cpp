@@ -310,6 +310,7 @@ json UncertaintyJson(const calibration::CalibrationSummary& run) {
           {"runs", u.groups},
           {"finite_difference_step", Number(u.fd_step)},
           {"stationary_located", u.stationary_located},
+          {"offset_limited", u.offset_limited},
           {"offset_unit", Vector(u.offset_unit)},
           {"stationary_values", Vector(u.stationary_values)},
           {"note", u.note},

@@ -58,8 +58,8 @@ TEST(EstimateUncertainty, MeanOfObservationsHasTheStandardErrorOfTheMean) {
 // Away from the optimum (a fit stopped in a dip of a rough objective) the objective's slope is
 // not zero. For the mean of G observations at mu = mean + d the residuals are linear, so the
 // Gauss-Newton step at any step is exact: it goes back to the mean (offset -d / 0.6 in unit
-// coordinates), and the covariance is the sandwich with the residuals at mu,
-// sum_g (mu - y_g)^2 / (G (G - 1)), plus the offset's square d^2.
+// coordinates) when the stencil holds it, and the covariance is the sandwich with the residuals
+// at mu, sum_g (mu - y_g)^2 / (G (G - 1)), plus the offset's square d^2.
 TEST(EstimateUncertainty, AFitOffItsStationaryPointHasTheOffsetInItsStandardError) {
   const double y[10] = {0.41, 0.55, 0.47, 0.62, 0.38, 0.51, 0.58, 0.44, 0.49, 0.60};
   double mean = 0;
@@ -73,9 +73,12 @@ TEST(EstimateUncertainty, AFitOffItsStationaryPointHasTheOffsetInItsStandardErro
       problem.Make({Free(GroundField::kMuMin, 0.2, 0.8)},
                    [&](const GroundValues& v, int g) { return v.mu_min - y[g]; });
   const Eigen::VectorXd u = Eigen::VectorXd::Constant(1, (mean + d - 0.2) / 0.6);
-  const Uncertainty out = EstimateUncertainty(objective, u, UncertaintyOptions{});
+  UncertaintyOptions wide;  // a stencil of +-0.1 holds the step, d / 0.6 = 0.067
+  wide.fd_step = 0.1;
+  const Uncertainty out = EstimateUncertainty(objective, u, wide);
   ASSERT_TRUE(out.computed) << out.note;
   EXPECT_TRUE(out.stationary_located);
+  EXPECT_FALSE(out.offset_limited);
   EXPECT_NEAR(out.offset_unit[0], -d / 0.6, 1e-9);
   EXPECT_NEAR(out.stationary_values[0], mean, 1e-9);
   EXPECT_NEAR(out.values[0], mean + d, 1e-15);
@@ -83,6 +86,15 @@ TEST(EstimateUncertainty, AFitOffItsStationaryPointHasTheOffsetInItsStandardErro
   EXPECT_NEAR(out.standard_error[0], std::sqrt(variance), 1e-9);
   EXPECT_EQ(out.evaluations, 3);  // the slope reuses the Jacobian's points
   EXPECT_NE(out.Report().find("stationary point"), std::string::npos) << out.Report();
+
+  // With the default stencil, +-0.01, the step is shortened to it: an offset of 0.01 of the range.
+  const Uncertainty narrow = EstimateUncertainty(objective, u, UncertaintyOptions{});
+  ASSERT_TRUE(narrow.computed) << narrow.note;
+  EXPECT_TRUE(narrow.offset_limited);
+  EXPECT_NEAR(narrow.offset_unit[0], -0.01, 1e-12);
+  const double narrow_variance = ss / 9 / 10 + 0.006 * 0.006;
+  EXPECT_NEAR(narrow.covariance(0, 0), narrow_variance, 1e-9 * narrow_variance);
+  EXPECT_NE(narrow.Report().find("shortened"), std::string::npos) << narrow.Report();
 
   // At the optimum itself there is no offset.
   const Uncertainty at = EstimateUncertainty(
