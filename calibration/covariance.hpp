@@ -25,20 +25,20 @@
 // dip are rejected on the rough values. The Gauss-Newton step at that step,
 // d = -(J^T J)^-1 J^T rbar = -H^-1 f'_h (f'_h the objective's central difference over +-h,
 // rbar the mean of the residuals there, so J^T rbar = f'_h / 2; the same evaluations as J),
-// points from the fit to the stationary point of the smoothed model. The slope was measured over
-// u -+ h only: a longer step is shortened to that stencil (its largest coordinate h, its
-// direction kept) rather than extrapolated, which along a valley of correlated parameters runs
-// to a corner of the box (measured on Tschamut's four parameters, correlations 0.73-0.97: steps
-// of up to 0.55 of a range at h = 0.163). Its distance is an error the
-// sandwich cannot see, and is added to the covariance as d d^T. Only where the differences
-// resolve the gradient (UncertaintyOptions::gradient_resolved): where they are noise-dominated, d
-// is the noise's too (measured on two correlated parameters: steps of 0.13 and 0.20 of the ranges
-// from a fit 0.005 from the truth; docs/calibration.md, "Stationarity"), and the stationary point
-// is not located. (The sandwich's
-// uncentred meat already holds d d^T / G of it: at most a factor 1 + 1/G too wide in that term.)
-// Measured on 24 runs of 5 rocks, whose fit moves by sd 0.043 with the model's seed: the offsets
-// were -0.057 and -0.078 where the fit lay 0.11 from the truth (docs/calibration.md,
-// "Stationarity").
+// points from the fit to the stationary point of the smoothed model. Its distance is an error
+// the sandwich cannot see, and is added to the covariance as d d^T (the sandwich's uncentred
+// meat already holds d d^T / G of it: at most a factor 1 + 1/G too wide in that term). Measured
+// on 24 runs of 5 rocks, whose fit moves by sd 0.043 with the model's seed: the offsets were
+// -0.057 and -0.078 where the fit lay 0.11 from the truth. Two limits (docs/calibration.md,
+// "Stationarity"):
+//  - the slope was measured over u -+ h only: a longer step is shortened to that stencil (its
+//    largest coordinate h, its direction kept) rather than extrapolated, which along a valley of
+//    correlated parameters runs to a corner of the box (Tschamut's four parameters,
+//    correlations 0.73-0.97: up to 0.55 of a range at h = 0.163);
+//  - only where the differences resolve the gradient (UncertaintyOptions::gradient_resolved):
+//    where they are noise-dominated d is the noise's too (two correlated parameters: steps of
+//    0.13 and 0.20 of the ranges from a fit 0.005 from the truth), and the stationary point is
+//    not located.
 
 #include <Eigen/Core>
 #include <string>
