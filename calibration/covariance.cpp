@@ -19,6 +19,8 @@
 namespace talus::calibration {
 namespace {
 
+constexpr double kAtBound = 1e-3;  // a coordinate this close to 0 or 1 lies at its bound
+
 // Ceres logs a rank-deficient covariance as an error on stderr; here it is an expected outcome,
 // reported in Uncertainty. Quiets glog below FATAL while alive (one thread computes it).
 class QuietCeresLog {
@@ -192,14 +194,24 @@ std::string ConstraintNote(std::string note, const Eigen::VectorXd& u,
     note += "weakly constrained (standard error above " + std::string(b) +
             " of the range): " + weak + ". ";
   }
+  // At a bound: within 1e-3 of the range, as CalibrationWarnings and the ground table say it.
+  // Near one: within the covariance's step, where its differences are cut short on that side;
+  // with steps of up to 0.25 that is no statement that the optimum lies beyond the bound.
+  const auto bound_distance = [&](int j) { return std::min(u[j], 1 - u[j]); };
   const std::string at_bound = Names(out, [&](int j) {
-    return out.identified[static_cast<std::size_t>(j)] &&
-           (u[j] <= options.fd_step || u[j] >= 1 - options.fd_step);
+    return out.identified[static_cast<std::size_t>(j)] && bound_distance(j) <= kAtBound;
+  });
+  const std::string near_bound = Names(out, [&](int j) {
+    return out.identified[static_cast<std::size_t>(j)] && bound_distance(j) > kAtBound &&
+           bound_distance(j) <= options.fd_step;
   });
   if (!at_bound.empty())
     note +=
         "at a bound (the optimum may lie beyond it; the interval is not reliable): " + at_bound +
         ". ";
+  if (!near_bound.empty())
+    note += "within the finite-difference step of a bound (its differences are cut short there): " +
+            near_bound + ". ";
   if (note.empty()) note = "every parameter is constrained by the observations.";
   while (!note.empty() && note.back() == ' ') note.pop_back();
   return note;

@@ -193,7 +193,8 @@ TEST(EstimateUncertainty, AParameterWithoutEffectIsUnidentifiedAndNamed) {
 }
 
 // Too few runs for the parameters (G <= n), a weakly constrained parameter (standard error above
-// weak_fraction of its range) and one at a bound are each stated in the note.
+// weak_fraction of its range), one at a bound and one within the finite-difference step of a bound
+// are each stated in the note.
 TEST(EstimateUncertainty, NotesStateTooFewRunsWeakParametersAndBounds) {
   {
     LinearProblem problem(2);
@@ -229,6 +230,14 @@ TEST(EstimateUncertainty, NotesStateTooFewRunsWeakParametersAndBounds) {
                                  "reliable): medium_hard.mu_min"),
               std::string::npos)
         << at_bound.note;
+    // Within the step (0.01) but not at the bound: said so, not called "at a bound".
+    const Uncertainty near =
+        EstimateUncertainty(objective, Eigen::VectorXd::Constant(1, 0.005), UncertaintyOptions{});
+    EXPECT_EQ(near.note.find("at a bound"), std::string::npos) << near.note;
+    EXPECT_NE(near.note.find("within the finite-difference step of a bound (its differences are "
+                             "cut short there): medium_hard.mu_min"),
+              std::string::npos)
+        << near.note;
   }
 }
 
