@@ -4,6 +4,7 @@
 #include <Eigen/Core>
 #include <vector>
 
+#include "solver/kinematics.hpp"
 #include "solver/soil.hpp"
 
 namespace talus {
@@ -58,6 +59,7 @@ struct StepWorkspace {
   std::vector<Eigen::Vector3d> last_percussion;
   std::vector<char> last_closed;
   std::vector<int> last_closed_list;
+  DriftTurn drift_turn;  // the last half-step's turn, which the next half-step mostly repeats
   // What the scene holds, looked up once per rock (SimulateRock) instead of in every step: some
   // ground category with the scarring soil, and some drag layer (a category's or the forest's).
   // True, i.e. looked for in every step, until set; Reset makes them true again.

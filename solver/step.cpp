@@ -33,9 +33,9 @@ Eigen::Vector3d FreeVelocity(const SolverOptions& opt, double dt, const Eigen::V
 }
 
 // End point (drift the second half with the end velocities), time and scar.
-void EndStep(const Scene& scene, double dt, const StepReport& report,
-             const StepWorkspace& workspace, RockState& state) {
-  Drift(state, 0.5 * dt);
+void EndStep(const Scene& scene, double dt, const StepReport& report, StepWorkspace& workspace,
+             RockState& state) {
+  Drift(state, 0.5 * dt, &workspace.drift_turn);
   state.time_s += dt;
   UpdateScar(scene, dt, report, workspace, state);
 }
@@ -188,7 +188,7 @@ StepReport StepOnce(const Scene& scene, const RockShape& rock, double dt, bool m
   StageClock clock(times);
 
   // 1. Midpoint: drift half a step with the begin velocities.
-  Drift(state, 0.5 * dt);
+  Drift(state, 0.5 * dt, &workspace.drift_turn);
   clock.Lap(&StageTimes::midpoint_s);
 
   // 2. Free rotation by the implicit midpoint rule.
@@ -302,7 +302,7 @@ StepReport FlightStep(const Scene& scene, const RockShape& rock, RockState& stat
   StepReport report;
   report.clear = true;
   StageClock clock(times);
-  Drift(state, 0.5 * scene.options.dt_s);
+  Drift(state, 0.5 * scene.options.dt_s, &workspace.drift_turn);
   clock.Lap(&StageTimes::midpoint_s);
   state.angular_velocity_rad_s =
       FreeRotation(rock.inertia_kg_m2, state.angular_velocity_rad_s, scene.options.dt_s);

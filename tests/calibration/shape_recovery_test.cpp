@@ -46,15 +46,9 @@ io::SceneFile LoadTwoBlockScene() {
          << 0.5 + 0.02 * (r % 10) << "," << 1.0 + 0.1 * (r % 7) << "," << (r % 2 ? "slab" : "round")
          << "\n";
   runs.close();
-  // Whole steps (impact_substeps = 1) and the Gauss-Seidel contact solve, the scheme these
-  // numbers were measured with. Under the default sub-steps the fit lands at mu_min 0.523, 3.3
-  // data standard errors above the truth (tolerance 3; stated standard error 0.018, whose
-  // interval holds the truth), roughness 0.279; under the default block on stall (2026-11-27) at
-  // 0.536, 5.0 of them (stated standard error 0.0215, whose interval holds the truth), roughness
-  // 0.252. Over six draws of the observations (release seeds 12345 and 100-104) the mu_min fits
-  // spread by 0.034 (sd) under Gauss-Seidel and 0.036 under the block on stall (bench/README.md,
-  // "A block solve for stalled pairs"), five times the data's standard error that the tolerance
-  // is built from: the tolerance holds for this draw, not for every draw.
+  // Whole steps (impact_substeps = 1) and the Gauss-Seidel contact solve, the scheme the fits'
+  // spread over draws was measured with (under the default sub-steps this draw fits mu_min 0.523,
+  // under the default block on stall 0.536, both within it; see the test's comment).
   std::ofstream(dir / "scene.toml") << R"([terrain]
 plane = { slope_deg = 28, slope_length_m = 30, runout_m = 40, width_m = 80, cell_m = 1 }
 default_ground = "medium_hard"
@@ -125,16 +119,22 @@ testing::DataError DataErrorOf(const BlockRuns& runs,
 }
 
 // Ceres from mu_min 0.8 and roughness 0.05 through the calibration call, the covariance at the
-// optimum with the step chosen there (as talus calibrate does): both parameters land within 3 data
-// standard errors (plus the optimiser's tolerance) of the truth, the start does not, and each
-// stated 95 % interval (fitted +- 1.96 standard errors) holds the truth, with a standard error
-// that neither understates the data's by more than a factor 2 nor exceeds it 3 times over. The
-// fitted blocks carry the roughness, the fitted table mu_min.
-// Measured: data's standard errors 0.0072 (mu_min; slab runs: sd 0.40 m, slope -12.7 m) and 0.045
-// (roughness; rock runs: sd 5.3 m, slope -26.6 m); fitted 0.495 and 0.265, stated standard errors
-// 0.019 and 0.031, at the step the rule chose, 0.25 of each range (noise-dominated below it).
-// mu_min's is 2.7 times the data's: over +-0.2 of mu_min the slab's response bends (-15 m per unit
-// below the truth, -10 above), and the covariance's secant is the flatter; conservative.
+// optimum with the step chosen there (as talus calibrate does): both parameters land within 3 of
+// the fits' measured spread over draws (plus the optimiser's tolerance) of the truth, the start
+// does not, and each stated 95 % interval (fitted +- 1.96 standard errors) holds the truth, with a
+// standard error that neither understates that spread by more than a factor 2 nor exceeds it 3
+// times over. The fitted blocks carry the roughness, the fitted table mu_min.
+// The bands are the fits' spread, not the data's standard error (printed: 0.0072 for mu_min, 0.044
+// for the roughness), because a fit of one draw also carries the model's own random numbers and
+// the optimiser's stop on a rough objective: over six draws of the observations (release seeds
+// 12345 and 100-104) the fits spread by sd 0.034 / 0.036 in mu_min and 0.018 / 0.030 in roughness
+// under Gauss-Seidel / the block on stall (bench/README.md, "A block solve for stalled pairs"),
+// five times the data's in mu_min. Bands of 3 data standard errors held for the draw of 12345 only
+// by chance: the free rotation's written-out Newton iteration (the same root to 1e-15 relative)
+// moved this fit from 0.495 to 0.546, within the spread (bench/README.md, "Free rotation written
+// out"). Measured then: fitted 0.546 and 0.283, stated standard errors 0.027 and 0.036, at the
+// step the rule chose, 0.25 of each range (noise-dominated).
+constexpr double kMuFitSpread = 0.036, kRoughnessFitSpread = 0.030;
 TEST(ShapeRecovery, CeresRecoversARoughnessAndMuMinTogether) {
   const io::SceneFile file = LoadTwoBlockScene();
   const Scene scene = testing::AsCalibrationRuns(file.scene);
@@ -190,23 +190,24 @@ TEST(ShapeRecovery, CeresRecoversARoughnessAndMuMinTogether) {
   ASSERT_TRUE(run.uncertainty && run.uncertainty->computed);
 
   const double tolerances[] = {
-      3 * mu_error.se + options.optimizer.xtol_abs * (kMuUpper - kMuLower),
-      3 * roughness_error.se + options.optimizer.xtol_abs * kRoughnessUpper};
+      3 * kMuFitSpread + options.optimizer.xtol_abs * (kMuUpper - kMuLower),
+      3 * kRoughnessFitSpread + options.optimizer.xtol_abs * kRoughnessUpper};
   const double truths[] = {kTruthMu, kTruthRoughness}, starts[] = {kStartMu, kStartRoughness};
   const double data_se[] = {mu_error.se, roughness_error.se};
+  const double spreads[] = {kMuFitSpread, kRoughnessFitSpread};
   for (int k = 0; k < 2; ++k) {
     const double fitted = run.fit.best.values[k];
     const double se = run.uncertainty->standard_error[k];
     std::printf(
         "%s: fitted %.4f (truth %.2f, tolerance %.4f), stated standard error %.4f "
-        "(data's %.4f)\n",
+        "(fits' spread %.4f, data's standard error %.4f)\n",
         run.uncertainty->names[static_cast<std::size_t>(k)].c_str(), fitted, truths[k],
-        tolerances[k], se, data_se[k]);
+        tolerances[k], se, spreads[k], data_se[k]);
     EXPECT_GT(std::abs(starts[k] - truths[k]), tolerances[k]);
     EXPECT_NEAR(fitted, truths[k], tolerances[k]);
     EXPECT_NEAR(fitted, truths[k], 1.96 * se);
-    EXPECT_LT(se, 3 * data_se[k]);
-    EXPECT_GT(se, data_se[k] / 2);
+    EXPECT_LT(se, 3 * spreads[k]);
+    EXPECT_GT(se, spreads[k] / 2);
   }
   EXPECT_EQ(run.uncertainty->names[1], "blocks.round.roughness");
   ASSERT_EQ(run.fitted_blocks.size(), 2u);
