@@ -347,8 +347,8 @@ std::vector<std::string> CalibrationWarnings(const CalibrationSummary& run,
                    "away from what was stated; check the prior or the model",
                    c.name.c_str(), c.ToValue(u[jj]), std::abs(r), c.prior->Describe().c_str()));
     }
-    if (jj < u.size() && (u[jj] <= 1e-3 || u[jj] >= 1 - 1e-3)) {
-      const bool low = u[jj] <= 1e-3;
+    if (jj < u.size() && (AtLowerBound(u[jj]) || AtUpperBound(u[jj]))) {
+      const bool low = AtLowerBound(u[jj]);
       out.push_back(Format("%s lies at the %s bound of its range (%g): the optimum may lie "
                            "beyond it; widen the bounds where physics allows",
                            c.name.c_str(), low ? "lower" : "upper", low ? c.lower : c.upper));

@@ -19,7 +19,6 @@
 namespace talus::calibration {
 namespace {
 
-constexpr double kAtBound = 1e-3;  // a coordinate this close to 0 or 1 lies at its bound
 
 // Ceres logs a rank-deficient covariance as an error on stderr; here it is an expected outcome,
 // reported in Uncertainty. Quiets glog below FATAL while alive (one thread computes it).
@@ -137,13 +136,10 @@ void Stationarity(const Objective& objective, const EvaluateFn& evaluate, const 
   Eigen::VectorXd slope = Eigen::VectorXd::Zero(n);
   for (int j = 0; j < n; ++j) {
     if (!out.identified[static_cast<std::size_t>(j)]) continue;
-    // As ResidualCost: u itself where a side is infeasible.
-    auto [lo, hi] = CentralPair(out.u, j, h);
-    std::optional<Evaluation> a = evaluate(lo), b = evaluate(hi);
-    if (a && !a->feasible) a = at, lo = out.u;
-    if (b && !b->feasible) b = at, hi = out.u;
-    if (!a || !b || hi[j] == lo[j]) return;
-    slope[j] = (b->value - a->value) / (hi[j] - lo[j]);
+    // The Jacobian's own pair (ResidualCost), so its evaluations come from the cache.
+    const std::optional<CentralDifference> d = TakeCentralDifference(evaluate, *at, j, h);
+    if (!d) return;
+    slope[j] = (d->hi.value - d->lo.value) / d->width;
   }
   // The slope was measured over u -+ h: a longer step extrapolates the smoothed model beyond
   // where it was measured (along a valley of correlated parameters, to a corner of the box), so
@@ -194,16 +190,15 @@ std::string ConstraintNote(std::string note, const Eigen::VectorXd& u,
     note += "weakly constrained (standard error above " + std::string(b) +
             " of the range): " + weak + ". ";
   }
-  // At a bound: within 1e-3 of the range, as CalibrationWarnings and the ground table say it.
+  // At a bound: within kAtBoundOfRange, as CalibrationWarnings and the ground table say it.
   // Near one: within the covariance's step, where its differences are cut short on that side;
   // with steps of up to 0.25 that is no statement that the optimum lies beyond the bound.
-  const auto bound_distance = [&](int j) { return std::min(u[j], 1 - u[j]); };
-  const std::string at_bound = Names(out, [&](int j) {
-    return out.identified[static_cast<std::size_t>(j)] && bound_distance(j) <= kAtBound;
-  });
+  const auto at = [&](int j) { return AtLowerBound(u[j]) || AtUpperBound(u[j]); };
+  const std::string at_bound = Names(
+      out, [&](int j) { return out.identified[static_cast<std::size_t>(j)] && at(j); });
   const std::string near_bound = Names(out, [&](int j) {
-    return out.identified[static_cast<std::size_t>(j)] && bound_distance(j) > kAtBound &&
-           bound_distance(j) <= options.fd_step;
+    return out.identified[static_cast<std::size_t>(j)] && !at(j) &&
+           std::min(u[j], 1 - u[j]) <= options.fd_step;
   });
   if (!at_bound.empty())
     note +=

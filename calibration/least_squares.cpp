@@ -33,19 +33,15 @@ struct Difference {
 };
 Difference MeasureDifference(const Objective& objective, const Evaluation& at, int j, double h,
                              int* evaluations) {
-  auto [lo, hi] = CentralPair(at.u, j, h);
-  const auto side = [&](Eigen::VectorXd& v) {
-    if (v[j] == at.u[j]) return at.residuals;
+  const EvaluateFn evaluate = [&](const Eigen::VectorXd& v) -> std::optional<Evaluation> {
     ++*evaluations;
-    const Evaluation e = objective.Evaluate(v);
-    if (e.feasible) return e.residuals;
-    v = at.u;
-    return at.residuals;
+    return objective.Evaluate(v);
   };
-  const Eigen::VectorXd a = side(lo), b = side(hi);
   Difference d;
-  d.width = hi[j] - lo[j];
-  if (d.width > 0) d.jtj = ((b - a) / d.width).squaredNorm();
+  if (const std::optional<CentralDifference> pair = TakeCentralDifference(evaluate, at, j, h)) {
+    d.width = pair->width;
+    d.jtj = ((pair->hi.residuals - pair->lo.residuals) / d.width).squaredNorm();
+  }
   return d;
 }
 

@@ -23,6 +23,13 @@
 
 namespace talus::calibration {
 
+// A coordinate within this much of 0 or 1 (1e-3 of the range) lies at its bound: the optimum may
+// lie beyond the range. The calibration's warnings, the uncertainty's note and the fitted ground
+// table's comments all say it by this test.
+inline constexpr double kAtBoundOfRange = 1e-3;
+inline bool AtLowerBound(double u) { return u <= kAtBoundOfRange; }
+inline bool AtUpperBound(double u) { return u >= 1 - kAtBoundOfRange; }
+
 // The fields of a ground category that a calibration may free: the seed's five and the scarring
 // soil's two (a category with model = "lu2019"). In the order of kGroundFields
 // (solver/ground.hpp), whose rows give their names, units and default transforms.

@@ -31,6 +31,26 @@ inline std::pair<Eigen::VectorXd, Eigen::VectorXd> CentralPair(const Eigen::Vect
   return {lo, hi};
 }
 
+// The central difference of step h in coordinate j at `at` (the evaluation at u), as the fit, its
+// step choice and the covariance take it: the evaluations at the pair u -+ h e_j (CentralPair),
+// with u's own standing in on a side that lies at u or is infeasible, and the pair's width.
+// Nullopt when a side cannot be evaluated (budget spent, interrupted) or the width is 0.
+struct CentralDifference {
+  Evaluation lo, hi;
+  double width = 0;
+};
+inline std::optional<CentralDifference> TakeCentralDifference(const EvaluateFn& evaluate,
+                                                              const Evaluation& at, int j,
+                                                              double h) {
+  auto [lo, hi] = CentralPair(at.u, j, h);
+  std::optional<Evaluation> a = lo[j] == at.u[j] ? at : evaluate(lo);
+  std::optional<Evaluation> b = hi[j] == at.u[j] ? at : evaluate(hi);
+  if (a && !a->feasible) a = at, lo = at.u;
+  if (b && !b->feasible) b = at, hi = at.u;
+  if (!a || !b || hi[j] == lo[j]) return std::nullopt;
+  return CentralDifference{std::move(*a), std::move(*b), hi[j] - lo[j]};
+}
+
 // The residual vector with central differences of absolute step h in unit coordinates. A point
 // that cannot be evaluated (infeasible, budget spent, interrupted) makes Ceres reject the step.
 class ResidualCost final : public ceres::CostFunction {
@@ -50,15 +70,9 @@ class ResidualCost final : public ceres::CostFunction {
     if (!jacobians || !jacobians[0]) return true;
     Eigen::Map<RowMajor> jacobian(jacobians[0], m_, n_);
     for (int j = 0; j < n_; ++j) {
-      // u itself where a side is infeasible.
-      auto [lo, hi] = CentralPair(u, j, h_);
-      std::optional<Evaluation> a = lo[j] == u[j] ? e : evaluate_(lo);
-      std::optional<Evaluation> b = hi[j] == u[j] ? e : evaluate_(hi);
-      if (!a && !b) return false;
-      if (a && !a->feasible) a = e, lo = u;
-      if (b && !b->feasible) b = e, hi = u;
-      if (!a || !b || hi[j] == lo[j]) return false;
-      jacobian.col(j) = (b->residuals - a->residuals) / (hi[j] - lo[j]);
+      const std::optional<CentralDifference> d = TakeCentralDifference(evaluate_, *e, j, h_);
+      if (!d) return false;
+      jacobian.col(j) = (d->hi.residuals - d->lo.residuals) / d->width;
     }
     return true;
   }

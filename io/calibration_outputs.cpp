@@ -365,7 +365,8 @@ std::string FittedValueNote(const Objective& objective, const calibration::Calib
 
 // Why a fitted value deserves a second look, as a TOML comment (" # ..."), or "": the coordinate
 // of `category`'s `field` is unidentified (its profile is flat, or the covariance found it so), or
-// the fit lies at a bound of its range (within 1e-3 of the range: the optimum may lie beyond).
+// the fit lies at a bound of its range (calibration::AtLowerBound, AtUpperBound: the optimum may
+// lie beyond).
 std::string FittedValueNote(const Objective& objective, const calibration::CalibrationSummary& run,
                             const std::string& category, calibration::GroundField field) {
   calibration::ParameterSpec spec;
@@ -396,10 +397,11 @@ std::string FittedValueNote(const Objective& objective, const calibration::Calib
     const auto jj = static_cast<Eigen::Index>(j);
     if (run.fit.best.u.size() > jj) {
       const double u = run.fit.best.u[jj];
-      if (u <= 1e-3 || u >= 1 - 1e-3) {
+      if (calibration::AtLowerBound(u) || calibration::AtUpperBound(u)) {
+        const bool low = calibration::AtLowerBound(u);
         if (!note.empty()) note += "; ";
-        note += std::string("at the ") + (u <= 1e-3 ? "lower" : "upper") + " bound of its range (" +
-                G(u <= 1e-3 ? c.lower : c.upper) + "): the optimum may lie beyond it";
+        note += std::string("at the ") + (low ? "lower" : "upper") + " bound of its range (" +
+                G(low ? c.lower : c.upper) + "): the optimum may lie beyond it";
       }
     }
     return note.empty() ? "" : "  # " + note;
