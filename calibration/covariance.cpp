@@ -19,7 +19,6 @@
 namespace talus::calibration {
 namespace {
 
-
 // Ceres logs a rank-deficient covariance as an error on stderr; here it is an expected outcome,
 // reported in Uncertainty. Quiets glog below FATAL while alive (one thread computes it).
 class QuietCeresLog {

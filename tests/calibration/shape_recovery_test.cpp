@@ -47,8 +47,9 @@ io::SceneFile LoadTwoBlockScene() {
          << "\n";
   runs.close();
   // Whole steps (impact_substeps = 1) and the Gauss-Seidel contact solve, the scheme the fits'
-  // spread over draws was measured with (under the default sub-steps this draw fits mu_min 0.523,
-  // under the default block on stall 0.536, both within it; see the test's comment).
+  // spread over draws was measured with (before the free rotation was written out, this draw fitted
+  // mu_min 0.523 under the default sub-steps and 0.536 under the default block on stall, both
+  // within it; see the test's comment).
   std::ofstream(dir / "scene.toml") << R"([terrain]
 plane = { slope_deg = 28, slope_length_m = 30, runout_m = 40, width_m = 80, cell_m = 1 }
 default_ground = "medium_hard"
