@@ -285,10 +285,8 @@ json CovarianceJson(const calibration::Uncertainty& u) {
   return rows;
 }
 
-// The sandwich covariance, with the bootstrap and the seed refits beside it; null without one.
-json UncertaintyJson(const calibration::CalibrationSummary& run) {
-  if (!run.uncertainty) return nullptr;
-  const auto& u = *run.uncertainty;
+// The sandwich covariance at one point.
+json SandwichJson(const calibration::Uncertainty& u) {
   json identified = json::array(), weak = json::array();
   for (std::size_t k = 0; k < u.identified.size(); ++k) {
     identified.push_back(bool(u.identified[k]));
@@ -315,9 +313,16 @@ json UncertaintyJson(const calibration::CalibrationSummary& run) {
           {"stationary_values", Vector(u.stationary_values)},
           {"note", u.note},
           {"evaluations", u.evaluations},
-          {"wall_time_s", u.wall_time_s},
-          {"bootstrap", run.bootstrap ? BootstrapJson(*run.bootstrap) : json(nullptr)},
-          {"seeds", run.seeds ? SeedRefitsJson(*run.seeds) : json(nullptr)}};
+          {"wall_time_s", u.wall_time_s}};
+}
+
+// The sandwich covariance, with the bootstrap and the seed refits beside it; null without one.
+json UncertaintyJson(const calibration::CalibrationSummary& run) {
+  if (!run.uncertainty) return nullptr;
+  json j = SandwichJson(*run.uncertainty);
+  j["bootstrap"] = run.bootstrap ? BootstrapJson(*run.bootstrap) : json(nullptr);
+  j["seeds"] = run.seeds ? SeedRefitsJson(*run.seeds) : json(nullptr);
+  return j;
 }
 
 // Each fold's fit and scores, and the scores pooled over the folds; null without folds.
@@ -557,6 +562,10 @@ std::string CalibrationJson(const CalibrationFile& file, const Objective& object
   j["cross_validation"] = CrossValidationJson(run, all_runs);
   j["roughness"] = RoughnessJson(run.roughness);
   return j.dump(2) + "\n";
+}
+
+std::string UncertaintyJson(const calibration::Uncertainty& uncertainty) {
+  return SandwichJson(uncertainty).dump(2) + "\n";
 }
 
 std::string HistoryCsv(const Objective& objective, const calibration::OptimizerSummary& summary) {

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "calibration/calibrate.hpp"
+#include "calibration/covariance.hpp"
 #include "calibration/objective.hpp"
 #include "calibration/optimizer.hpp"
 #include "io/calibration_file.hpp"
@@ -29,5 +30,8 @@ std::string CalibrationJson(const CalibrationFile& file, const calibration::Obje
                             const calibration::CalibrationSummary& run, const std::string& version);
 std::string HistoryCsv(const calibration::Objective& objective,
                        const calibration::OptimizerSummary& summary);
+// The sandwich covariance at one point, as calibration.json's "uncertainty" holds it (without its
+// "bootstrap" and "seeds").
+std::string UncertaintyJson(const calibration::Uncertainty& uncertainty);
 
 }  // namespace talus::io

@@ -6,6 +6,8 @@
 #include <memory>
 
 #include "calibration/calibrate.hpp"
+#include "calibration/covariance.hpp"
+#include "calibration/least_squares.hpp"
 #include "io/calibration_file.hpp"
 #include "io/calibration_outputs.hpp"
 #include "io/summary.hpp"
@@ -56,7 +58,8 @@ Eigen::VectorXd VectorOf(const py::array_t<double, py::array::c_style | py::arra
                          int dimension, const char* what) {
   if (a.ndim() != 1 || a.shape(0) != dimension) {
     std::string shape;
-    for (py::ssize_t k = 0; k < a.ndim(); ++k) shape += (k ? ", " : "") + std::to_string(a.shape(k));
+    for (py::ssize_t k = 0; k < a.ndim(); ++k)
+      shape += (k ? ", " : "") + std::to_string(a.shape(k));
     throw InputError(std::string(what) + ": expected a vector of " + std::to_string(dimension) +
                      " values (one per parameter), got shape (" + shape + ")");
   }
@@ -135,6 +138,45 @@ py::list Parameters(const Calibration& c) {
   return out;
 }
 
+// The sandwich covariance at unit coordinates u, as talus calibrate estimates it at its optimum
+// (calibration::EstimateUncertainty with the file's [uncertainty] options): the central-difference
+// step is fd_step, else the file's, else chosen at u by the fit's rule. Without the roughness and
+// the profiles a calibration may have measured (their noise level and flat profiles).
+py::dict UncertaintyAt(const Calibration& c, const Eigen::VectorXd& u, const py::object& fd_step) {
+  const auto& coordinates = c.objective().parameters().coordinates();
+  for (Eigen::Index k = 0; k < u.size(); ++k)
+    if (!(u[k] >= 0 && u[k] <= 1))
+      throw InputError(coordinates[static_cast<std::size_t>(k)].name +
+                       ": the point is outside the parameter's bounds (unit coordinate " +
+                       std::to_string(u[k]) + ")");
+  calibration::UncertaintyOptions options = c.file.options.uncertainty_options;
+  if (!fd_step.is_none()) {
+    const double h = fd_step.cast<double>();
+    if (!(h > 0 && h <= 0.25))
+      throw InputError("fd_step: " + std::to_string(h) +
+                       " must be in (0, 0.25] (unit coordinates)");
+    options.fd_step = h;
+  }
+  std::string json, report;
+  WithoutGil([&] {
+    if (!(options.fd_step > 0)) {
+      const calibration::StepChoice choice =
+          calibration::ChooseFiniteDifferenceStep(c.objective(), u);
+      report = choice.Report();
+      options.fd_step = choice.step;
+      options.gradient_resolved = !choice.noise_dominated;
+    }
+    const calibration::Uncertainty result =
+        calibration::EstimateUncertainty(c.objective(), u, options);
+    json = io::UncertaintyJson(result);
+    report += result.Report();
+    return 0;
+  });
+  py::dict out = FromJson(json);
+  out["report"] = report;
+  return out;
+}
+
 py::dict Run(const Calibration& c, const py::object& progress, const py::object& max_evaluations) {
   calibration::CalibrationOptions options = c.file.options;
   if (!max_evaluations.is_none()) {
@@ -198,13 +240,14 @@ void BindCalibration(py::module_& m) {
           "kinds", [](const Calibration& c) { return c.objective().kinds(); },
           "The observation kinds the objective scores, in order.")
       .def_property_readonly("holdout", [](const Calibration& c) { return c.problem->holdout(); })
-      .def_property_readonly("fitted_runs",
-                             [](const Calibration& c) {
-                               std::vector<std::string> ids;
-                               for (const ensemble::ReleaseRun& r : c.problem->fitted_runs().release.runs)
-                                 ids.push_back(r.id);
-                               return ids;
-                             })
+      .def_property_readonly(
+          "fitted_runs",
+          [](const Calibration& c) {
+            std::vector<std::string> ids;
+            for (const ensemble::ReleaseRun& r : c.problem->fitted_runs().release.runs)
+              ids.push_back(r.id);
+            return ids;
+          })
       .def_property_readonly(
           "start_unit", [](const Calibration& c) { return Array(c.objective().StartPoint()); },
           "Unit coordinates of the scene's own values: where the optimiser starts.")
@@ -223,7 +266,8 @@ void BindCalibration(py::module_& m) {
       .def(
           "to_values",
           [](const Calibration& c, const Vector& u) {
-            return Array(c.objective().parameters().Values(VectorOf(u, c.objective().dimension(), "u")));
+            return Array(
+                c.objective().parameters().Values(VectorOf(u, c.objective().dimension(), "u")));
           },
           py::arg("u"), "Parameter values of unit coordinates (clamped to [0, 1]).")
       .def(
@@ -252,6 +296,27 @@ void BindCalibration(py::module_& m) {
             return FromJson(io::GroundTableJson(c.objective().GroundOf(u)));
           },
           py::arg("values"), "The ground table these parameter values make, as Scene.ground.")
+      .def(
+          "uncertainty",
+          [](const Calibration& c, const Vector& values, const py::object& fd_step) {
+            return UncertaintyAt(
+                c, UnitOfValues(c, VectorOf(values, c.objective().dimension(), "values")), fd_step);
+          },
+          py::arg("values"), py::arg("fd_step") = py::none(),
+          "The sandwich covariance at parameter values (an optimum found with SciPy, say), as "
+          "talus calibrate estimates it at its own: a dict with calibration.json's 'uncertainty' "
+          "keys ('standard_error', 'covariance', 'correlation', 'identified', 'note', ...; no "
+          "'bootstrap' or 'seeds') and 'report', the text talus calibrate prints. fd_step: the "
+          "central-difference step in unit coordinates; None takes the file's [uncertainty] "
+          "fd_step, else chooses it at the point by the fit's rule. It runs 2 n + 1 evaluations "
+          "and more (the step's choice, a rank-deficient J^T J's profiles).")
+      .def(
+          "uncertainty_unit",
+          [](const Calibration& c, const Vector& u, const py::object& fd_step) {
+            return UncertaintyAt(c, VectorOf(u, c.objective().dimension(), "u"), fd_step);
+          },
+          py::arg("u"), py::arg("fd_step") = py::none(),
+          "uncertainty() at unit coordinates, as calibration.json's optimiser starts list them.")
       .def("run", &Run, py::arg("progress") = py::none(), py::arg("max_evaluations") = py::none(),
            "Runs the calibration the file describes through the call talus calibrate makes (the "
            "fit, then the measurements at the optimum, the held-out runs and folds asked for at "

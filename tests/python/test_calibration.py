@@ -3,6 +3,7 @@ built-in calibration through the same call; threads with the GIL released."""
 
 import concurrent.futures
 import csv
+import json
 
 import numpy as np
 import pytest
@@ -90,3 +91,43 @@ def test_a_parameters_prior_is_read_and_priced(small_calibration, tmp_path):
     e = calibration.evaluate_unit(calibration.start_unit)
     assert e["prior"] == pytest.approx(0.2 * ((start[0] - 0.5) / 0.1) ** 2, rel=1e-12)
     assert e["value"] == pytest.approx(e["data"] + e["prior"], rel=1e-12)
+
+
+def test_uncertainty_at_a_point_is_the_programs_at_its_optimum(small_calibration, tmp_path):
+    # talus calibrate's sandwich covariance at its optimum, with the file's fixed step, and
+    # Calibration.uncertainty_unit at that optimum's unit coordinates: the same evaluations, so the
+    # same numbers to the bit (the fit is one BOBYQA start: its best point is the optimum).
+    text = small_calibration.read_text().replace("[uncertainty]\nenabled = false",
+                                                 "[uncertainty]\nfd_step = 0.05")
+    assert "fd_step = 0.05" in text
+    path = tmp_path / "with_uncertainty.toml"
+    path.write_text(text)
+    out = tmp_path / "out"
+    run_talus("calibrate", path, "--out", out, "--threads", "2")
+    with open(out / "calibration.json") as f:
+        program = json.load(f)
+    theirs = program["uncertainty"]
+    assert theirs["finite_difference_step"] == 0.05
+
+    calibration = talus.Calibration.load(path, threads=2)
+    starts = program["starts"]
+    best = min(starts, key=lambda s: s["best_objective"])["best"]
+    mine = calibration.uncertainty_unit(np.array(best))
+    for key in ("names", "values", "standard_error", "standard_error_unit", "correlation",
+                "covariance", "identified", "weak", "computed", "rank_deficient", "note",
+                "finite_difference_step", "stationary_located", "offset_unit",
+                "stationary_values"):
+        assert mine[key] == theirs[key], key
+    assert "bootstrap" not in mine and "seeds" not in mine
+    assert mine["names"] == ["medium.mu_min", "medium.kappa"]
+    assert mine["report"]
+
+    # By values, with a step of its own: that step, and the errors of the same parameters.
+    other = calibration.uncertainty(np.array(theirs["values"]), fd_step=0.1)
+    assert other["finite_difference_step"] == 0.1
+    assert len(other["standard_error"]) == 2
+
+    with pytest.raises(talus.InputError, match="fd_step"):
+        calibration.uncertainty(np.array(theirs["values"]), fd_step=0.5)
+    with pytest.raises(talus.InputError, match="medium.mu_min: the point is outside"):
+        calibration.uncertainty(np.array([5.0, 2.0]))
