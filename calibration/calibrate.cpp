@@ -171,15 +171,8 @@ void Pipeline::Uncertainty() {
                          : run_.roughness     ? run_.roughness->fd_step
                                               : 0.01;
   if (!(uncertainty.fd_step > 0)) {
-    // The covariance's step is chosen at the optimum by the fit's rule, not taken from the start:
-    // near the optimum the residuals' trend is small against the ensemble's noise, and a step
-    // chosen where the trend was large reads noise as curvature (J^T J = S + N / w^2), which
-    // shrinks the stated standard error (docs/calibration.md, "Ceres and the uncertainty").
     Say("Choosing the covariance's finite-difference step at the optimum...\n");
-    const StepChoice choice = ChooseFiniteDifferenceStep(objective_, best.u);
-    Say(choice.Report());
-    uncertainty.fd_step = choice.step;
-    uncertainty.gradient_resolved = !choice.noise_dominated;
+    Say(ChooseCovarianceStep(objective_, best.u, uncertainty));
   }
   uncertainty.noise = run_.roughness ? run_.roughness->level() : 0;
   uncertainty.profiles = run_.profiles;

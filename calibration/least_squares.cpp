@@ -270,6 +270,15 @@ StepChoice ChooseFiniteDifferenceStep(const Objective& objective, const Eigen::V
   return out;
 }
 
+std::string ChooseCovarianceStep(const Objective& objective, const Eigen::VectorXd& u,
+                                 UncertaintyOptions& options) {
+  if (options.fd_step > 0) return "";
+  const StepChoice choice = ChooseFiniteDifferenceStep(objective, u);
+  options.fd_step = choice.step;
+  options.gradient_resolved = !choice.noise_dominated;
+  return choice.Report();
+}
+
 double StepChoice::shrink() const {
   double out = 1;
   const double w = 2 * step;

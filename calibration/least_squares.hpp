@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "calibration/covariance.hpp"
 #include "calibration/objective.hpp"
 #include "calibration/optimizer.hpp"
 
@@ -63,6 +64,15 @@ struct StepChoice {
 // what the objective throws, and std::invalid_argument for invalid options.
 StepChoice ChooseFiniteDifferenceStep(const Objective& objective, const Eigen::VectorXd& u,
                                       const StepChoiceOptions& options = {});
+
+// The covariance's central-difference step at u (a fit's optimum): options.fd_step when it is
+// given (> 0), else ChooseFiniteDifferenceStep's at u, which also sets options.gradient_resolved.
+// Chosen at the optimum, not taken from the start: near the optimum the residuals' trend is small
+// against the ensemble's noise, and a step chosen where the trend was large reads noise as
+// curvature (J^T J = S + N / w^2), which shrinks the stated standard error (docs/calibration.md,
+// "Ceres and the uncertainty"). Returns the choice's report ("" when the step was given).
+std::string ChooseCovarianceStep(const Objective& objective, const Eigen::VectorXd& u,
+                                 UncertaintyOptions& options);
 
 // options.algorithm == "ceres": Levenberg-Marquardt with bounds [0, 1] on every coordinate, from
 // each start in turn (StartPoints), within the budget of evaluations (each Jacobian costs 2n) and

@@ -6,7 +6,6 @@
 #include <memory>
 
 #include "calibration/calibrate.hpp"
-#include "calibration/covariance.hpp"
 #include "calibration/least_squares.hpp"
 #include "io/calibration_file.hpp"
 #include "io/calibration_outputs.hpp"
@@ -159,13 +158,7 @@ py::dict UncertaintyAt(const Calibration& c, const Eigen::VectorXd& u, const py:
   }
   std::string json, report;
   WithoutGil([&] {
-    if (!(options.fd_step > 0)) {
-      const calibration::StepChoice choice =
-          calibration::ChooseFiniteDifferenceStep(c.objective(), u);
-      report = choice.Report();
-      options.fd_step = choice.step;
-      options.gradient_resolved = !choice.noise_dominated;
-    }
+    report = calibration::ChooseCovarianceStep(c.objective(), u, options);
     const calibration::Uncertainty result =
         calibration::EstimateUncertainty(c.objective(), u, options);
     json = io::UncertaintyJson(result);
