@@ -65,6 +65,14 @@ struct StepWorkspace {
   // True, i.e. looked for in every step, until set; Reset makes them true again.
   bool scene_has_soil = true;
   bool scene_has_drag = true;
+  // Contact detection on hulls of many vertices (DetectContacts): where the last two walks to a
+  // lowest vertex ended, and the vertices that may touch, found from there (marked with the
+  // search's stamp).
+  int walk_end[2] = {0, 0};
+  bool walk_pays = true;
+  std::vector<int> candidates;
+  std::vector<unsigned> marks;
+  unsigned stamp = 0;
 
   void Reset(std::size_t vertex_count) {
     contacts.clear();
@@ -72,6 +80,7 @@ struct StepWorkspace {
     last_percussion.assign(vertex_count, Eigen::Vector3d::Zero());
     last_closed.assign(vertex_count, 0);
     last_closed_list.clear();
+    walk_end[0] = walk_end[1] = 0;
   }
   // Forgets the previous step's percussions (cost proportional to the contacts it had).
   void ForgetPercussions() {

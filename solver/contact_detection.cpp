@@ -80,6 +80,80 @@ void AddCornerContact(const Scene& scene, FrictionOfScar& friction, const Eigen:
   SetFrame(scene, friction, x_end, n, c);
 }
 
+// Hulls of at least this many vertices are walked over to their lowest vertices first, which may
+// show that none can touch, or that few can: those are then searched from there instead of
+// looped over, when they lie within this share of the hull's extent from the lowest vertex
+// (DetectContacts).
+constexpr int kWalkFrom = 48;
+constexpr double kSearchShare = 0.05;
+
+// b . d summed as Eigen sums it, (x + y) + z.
+double Along(const Eigen::Vector3d& b, const Eigen::Vector3d& d) {
+  return d.x() * b.x() + d.y() * b.y() + d.z() * b.z();
+}
+
+// The vertex of least b . d, walked over the hull's edges from `start`: on a convex polyhedron a
+// vertex no lower than its neighbours is the lowest (up to round-off, which the caller's slack
+// covers).
+int WalkToLowest(const RockShape& rock, const Eigen::Vector3d& d, int start, double* lowest) {
+  const Eigen::Vector3d* vertices = rock.vertices_m.data();
+  int at = start;
+  double least = Along(vertices[at], d);
+  for (;;) {
+    int next = at;
+    for (int i = rock.neighbour_start[at]; i < rock.neighbour_start[at + 1]; ++i) {
+      const int k = rock.neighbours[i];
+      const double along = Along(vertices[k], d);
+      if (along < least) {
+        least = along;
+        next = k;
+      }
+    }
+    if (next == at) break;
+    at = next;
+  }
+  *lowest = least;
+  return at;
+}
+
+// workspace.candidates: in ascending order, every vertex b with b . d1 <= within1 or
+// b . d2 <= within2, given the lowest vertex along each direction, lowest1 and lowest2. Each of the
+// two sets is connected over the hull's edges (from any of its vertices a descending edge leads on
+// to the lowest vertex), so their union is searched from those two, at a cost that grows with the
+// vertices found, not with the hull.
+void SearchFromLowest(const RockShape& rock, const Eigen::Vector3d& d1, double within1, int lowest1,
+                      const Eigen::Vector3d& d2, double within2, int lowest2,
+                      StepWorkspace& workspace) {
+  std::vector<int>& found = workspace.candidates;
+  std::vector<unsigned>& marks = workspace.marks;
+  found.clear();
+  if (marks.size() != rock.vertices_m.size() || workspace.stamp == ~0u) {
+    marks.assign(rock.vertices_m.size(), 0);
+    workspace.stamp = 0;
+  }
+  const unsigned stamp = ++workspace.stamp;
+  const Eigen::Vector3d* vertices = rock.vertices_m.data();
+  for (const int seed : {lowest1, lowest2}) {
+    if (marks[seed] == stamp) continue;
+    if (Along(vertices[seed], d1) > within1 && Along(vertices[seed], d2) > within2) continue;
+    marks[seed] = stamp;
+    found.push_back(seed);
+  }
+  // Breadth first, `found` doubling as the queue.
+  for (std::size_t next = 0; next < found.size(); ++next) {
+    const int at = found[next];
+    for (int i = rock.neighbour_start[at]; i < rock.neighbour_start[at + 1]; ++i) {
+      const int k = rock.neighbours[i];
+      if (marks[k] == stamp) continue;
+      const Eigen::Vector3d& b = vertices[k];
+      if (Along(b, d1) > within1 && Along(b, d2) > within2) continue;
+      marks[k] = stamp;
+      found.push_back(k);
+    }
+  }
+  std::sort(found.begin(), found.end());
+}
+
 }  // namespace
 
 // Whether the terrain point (x, y) is over a soil category, and then in *depth_m the depth of the
@@ -137,97 +211,137 @@ DetectResult DetectContacts(const Scene& scene, const RockShape& rock, const Roc
   const Eigen::Vector3d m_body = rotation.transpose() * m;
   const Eigen::Vector3d rate_lever = m_body.cross(omega_rad_s);
 
-  // The vertices that may touch: within the terrain's departure of the local plane at the
-  // midpoint or at their predicted end point (every vertex without a local plane). In blocks of
-  // vertices: first the lowest height of each, a loop of plain arithmetic free of calls that keeps
-  // the plane and the rates in registers (the dot products summed as Eigen sums them,
-  // (x + y) + z), then the test of those that may touch against the terrain.
   const int vertex_count = static_cast<int>(rock.vertices_m.size());
   const Eigen::Vector3d* vertices = rock.vertices_m.data();
-  constexpr int kBlock = 32;
-  double lowest[kBlock];
-  for (int first = 0; first < vertex_count; first += kBlock) {
-    const int count = std::min(kBlock, vertex_count - first);
-    for (int j = 0; j < count; ++j) {
-      const Eigen::Vector3d& b = vertices[first + j];
-      const double height = m_body.x() * b.x() + m_body.y() * b.y() + m_body.z() * b.z();
-      const double rate = b.x() * rate_lever.x() + b.y() * rate_lever.y() + b.z() * rate_lever.z();
-      lowest[j] = centre_height + height + horizon_s * std::min(0.0, centre_rate + rate);
+  // The lowest a vertex comes above the local plane over the horizon: its height at the midpoint
+  // or, approaching, at the end of the horizon (the dot products summed as Eigen sums them,
+  // (x + y) + z). The vertices that may touch come within the terrain's departure of the plane.
+  const auto lowest_of = [&](const Eigen::Vector3d& b) {
+    const double height = m_body.x() * b.x() + m_body.y() * b.y() + m_body.z() * b.z();
+    const double rate = b.x() * rate_lever.x() + b.y() * rate_lever.y() + b.z() * rate_lever.z();
+    return centre_height + height + horizon_s * std::min(0.0, centre_rate + rate);
+  };
+  // Tests vertex k against the terrain itself; false when it lies outside the domain.
+  const auto test = [&](int k) -> bool {
+    const Eigen::Vector3d& b = vertices[k];
+    const Eigen::Vector3d arm = rotation * b;
+    const Eigen::Vector3d x = r + arm;
+    // The gap (x_z - h) n_z has the sign of x_z - h: the normal is needed only for contacts.
+    Terrain::Cell cell;
+    if (!terrain.Locate(x.x(), x.y(), &cell)) return false;
+    const double height = Terrain::HeightIn(cell);
+    if (std::isnan(height)) return false;  // a nodata corner
+    // Over soil, the contact is with the rebound plane below the surface.
+    double depth = 0;
+    if (any_soil && x.z() <= height &&
+        SoilDepthAt(scene, rock, x.x(), x.y(), velocity_m_s.z(), soil, &depth)) {
+      in_soil = true;
+      soil.submerged = true;
     }
-    for (int j = 0; j < count; ++j) {
-      if (local && lowest[j] > plane.deviation_m) continue;
-      const int k = first + j;
-      const Eigen::Vector3d& b = vertices[k];
-      const Eigen::Vector3d arm = rotation * b;
-      const Eigen::Vector3d x = r + arm;
-      // The gap (x_z - h) n_z has the sign of x_z - h: the normal is needed only for contacts.
-      Terrain::Cell cell;
-      if (!terrain.Locate(x.x(), x.y(), &cell)) return DetectResult::kOutsideDomain;
-      const double height = Terrain::HeightIn(cell);
-      if (std::isnan(height)) return DetectResult::kOutsideDomain;  // a nodata corner
-      // Over soil, the contact is with the rebound plane below the surface.
-      double depth = 0;
-      if (any_soil && x.z() <= height &&
-          SoilDepthAt(scene, rock, x.x(), x.y(), velocity_m_s.z(), soil, &depth)) {
-        in_soil = true;
-        soil.submerged = true;
-      }
-      if (x.z() <= height - depth) {
-        // Closed at the midpoint.
-        const Eigen::Vector3d normal = terrain.NormalIn(cell);
-        Contact& c = workspace.contacts.emplace_back();
-        c.vertex = k;
-        c.lever_m = b;
-        c.gap_m = 0;
-        SetFrame(scene, friction, x, normal, c);
-        if (horizon_s > 0 && depth == 0)
-          AddCornerContact(scene, friction, rotation, velocity_m_s, omega_rad_s, horizon_s,
-                           allowed_depth_m, k, b, x, normal, workspace);
-        continue;
-      }
-      if (horizon_s == 0) continue;
-      // Open: predicted to close when the vertex, moving for the horizon with its predicted
-      // velocity, would end deeper than allowed_depth_m. The contact takes the terrain's tangent
-      // plane at that end point (so that a vertex heading past a concave kink meets the face it
-      // will hit); its gap is the midpoint vertex's distance to that plane plus the allowed depth.
-      const Eigen::Vector3d x_end =
-          x + horizon_s * (velocity_m_s + rotation * omega_rad_s.cross(b));
-      TerrainSample end;
-      if (!terrain.Sample(x_end.x(), x_end.y(), &end)) continue;  // leaving: the next step says so
-      const Eigen::Vector3d& n = end.normal;
-      const double end_gap = (x_end.z() - end.height_m) * n.z();
-      if (end_gap >= -allowed_depth_m) {
-        // Not predicted; held if it was a contact in the step before and reaches the terrain by
-        // the next midpoint (ContactHold::kHeld), outside the soil, whose contacts sink by design.
-        if (!hold || end_gap >= 0 || static_cast<std::size_t>(k) >= workspace.last_closed.size() ||
-            !workspace.last_closed[k])
-          continue;
-        if (any_soil && scene.ground.params(terrain.GroundAt(x_end.x(), x_end.y())).IsSoil())
-          continue;
-        const Eigen::Vector3d on_plane(x_end.x(), x_end.y(), end.height_m);
-        Contact& c = workspace.contacts.emplace_back();
-        c.vertex = k;
-        c.gap_m = std::max(0.0, n.dot(x - on_plane));
-        c.held = true;
-        c.lever_m = b;
-        SetFrame(scene, friction, x_end, n, c);
-        continue;
-      }
-      double depth_end = 0;
-      if (any_soil &&
-          SoilDepthAt(scene, rock, x_end.x(), x_end.y(), velocity_m_s.z(), soil, &depth_end)) {
-        in_soil = true;
-        if ((x_end.z() - end.height_m + depth_end) * n.z() >= -allowed_depth_m) continue;
-      }
-      const Eigen::Vector3d on_plane(x_end.x(), x_end.y(), end.height_m - depth_end);
+    if (x.z() <= height - depth) {
+      // Closed at the midpoint.
+      const Eigen::Vector3d normal = terrain.NormalIn(cell);
       Contact& c = workspace.contacts.emplace_back();
       c.vertex = k;
-      const double gap_mid = n.dot(x - on_plane);
-      c.gap_m = std::max(0.0, gap_mid + allowed_depth_m);  // never a push out
-      c.lever_m = PredictedLeverArm(scene.options.predicted_lever, b, omega_rad_s, horizon_s,
-                                    gap_mid, n.dot(x_end - on_plane));
-      SetFrame(scene, friction, x_end, n, c);
+      c.lever_m = b;
+      c.gap_m = 0;
+      SetFrame(scene, friction, x, normal, c);
+      if (horizon_s > 0 && depth == 0)
+        AddCornerContact(scene, friction, rotation, velocity_m_s, omega_rad_s, horizon_s,
+                         allowed_depth_m, k, b, x, normal, workspace);
+      return true;
     }
+    if (horizon_s == 0) return true;
+    // Open: predicted to close when the vertex, moving for the horizon with its predicted
+    // velocity, would end deeper than allowed_depth_m. The contact takes the terrain's tangent
+    // plane at that end point (so that a vertex heading past a concave kink meets the face it
+    // will hit); its gap is the midpoint vertex's distance to that plane plus the allowed depth.
+    const Eigen::Vector3d x_end = x + horizon_s * (velocity_m_s + rotation * omega_rad_s.cross(b));
+    TerrainSample end;
+    if (!terrain.Sample(x_end.x(), x_end.y(), &end)) return true;  // leaving: the next step says so
+    const Eigen::Vector3d& n = end.normal;
+    const double end_gap = (x_end.z() - end.height_m) * n.z();
+    if (end_gap >= -allowed_depth_m) {
+      // Not predicted; held if it was a contact in the step before and reaches the terrain by
+      // the next midpoint (ContactHold::kHeld), outside the soil, whose contacts sink by design.
+      if (!hold || end_gap >= 0 || static_cast<std::size_t>(k) >= workspace.last_closed.size() ||
+          !workspace.last_closed[k])
+        return true;
+      if (any_soil && scene.ground.params(terrain.GroundAt(x_end.x(), x_end.y())).IsSoil())
+        return true;
+      const Eigen::Vector3d on_plane(x_end.x(), x_end.y(), end.height_m);
+      Contact& c = workspace.contacts.emplace_back();
+      c.vertex = k;
+      c.gap_m = std::max(0.0, n.dot(x - on_plane));
+      c.held = true;
+      c.lever_m = b;
+      SetFrame(scene, friction, x_end, n, c);
+      return true;
+    }
+    double depth_end = 0;
+    if (any_soil &&
+        SoilDepthAt(scene, rock, x_end.x(), x_end.y(), velocity_m_s.z(), soil, &depth_end)) {
+      in_soil = true;
+      if ((x_end.z() - end.height_m + depth_end) * n.z() >= -allowed_depth_m) return true;
+    }
+    const Eigen::Vector3d on_plane(x_end.x(), x_end.y(), end.height_m - depth_end);
+    Contact& c = workspace.contacts.emplace_back();
+    c.vertex = k;
+    const double gap_mid = n.dot(x - on_plane);
+    c.gap_m = std::max(0.0, gap_mid + allowed_depth_m);  // never a push out
+    c.lever_m = PredictedLeverArm(scene.options.predicted_lever, b, omega_rad_s, horizon_s, gap_mid,
+                                  n.dot(x_end - on_plane));
+    SetFrame(scene, friction, x_end, n, c);
+    return true;
+  };
+
+  // Hulls of many vertices: walks over the hull's edges, from where the last ones ended, find the
+  // lowest vertex along the plane's normal and along that of the end points (the lowest heights
+  // at the midpoint and at the end of the horizon, bounded by two linear functions of b); when
+  // both are out of reach of the terrain, no vertex is (to round-off, which `slack` covers many
+  // times over). When the vertices within reach lie in a thin cap of the hull, they are searched
+  // for from those two; otherwise all are looped over. The walks are taken while they pay: after
+  // a detection where no vertex came within reach (a rock near the terrain but not on it) or that
+  // searched.
+  bool none = false, searched = false;
+  const bool walk = local && vertex_count >= kWalkFrom && !rock.neighbours.empty();
+  if (walk && workspace.walk_pays) {
+    const double slack = 1e-9 * (m.norm() * reach + std::abs(centre_height) +
+                                 std::abs(plane.deviation_m) + horizon_s * std::abs(centre_rate));
+    const double within1 = plane.deviation_m - centre_height + slack;
+    const double within2 = within1 - horizon_s * centre_rate;
+    const Eigen::Vector3d d2 = m_body + horizon_s * rate_lever;
+    int* ends = workspace.walk_end;
+    double lowest1 = 0, lowest2 = 0;
+    ends[0] = WalkToLowest(rock, m_body, std::clamp(ends[0], 0, vertex_count - 1), &lowest1);
+    ends[1] = WalkToLowest(rock, d2, std::clamp(ends[1], 0, vertex_count - 1), &lowest2);
+    none = lowest1 > within1 && lowest2 > within2;
+    const double cap = kSearchShare * 2 * radius * m.norm();
+    if (!none && within1 - lowest1 < cap && within2 - lowest2 < cap) {
+      SearchFromLowest(rock, m_body, within1, ends[0], d2, within2, ends[1], workspace);
+      for (const int k : workspace.candidates)
+        if (lowest_of(vertices[k]) <= plane.deviation_m && !test(k))
+          return DetectResult::kOutsideDomain;
+      searched = true;
+    }
+  }
+  if (!none && !searched) {
+    // In blocks of vertices: first the lowest height of each, a loop of plain arithmetic free of
+    // calls that keeps the plane and the rates in registers, then the test of those that may
+    // touch (every vertex without a local plane).
+    bool any = false;
+    constexpr int kBlock = 32;
+    double lowest[kBlock];
+    for (int first = 0; first < vertex_count; first += kBlock) {
+      const int count = std::min(kBlock, vertex_count - first);
+      for (int j = 0; j < count; ++j) lowest[j] = lowest_of(vertices[first + j]);
+      for (int j = 0; j < count; ++j) {
+        if (local && lowest[j] > plane.deviation_m) continue;
+        any = true;
+        if (!test(first + j)) return DetectResult::kOutsideDomain;
+      }
+    }
+    workspace.walk_pays = !any;
   }
   if (!in_soil) soil = SoilContact{};
   return DetectResult::kOk;

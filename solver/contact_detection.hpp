@@ -35,7 +35,9 @@ inline double PredictionHorizon(const SolverOptions& options) { return options.d
 // A rock whose bounding sphere clears the terrain's local plane, over the horizon, by more than
 // the terrain departs from that plane (Terrain::PlaneAround, over the box that the sphere reaches
 // within the horizon) costs one test (kClear); otherwise only the vertices within that departure
-// of the plane are tested against the terrain itself. Returns kOutsideDomain when a
+// of the plane are tested against the terrain itself. On hulls of many vertices, walks over the
+// hull's edges to its lowest vertices find those without looking at every vertex when few or none
+// are within that departure (the same contacts, in the same order). Returns kOutsideDomain when a
 // vertex that may touch lies outside the DEM or over nodata.
 DetectResult DetectContacts(const Scene& scene, const RockShape& rock, const RockState& mid,
                             const Eigen::Matrix3d& rotation, const Eigen::Vector3d& velocity_m_s,

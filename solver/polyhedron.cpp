@@ -1,10 +1,31 @@
 #include "solver/polyhedron.hpp"
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
 namespace talus {
+namespace {
+
+// The hull's edges as RockShape::neighbours, from its triangles: each edge once per end.
+void SetNeighbours(RockShape& rock) {
+  std::vector<std::vector<int>> lists(rock.vertices_m.size());
+  for (const auto& t : rock.triangles)
+    for (int e = 0; e < 3; ++e) {
+      lists[t[e]].push_back(t[(e + 1) % 3]);
+      lists[t[(e + 1) % 3]].push_back(t[e]);
+    }
+  rock.neighbour_start.assign(1, 0);
+  for (std::vector<int>& list : lists) {
+    std::sort(list.begin(), list.end());
+    list.erase(std::unique(list.begin(), list.end()), list.end());
+    rock.neighbours.insert(rock.neighbours.end(), list.begin(), list.end());
+    rock.neighbour_start.push_back(static_cast<int>(rock.neighbours.size()));
+  }
+}
+
+}  // namespace
 
 std::vector<Eigen::Vector3d> UsedVertices(const Polyhedron& poly) {
   std::vector<char> used(poly.vertices_m.size(), 0);
@@ -75,6 +96,7 @@ RockShape MakeRockShape(const Polyhedron& hull, double density_kg_m3) {
   }
   for (const auto& t : hull.triangles)
     rock.triangles.push_back({renumber[t[0]], renumber[t[1]], renumber[t[2]]});
+  SetNeighbours(rock);
   Eigen::Vector3d lo = Eigen::Vector3d::Zero(), hi = Eigen::Vector3d::Zero();
   for (const Eigen::Vector3d& b : rock.vertices_m) {
     lo = lo.cwiseMin(b);

@@ -34,6 +34,11 @@ struct RockShape {
   // Hull faces: indices into vertices_m, counter-clockwise seen from outside (the scarring soil
   // clips them by the terrain, solver/soil.hpp). Empty for a shape not made by MakeRockShape.
   std::vector<std::array<int, 3>> triangles;
+  // The hull's edges, for walks over it (contact detection on hulls of many vertices): the
+  // neighbours of vertex k are neighbours[neighbour_start[k] .. neighbour_start[k + 1]), in
+  // ascending order. Empty with the triangles.
+  std::vector<int> neighbour_start;
+  std::vector<int> neighbours;
   double mass_kg = 0;
   double volume_m3 = 0;
   Eigen::Vector3d inertia_kg_m2 = Eigen::Vector3d::Ones();  // principal moments, ascending

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -88,6 +89,33 @@ TEST(RockShape, PrincipalFrameIsRightHandedAndReproducesTheInput) {
   const Eigen::Vector3d minor = rock.principal_to_input * Eigen::Vector3d::UnitX();
   EXPECT_NEAR(std::abs(minor.dot(q * Eigen::Vector3d::UnitX())), 1.0, 1e-9);
   EXPECT_NEAR(rock.bounding_radius_m, std::sqrt(1.5 * 1.5 + 0.5 * 0.5 + 1.0), 1e-12);
+}
+
+TEST(RockShape, NeighboursAreTheHullsEdges) {
+  // A closed triangulated surface of genus 0 with V vertices has E = 3 V - 6 edges (Euler: V - E +
+  // F = 2 and 2 E = 3 F); each edge is listed at both its ends, once, and is a side of a triangle.
+  for (const Polyhedron& hull : {MakeBox(3, 1, 2), MakeEllipsoid(0.5, 0.4, 0.3, 2)}) {
+    const RockShape rock = MakeRockShape(hull, 2500);
+    const int vertex_count = static_cast<int>(rock.vertices_m.size());
+    ASSERT_EQ(rock.neighbour_start.size(), rock.vertices_m.size() + 1);
+    EXPECT_EQ(rock.neighbours.size(), 2 * (3 * rock.vertices_m.size() - 6));
+    for (int a = 0; a < vertex_count; ++a) {
+      for (int i = rock.neighbour_start[a]; i < rock.neighbour_start[a + 1]; ++i) {
+        const int b = rock.neighbours[i];
+        ASSERT_NE(a, b);
+        if (i > rock.neighbour_start[a]) {
+          EXPECT_LT(rock.neighbours[i - 1], b);
+        }
+        const auto begin = rock.neighbours.begin();
+        EXPECT_TRUE(std::binary_search(begin + rock.neighbour_start[b],
+                                       begin + rock.neighbour_start[b + 1], a));
+        EXPECT_TRUE(std::any_of(rock.triangles.begin(), rock.triangles.end(), [&](const auto& t) {
+          return std::count(t.begin(), t.end(), a) && std::count(t.begin(), t.end(), b);
+        }));
+      }
+    }
+  }
+  EXPECT_EQ(MakeRockShape(MakeEllipsoid(0.5, 0.4, 0.3, 2), 2500).vertices_m.size(), 162u);
 }
 
 }  // namespace
