@@ -252,11 +252,12 @@ std::vector<int> VerticesThatTouch(const Scene& scene, const RockState& mid,
 // A 1 x 0.8 x 0.6 m box.
 RockShape TestBox() { return MakeRockShape(MakeBox(1.0, 0.8, 0.6), 2700); }
 
-// Runs DetectContacts for 4000 random states of `rock` (a 1 x 0.8 x 0.6 m box) near the terrain of
-// `hf` (centres in [lo, hi]^2 horizontally, up to `spread_m` above the terrain), fast (up to
-// `speed_m_s` / 2 per component) and spinning, with a 20 ms horizon, and checks that it finds
-// exactly the vertices that testing every one finds; with `held`, under ContactHold::kHeld with
-// every vertex a contact of the step before. Returns the contacts found and the states without one.
+// Runs DetectContacts for 4000 random states of `rock` (by default a 1 x 0.8 x 0.6 m box) near the
+// terrain of `hf` (centres in [lo, hi]^2 horizontally, up to `spread_m` above the terrain), fast
+// (up to `speed_m_s` / 2 per component) and spinning, with a 20 ms horizon, and checks that it
+// finds exactly the vertices that testing every one finds; with `held`, under ContactHold::kHeld
+// with every vertex a contact of the step before. Returns the contacts found and the states without
+// one.
 std::pair<long, long> CheckDetection(const Heightfield& hf, double lo, double hi, bool held = false,
                                      double spread_m = 1.5, double speed_m_s = 60,
                                      const RockShape& rock = TestBox()) {
@@ -361,13 +362,15 @@ TEST(Detection, SkipsOnlyVerticesThatCannotTouchOnAPlane) {
 }
 
 TEST(Detection, SearchesHullsOfManyVerticesFromTheirLowest) {
-  // A hull of many vertices (kWalkFrom or more) is not looped over: its vertices that may touch are
-  // searched over its edges from the lowest ones along the plane's normal and along its rate of
-  // approach. Ellipsoids of the box's size, of 162 and 642 vertices (the finer one with faces
-  // within a few degrees of each other, where round-off decides which of two vertices is lower),
-  // on the three terrains above, with and without held contacts: the same vertices as testing
-  // every one. (Measured on mutants: keeping only the lowest vertex along each direction misses
-  // contacts in every case, and a search along the plane's normal alone misses predicted ones.)
+  // On a hull of many vertices (48 or more) walks over its edges find the lowest vertices along the
+  // plane's normal and along that of the end points; when none is in reach, no vertex is tested,
+  // and when those in reach lie in a thin cap they are searched from there instead of looped
+  // over. Ellipsoids of the box's size, of 162 and 642 vertices (the finer one with faces within a
+  // few degrees of each other, where round-off decides which of two vertices is lower), on the
+  // rough DEM and the plane above, with and without held contacts: the same vertices as testing
+  // every one. (Measured on mutants: a search that keeps only the lowest vertices misses 104
+  // contacts on the plane, and walks and a search along the plane's normal alone miss predicted
+  // contacts in every case.)
   Heightfield rough;
   rough.grid = {60, 60, 0.0, 0.0, 5.0, 5.0};
   for (int j = 0; j < 60; ++j)
