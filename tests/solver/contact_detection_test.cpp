@@ -300,6 +300,27 @@ std::pair<long, long> CheckDetection(const Heightfield& hf, double lo, double hi
   return {contacts, untouched};
 }
 
+// Rough terrain: 5 m cells, heights varying by metres from node to node.
+Heightfield RoughDem() {
+  Heightfield hf;
+  hf.grid = {60, 60, 0.0, 0.0, 5.0, 5.0};
+  for (int j = 0; j < 60; ++j)
+    for (int i = 0; i < 60; ++i)
+      hf.z_m.push_back(-2.0 * i + 4 * std::sin(1.3 * i) * std::cos(0.7 * j) +
+                       0.8 * ((i * 7 + j * 13) % 5));
+  return hf;
+}
+
+// A plane: a 40 degree slope across 2 m cells, as the benchmark ramp.
+Heightfield PlaneDem() {
+  Heightfield hf;
+  hf.grid = {100, 40, 0.0, 0.0, 2.0, 2.0};
+  for (int j = 0; j < 40; ++j)
+    for (int i = 0; i < 100; ++i)
+      hf.z_m.push_back(-std::tan(40 * std::numbers::pi / 180) * 2.0 * i);
+  return hf;
+}
+
 TEST(Detection, SkipsOnlyVerticesThatCannotTouch) {
   // DetectContacts tests only the vertices within the terrain's departure from its local plane
   // (Terrain::PlaneAround over the box the rock reaches within the horizon). On rough terrain
@@ -308,13 +329,7 @@ TEST(Detection, SkipsOnlyVerticesThatCannotTouch) {
   // predicted end points leave the bounding sphere's box by up to a metre, it must find exactly
   // the vertices that testing every one finds. (With the box of the bounding sphere alone, 19 of
   // these 4000 states missed a predicted contact.)
-  Heightfield hf;
-  hf.grid = {60, 60, 0.0, 0.0, 5.0, 5.0};
-  for (int j = 0; j < 60; ++j)
-    for (int i = 0; i < 60; ++i)
-      hf.z_m.push_back(-2.0 * i + 4 * std::sin(1.3 * i) * std::cos(0.7 * j) +
-                       0.8 * ((i * 7 + j * 13) % 5));
-  const auto [contacts, untouched] = CheckDetection(hf, 20, 270);
+  const auto [contacts, untouched] = CheckDetection(RoughDem(), 20, 270);
   EXPECT_GT(contacts, 1000);  // measured: 6975
   EXPECT_GT(untouched, 400);  // measured: 1575
 }
@@ -348,14 +363,9 @@ TEST(Detection, SkipsOnlyVerticesThatCannotTouchOnAPlane) {
   // found here, down to 1.5 times 9 states' contacts, and one that skips the held vertices ending
   // within the allowed depth 38 of the 7540 found with held contacts; the oracles of the rough
   // DEMs above miss none of these.)
-  Heightfield hf;
-  hf.grid = {100, 40, 0.0, 0.0, 2.0, 2.0};
-  for (int j = 0; j < 40; ++j)
-    for (int i = 0; i < 100; ++i)
-      hf.z_m.push_back(-std::tan(40 * std::numbers::pi / 180) * 2.0 * i);
   for (const bool held : {false, true}) {
     SCOPED_TRACE(held ? "held contacts" : "midpoint");
-    const auto [contacts, untouched] = CheckDetection(hf, 10, 70, held, 1.2, 26);
+    const auto [contacts, untouched] = CheckDetection(PlaneDem(), 10, 70, held, 1.2, 26);
     EXPECT_GT(contacts, 1000);  // measured: 7494 and 7540
     EXPECT_GT(untouched, 400);  // measured: 1088 and 1080
   }
@@ -371,26 +381,15 @@ TEST(Detection, SearchesHullsOfManyVerticesFromTheirLowest) {
   // every one. (Measured on mutants: a search that keeps only the lowest vertices misses 104
   // contacts on the plane, and walks and a search along the plane's normal alone miss predicted
   // contacts in every case.)
-  Heightfield rough;
-  rough.grid = {60, 60, 0.0, 0.0, 5.0, 5.0};
-  for (int j = 0; j < 60; ++j)
-    for (int i = 0; i < 60; ++i)
-      rough.z_m.push_back(-2.0 * i + 4 * std::sin(1.3 * i) * std::cos(0.7 * j) +
-                          0.8 * ((i * 7 + j * 13) % 5));
-  Heightfield plane;
-  plane.grid = {100, 40, 0.0, 0.0, 2.0, 2.0};
-  for (int j = 0; j < 40; ++j)
-    for (int i = 0; i < 100; ++i)
-      plane.z_m.push_back(-std::tan(40 * std::numbers::pi / 180) * 2.0 * i);
   for (const int subdivisions : {2, 3}) {
     const RockShape rock = MakeRockShape(MakeEllipsoid(0.5, 0.4, 0.3, subdivisions), 2700);
     SCOPED_TRACE(std::to_string(rock.vertices_m.size()) + " vertices");
-    const auto [contacts, untouched] = CheckDetection(rough, 20, 270, false, 1.5, 60, rock);
+    const auto [contacts, untouched] = CheckDetection(RoughDem(), 20, 270, false, 1.5, 60, rock);
     EXPECT_GT(contacts, 1000);
     EXPECT_GT(untouched, 400);
     for (const bool held : {false, true}) {
       SCOPED_TRACE(held ? "held contacts" : "midpoint");
-      const auto [on_plane, none] = CheckDetection(plane, 10, 70, held, 1.2, 26, rock);
+      const auto [on_plane, none] = CheckDetection(PlaneDem(), 10, 70, held, 1.2, 26, rock);
       EXPECT_GT(on_plane, 1000);
       EXPECT_GT(none, 400);
     }
