@@ -66,8 +66,8 @@ struct StepWorkspace {
   bool scene_has_soil = true;
   bool scene_has_drag = true;
   // Contact detection on hulls of many vertices (DetectContacts): where the last two walks to a
-  // lowest vertex ended, and the vertices that may touch, found from there (marked with the
-  // search's stamp).
+  // lowest vertex ended, whether to walk in the next detection, and the vertices that may touch,
+  // found from there (marked with the search's stamp). Only the time taken depends on them.
   int walk_end[2] = {0, 0};
   bool walk_pays = true;
   std::vector<int> candidates;
@@ -81,6 +81,7 @@ struct StepWorkspace {
     last_closed.assign(vertex_count, 0);
     last_closed_list.clear();
     walk_end[0] = walk_end[1] = 0;
+    walk_pays = true;
   }
   // Forgets the previous step's percussions (cost proportional to the contacts it had).
   void ForgetPercussions() {
