@@ -214,12 +214,11 @@ DetectResult DetectContacts(const Scene& scene, const RockShape& rock, const Roc
   const int vertex_count = static_cast<int>(rock.vertices_m.size());
   const Eigen::Vector3d* vertices = rock.vertices_m.data();
   // The lowest a vertex comes above the local plane over the horizon: its height at the midpoint
-  // or, approaching, at the end of the horizon (the dot products summed as Eigen sums them,
-  // (x + y) + z). The vertices that may touch come within the terrain's departure of the plane.
+  // or, approaching, at the end of the horizon. The vertices that may touch come within the
+  // terrain's departure of the plane.
   const auto lowest_of = [&](const Eigen::Vector3d& b) {
-    const double height = m_body.x() * b.x() + m_body.y() * b.y() + m_body.z() * b.z();
-    const double rate = b.x() * rate_lever.x() + b.y() * rate_lever.y() + b.z() * rate_lever.z();
-    return centre_height + height + horizon_s * std::min(0.0, centre_rate + rate);
+    const double rate = Along(b, rate_lever);
+    return centre_height + Along(b, m_body) + horizon_s * std::min(0.0, centre_rate + rate);
   };
   // Tests vertex k against the terrain itself; false when it lies outside the domain.
   const auto test = [&](int k) -> bool {
