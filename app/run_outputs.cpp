@@ -148,9 +148,11 @@ std::vector<std::string> WriteSummaryOutputs(
     map_lines.push_back({barrier.name, barrier.vertices_m});
   std::vector<std::vector<Eigen::Vector2d>> xy;
   for (const io::SamplePath& p : paths) xy.push_back(p.xy_m);
+  std::string quicklook_png;
   if (scene.output.quicklook) {
-    io::WriteQuickLookPng(staging.path("quicklook.png"), scene.scene.terrain.heights(),
-                          io::QuickLookLayer(layers), xy, {}, map_lines);
+    quicklook_png = io::QuickLookPng(scene.scene.terrain.heights(), io::QuickLookLayer(layers), xy,
+                                     {}, map_lines);
+    WriteFileAtomically(staging.path("quicklook.png"), quicklook_png);
     outputs.push_back("quicklook.png");
     wrote(1);
   }
@@ -178,6 +180,7 @@ std::vector<std::string> WriteSummaryOutputs(
     page.layers = &layers;
     page.paths = std::move(xy);
     page.lines = std::move(map_lines);
+    page.quicklook_png = std::move(quicklook_png);
     page.rocks = io::RockColumns(staging.path("rocks.csv"));
     WriteFileAtomically(staging.path("report.html"), io::RunReportHtml(page));
     wrote(1);

@@ -1,15 +1,20 @@
 #include "io/quicklook.hpp"
 
 #include <cairo.h>
+#include <png.h>
 
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <csetjmp>
 #include <cstdint>
 #include <cstdio>
+#include <cstring>
 #include <memory>
 #include <numbers>
 #include <stdexcept>
+#include <string>
+#include <vector>
 
 #include "common/atomic_file.hpp"
 #include "common/format.hpp"
@@ -201,6 +206,85 @@ void DrawLegend(cairo_t* cr, const ensemble::RasterLayer* layer, const QuickLook
   Text(cr, x, layout.height - 12, 11, "hillshade: sun from the north-west");
 }
 
+// The quick-look's PNG encoding: zlib level 1 and each row as its difference from the row above
+// ("up"). Against libpng's defaults (level 6, the best of five filters per row, which cairo's own
+// writer takes) it encodes a 790 x 740 map 4.2 times as fast for 8 % more bytes (bench/README.md,
+// "The quick-look's PNG").
+constexpr int kPngLevel = 1;
+constexpr int kPngFilter = PNG_FILTER_UP;
+
+struct PngSink {
+  std::string* out;
+  char message[200];
+};
+
+// Writes `rows` (height rows of width RGB pixels, 8 bits each) to sink->out as a PNG. False with
+// sink->message set when libpng fails. Only trivially destructible objects live in this frame,
+// which libpng's errors leave by longjmp.
+bool EncodeRgbPng(const unsigned char* rows, int width, int height, PngSink* sink) {
+  png_structp png = png_create_write_struct(
+      PNG_LIBPNG_VER_STRING, sink,
+      [](png_structp p, png_const_charp message) {
+        auto* s = static_cast<PngSink*>(png_get_error_ptr(p));
+        std::snprintf(s->message, sizeof s->message, "%s", message);
+        png_longjmp(p, 1);
+      },
+      [](png_structp, png_const_charp) {});
+  if (png == nullptr) {
+    std::snprintf(sink->message, sizeof sink->message, "libpng could not start");
+    return false;
+  }
+  png_infop info = png_create_info_struct(png);
+  if (info == nullptr || setjmp(png_jmpbuf(png))) {
+    png_destroy_write_struct(&png, &info);
+    return false;
+  }
+  png_set_write_fn(
+      png, sink,
+      [](png_structp p, png_bytep data, png_size_t length) {
+        static_cast<PngSink*>(png_get_io_ptr(p))
+            ->out->append(reinterpret_cast<char*>(data), length);
+      },
+      nullptr);
+  png_set_IHDR(png, info, static_cast<png_uint_32>(width), static_cast<png_uint_32>(height), 8,
+               PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
+               PNG_FILTER_TYPE_DEFAULT);
+  png_set_compression_level(png, kPngLevel);
+  png_set_filter(png, PNG_FILTER_TYPE_BASE, kPngFilter);
+  png_write_info(png, info);
+  const std::size_t stride = 3 * static_cast<std::size_t>(width);
+  for (int y = 0; y < height; ++y) png_write_row(png, rows + y * stride);
+  png_write_end(png, info);
+  png_destroy_write_struct(&png, &info);
+  return true;
+}
+
+// The surface (CAIRO_FORMAT_RGB24: a 32-bit 0xXXRRGGBB per pixel) as a PNG.
+std::string SurfacePng(cairo_surface_t* surface) {
+  cairo_surface_flush(surface);
+  const int width = cairo_image_surface_get_width(surface);
+  const int height = cairo_image_surface_get_height(surface);
+  const int stride = cairo_image_surface_get_stride(surface);
+  const unsigned char* data = cairo_image_surface_get_data(surface);
+  std::vector<unsigned char> rows(3 * static_cast<std::size_t>(width) * height);
+  unsigned char* to = rows.data();
+  for (int y = 0; y < height; ++y) {
+    const unsigned char* from = data + static_cast<std::size_t>(y) * stride;
+    for (int x = 0; x < width; ++x, to += 3) {
+      std::uint32_t pixel;
+      std::memcpy(&pixel, from + 4 * x, sizeof pixel);
+      to[0] = static_cast<unsigned char>(pixel >> 16);
+      to[1] = static_cast<unsigned char>(pixel >> 8);
+      to[2] = static_cast<unsigned char>(pixel);
+    }
+  }
+  std::string png;
+  PngSink sink{&png, ""};
+  if (!EncodeRgbPng(rows.data(), width, height, &sink))
+    throw std::runtime_error(std::string("cannot encode the quick-look: ") + sink.message);
+  return png;
+}
+
 }  // namespace
 
 const ensemble::RasterLayer* QuickLookLayer(const std::vector<ensemble::RasterLayer>& layers) {
@@ -306,19 +390,7 @@ std::string QuickLookPng(const Heightfield& dem, const ensemble::RasterLayer* la
   cairo_reset_clip(cr);
   DrawLegend(cr, layer, legend, paths.size(), markers, lines.size(), layout);
 
-  cairo_surface_flush(surface.get());
-  std::string png;
-  const cairo_status_t encoded = cairo_surface_write_to_png_stream(
-      surface.get(),
-      [](void* closure, const unsigned char* data, unsigned int length) {
-        static_cast<std::string*>(closure)->append(reinterpret_cast<const char*>(data), length);
-        return CAIRO_STATUS_SUCCESS;
-      },
-      &png);
-  if (encoded != CAIRO_STATUS_SUCCESS)
-    throw std::runtime_error(std::string("cannot encode the quick-look: ") +
-                             cairo_status_to_string(encoded));
-  return png;
+  return SurfacePng(surface.get());
 }
 
 void WriteQuickLookPng(const std::string& path, const Heightfield& dem,

@@ -186,8 +186,12 @@ std::string MapsSection(const RunReportInput& input) {
   }
   if (maps.empty()) return "";
   std::string html = "<h2>Maps</h2>\n";
+  const ensemble::RasterLayer* quicklook =
+      input.quicklook_png.empty() ? nullptr : QuickLookLayer(*input.layers);
   for (const ensemble::RasterLayer* layer : maps) {
-    const std::string png = QuickLookPng(*input.dem, layer, input.paths, {}, input.lines);
+    const std::string png = layer == quicklook
+                                ? input.quicklook_png
+                                : QuickLookPng(*input.dem, layer, input.paths, {}, input.lines);
     html +=
         html::PngFigure(png, layer->name, LegendOf(*layer).title + " (" + layer->name + ".tif)");
   }

@@ -46,6 +46,9 @@ struct RunReportInput {
   const std::vector<ensemble::RasterLayer>* layers = nullptr;
   std::vector<std::vector<Eigen::Vector2d>> paths;  // the quick-look's sampled paths
   std::vector<MapLine> lines;                       // evaluation lines, drawn on the maps
+  // quicklook.png's bytes, when the run wrote it from these paths and lines: the map of
+  // QuickLookLayer(*layers), shown again instead of drawn again.
+  std::string quicklook_png;
   ColumnSource rocks;  // per-rock values (RockColumns); none when empty
   std::size_t statistics_budget_bytes = kColumnStatisticsBudgetBytes;  // for SummarizeColumns
 };

@@ -2,6 +2,7 @@
 // interrupts and the command line's messages and exit codes.
 
 #include <cpl_minixml.h>
+#include <cpl_string.h>
 #include <fcntl.h>
 #include <gdal_priv.h>
 #include <gtest/gtest.h>
@@ -138,6 +139,14 @@ TEST(SimulateCommand, WritesEveryOutputIdenticallyForOneAndTwoThreads) {
   }
   EXPECT_EQ(tifs, 12);
   EXPECT_TRUE(Slurp(a / "trajectories.h5") == Slurp(b / "trajectories.h5"));
+  // The report's map of the quick-look's layer (speed_max here) is quicklook.png itself.
+  const std::string quicklook = Slurp(a / "quicklook.png");
+  char* base64 = CPLBase64Encode(static_cast<int>(quicklook.size()),
+                                 reinterpret_cast<const GByte*>(quicklook.data()));
+  ASSERT_NE(base64, nullptr);
+  EXPECT_NE(Slurp(a / "report.html").find(std::string("data:image/png;base64,") + base64 + "\""),
+            std::string::npos);
+  CPLFree(base64);
   for (const char* name :
        {"rocks.csv", "trajectories.h5", "summary.json", "quicklook.png", "rocks.gpkg"})
     EXPECT_TRUE(fs::exists(a / name)) << name;
