@@ -2,10 +2,12 @@
 // Contact data shared by the detection and solve stages, and the per-thread step workspace.
 
 #include <Eigen/Core>
+#include <memory>
 #include <vector>
 
 #include "solver/kinematics.hpp"
 #include "solver/soil.hpp"
+#include "solver/terrain.hpp"
 
 namespace talus {
 
@@ -73,6 +75,15 @@ struct StepWorkspace {
   std::vector<int> candidates;
   std::vector<unsigned> marks;
   unsigned stamp = 0;
+  // Contact detection's local plane (DetectContacts), taken over a box wider than the detection's
+  // and kept while the detection boxes of later steps lie inside it: the heights it was taken on
+  // (null: none kept), the box's centre and half-width, and the plane. Only the time taken depends
+  // on it.
+  struct KeptPlane {
+    std::shared_ptr<const Heightfield> heights;
+    double x_m = 0, y_m = 0, half_m = 0;
+    Terrain::LocalPlane plane;
+  } kept_plane;
 
   void Reset(std::size_t vertex_count) {
     contacts.clear();
@@ -82,6 +93,7 @@ struct StepWorkspace {
     last_closed_list.clear();
     walk_end[0] = walk_end[1] = 0;
     walk_pays = true;
+    kept_plane.heights.reset();
   }
   // Forgets the previous step's percussions (cost proportional to the contacts it had).
   void ForgetPercussions() {

@@ -154,6 +154,46 @@ void SearchFromLowest(const RockShape& rock, const Eigen::Vector3d& d1, double w
   std::sort(found.begin(), found.end());
 }
 
+// The detection's local plane of a hull of fewer than kWalkFrom vertices is taken over a box wider
+// than the detection box by this many times the travel that box allows for over the horizon, and
+// kept for the steps whose boxes lie inside it (LocalPlaneFor). Its bound is looser than the
+// detection box's own, so more vertices come within reach: on hulls of many vertices (a scan on
+// rough terrain) those extra tests cost more than the plane saves (bench/README.md, "A kept local
+// plane").
+constexpr double kKeptPlaneTravels = 4;
+
+// The local plane of the detection box of half-width `reach` around (x, y) (Terrain::PlaneAround).
+// With a margin > 0: the kept plane when the box lies inside the kept plane's box; else a plane
+// over the box widened by `margin`, which is kept, when that box still takes PlaneAround's exact
+// bound (at most kExactCells cells a side) and lies on the DEM clear of nodata; else the plane over
+// the box itself. A plane's bound over a box holds over every box inside it, so the contacts found
+// do not depend on which plane is taken, only which vertices are tested against the terrain.
+// *anchor_m: the point where the plane's `at` was sampled.
+bool LocalPlaneFor(const Terrain& terrain, double x_m, double y_m, double reach, double margin,
+                   StepWorkspace::KeptPlane& kept, Terrain::LocalPlane* plane,
+                   Eigen::Vector2d* anchor_m) {
+  if (kept.heights.get() == &terrain.heights() && std::abs(x_m - kept.x_m) + reach <= kept.half_m &&
+      std::abs(y_m - kept.y_m) + reach <= kept.half_m) {
+    *plane = kept.plane;
+    *anchor_m = Eigen::Vector2d(kept.x_m, kept.y_m);
+    return true;
+  }
+  *anchor_m = Eigen::Vector2d(x_m, y_m);
+  const GridGeometry& grid = terrain.heights().grid;
+  const double wide = reach + margin;
+  if (margin > 0 && 2 * wide <= Terrain::kExactCells * std::min(grid.dx_m, grid.dy_m) &&
+      terrain.PlaneAround(x_m, y_m, wide, &kept.plane)) {
+    kept.heights = terrain.shared_heights();
+    kept.x_m = x_m;
+    kept.y_m = y_m;
+    kept.half_m = wide * (1 - 1e-12);  // a box inside by more than the rounding of its edges
+    *plane = kept.plane;
+    return true;
+  }
+  kept.heights.reset();
+  return terrain.PlaneAround(x_m, y_m, reach, plane);
+}
+
 }  // namespace
 
 // Whether the terrain point (x, y) is over a soil category, and then in *depth_m the depth of the
@@ -192,10 +232,17 @@ DetectResult DetectContacts(const Scene& scene, const RockShape& rock, const Roc
   // prediction is linear in time, as the solver's contact velocities are.
   // The box holds every vertex at the midpoint and at its predicted end point.
   const double reach = radius + horizon_s * (velocity_m_s.norm() + radius * omega_rad_s.norm());
+  const double margin = static_cast<int>(rock.vertices_m.size()) < kWalkFrom
+                            ? kKeptPlaneTravels * (reach - radius)
+                            : 0.0;
   Terrain::LocalPlane plane;
-  const bool local = terrain.PlaneAround(r.x(), r.y(), reach, &plane);
+  Eigen::Vector2d anchor;
+  const bool local =
+      LocalPlaneFor(terrain, r.x(), r.y(), reach, margin, workspace.kept_plane, &plane, &anchor);
   const Eigen::Vector3d m(-plane.slope_x, -plane.slope_y, 1.0);
-  const double centre_height = r.z() - plane.at.height_m;  // m . (r - (x, y, h)) as x, y match
+  // m . (r - (anchor, h)): the height of the centre above the plane.
+  const double centre_height = r.z() - (plane.at.height_m + plane.slope_x * (r.x() - anchor.x()) +
+                                        plane.slope_y * (r.y() - anchor.y()));
   const double centre_rate = m.dot(velocity_m_s);
   const double lowest_rate = centre_rate - radius * m.norm() * omega_rad_s.norm();
   if (local && centre_height - radius * m.norm() + horizon_s * std::min(0.0, lowest_rate) >

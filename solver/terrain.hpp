@@ -144,6 +144,8 @@ class Terrain {
   bool MaxAbovePlane(const Box& box, const Plane& plane, double* above_m) const;
 
   const Heightfield& heights() const { return *heights_; }
+  // The heights, shared: what holds them keeps them (and their address) alive.
+  const std::shared_ptr<const Heightfield>& shared_heights() const { return heights_; }
   int default_ground() const { return default_ground_; }
   bool has_ground_grid() const { return !ground_->index.empty(); }
   const GroundGrid& ground_grid() const { return *ground_; }
