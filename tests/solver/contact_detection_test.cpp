@@ -252,6 +252,43 @@ std::vector<int> VerticesThatTouch(const Scene& scene, const RockState& mid,
 // A 1 x 0.8 x 0.6 m box.
 RockShape TestBox() { return MakeRockShape(MakeBox(1.0, 0.8, 0.6), 2700); }
 
+// A scene of `hf` and `rock` for the detection oracles, with held contacts if asked.
+Scene DetectionScene(const Heightfield& hf, const RockShape& rock, bool held) {
+  Scene scene;
+  scene.terrain = Terrain(hf, 0);
+  scene.rock = rock;
+  if (held) scene.options.contact_hold = ContactHold::kHeld;
+  return scene;
+}
+
+// A random velocity (up to speed_m_s / 2 per component) and angular velocity (up to 15 rad/s).
+std::pair<Eigen::Vector3d, Eigen::Vector3d> RandomMotion(RockRandom& random, double speed_m_s) {
+  const Eigen::Vector3d v =
+      speed_m_s *
+      Eigen::Vector3d(random.Uniform() - 0.5, random.Uniform() - 0.5, random.Uniform() - 0.5);
+  const Eigen::Vector3d omega =
+      30 * Eigen::Vector3d(random.Uniform() - 0.5, random.Uniform() - 0.5, random.Uniform() - 0.5);
+  return {v, omega};
+}
+
+// DetectContacts on one state, checked against testing every vertex; the contacts it found.
+long ExpectTheContactsOfTestingEvery(const Scene& scene, const RockState& mid,
+                                     const Eigen::Vector3d& v, const Eigen::Vector3d& omega,
+                                     double horizon_s, double allowed_depth_m, bool held,
+                                     StepWorkspace& ws, const std::string& where) {
+  const Eigen::Matrix3d rotation = mid.orientation.toRotationMatrix();
+  EXPECT_NE(
+      DetectContacts(scene, scene.rock, mid, rotation, v, omega, horizon_s, allowed_depth_m, ws),
+      DetectResult::kOutsideDomain)
+      << where;
+  std::vector<int> found;
+  for (const Contact& c : ws.contacts) found.push_back(c.vertex);
+  EXPECT_EQ(found,
+            VerticesThatTouch(scene, mid, rotation, v, omega, horizon_s, allowed_depth_m, held))
+      << where;
+  return static_cast<long>(found.size());
+}
+
 // Runs DetectContacts for 4000 random states of `rock` (by default a 1 x 0.8 x 0.6 m box) near the
 // terrain of `hf` (centres in [lo, hi]^2 horizontally, up to `spread_m` above the terrain), fast
 // (up to `speed_m_s` / 2 per component) and spinning, with a 20 ms horizon, and checks that it
@@ -261,11 +298,7 @@ RockShape TestBox() { return MakeRockShape(MakeBox(1.0, 0.8, 0.6), 2700); }
 std::pair<long, long> CheckDetection(const Heightfield& hf, double lo, double hi, bool held = false,
                                      double spread_m = 1.5, double speed_m_s = 60,
                                      const RockShape& rock = TestBox()) {
-  Scene scene;
-  scene.terrain = Terrain(hf, 0);
-  scene.rock = rock;
-  if (held) scene.options.contact_hold = ContactHold::kHeld;
-  const double horizon_s = 0.02, allowed_depth_m = 0.006;
+  const Scene scene = DetectionScene(hf, rock, held);
   StepWorkspace ws;
   ws.Reset(scene.rock.vertices_m.size());
   if (held) ws.last_closed.assign(scene.rock.vertices_m.size(), 1);
@@ -278,23 +311,11 @@ std::pair<long, long> CheckDetection(const Heightfield& hf, double lo, double hi
     double h = 0;
     EXPECT_TRUE(scene.terrain.Height(x, y, &h));
     mid.position_m = {x, y, h + spread_m * random.Uniform()};
-    const Eigen::Vector3d v =
-        speed_m_s *
-        Eigen::Vector3d(random.Uniform() - 0.5, random.Uniform() - 0.5, random.Uniform() - 0.5);
-    const Eigen::Vector3d omega =
-        30 *
-        Eigen::Vector3d(random.Uniform() - 0.5, random.Uniform() - 0.5, random.Uniform() - 0.5);
-    const Eigen::Matrix3d rotation = mid.orientation.toRotationMatrix();
-    EXPECT_NE(
-        DetectContacts(scene, scene.rock, mid, rotation, v, omega, horizon_s, allowed_depth_m, ws),
-        DetectResult::kOutsideDomain);
-    std::vector<int> found;
-    for (const Contact& c : ws.contacts) found.push_back(c.vertex);
-    EXPECT_EQ(found,
-              VerticesThatTouch(scene, mid, rotation, v, omega, horizon_s, allowed_depth_m, held))
-        << "state " << k;
-    contacts += static_cast<long>(found.size());
-    untouched += found.empty();
+    const auto [v, omega] = RandomMotion(random, speed_m_s);
+    const long found = ExpectTheContactsOfTestingEvery(scene, mid, v, omega, 0.02, 0.006, held, ws,
+                                                       "state " + std::to_string(k));
+    contacts += found;
+    untouched += found == 0;
   }
   std::printf("%ld contacts; %ld of 4000 states without one\n", contacts, untouched);
   return {contacts, untouched};
@@ -405,11 +426,8 @@ TEST(Detection, SearchesHullsOfManyVerticesFromTheirLowest) {
 std::pair<long, long> CheckDetectionAlongPaths(const Heightfield& hf, double lo, double hi,
                                                bool held, double spread_m, double speed_m_s,
                                                const RockShape& rock = TestBox()) {
-  Scene scene;
-  scene.terrain = Terrain(hf, 0);
-  scene.rock = rock;
-  if (held) scene.options.contact_hold = ContactHold::kHeld;
-  const double dt_s = 0.002, allowed_depth_m = 0.006;
+  const Scene scene = DetectionScene(hf, rock, held);
+  const double dt_s = 0.002;
   StepWorkspace ws;
   ws.Reset(scene.rock.vertices_m.size());
   long contacts = 0, kept = 0;
@@ -419,30 +437,17 @@ std::pair<long, long> CheckDetectionAlongPaths(const Heightfield& hf, double lo,
     mid.orientation = random.Orientation();
     double x = lo + (hi - lo) * random.Uniform(), y = lo + (hi - lo) * random.Uniform();
     const double above = spread_m * random.Uniform();
-    const Eigen::Vector3d v =
-        speed_m_s *
-        Eigen::Vector3d(random.Uniform() - 0.5, random.Uniform() - 0.5, random.Uniform() - 0.5);
-    const Eigen::Vector3d omega =
-        30 *
-        Eigen::Vector3d(random.Uniform() - 0.5, random.Uniform() - 0.5, random.Uniform() - 0.5);
+    const auto [v, omega] = RandomMotion(random, speed_m_s);
+    const Eigen::Quaterniond turn(Eigen::AngleAxisd(dt_s * omega.norm(), omega.normalized()));
     for (int step = 0; step < 25; ++step, x += dt_s * v.x(), y += dt_s * v.y()) {
       double h = 0;
       EXPECT_TRUE(scene.terrain.Height(x, y, &h));
       mid.position_m = {x, y, h + above};
-      mid.orientation = (mid.orientation * Eigen::Quaterniond(Eigen::AngleAxisd(
-                                               dt_s * omega.norm(), omega.normalized())))
-                            .normalized();
+      mid.orientation = (mid.orientation * turn).normalized();
       if (held) ws.last_closed.assign(scene.rock.vertices_m.size(), 1);
-      const Eigen::Matrix3d rotation = mid.orientation.toRotationMatrix();
-      EXPECT_NE(
-          DetectContacts(scene, scene.rock, mid, rotation, v, omega, dt_s, allowed_depth_m, ws),
-          DetectResult::kOutsideDomain);
-      std::vector<int> found;
-      for (const Contact& c : ws.contacts) found.push_back(c.vertex);
-      EXPECT_EQ(found,
-                VerticesThatTouch(scene, mid, rotation, v, omega, dt_s, allowed_depth_m, held))
-          << "path " << path << ", step " << step;
-      contacts += static_cast<long>(found.size());
+      contacts += ExpectTheContactsOfTestingEvery(
+          scene, mid, v, omega, dt_s, 0.006, held, ws,
+          "path " + std::to_string(path) + ", step " + std::to_string(step));
       kept +=
           ws.kept_plane.heights != nullptr && (ws.kept_plane.x_m != x || ws.kept_plane.y_m != y);
     }
@@ -483,32 +488,24 @@ TEST(Detection, APlaneKeptOnOneTerrainIsNotUsedOnAnother) {
   // One workspace, two terrains, the same place: the plane kept on the first is not taken for the
   // second (its heights are another DEM's), and the second finds what testing every vertex finds.
   // (Measured on a mutant that takes it: the plane's bound on the rough DEM misses contacts.)
-  const Heightfield rough = RoughDem(), plane = PlaneDem();
-  Scene on_rough, on_plane;
-  on_rough.terrain = Terrain(rough, 0);
-  on_plane.terrain = Terrain(plane, 0);
-  on_rough.rock = on_plane.rock = TestBox();
+  const Scene on_plane = DetectionScene(PlaneDem(), TestBox(), false);
+  const Scene on_rough = DetectionScene(RoughDem(), TestBox(), false);
   StepWorkspace ws;
   ws.Reset(on_rough.rock.vertices_m.size());
   const Eigen::Vector3d v(3, 1, -2), omega(2, -1, 3);
-  const Eigen::Matrix3d rotation =
-      Eigen::AngleAxisd(0.4, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  RockState mid;
+  mid.orientation = Eigen::AngleAxisd(0.4, Eigen::Vector3d(1, 2, 3).normalized());
   long contacts = 0;
   for (int k = 0; k < 40; ++k) {
     const double x = 40 + 0.3 * k, y = 30;
     for (const Scene* scene : {&on_plane, &on_rough}) {
       double h = 0;
       ASSERT_TRUE(scene->terrain.Height(x, y, &h));
-      RockState mid;
-      mid.orientation = Eigen::Quaterniond(rotation);
       mid.position_m = {x, y, h + 0.1};
-      DetectContacts(*scene, scene->rock, mid, rotation, v, omega, 0.002, 0.006, ws);
-      std::vector<int> found;
-      for (const Contact& c : ws.contacts) found.push_back(c.vertex);
-      EXPECT_EQ(found, VerticesThatTouch(*scene, mid, rotation, v, omega, 0.002, 0.006, false))
-          << (scene == &on_rough ? "rough" : "plane") << ", point " << k;
+      contacts += ExpectTheContactsOfTestingEvery(
+          *scene, mid, v, omega, 0.002, 0.006, false, ws,
+          std::string(scene == &on_rough ? "rough" : "plane") + ", point " + std::to_string(k));
       EXPECT_EQ(ws.kept_plane.heights.get(), &scene->terrain.heights());
-      contacts += static_cast<long>(found.size());
     }
   }
   EXPECT_GT(contacts, 40);
