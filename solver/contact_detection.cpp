@@ -162,8 +162,8 @@ void SearchFromLowest(const RockShape& rock, const Eigen::Vector3d& d1, double w
 // plane").
 constexpr double kKeptPlaneTravels = 4;
 
-// The local plane of the detection box of half-width `reach` around (x, y) (Terrain::PlaneAround).
-// With a margin > 0: the kept plane when the box lies inside the kept plane's box; else a plane
+// The local plane of the detection box of half-width `reach` around (x, y) (Terrain::PlaneAround):
+// the kept plane when the box lies inside the kept plane's box; else, with a margin > 0, a plane
 // over the box widened by `margin`, which is kept, when that box still takes PlaneAround's exact
 // bound (at most kExactCells cells a side) and lies on the DEM clear of nodata; else the plane over
 // the box itself. A plane's bound over a box holds over every box inside it, so the contacts found
