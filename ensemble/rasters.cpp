@@ -8,6 +8,8 @@
 #include <ostream>
 #include <utility>
 
+#include "common/rounding.hpp"
+
 namespace talus::ensemble {
 
 namespace {
@@ -40,8 +42,9 @@ FootprintRecorder::FootprintRecorder(const RasterRequest& request, const Terrain
 
 int FootprintRecorder::CellOf(double x_m, double y_m) const {
   const GridGeometry& g = request_.grid;
-  const long i = std::lround((x_m - g.x0_m) / g.dx_m);
-  const long j = std::lround((y_m - g.y0_m) / g.dy_m);
+  // The nearest node (std::lround without its call: a step's mark takes two).
+  const long i = RoundHalfAway((x_m - g.x0_m) / g.dx_m);
+  const long j = RoundHalfAway((y_m - g.y0_m) / g.dy_m);
   if (i < 0 || j < 0 || i >= g.nx || j >= g.ny) return -1;
   return static_cast<int>(j * g.nx + i);
 }
@@ -87,9 +90,11 @@ void FootprintRecorder::OnStep(const RockState& state, const StepReport&,
   const auto energy = request_.energy ? static_cast<float>(KineticEnergy(*rock_, state)) : 0.0f;
   const auto jump =
       static_cast<float>((state.position_m.z() - ground.height_m) * ground.normal.z());
-  // A step longer than half a cell marks the cells in between too.
+  // A step longer than half a cell marks the cells in between too. Most steps move less than half
+  // of that, which their squared length shows without a root.
   const double half_cell = 0.5 * std::min(request_.grid.dx_m, request_.grid.dy_m);
-  const double moved = (state.position_m - previous_).head<2>().norm();
+  const double moved2 = (state.position_m - previous_).head<2>().squaredNorm();
+  const double moved = moved2 < 0.25 * half_cell * half_cell ? 0.0 : std::sqrt(moved2);
   const int pieces = moved > half_cell ? static_cast<int>(std::ceil(moved / half_cell)) : 1;
   for (int k = 1; k < pieces; ++k)
     Mark(previous_ + (double(k) / pieces) * (state.position_m - previous_), speed, energy, jump);

@@ -2,6 +2,7 @@
 // Contact data shared by the detection and solve stages, and the per-thread step workspace.
 
 #include <Eigen/Core>
+#include <limits>
 #include <memory>
 #include <vector>
 
@@ -62,6 +63,12 @@ struct StepWorkspace {
   std::vector<char> last_closed;
   std::vector<int> last_closed_list;
   DriftTurn drift_turn;  // the last half-step's turn, which the next half-step mostly repeats
+  // The scar's last decay factor exp(-beta dt) and its beta (1/s) and dt (s); NaN: none yet.
+  struct ScarDecay {
+    double beta_1_s = std::numeric_limits<double>::quiet_NaN();
+    double dt_s = std::numeric_limits<double>::quiet_NaN();
+    double factor = 1;
+  } scar_decay;
   // What the scene holds, looked up once per rock (SimulateRock) instead of in every step: some
   // ground category with the scarring soil, and some drag layer (a category's or the forest's).
   // True, i.e. looked for in every step, until set; Reset makes them true again.

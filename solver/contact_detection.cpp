@@ -66,8 +66,9 @@ void AddCornerContact(const Scene& scene, FrictionOfScar& friction, const Eigen:
                       const Eigen::Vector3d& normal, StepWorkspace& workspace) {
   const Eigen::Vector3d move = horizon_s * (velocity_m_s + rotation * omega_rad_s.cross(b));
   const Eigen::Vector3d x_end = x + move - std::min(0.0, normal.dot(move)) * normal;
+  // Not below the terrain at the end point: not deeper than allowed either.
   TerrainSample end;
-  if (!scene.terrain.Sample(x_end.x(), x_end.y(), &end)) return;
+  if (!scene.terrain.SampleBelow(x_end.x(), x_end.y(), x_end.z(), &end)) return;
   const Eigen::Vector3d& n = end.normal;
   if (n.dot(normal) >= 1 - 1e-12) return;  // the same face
   if ((x_end.z() - end.height_m) * n.z() >= -allowed_depth_m) return;
@@ -303,8 +304,10 @@ DetectResult DetectContacts(const Scene& scene, const RockShape& rock, const Roc
     // plane at that end point (so that a vertex heading past a concave kink meets the face it
     // will hit); its gap is the midpoint vertex's distance to that plane plus the allowed depth.
     const Eigen::Vector3d x_end = x + horizon_s * (velocity_m_s + rotation * omega_rad_s.cross(b));
+    // Not below the terrain at the end point (or leaving the DEM: the next step says so): neither
+    // predicted nor held.
     TerrainSample end;
-    if (!terrain.Sample(x_end.x(), x_end.y(), &end)) return true;  // leaving: the next step says so
+    if (!terrain.SampleBelow(x_end.x(), x_end.y(), x_end.z(), &end)) return true;
     const Eigen::Vector3d& n = end.normal;
     const double end_gap = (x_end.z() - end.height_m) * n.z();
     if (end_gap >= -allowed_depth_m) {

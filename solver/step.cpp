@@ -13,15 +13,20 @@ namespace talus {
 namespace {
 
 // Scar: grows with the speed while a contact carries load, decays as exp(-beta dt) otherwise.
-void UpdateScar(const Scene& scene, double dt, const StepReport& report,
-                const StepWorkspace& workspace, RockState& state) {
+// The decay's factor is kept with its beta and dt, which a flight repeats in every step.
+void UpdateScar(const Scene& scene, double dt, const StepReport& report, StepWorkspace& workspace,
+                RockState& state) {
   if (report.loaded) {
     state.scar_m += dt * state.velocity_m_s.norm();
     for (const Contact& c : workspace.contacts)
       if (c.percussion.x() > 0) state.scar_ground = c.ground;
   } else if (state.scar_m > 0) {
     const int ground = state.scar_ground >= 0 ? state.scar_ground : scene.terrain.default_ground();
-    state.scar_m *= std::exp(-scene.ground.params(ground).beta_1_s * dt);
+    const double beta = scene.ground.params(ground).beta_1_s;
+    StepWorkspace::ScarDecay& decay = workspace.scar_decay;
+    if (beta != decay.beta_1_s || dt != decay.dt_s)  // NaN until set: taken the first time
+      decay = {beta, dt, std::exp(-beta * dt)};
+    state.scar_m *= decay.factor;
   }
 }
 

@@ -6,6 +6,8 @@
 #include <numbers>
 #include <sstream>
 
+#include "common/rounding.hpp"
+
 namespace talus {
 namespace {
 
@@ -134,11 +136,21 @@ bool Terrain::Sample(double x_m, double y_m, TerrainSample* out) const {
   return true;
 }
 
+bool Terrain::SampleBelow(double x_m, double y_m, double z_m, TerrainSample* out) const {
+  Cell c;
+  if (!Locate(x_m, y_m, &c)) return false;
+  const double h = HeightIn(c);
+  if (std::isnan(h) || z_m >= h) return false;  // a nodata corner, or at or above the terrain
+  out->height_m = h;
+  out->normal = NormalIn(c);
+  return true;
+}
+
 int Terrain::GroundAt(double x_m, double y_m) const {
   if (!ground_index_) return default_ground_;
   const GridGeometry& g = ground_geometry_;
-  const long i = std::lround((x_m - g.x0_m) / g.dx_m);
-  const long j = std::lround((y_m - g.y0_m) / g.dy_m);
+  const long i = RoundHalfAway((x_m - g.x0_m) / g.dx_m);
+  const long j = RoundHalfAway((y_m - g.y0_m) / g.dy_m);
   if (i < 0 || j < 0 || i >= g.nx || j >= g.ny) return default_ground_;
   const std::uint8_t index = ground_index_[static_cast<std::size_t>(j) * g.nx + i];
   return index == GroundGrid::kNoGround ? default_ground_ : index;

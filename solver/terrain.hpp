@@ -87,6 +87,10 @@ class Terrain {
   bool Sample(double x_m, double y_m, TerrainSample* out) const;
   // The height alone (the contact test's fast path); false as for Sample.
   bool Height(double x_m, double y_m, double* height_m) const;
+  // Sample for a point (x, y, z) that may lie below the terrain, its normal taken only if it does:
+  // false as for Sample and where z is at or above the height (where a gap (z - h) n_z is not
+  // negative). The same bits as Sample where true.
+  bool SampleBelow(double x_m, double y_m, double z_m, TerrainSample* out) const;
 
   // The cell holding a point: its lower and upper rows of node heights (corners [0] and [1] of
   // each) and the point's local coordinates (u, w) in [0, 1]^2. For a height that may need its

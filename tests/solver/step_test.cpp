@@ -345,18 +345,46 @@ TEST(Scar, FrictionFollowsMuOfScarAlongASlide) {
   EXPECT_NEAR(s.scar_m, scar, 0.01 * scar);
 }
 
-TEST(Scar, DecaysExponentiallyInFlight) {
-  // ds/dt = -beta s in flight: s(t) = s0 exp(-beta t); the discrete update is exact.
-  const GroundParams ground{0.3, 2.0, 120, 2.0, 0.5};
-  const Scene scene = scenes::Incline(0, MakeRockShape(MakeBox(1, 1, 1), 2700), ground);
-  StepWorkspace ws;
+// The scars' ground (beta 120 1/s), and a unit cube 500 m above it with a scar of 2 m.
+constexpr GroundParams kScarredGround{0.3, 2.0, 120, 2.0, 0.5};
+RockState ScarredInFlight(const Scene& scene, StepWorkspace& ws) {
   ws.Reset(scene.rock.vertices_m.size());
   RockState s;
   s.position_m = {50, 0, 500};
   s.scar_m = 2.0;
   s.scar_ground = scene.terrain.default_ground();
+  return s;
+}
+
+TEST(Scar, DecaysExponentiallyInFlight) {
+  // ds/dt = -beta s in flight: s(t) = s0 exp(-beta t); the discrete update is exact.
+  const Scene scene = scenes::Incline(0, MakeRockShape(MakeBox(1, 1, 1), 2700), kScarredGround);
+  StepWorkspace ws;
+  RockState s = ScarredInFlight(scene, ws);
   s = Advance(scene, s, 10, ws);
   EXPECT_NEAR(s.scar_m, 2.0 * std::exp(-120 * 0.02), 1e-12);
+}
+
+TEST(Scar, DecaysByTheFactorOfItsOwnGroundAndStep) {
+  // The step keeps the decay factor exp(-beta dt) while beta and dt stay: after a change of the
+  // step's length (impact sub-steps are shorter) or of the scar's ground it takes the new one.
+  // Exact: the reference multiplies the same factors in the same order.
+  Scene scene = scenes::Incline(0, MakeRockShape(MakeBox(1, 1, 1), 2700), kScarredGround);
+  GroundParams slower = kScarredGround;
+  slower.beta_1_s = 60;
+  const int other = scene.ground.Set(GroundCategory{"slower", 99, slower});
+  StepWorkspace ws;
+  RockState s = ScarredInFlight(scene, ws);
+  double expected = 2.0;
+  s = Advance(scene, s, 5, ws);
+  for (int k = 0; k < 5; ++k) expected *= std::exp(-120 * 0.002);
+  scene.options.dt_s = 0.0005;
+  s = Advance(scene, s, 4, ws);
+  for (int k = 0; k < 4; ++k) expected *= std::exp(-120 * 0.0005);
+  s.scar_ground = other;
+  s = Advance(scene, s, 3, ws);
+  for (int k = 0; k < 3; ++k) expected *= std::exp(-60 * 0.0005);
+  EXPECT_EQ(s.scar_m, expected);
 }
 
 TEST(Drag, SlowsASlidingBlockAsImplicitViscousDrag) {

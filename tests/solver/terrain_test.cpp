@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <random>
 
 namespace talus {
 namespace {
@@ -222,6 +223,48 @@ TEST(Terrain, MaxAbovePlaneBoundsTheTerrainOverTheBox) {
   const Terrain h(holed, 0);
   EXPECT_FALSE(h.MaxAbovePlane({128.6, 129.0, -6.0, -5.5}, plane, &above));  // a cell with it
   EXPECT_TRUE(h.MaxAbovePlane({125.0, 128.4, -6.0, -5.5}, plane, &above));   // none
+}
+
+// SampleBelow answers as Sample where the point lies below the terrain, the same bits, and false
+// where it lies at or above it, outside the grid or over a nodata corner (contact detection takes
+// a normal only where a vertex is below the terrain).
+TEST(Terrain, SampleBelowIsSampleUnderTheTerrainOnly) {
+  Heightfield hf;
+  hf.grid = {6, 5, 100.0, 200.0, 2.0, 2.5};
+  std::mt19937_64 random(3);
+  std::uniform_real_distribution<double> height(-3.0, 3.0);
+  for (int k = 0; k < 30; ++k) hf.z_m.push_back(height(random));
+  hf.z_m[7] = std::numeric_limits<double>::quiet_NaN();  // node (1, 1): cells (0..1, 0..1)
+  const Terrain t(hf, 0);
+  std::uniform_real_distribution<double> x(99.0, 111.0), y(199.0, 211.0), offset(-0.5, 0.5);
+  int below = 0, above = 0, outside = 0;
+  for (int k = 0; k < 20000; ++k) {
+    const double px = x(random), py = y(random);
+    TerrainSample sample;
+    const bool sampled = t.Sample(px, py, &sample);
+    // Exactly at the height, just above and below it, and away from it.
+    const double pz = !sampled     ? 0.0
+                      : k % 4 == 0 ? sample.height_m
+                      : k % 4 == 1 ? std::nextafter(sample.height_m, -1e300)
+                      : k % 4 == 2 ? std::nextafter(sample.height_m, 1e300)
+                                   : sample.height_m + offset(random);
+    TerrainSample under;
+    const bool is_below = t.SampleBelow(px, py, pz, &under);
+    ASSERT_EQ(is_below, sampled && pz < sample.height_m) << px << " " << py << " " << pz;
+    if (!sampled) {
+      ++outside;
+    } else if (is_below) {
+      ++below;
+      EXPECT_EQ(under.height_m, sample.height_m);
+      EXPECT_EQ(under.normal, sample.normal);
+    } else {
+      ++above;
+    }
+  }
+  // Every case was met many times (outside the grid and over the nodata node among them).
+  EXPECT_GT(below, 3000);
+  EXPECT_GT(above, 3000);
+  EXPECT_GT(outside, 3000);
 }
 
 TEST(Terrain, GroundGridUsesNearestCellAndDefault) {
