@@ -232,10 +232,10 @@ DetectResult DetectContacts(const Scene& scene, const RockShape& rock, const Roc
   // Over the horizon it changes at the rate m . (v + w x arm) = m . v + b . (m_body x W): the
   // prediction is linear in time, as the solver's contact velocities are.
   // The box holds every vertex at the midpoint and at its predicted end point.
-  const double reach = radius + horizon_s * (velocity_m_s.norm() + radius * omega_rad_s.norm());
-  const double margin = static_cast<int>(rock.vertices_m.size()) < kWalkFrom
-                            ? kKeptPlaneTravels * (reach - radius)
-                            : 0.0;
+  const double travel = horizon_s * (velocity_m_s.norm() + radius * omega_rad_s.norm());
+  const double reach = radius + travel;
+  const double margin =
+      static_cast<int>(rock.vertices_m.size()) < kWalkFrom ? kKeptPlaneTravels * travel : 0.0;
   Terrain::LocalPlane plane;
   Eigen::Vector2d anchor;
   const bool local =
