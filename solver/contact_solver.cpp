@@ -251,6 +251,7 @@ struct SweepSetting {
   double radius_m;             // the rock's bounding radius: where dw is felt most
   bool viscous_friction;       // ViscousReading::kContactFriction
   bool block;                  // ContactSolveMethod::kBlock
+  bool single;                 // one contact: solved exactly in one sweep, its change not needed
 };
 
 // Per-contact Jacobians, step lengths and warm start: each contact's Delassus block and prox
@@ -309,7 +310,8 @@ void PrepareContacts(const Scene& scene, const RockShape& rock, double dt_s,
 }
 
 // One Gauss-Seidel sweep over the contacts, each solved exactly with the others held fixed;
-// returns the largest velocity change it made at a point of the rock (m/s). Inlined into the
+// returns the largest velocity change it made at a point of the rock (m/s), 0 for a single
+// contact. Inlined into the
 // solve's loop: as a call it costs 0.9 % of the ramp's instructions (bench/ramp_bench.cpp).
 [[gnu::always_inline]] inline double Sweep(const SweepSetting& setting,
                                            std::vector<Contact>& contacts,
@@ -358,7 +360,8 @@ void PrepareContacts(const Scene& scene, const RockShape& rock, double dt_s,
     const Eigen::Vector3d dw = c.inv_inertia_arms * delta;
     velocity_m_s += dv;
     omega_rad_s += dw;
-    max_change = std::max(max_change, dv.norm() + setting.radius_m * dw.norm());
+    if (!setting.single)
+      max_change = std::max(max_change, dv.norm() + setting.radius_m * dw.norm());
   }
   return max_change;
 }
@@ -397,7 +400,8 @@ ContactSolveReport SolveContacts(const Scene& scene, const RockShape& rock, doub
                              .local_tolerance_m_s = 1e-3 * opt.tolerance_m_s,
                              .radius_m = rock.bounding_radius_m,
                              .viscous_friction = opt.viscous == ViscousReading::kContactFriction,
-                             .block = opt.contact_solve == ContactSolveMethod::kBlock};
+                             .block = opt.contact_solve == ContactSolveMethod::kBlock,
+                             .single = workspace.contacts.size() == 1};
   // Two contacts as one block: with the block method after the first sweep; on stall after
   // kPairStallSweeps sweeps; never with Gauss-Seidel alone.
   const int pair_block_after = setting.block ? 1
@@ -409,7 +413,7 @@ ContactSolveReport SolveContacts(const Scene& scene, const RockShape& rock, doub
     const double max_change = Sweep(setting, workspace.contacts, velocity_m_s, omega_rad_s);
     report.iterations = iter;
     // One contact is solved exactly by its local solve: no second sweep is needed.
-    if (max_change <= opt.tolerance_m_s || workspace.contacts.size() == 1) {
+    if (setting.single || max_change <= opt.tolerance_m_s) {
       report.converged = true;
       break;
     }

@@ -70,8 +70,15 @@ RockResult SimulateRock(const Scene& scene, const RockShape& rock, const RockSta
   workspace.step.Reset(rock.vertices_m.size());
   workspace.step.scene_has_soil = scene.ground.AnySoil();
   workspace.step.scene_has_drag = scene.ground.AnyDragLayer() || !scene.forest_drag.empty();
+  // The path's largest speed, angular speed and displacement are kept squared and their roots
+  // taken once at the end: the square root is monotone and correctly rounded, so the root of the
+  // largest square is the largest root, bit for bit.
+  double max_speed2 = 0, max_angular_speed2 = 0, max_displacement2 = 0;
   auto finish = [&](EndReason end) {
     result.end = end;
+    result.max_speed_m_s = std::sqrt(max_speed2);
+    result.max_angular_speed_rad_s = std::sqrt(max_angular_speed2);
+    result.max_displacement_m = std::sqrt(max_displacement2);
     result.final_state = state;
     result.travel_time_s = state.time_s - start.time_s;
     result.runout_m = (state.position_m - start.position_m).head<2>().norm();
@@ -87,15 +94,14 @@ RockResult SimulateRock(const Scene& scene, const RockShape& rock, const RockSta
 
   // Statistics along the path, the release state included.
   auto record = [&](const TerrainSample& under) {
-    result.max_speed_m_s = std::max(result.max_speed_m_s, state.velocity_m_s.norm());
+    max_speed2 = std::max(max_speed2, state.velocity_m_s.squaredNorm());
     result.max_kinetic_energy_j = std::max(result.max_kinetic_energy_j, KineticEnergy(rock, state));
     result.max_jump_height_m = std::max(result.max_jump_height_m,
                                         (state.position_m.z() - under.height_m) * under.normal.z());
-    result.max_angular_speed_rad_s =
-        std::max(result.max_angular_speed_rad_s, state.angular_velocity_rad_s.norm());
+    max_angular_speed2 = std::max(max_angular_speed2, state.angular_velocity_rad_s.squaredNorm());
     result.max_scar_m = std::max(result.max_scar_m, state.scar_m);
-    result.max_displacement_m =
-        std::max(result.max_displacement_m, (state.position_m - start.position_m).norm());
+    max_displacement2 =
+        std::max(max_displacement2, (state.position_m - start.position_m).squaredNorm());
   };
   record(ground);
 
@@ -155,10 +161,10 @@ RockResult SimulateRock(const Scene& scene, const RockShape& rock, const RockSta
     if (observer) observer->OnStep(state, step, ground);
     if (stopped) return finish(EndReason::kBarrier);
 
-    // Rest: slow and in contact for the hold time.
-    const bool slow = state.velocity_m_s.norm() <= opt.rest_speed_m_s &&
+    // Rest: slow and in contact for the hold time (speeds looked at in contact steps only).
+    const bool slow = step.contacts > 0 && state.velocity_m_s.norm() <= opt.rest_speed_m_s &&
                       state.angular_velocity_rad_s.norm() <= opt.rest_angular_speed_rad_s;
-    state.rest_timer_s = (slow && step.contacts > 0) ? state.rest_timer_s + opt.dt_s : 0.0;
+    state.rest_timer_s = slow ? state.rest_timer_s + opt.dt_s : 0.0;
     if (state.rest_timer_s >= opt.rest_hold_s) return finish(EndReason::kRest);
     if (state.time_s >= end_time - 0.5 * opt.dt_s) return finish(EndReason::kMaxTime);
   }
