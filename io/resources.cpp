@@ -22,12 +22,13 @@ namespace talus::io {
 namespace {
 
 // Sizes of the output files. trajectories.h5 takes a row of its rock index per rock (56 bytes
-// before compression) and a part per sample (deflate-compressed doubles: 84 bytes measured on
-// cases/tirol, 82 on a 40 degree plane, 10^4 rocks of 41 samples in 33.5 MB; bench/README.md,
-// "Output sizes"); a row of rocks.csv (148 bytes). GeoTIFFs are counted uncompressed (4 bytes per
+// before compression) and a part per sample (121 bytes of values, of which the velocities,
+// quaternions and scars are stored plain and the rest deflate-compressed: 92 bytes measured on
+// cases/tirol, 108 on the 40 degree ramp, 200 rocks each; bench/README.md, "Trajectories: deflate
+// where it pays"); a row of rocks.csv (148 bytes). GeoTIFFs are counted uncompressed (4 bytes per
 // cell), an upper bound.
 constexpr double kTrajectoryBytesPerRock = 56;
-constexpr double kTrajectoryBytesPerSample = 84;
+constexpr double kTrajectoryBytesPerSample = 108;
 constexpr double kRocksCsvBytesPerRow = 150;
 // A row of evaluation_lines.csv (cases/tirol, two lines: 260 rows, 35 934 bytes, 138 per row).
 constexpr double kEvaluationLinesCsvBytesPerRow = 150;

@@ -150,14 +150,21 @@ void IntegerAttribute(hid_t object, const char* name, long value) {
 // Rows per chunk of every table: 8192 samples are 192 kB of positions before compression.
 constexpr hsize_t kChunkRows = 8192;
 
-// One growing table of `width` values of `type` per row: chunked (kChunkRows rows), shuffled and
-// deflate-compressed, with attributes units and frame. Rows are buffered and written a whole
-// chunk at a time (the rest by Finish), so that each chunk is compressed once and the bytes depend
-// on the rows alone, not on how they arrived.
+// Whether a table is deflate-compressed. Deflate takes the shuffled bytes of doubles whose
+// mantissas vary in every sample (velocities, quaternions, scars) to 86 % of their size at a
+// quarter of a second per 10^7 of them; times, contact flags and the rocks' index to 6 %, positions
+// and angular velocities (zero at rest) to 70 and 43 % (cases/tirol, 200 rocks; bench/README.md,
+// "Trajectories: deflate where it pays").
+enum class Deflate : bool { kNo, kYes };
+
+// One growing table of `width` values of `type` per row: chunked (kChunkRows rows), with
+// attributes units and frame, and with kYes shuffled and deflate-compressed. Rows are buffered and
+// written a whole chunk at a time (the rest by Finish), so that each chunk is compressed once and
+// the bytes depend on the rows alone, not on how they arrived.
 class Column {
  public:
   Column(hid_t parent, const char* name, hid_t type, hsize_t width, const char* units,
-         const char* frame)
+         const char* frame, Deflate deflate = Deflate::kYes)
       : type_(type), width_(width), row_bytes_(H5Tget_size(type) * width) {
     const hsize_t dims[2] = {0, width}, max[2] = {H5S_UNLIMITED, width};
     const hsize_t chunk[2] = {kChunkRows, width};
@@ -165,8 +172,10 @@ class Column {
     const Handle space(Check(H5Screate_simple(rank, dims, max), "create a dataspace"), H5Sclose);
     const Handle properties = UntimedCreation(H5P_DATASET_CREATE);
     Check(H5Pset_chunk(properties.get(), rank, chunk), "set chunks");
-    Check(H5Pset_shuffle(properties.get()), "set shuffle");
-    Check(H5Pset_deflate(properties.get(), 4), "set deflate");
+    if (deflate == Deflate::kYes) {
+      Check(H5Pset_shuffle(properties.get()), "set shuffle");
+      Check(H5Pset_deflate(properties.get(), 4), "set deflate");
+    }
     set_ = Handle(Check(H5Dcreate2(parent, name, type, space.get(), H5P_DEFAULT, properties.get(),
                                    H5P_DEFAULT),
                         "create a dataset"),
@@ -301,11 +310,11 @@ TrajectoryWriter::TrajectoryWriter(const std::string& path, const RockShape& roc
     const hid_t d = H5T_NATIVE_DOUBLE, g = m.samples_group.get(), r = m.rocks_group.get();
     m.t.emplace(g, "t", d, 1, "s", "none");
     m.position.emplace(g, "position", d, 3, "m", "world");
-    m.quaternion.emplace(g, "quaternion", d, 4, "1", "world");
-    m.velocity.emplace(g, "velocity", d, 3, "m/s", "world");
+    m.quaternion.emplace(g, "quaternion", d, 4, "1", "world", Deflate::kNo);
+    m.velocity.emplace(g, "velocity", d, 3, "m/s", "world", Deflate::kNo);
     m.angular.emplace(g, "angular_velocity", d, 3, "rad/s", "world");
     m.contact.emplace(g, "contact", H5T_NATIVE_UINT8, 1, "1", "none");
-    m.scar.emplace(g, "scar", d, 1, "m", "none");
+    m.scar.emplace(g, "scar", d, 1, "m", "none", Deflate::kNo);
     m.rock.emplace(r, "rock", H5T_NATIVE_INT64, 1, "1", "none");
     m.first_sample.emplace(r, "first_sample", H5T_NATIVE_INT64, 1, "1", "none");
     m.sample_count.emplace(r, "sample_count", H5T_NATIVE_INT64, 1, "1", "none");

@@ -7,9 +7,9 @@
 //          principal_inertia_kg_m2 (r x 3)
 // Every dataset has string attributes `units` and `frame` ("world", "body" or "none"); the root
 // has `format`, `format_version`, `crs` (the DEM's WKT, or "local metres") and the scene rock's
-// mass_kg and principal_inertia_kg_m2. Tables are chunked (8192 rows), shuffled and
-// deflate-compressed, written a chunk at a time (memory does not grow with the rocks), complete or
-// absent. Objects carry no timestamps and the bytes depend on the rocks alone: the same rocks give
+// mass_kg and principal_inertia_kg_m2. Tables are chunked (8192 rows), written a chunk at a time
+// (memory does not grow with the rocks), complete or absent; all but velocity, quaternion and scar
+// are shuffled and deflate-compressed. Objects carry no timestamps and the bytes depend on the rocks alone: the same rocks give
 // the same bytes, however they were split. Every HDF5 failure (a full disk, a file-size limit) is
 // one std::runtime_error naming the file and the reason; HDF5 prints nothing itself; a writer that
 // failed writes nothing more and its temporary file goes with it.
