@@ -146,12 +146,17 @@ std::vector<std::string> WriteSummaryOutputs(
     map_lines.push_back({line.name, line.vertices_m});
   for (const Barrier& barrier : scene.scene.barriers)
     map_lines.push_back({barrier.name, barrier.vertices_m});
-  std::vector<std::vector<Eigen::Vector2d>> xy;
-  for (const io::SamplePath& p : paths) xy.push_back(p.xy_m);
+  // The paths, drawn once for the quick-look and the report's maps.
+  io::MapPaths map_paths;
+  if (scene.output.quicklook || (scene.output.report && !layers.empty())) {
+    std::vector<std::vector<Eigen::Vector2d>> xy;
+    for (const io::SamplePath& p : paths) xy.push_back(p.xy_m);
+    map_paths = io::MapPaths(scene.scene.terrain.heights().grid, xy);
+  }
   std::string quicklook_png;
   if (scene.output.quicklook) {
-    quicklook_png = io::QuickLookPng(scene.scene.terrain.heights(), io::QuickLookLayer(layers), xy,
-                                     {}, map_lines);
+    quicklook_png = io::QuickLookPngOf(scene.scene.terrain.heights(), io::QuickLookLayer(layers),
+                                       map_paths, {}, map_lines);
     WriteFileAtomically(staging.path("quicklook.png"), quicklook_png);
     outputs.push_back("quicklook.png");
     wrote(1);
@@ -178,7 +183,7 @@ std::vector<std::string> WriteSummaryOutputs(
     page.summary_json = summary;
     page.dem = &scene.scene.terrain.heights();
     page.layers = &layers;
-    page.paths = std::move(xy);
+    page.paths = std::move(map_paths);
     page.lines = std::move(map_lines);
     page.quicklook_png = std::move(quicklook_png);
     page.rocks = io::RockColumns(staging.path("rocks.csv"));

@@ -18,6 +18,7 @@
 
 #include "common/atomic_file.hpp"
 #include "common/format.hpp"
+#include "common/rounding.hpp"
 
 namespace talus::io {
 namespace {
@@ -88,9 +89,9 @@ void PaintMap(cairo_surface_t* surface, const Heightfield& dem, const ensemble::
             colour[b] = 0.25 * colour[b] + 0.75 * legend.classes[k].rgb[b];
       }
       // CAIRO_FORMAT_RGB24: one 32-bit word per pixel, 0x00RRGGBB in native byte order.
-      const std::uint32_t word = (static_cast<std::uint32_t>(std::lround(colour[0])) << 16) |
-                                 (static_cast<std::uint32_t>(std::lround(colour[1])) << 8) |
-                                 static_cast<std::uint32_t>(std::lround(colour[2]));
+      const std::uint32_t word = (static_cast<std::uint32_t>(RoundHalfAway(colour[0])) << 16) |
+                                 (static_cast<std::uint32_t>(RoundHalfAway(colour[1])) << 8) |
+                                 static_cast<std::uint32_t>(RoundHalfAway(colour[2]));
       for (int dy = 0; dy < scale; ++dy) {
         auto* row = reinterpret_cast<std::uint32_t*>(
             data + static_cast<std::size_t>((g.ny - 1 - j) * scale + dy) * stride);
@@ -313,9 +314,60 @@ double ScaleBarLength(double at_most_m) {
   return decade;
 }
 
+namespace {
+// Map coordinates to the map's pixels: cell centres at pixel centres, north up.
+Eigen::Vector2d PixelOf(const GridGeometry& g, const QuickLookLayout& layout,
+                        const Eigen::Vector2d& p) {
+  return Eigen::Vector2d((p.x() - g.x0_m + 0.5 * g.dx_m) / g.dx_m * layout.scale,
+                         (g.y_max_m() + 0.5 * g.dy_m - p.y()) / g.dy_m * layout.scale);
+}
+}  // namespace
+
+MapPaths::MapPaths(const GridGeometry& grid, const std::vector<std::vector<Eigen::Vector2d>>& paths)
+    : count_(paths.size()) {
+  if (std::none_of(paths.begin(), paths.end(), [](const auto& p) { return p.size() >= 2; })) return;
+  const QuickLookLayout layout = QuickLookLayoutOf(grid);
+  layer_.reset(cairo_image_surface_create(CAIRO_FORMAT_ARGB32, layout.map_width, layout.map_height),
+               cairo_surface_destroy);
+  if (cairo_surface_status(layer_.get()) != CAIRO_STATUS_SUCCESS)
+    throw std::runtime_error(std::string("cannot draw the quick-look: ") +
+                             cairo_status_to_string(cairo_surface_status(layer_.get())));
+  const std::unique_ptr<cairo_t, decltype(&cairo_destroy)> context(cairo_create(layer_.get()),
+                                                                   cairo_destroy);
+  cairo_t* cr = context.get();
+  SetColour(cr, kPathRgb, kPathOpacity);
+  cairo_set_line_width(cr, 1.5);
+  cairo_set_line_join(cr, CAIRO_LINE_JOIN_ROUND);
+  for (const auto& line : paths) {
+    if (line.size() < 2) continue;
+    Eigen::Vector2d last = PixelOf(grid, layout, line.front());
+    cairo_move_to(cr, last.x(), last.y());
+    for (std::size_t k = 1; k < line.size(); ++k) {
+      const Eigen::Vector2d p = PixelOf(grid, layout, line[k]);
+      if (k + 1 < line.size() && (p - last).squaredNorm() < 1) continue;
+      cairo_line_to(cr, p.x(), p.y());
+      last = p;
+    }
+    cairo_stroke(cr);
+  }
+  cairo_surface_flush(layer_.get());
+}
+
+void MapPaths::Paint(cairo_t* cr) const {
+  if (!layer_) return;
+  cairo_set_source_surface(cr, layer_.get(), 0, 0);
+  cairo_paint(cr);
+}
+
 std::string QuickLookPng(const Heightfield& dem, const ensemble::RasterLayer* layer,
                          const std::vector<std::vector<Eigen::Vector2d>>& paths,
                          const std::vector<MapMarker>& markers, const std::vector<MapLine>& lines) {
+  return QuickLookPngOf(dem, layer, MapPaths(dem.grid, paths), markers, lines);
+}
+
+std::string QuickLookPngOf(const Heightfield& dem, const ensemble::RasterLayer* layer,
+                           const MapPaths& paths, const std::vector<MapMarker>& markers,
+                           const std::vector<MapLine>& lines) {
   const GridGeometry& g = dem.grid;
   const QuickLookLayout layout = QuickLookLayoutOf(g);
   const QuickLookLegend legend = layer ? LegendOf(*layer) : QuickLookLegend{};
@@ -332,27 +384,11 @@ std::string QuickLookPng(const Heightfield& dem, const ensemble::RasterLayer* la
   cairo_paint(cr);
   PaintMap(surface.get(), dem, layer, legend, layout.scale);
 
-  // Paths: translucent blue lines.
-  auto pixel = [&](const Eigen::Vector2d& p) {
-    return Eigen::Vector2d((p.x() - g.x0_m + 0.5 * g.dx_m) / g.dx_m * layout.scale,
-                           (g.y_max_m() + 0.5 * g.dy_m - p.y()) / g.dy_m * layout.scale);
-  };
+  // Paths: translucent blue lines, drawn once for the run (MapPaths).
+  auto pixel = [&](const Eigen::Vector2d& p) { return PixelOf(g, layout, p); };
   cairo_rectangle(cr, 0, 0, layout.map_width, layout.map_height);
   cairo_clip(cr);
-  SetColour(cr, kPathRgb, kPathOpacity);
-  cairo_set_line_width(cr, 1.5);
-  cairo_set_line_join(cr, CAIRO_LINE_JOIN_ROUND);
-  for (const auto& line : paths) {
-    if (line.size() < 2) continue;
-    for (std::size_t k = 0; k < line.size(); ++k) {
-      const Eigen::Vector2d p = pixel(line[k]);
-      if (k == 0)
-        cairo_move_to(cr, p.x(), p.y());
-      else
-        cairo_line_to(cr, p.x(), p.y());
-    }
-    cairo_stroke(cr);
-  }
+  paths.Paint(cr);
   // Evaluation lines: black over a white halo, named at their first vertex.
   for (const MapLine& line : lines) {
     if (line.xy_m.size() < 2) continue;

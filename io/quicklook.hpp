@@ -7,12 +7,17 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "ensemble/rasters.hpp"
 #include "io/map_classes.hpp"
 #include "solver/terrain.hpp"
+
+// cairo's types (cairo.h declares them so).
+typedef struct _cairo cairo_t;
+typedef struct _cairo_surface cairo_surface_t;
 
 namespace talus::io {
 
@@ -45,9 +50,35 @@ struct QuickLookLayout {
 };
 QuickLookLayout QuickLookLayoutOf(const GridGeometry& grid);
 
+// The rocks' paths as the maps of a run show them: translucent blue lines on a transparent layer
+// of the map's size (QuickLookLayoutOf(grid)), drawn once and laid over each map, since every map
+// of a run shows the same paths. Stroking them was most of a map's cost: 4.6·10⁸ instructions for
+// the 4 maps of a 50-rock tirol run (40 paths), of 8.6·10⁹ for the whole run (bench/README.md,
+// "What a run pays besides its rocks").
+// A vertex within a pixel of the last one drawn is skipped (never a path's last): the line it
+// would add is shorter than the line is wide, and a slow rock's samples crowd into one pixel.
+// The line drawn stays within a pixel of the path.
+class MapPaths {
+ public:
+  MapPaths() = default;  // no paths
+  // paths: horizontal positions, map coordinates of `grid`.
+  MapPaths(const GridGeometry& grid, const std::vector<std::vector<Eigen::Vector2d>>& paths);
+  // Lays the paths over a map of the grid they were drawn for (QuickLookPngOf), within cr's clip.
+  void Paint(cairo_t* cr) const;
+  std::size_t size() const { return count_; }  // the paths given (the legend counts them)
+
+ private:
+  std::shared_ptr<cairo_surface_t> layer_;  // null: no path of two points or more
+  std::size_t count_ = 0;
+};
+
 // The picture as PNG bytes (cairo), and written atomically to `path`. paths: horizontal
 // positions, map coordinates; lines are drawn over the paths, markers last, in order. The same
-// inputs give the same bytes.
+// inputs give the same bytes. QuickLookPngOf takes paths already drawn for dem's grid, for a run
+// that draws several maps.
+std::string QuickLookPngOf(const Heightfield& dem, const ensemble::RasterLayer* layer,
+                           const MapPaths& paths, const std::vector<MapMarker>& markers = {},
+                           const std::vector<MapLine>& lines = {});
 std::string QuickLookPng(const Heightfield& dem, const ensemble::RasterLayer* layer,
                          const std::vector<std::vector<Eigen::Vector2d>>& paths,
                          const std::vector<MapMarker>& markers = {},

@@ -191,7 +191,7 @@ std::string MapsSection(const RunReportInput& input) {
   for (const ensemble::RasterLayer* layer : maps) {
     const std::string png = layer == quicklook
                                 ? input.quicklook_png
-                                : QuickLookPng(*input.dem, layer, input.paths, {}, input.lines);
+                                : QuickLookPngOf(*input.dem, layer, input.paths, {}, input.lines);
     html +=
         html::PngFigure(png, layer->name, LegendOf(*layer).title + " (" + layer->name + ".tif)");
   }

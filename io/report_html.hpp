@@ -44,8 +44,8 @@ struct RunReportInput {
   std::string summary_json;  // summary.json's text (its timings and threads are not shown)
   const Heightfield* dem = nullptr;
   const std::vector<ensemble::RasterLayer>* layers = nullptr;
-  std::vector<std::vector<Eigen::Vector2d>> paths;  // the quick-look's sampled paths
-  std::vector<MapLine> lines;                       // evaluation lines, drawn on the maps
+  MapPaths paths;              // the quick-look's sampled paths, drawn for dem's grid
+  std::vector<MapLine> lines;  // evaluation lines, drawn on the maps
   // quicklook.png's bytes, when the run wrote it from these paths and lines: the map of
   // QuickLookLayer(*layers), shown again instead of drawn again.
   std::string quicklook_png;

@@ -24,9 +24,9 @@ namespace {
 // Sizes of the output files. trajectories.h5 takes a row of its rock index per rock (56 bytes
 // before compression) and a part per sample (121 bytes of values, of which the velocities,
 // quaternions and scars are stored plain and the rest deflate-compressed: 92 bytes measured on
-// cases/tirol, 108 on the 40 degree ramp, 200 rocks each; bench/README.md, "Trajectories: deflate
-// where it pays"); a row of rocks.csv (148 bytes). GeoTIFFs are counted uncompressed (4 bytes per
-// cell), an upper bound.
+// cases/tirol, 108 on the 40 degree ramp, 200 rocks each; bench/README.md, "What a run pays
+// besides its rocks"); a row of rocks.csv (148 bytes). GeoTIFFs are counted uncompressed (4 bytes
+// per cell), an upper bound.
 constexpr double kTrajectoryBytesPerRock = 56;
 constexpr double kTrajectoryBytesPerSample = 108;
 constexpr double kRocksCsvBytesPerRow = 150;
@@ -52,8 +52,9 @@ constexpr double kGeoTiffBytesPerCell = 4;
 constexpr double kHeapBlockOverhead = 16;
 constexpr double kVectorGrowth = 1.5;
 
-// The quick-look image per pixel, an upper bound: cairo's 4-byte canvas, the 3-byte rows handed to
-// libpng and the encoded PNG (io/quicklook.cpp) come to under 10 bytes.
+// The quick-look image per pixel, an upper bound: cairo's 4-byte canvas, the paths' 4-byte layer
+// (MapPaths), the 3-byte rows handed to libpng and the encoded PNG (io/quicklook.cpp) come to
+// under 14 bytes.
 constexpr double kQuickLookBytesPerPixel = 3 * sizeof(double) + 1 + 3;
 
 std::string Cells(const GridGeometry& g) {

@@ -154,7 +154,7 @@ constexpr hsize_t kChunkRows = 8192;
 // mantissas vary in every sample (velocities, quaternions, scars) to 86 % of their size at a
 // quarter of a second per 10^7 of them; times, contact flags and the rocks' index to 6 %, positions
 // and angular velocities (zero at rest) to 70 and 43 % (cases/tirol, 200 rocks; bench/README.md,
-// "Trajectories: deflate where it pays").
+// "What a run pays besides its rocks").
 enum class Deflate : bool { kNo, kYes };
 
 // One growing table of `width` values of `type` per row: chunked (kChunkRows rows), with

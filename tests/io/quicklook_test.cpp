@@ -3,6 +3,7 @@
 #include <gdal_priv.h>
 #include <gtest/gtest.h>
 
+#include "common/atomic_file.hpp"
 #include "test_files.hpp"
 
 namespace talus::io {
@@ -88,6 +89,44 @@ TEST(QuickLook, DrawsEvaluationLinesInBlack) {
     ASSERT_NE(png, nullptr);
     const int y = layout.map_height / 2;
     EXPECT_EQ(Pixel(png, 1, column, y) < 30, with_line) << int(Pixel(png, 1, column, y));
+    GDALClose(png);
+  }
+}
+
+// Paths are drawn in translucent blue along their vertices: those crowded within a pixel of the
+// last one drawn are skipped, the others are not (a path that turns stays turned).
+TEST(QuickLook, DrawsPathsInBlueAlongTheirVertices) {
+  const auto dir = testing::FreshDir("paths");
+  const Heightfield dem = MakePlaneHeightfield({30, 20, 10, 20, 1});
+  const QuickLookLayout layout = QuickLookLayoutOf(dem.grid);
+  // A rock creeping 1 cm in 500 samples (a hundredth of a pixel each), then north 8 m in steps of
+  // 1 m, then east 20 m in one.
+  std::vector<Eigen::Vector2d> path;
+  for (int k = 0; k <= 500; ++k) path.emplace_back(3 + 0.01 * k / 500, 0);
+  for (int k = 1; k <= 8; ++k) path.emplace_back(3, k);
+  path.emplace_back(23, 8);
+  const MapPaths paths(dem.grid, {path});
+  EXPECT_EQ(paths.size(), 1u);
+  // The pixel of (x, y) m, where the map places cell centres.
+  const auto column = [&](double x) {
+    return static_cast<int>((x - dem.grid.x0_m + 0.5) * layout.scale);
+  };
+  const auto row = [&](double y) {
+    return static_cast<int>((dem.grid.y_max_m() + 0.5 - y) * layout.scale);
+  };
+  const auto file = (dir / "quicklook.png").string();
+  RegisterGdal();
+  for (const bool with_path : {false, true}) {
+    WriteFileAtomically(file, QuickLookPngOf(dem, nullptr, with_path ? paths : MapPaths(), {}, {}));
+    GDALDataset* png = static_cast<GDALDataset*>(GDALOpen(file.c_str(), GA_ReadOnly));
+    ASSERT_NE(png, nullptr);
+    const auto blue = [&](double x, double y) {
+      return Pixel(png, 3, column(x), row(y)) > Pixel(png, 1, column(x), row(y)) + 30;
+    };
+    EXPECT_EQ(blue(3, 0.5), with_path);  // the creep's end, heading north
+    EXPECT_EQ(blue(3, 5), with_path);
+    EXPECT_EQ(blue(20, 8), with_path);
+    EXPECT_FALSE(blue(13, 4));  // the corner is not cut
     GDALClose(png);
   }
 }
