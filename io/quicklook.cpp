@@ -315,6 +315,18 @@ double ScaleBarLength(double at_most_m) {
 }
 
 namespace {
+// A new image surface of the picture's size; throws when cairo cannot make one (out of memory).
+cairo_surface_t* NewSurface(cairo_format_t format, int width, int height) {
+  cairo_surface_t* surface = cairo_image_surface_create(format, width, height);
+  if (cairo_surface_status(surface) != CAIRO_STATUS_SUCCESS) {
+    const std::string why = cairo_status_to_string(cairo_surface_status(surface));
+    cairo_surface_destroy(surface);
+    throw std::runtime_error("cannot draw the quick-look: " + why);
+  }
+  return surface;
+}
+using Context = std::unique_ptr<cairo_t, decltype(&cairo_destroy)>;
+
 // Map coordinates to the map's pixels: cell centres at pixel centres, north up.
 Eigen::Vector2d PixelOf(const GridGeometry& g, const QuickLookLayout& layout,
                         const Eigen::Vector2d& p) {
@@ -323,17 +335,18 @@ Eigen::Vector2d PixelOf(const GridGeometry& g, const QuickLookLayout& layout,
 }
 }  // namespace
 
+struct MapPathsLayer {
+  std::unique_ptr<cairo_surface_t, decltype(&cairo_surface_destroy)> surface{nullptr,
+                                                                             cairo_surface_destroy};
+};
+
 MapPaths::MapPaths(const GridGeometry& grid, const std::vector<std::vector<Eigen::Vector2d>>& paths)
     : count_(paths.size()) {
   if (std::none_of(paths.begin(), paths.end(), [](const auto& p) { return p.size() >= 2; })) return;
   const QuickLookLayout layout = QuickLookLayoutOf(grid);
-  layer_.reset(cairo_image_surface_create(CAIRO_FORMAT_ARGB32, layout.map_width, layout.map_height),
-               cairo_surface_destroy);
-  if (cairo_surface_status(layer_.get()) != CAIRO_STATUS_SUCCESS)
-    throw std::runtime_error(std::string("cannot draw the quick-look: ") +
-                             cairo_status_to_string(cairo_surface_status(layer_.get())));
-  const std::unique_ptr<cairo_t, decltype(&cairo_destroy)> context(cairo_create(layer_.get()),
-                                                                   cairo_destroy);
+  auto layer = std::make_shared<MapPathsLayer>();
+  layer->surface.reset(NewSurface(CAIRO_FORMAT_ARGB32, layout.map_width, layout.map_height));
+  const Context context(cairo_create(layer->surface.get()), cairo_destroy);
   cairo_t* cr = context.get();
   SetColour(cr, kPathRgb, kPathOpacity);
   cairo_set_line_width(cr, 1.5);
@@ -350,13 +363,8 @@ MapPaths::MapPaths(const GridGeometry& grid, const std::vector<std::vector<Eigen
     }
     cairo_stroke(cr);
   }
-  cairo_surface_flush(layer_.get());
-}
-
-void MapPaths::Paint(cairo_t* cr) const {
-  if (!layer_) return;
-  cairo_set_source_surface(cr, layer_.get(), 0, 0);
-  cairo_paint(cr);
+  cairo_surface_flush(layer->surface.get());
+  layer_ = std::move(layer);
 }
 
 std::string QuickLookPng(const Heightfield& dem, const ensemble::RasterLayer* layer,
@@ -372,13 +380,8 @@ std::string QuickLookPngOf(const Heightfield& dem, const ensemble::RasterLayer* 
   const QuickLookLayout layout = QuickLookLayoutOf(g);
   const QuickLookLegend legend = layer ? LegendOf(*layer) : QuickLookLegend{};
   const std::unique_ptr<cairo_surface_t, decltype(&cairo_surface_destroy)> surface(
-      cairo_image_surface_create(CAIRO_FORMAT_RGB24, layout.width, layout.height),
-      cairo_surface_destroy);
-  if (cairo_surface_status(surface.get()) != CAIRO_STATUS_SUCCESS)
-    throw std::runtime_error(std::string("cannot draw the quick-look: ") +
-                             cairo_status_to_string(cairo_surface_status(surface.get())));
-  const std::unique_ptr<cairo_t, decltype(&cairo_destroy)> context(cairo_create(surface.get()),
-                                                                   cairo_destroy);
+      NewSurface(CAIRO_FORMAT_RGB24, layout.width, layout.height), cairo_surface_destroy);
+  const Context context(cairo_create(surface.get()), cairo_destroy);
   cairo_t* cr = context.get();
   cairo_set_source_rgb(cr, 1, 1, 1);
   cairo_paint(cr);
@@ -388,7 +391,10 @@ std::string QuickLookPngOf(const Heightfield& dem, const ensemble::RasterLayer* 
   auto pixel = [&](const Eigen::Vector2d& p) { return PixelOf(g, layout, p); };
   cairo_rectangle(cr, 0, 0, layout.map_width, layout.map_height);
   cairo_clip(cr);
-  paths.Paint(cr);
+  if (paths.layer()) {
+    cairo_set_source_surface(cr, paths.layer()->surface.get(), 0, 0);
+    cairo_paint(cr);
+  }
   // Evaluation lines: black over a white halo, named at their first vertex.
   for (const MapLine& line : lines) {
     if (line.xy_m.size() < 2) continue;

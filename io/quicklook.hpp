@@ -15,10 +15,6 @@
 #include "io/map_classes.hpp"
 #include "solver/terrain.hpp"
 
-// cairo's types (cairo.h declares them so).
-typedef struct _cairo cairo_t;
-typedef struct _cairo_surface cairo_surface_t;
-
 namespace talus::io {
 
 // The layer the quick-look shows: the first of reach_probability, energy_max, speed_max, passages
@@ -58,17 +54,19 @@ QuickLookLayout QuickLookLayoutOf(const GridGeometry& grid);
 // A vertex within a pixel of the last one drawn is skipped (never a path's last): the line it
 // would add is shorter than the line is wide, and a slow rock's samples crowd into one pixel.
 // The line drawn stays within a pixel of the path.
+struct MapPathsLayer;  // the layer drawn (io/quicklook.cpp)
 class MapPaths {
  public:
   MapPaths() = default;  // no paths
   // paths: horizontal positions, map coordinates of `grid`.
   MapPaths(const GridGeometry& grid, const std::vector<std::vector<Eigen::Vector2d>>& paths);
-  // Lays the paths over a map of the grid they were drawn for (QuickLookPngOf), within cr's clip.
-  void Paint(cairo_t* cr) const;
   std::size_t size() const { return count_; }  // the paths given (the legend counts them)
+  // The layer, for the maps of the grid the paths were drawn for (QuickLookPngOf); null without a
+  // path of two points or more.
+  const std::shared_ptr<const MapPathsLayer>& layer() const { return layer_; }
 
  private:
-  std::shared_ptr<cairo_surface_t> layer_;  // null: no path of two points or more
+  std::shared_ptr<const MapPathsLayer> layer_;
   std::size_t count_ = 0;
 };
 
