@@ -311,8 +311,8 @@ void PrepareContacts(const Scene& scene, const RockShape& rock, double dt_s,
 
 // One Gauss-Seidel sweep over the contacts, each solved exactly with the others held fixed;
 // returns the largest velocity change it made at a point of the rock (m/s), 0 for a single
-// contact. Inlined into the
-// solve's loop: as a call it costs 0.9 % of the ramp's instructions (bench/ramp_bench.cpp).
+// contact. Inlined into the solve's loop: as a call it costs 0.9 % of the ramp's instructions
+// (bench/ramp_bench.cpp).
 [[gnu::always_inline]] inline double Sweep(const SweepSetting& setting,
                                            std::vector<Contact>& contacts,
                                            Eigen::Vector3d& velocity_m_s,
