@@ -163,6 +163,21 @@ void LoadSolver(const Section& s, SolverOptions& o, SolverPreset& preset,
                   RoundTrip(o.normal_restitution) + ")");
     o.contact_hold = ContactHold::kMidpoint;
   }
+  // Every impact in sub-steps needs sub-steps, and held contacts: without them a pivot that a
+  // step leaves free comes back in the next as a new contact, and the step is split for it.
+  if (s.Has("substep_impacts") && o.substep_impacts == SubstepImpacts::kAll) {
+    if (o.normal_restitution > 0)
+      s.FailCheck(
+          "substep_impacts = \"all\" needs normal_restitution = 0 (Newton's law keeps "
+          "whole steps; it is " +
+          RoundTrip(o.normal_restitution) + ")");
+    if (o.impact_substeps == 1)
+      s.FailCheck("substep_impacts = \"all\" needs impact_substeps > 1 (it is 1: whole steps)");
+    if (o.contact_hold != ContactHold::kHeld)
+      s.FailCheck(
+          "substep_impacts = \"all\" needs contact_hold = \"held\" (without it a pivot "
+          "that a step leaves free would come back as a new contact and split the next)");
+  }
   std::string why;
   if (!o.IsValid(&why)) s.FailCheck(why);
 }

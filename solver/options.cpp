@@ -12,6 +12,7 @@ constexpr std::array<const char*, 3> kContactSolveMethods = {"gauss_seidel", "bl
                                                              "block_on_stall"};
 constexpr std::array<const char*, 2> kPredictedLevers = {"midpoint", "touch"};
 constexpr std::array<const char*, 2> kContactHolds = {"midpoint", "held"};
+constexpr std::array<const char*, 2> kSubstepImpacts = {"fast", "all"};
 constexpr std::array<const char*, 2> kSoilDragPoints = {"centre_of_mass", "submerged_centroid"};
 constexpr std::array<const char*, 3> kSolverPresets = {"fast", "default", "accurate"};
 
@@ -21,6 +22,7 @@ constinit const EnumNames kViscousReadingNames{"reading", kViscousReadings};
 constinit const EnumNames kContactSolveMethodNames{"method", kContactSolveMethods};
 constinit const EnumNames kPredictedLeverNames{"lever", kPredictedLevers};
 constinit const EnumNames kContactHoldNames{"contact hold", kContactHolds};
+constinit const EnumNames kSubstepImpactsNames{"impacts", kSubstepImpacts};
 constinit const EnumNames kSoilDragPointNames{"drag point", kSoilDragPoints};
 constinit const EnumNames kSolverPresetNames{"preset", kSolverPresets};
 
@@ -42,6 +44,11 @@ bool ParsePredictedLever(std::string_view name, PredictedLever* lever) {
 const char* ToString(ContactHold hold) { return kContactHoldNames.NameOf(hold); }
 bool ParseContactHold(std::string_view name, ContactHold* hold) {
   return kContactHoldNames.Parse(name, hold);
+}
+
+const char* ToString(SubstepImpacts impacts) { return kSubstepImpactsNames.NameOf(impacts); }
+bool ParseSubstepImpacts(std::string_view name, SubstepImpacts* impacts) {
+  return kSubstepImpactsNames.Parse(name, impacts);
 }
 
 const char* ToString(SoilDragPoint point) { return kSoilDragPointNames.NameOf(point); }
@@ -81,7 +88,7 @@ constexpr Bounds Choices(const std::array<const char*, N>& /*names*/) {
 }  // namespace
 
 // In the order of summary.json's "solver".
-constinit const std::array<SolverOptionInfo, 18> kSolverOptions = {{
+constinit const std::array<SolverOptionInfo, 19> kSolverOptions = {{
     {.key = "dt_s",
      .type = Type::kNumber,
      .member = MemberOf<&O::dt_s>(),
@@ -176,6 +183,13 @@ constinit const std::array<SolverOptionInfo, 18> kSolverOptions = {{
      .unit = "1",
      .valid = Bounds::Between(1, 64),
      .doc = "a step with an impact is taken as this many sub-steps; 1: never (below)"},
+    {.key = "substep_impacts",
+     .type = Type::kChoice,
+     .member = MemberOf<&O::substep_impacts>(),
+     .unit = "1",
+     .valid = Choices(kSubstepImpacts),
+     .choices = &kSubstepImpactsNames,
+     .doc = "which steps impact_substeps splits: fast impacts, or every new contact (below)"},
     {.key = "soil_drag",
      .type = Type::kChoice,
      .member = MemberOf<&O::soil_drag>(),

@@ -336,6 +336,32 @@ TEST(LoadScene, ContactHoldIsChosenByNameWithDidYouMean) {
       "'held'?)");
 }
 
+// substep_impacts = "all" splits every step with a new contact: it needs sub-steps and held
+// contacts, and a scene without them is told which key is missing.
+TEST(LoadScene, SubstepImpactsAllNeedsSubStepsAndHeldContacts) {
+  const auto dir = testing::FreshDir("substep_impacts");
+  const auto with = [](const std::string& keys) {
+    return Replace(kPlaneScene, "max_time_s = 20", "max_time_s = 20\n" + keys);
+  };
+  testing::WriteText(dir / "scene.toml", kPlaneScene);
+  EXPECT_EQ(LoadScene((dir / "scene.toml").string()).scene.options.substep_impacts,
+            SubstepImpacts::kFast);  // the default
+  testing::WriteText(dir / "scene.toml",
+                     with("contact_hold = \"held\"\nsubstep_impacts = \"all\""));
+  EXPECT_EQ(LoadScene((dir / "scene.toml").string()).scene.options.substep_impacts,
+            SubstepImpacts::kAll);
+  EXPECT_HAS(ErrorOf(with("substep_impacts = \"all\""), dir),
+             "substep_impacts = \"all\" needs contact_hold = \"held\"");
+  EXPECT_HAS(
+      ErrorOf(with("contact_hold = \"held\"\nsubstep_impacts = \"all\"\nimpact_substeps = 1"), dir),
+      "substep_impacts = \"all\" needs impact_substeps > 1 (it is 1: whole steps)");
+  EXPECT_HAS(ErrorOf(with("normal_restitution = 0.4\nsubstep_impacts = \"all\""), dir),
+             "substep_impacts = \"all\" needs normal_restitution = 0 (Newton's law keeps whole "
+             "steps; it is 0.4)");
+  EXPECT_HAS(ErrorOf(with("substep_impacts = \"al\""), dir),
+             "solver.substep_impacts: unknown impacts 'al' (did you mean 'all'?)");
+}
+
 // [solver] preset sets the accuracy knobs (solver/options.hpp) and keys the scene gives win over
 // it; talus simulate --preset (UseSolverPreset) wins over both and names the values it changed.
 TEST(LoadScene, SolverPresetSetsTheKnobsTheSceneDoesNotGive) {
@@ -410,6 +436,8 @@ TEST(LoadScene, EverySolverOptionOfTheTableIsReadAndWrittenBack) {
     // The restitution coefficients are one (SolverOptions::IsValid): the pair is given together.
     std::string keys = std::string(f.key) + " = " + text;
     if (std::string(f.key) == "tangential_restitution") keys += "\nnormal_restitution = " + text;
+    // Every impact in sub-steps goes with held contacts (io/scene_file.cpp).
+    if (std::string(f.key) == "substep_impacts") keys += "\ncontact_hold = \"held\"";
     testing::WriteText(dir / "scene.toml",
                        Replace(kPlaneScene, "dt_s = 0.004\nmax_time_s = 20", keys));
     SceneFile scene;

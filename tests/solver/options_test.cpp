@@ -115,6 +115,17 @@ TEST(Options, ContactHoldNamesRoundTrip) {
   EXPECT_FALSE(ParseContactHold("hold", &parsed));
 }
 
+TEST(Options, SubstepImpactsNamesRoundTrip) {
+  EXPECT_EQ(SolverOptions{}.substep_impacts, SubstepImpacts::kFast);
+  for (SubstepImpacts i : {SubstepImpacts::kFast, SubstepImpacts::kAll}) {
+    SubstepImpacts parsed = SubstepImpacts::kFast;
+    EXPECT_TRUE(ParseSubstepImpacts(ToString(i), &parsed));
+    EXPECT_EQ(parsed, i);
+  }
+  SubstepImpacts parsed = SubstepImpacts::kAll;
+  EXPECT_FALSE(ParseSubstepImpacts("every", &parsed));
+}
+
 TEST(Options, PredictedLeverNamesRoundTrip) {
   EXPECT_EQ(SolverOptions{}.predicted_lever, PredictedLever::kMidpoint);
   for (PredictedLever l : {PredictedLever::kMidpoint, PredictedLever::kTouch}) {

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdio>
 #include <numbers>
+#include <utility>
 
 #include "scenes/scenes.hpp"
 #include "solver/shapes.hpp"
@@ -188,18 +189,25 @@ namespace talus {
 namespace {
 
 // Impact sub-steps (SolverOptions::impact_substeps): a step whose contact set holds a predicted
-// contact is, bit for bit, that many steps of dt / impact_substeps; every other step is one step
-// of dt as without the option.
+// contact (with substep_impacts "all", also a new contact) is, bit for bit, that many steps of
+// dt / impact_substeps; every other step is one step of dt as without the option.
 TEST(ImpactSubsteps, ASplitStepIsExactlyItsSubSteps) {
-  for (const int k : {2, 4}) {
+  for (const auto& [k, impacts] : {std::pair{2, SubstepImpacts::kFast},
+                                   {4, SubstepImpacts::kFast},
+                                   {4, SubstepImpacts::kAll}}) {
     Prism split = MakePrism(8, 12, 0.002);
     split.scene.options.impact_substeps = k;
+    split.scene.options.substep_impacts = impacts;
     Prism fine = MakePrism(8, 12, 0.002 / k);
     StepWorkspace ws_split, ws_fine, ws_plain;
     ws_split.Reset(split.scene.rock.vertices_m.size());
     ws_fine.Reset(fine.scene.rock.vertices_m.size());
     ws_plain.Reset(split.scene.rock.vertices_m.size());
     Prism plain = MakePrism(8, 12, 0.002);
+    // "all" goes with held contacts (io/scene_file.cpp): all three hold.
+    const ContactHold hold =
+        impacts == SubstepImpacts::kAll ? ContactHold::kHeld : ContactHold::kMidpoint;
+    for (Prism* p : {&split, &fine, &plain}) p->scene.options.contact_hold = hold;
     RockState s;
     s.orientation = split.scene.rock.PrincipalOrientation(split.axis_across);
     TerrainSample ground;
@@ -240,9 +248,14 @@ TEST(ImpactSubsteps, ASplitStepIsExactlyItsSubSteps) {
       ws_fine = ws_split;
       ws_plain = ws_split;
     }
-    std::printf("impact_substeps %d: %d split steps, %d single steps\n", k, splits, singles);
+    std::printf("impact_substeps %d, substep_impacts %s: %d split steps, %d single steps\n", k,
+                ToString(impacts), splits, singles);
     EXPECT_GE(splits, 1);      // the landing
     EXPECT_GT(singles, 1000);  // the fall and the rolling
+    // "all": also the steps in which the prism's next edge arrives as it rolls (7 split steps).
+    if (impacts == SubstepImpacts::kAll) {
+      EXPECT_GE(splits, 4);
+    }
   }
 }
 

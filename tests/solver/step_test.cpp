@@ -941,3 +941,87 @@ TEST(Contact, ATippingBlockKeepsItsPivotLoaded) {
 
 }  // namespace
 }  // namespace talus
+
+namespace talus {
+namespace {
+
+// A strike: a 1 m cube of 2500 kg spinning at 8 rad/s about y and moving at 12 m/s along x, without
+// gravity, whose lowest edge dips 2 mm below flat ground at the bottom of its arc. The edge arrives
+// at 0.42 m/s, 0.85 mm per 2 ms step, far less than the 10 mm a step may sink (the penetration
+// tolerance), so the impact is not predicted but found closed at a step's midpoint; after the
+// plastic impact the edge's normal velocity is zero and the spin lifts it off at once. In the model
+// the impact takes no time, so it grows no scar and the viscous term does no work (seed paper,
+// eq. 1: the scar grows at |v| while in contact). Runs 0.1 s, the strike at 0.05 s, and returns the
+// largest scar and the kinetic energy lost.
+struct Struck {
+  double scar_m = 0, lost_j = 0, speed_m_s = 0;
+  int split_steps = 0;
+};
+
+Struck Strike(SubstepImpacts impacts, double dt) {
+  Scene scene = scenes::Incline(0, MakeRockShape(MakeBox(1, 1, 1), 2500),
+                                GroundParams{0.35, 2.0, 150, 2.0, 0.6});
+  scene.options.dt_s = dt;
+  scene.options.gravity_m_s2 = 0;
+  scene.options.tolerance_m_s = 1e-12;
+  scene.options.substep_impacts = impacts;
+  scene.options.contact_hold = ContactHold::kHeld;  // which "all" goes with (io/scene_file.cpp)
+  StepWorkspace ws;
+  ws.Reset(scene.rock.vertices_m.size());
+  const double tau = 0.05, spin = 8;
+  RockState s = Touching(scene, AboutY(45 * kDeg), 50, 0);  // an edge down
+  s.position_m.z() -= 0.002;
+  s.velocity_m_s = {12, 0, 0};
+  const Eigen::Vector3d omega_world(0, spin, 0);
+  // Back along the free motion (exact for the cube's isotropic inertia) by tau.
+  s.position_m -= tau * s.velocity_m_s;
+  s.orientation = Eigen::AngleAxisd(-spin * tau, Eigen::Vector3d::UnitY()) * s.orientation;
+  s.angular_velocity_rad_s = s.orientation.inverse() * omega_world;
+  const auto kinetic = [&](const RockState& r) {
+    return 0.5 * scene.rock.mass_kg * r.velocity_m_s.squaredNorm() +
+           0.5 * r.angular_velocity_rad_s.dot(
+                     scene.rock.inertia_kg_m2.cwiseProduct(r.angular_velocity_rad_s));
+  };
+  Struck out;
+  out.speed_m_s = s.velocity_m_s.norm();
+  const double before = kinetic(s);
+  const int steps = static_cast<int>(std::lround(2 * tau / dt));
+  for (int k = 0; k < steps; ++k) {
+    out.split_steps += Step(scene, s, ws).substeps > 1;
+    out.scar_m = std::max(out.scar_m, s.scar_m);
+  }
+  out.lost_j = before - kinetic(s);
+  return out;
+}
+
+TEST(ImpactSubsteps, AStrikeIsChargedASubStepOfContactUnderAll) {
+  // Every discrete run charges the strike the (sub-)step its edge is found closed in: the scar
+  // grows by at most |v| h in it, h the loaded (sub-)step, and tends to the model's zero with h.
+  // "fast" takes the slowly arriving edge in a whole step of 2 ms; "all" splits that step into four
+  // sub-steps of 0.5 ms, one of them loaded. The energy lost (plastic impact and Coulomb friction;
+  // the viscous work of one step is a few joules here) agrees with a fine step's within 1 %
+  // (measured: -0.02 % with "fast", -0.19 % with "all"). Measured scars: 0.0237 m ("fast"),
+  // 0.0051 m ("all": 0.006 m less two sub-steps' decay), 0.00074 m at 0.0625 ms.
+  const double fine_dt = 0.0000625, dt = 0.002;
+  const Struck fine = Strike(SubstepImpacts::kFast, fine_dt);
+  EXPECT_GT(fine.scar_m, 0);
+  EXPECT_LE(fine.scar_m, fine.speed_m_s * fine_dt);
+  for (SubstepImpacts impacts : {SubstepImpacts::kFast, SubstepImpacts::kAll}) {
+    const Struck coarse = Strike(impacts, dt);
+    std::printf("%s: scar %.5f m (fine %.5f), lost %.2f J (fine %.2f), %d split steps\n",
+                ToString(impacts), coarse.scar_m, fine.scar_m, coarse.lost_j, fine.lost_j,
+                coarse.split_steps);
+    EXPECT_NEAR(coarse.lost_j, fine.lost_j, 0.01 * fine.lost_j) << ToString(impacts);
+    if (impacts == SubstepImpacts::kFast) {
+      EXPECT_EQ(coarse.split_steps, 0);
+      EXPECT_GT(coarse.scar_m, 0.9 * coarse.speed_m_s * dt);  // a whole step of contact
+    } else {
+      EXPECT_EQ(coarse.split_steps, 1);
+      EXPECT_GT(coarse.scar_m, 0);
+      EXPECT_LE(coarse.scar_m, coarse.speed_m_s * dt / 4);  // one sub-step at most
+    }
+  }
+}
+
+}  // namespace
+}  // namespace talus
