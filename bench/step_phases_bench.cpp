@@ -6,6 +6,9 @@
 // carried load) the mechanical energy each run lost per kilogram, the difference coarse - fine with
 // its standard error, the share of the window's steps that carried load and the mean scar length.
 // A class where the coarse step loses less energy than the fine one is where its rocks run further.
+// Per class also the highest the centre of mass rose above the terrain after the window's first
+// loaded step (the rebound's jump height), fine and coarse - fine. With --from-coarse the starts
+// are taken from a run at the coarse step instead: the states the coarse step's own rocks visit.
 //
 // Landings (starts in flight faster than --landing-speed): the same difference at the end of each
 // coarse step from the coarse run's first loaded step on, split into the work of the normal and of
@@ -90,6 +93,10 @@ struct Mark {
 // One window from a start. False when the rock left the DEM or the state stopped being finite.
 struct Window {
   double energy_j_kg = 0, loaded = 0, scar_m = 0;  // energy change; mean loaded share and scar
+  // The highest the centre of mass came above the terrain (along its normal) after the window's
+  // first loaded step, as the jump height of talus simulate's statistics: the rebound's; read at
+  // the end of each step that carried no load.
+  double apex_m = 0;
   std::vector<Mark> marks;
   int first_loaded_mark = -1;  // first mark in which the run carried load; -1: never
 };
@@ -164,6 +171,10 @@ bool RunWindow(const talus::Scene& scene, const Start& start, double window_s, d
     loaded += r.loaded;
     scar += s.scar_m;
     if (r.loaded && w.first_loaded_mark < 0) w.first_loaded_mark = static_cast<int>(k / per_mark);
+    talus::TerrainSample under;
+    if (w.first_loaded_mark >= 0 && !r.loaded &&
+        scene.terrain.Sample(s.position_m.x(), s.position_m.y(), &under))
+      w.apex_m = std::max(w.apex_m, (s.position_m.z() - under.height_m) * under.normal.z());
     if ((k + 1) % per_mark == 0) {
       running.energy_j_kg = (MechanicalEnergy(scene, rock, s) - e0) / rock.mass_kg;
       running.rotational_j_kg = (RotationalEnergy(rock, s) - r0) / rock.mass_kg;
@@ -266,10 +277,12 @@ struct Landing {
 struct Tally {
   long n = 0;
   double fine = 0, coarse = 0;
-  Moments diff;
-  double loaded_fine = 0, loaded_coarse = 0, scar_fine = 0, scar_coarse = 0;
+  Moments diff, apex;
+  double loaded_fine = 0, loaded_coarse = 0, scar_fine = 0, scar_coarse = 0, apex_fine = 0;
   void Add(const Window& f, const Window& c) {
     ++n;
+    apex.Add(c.apex_m - f.apex_m);
+    apex_fine += f.apex_m;
     fine += f.energy_j_kg;
     coarse += c.energy_j_kg;
     diff.Add(c.energy_j_kg - f.energy_j_kg);
@@ -325,6 +338,9 @@ int RunBenchmark(int argc, char** argv) {
   app.add_option("--show-landings", show,
                  "Print the loaded steps of the first N landings (fine and coarse, per coarse "
                  "step from the coarse run's first loaded one)");
+  bool from_coarse = false;
+  app.add_flag("--from-coarse", from_coarse,
+               "Take the starts from a run at the coarse step (default: at the fine step)");
   std::vector<std::string> ground_sets;
   app.add_option("--ground", ground_sets,
                  "KEY=VALUE set on every ground category, e.g. nu=0 (a [ground.<name>] key)");
@@ -345,7 +361,7 @@ int RunBenchmark(int argc, char** argv) {
   options.threads = 1;
   options.extra_recorders.push_back(
       [&] { return std::make_unique<StartRecorder>(interval_s, &starts); });
-  talus::ensemble::RunEnsemble(fine, release, options, nullptr);
+  talus::ensemble::RunEnsemble(from_coarse ? coarse : fine, release, options, nullptr);
 
   // Classes: speed of the centre of mass at the start (upper bounds, m/s), and whether the step
   // that ended there carried load; each start also counts in its speed's "all".
@@ -379,21 +395,25 @@ int RunBenchmark(int argc, char** argv) {
       shown += "    fine " + fine_steps + "  coarse " + coarse_steps + "\n";
     }
   }
-  std::printf("%zu starts (%ld left the DEM within a window); windows of %g s at %g and %g s\n\n",
-              starts.size(), left, window_s, fine_s, coarse_s);
+  std::printf(
+      "%zu starts from the run at %g s (%ld left the DEM within a window); windows of %g s at %g "
+      "and %g s\n\n",
+      starts.size(), from_coarse ? coarse_s : fine_s, left, window_s, fine_s, coarse_s);
   std::printf(
       "| speed (m/s) | start | windows | energy change, fine (J/kg) | coarse (J/kg) | "
-      "coarse - fine (J/kg) | loaded steps, fine | coarse | mean scar, fine (m) | coarse (m) |\n"
-      "|---|---|---|---|---|---|---|---|---|---|\n");
+      "coarse - fine (J/kg) | loaded steps, fine | coarse | mean scar, fine (m) | coarse (m) | "
+      "highest centre above the terrain, fine (m) | coarse - fine (m) |\n"
+      "|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   for (const auto& [key, t] : tallies) {
     const double low = key.first == 0 ? 0 : kSpeeds[key.first - 1];
-    std::printf("| %g-%g | %s | %ld | %.4f | %.4f | %s | %.3f | %.3f | %.4f | %.4f |\n", low,
-                kSpeeds[key.first],
+    std::printf("| %g-%g | %s | %ld | %.4f | %.4f | %s | %.3f | %.3f | %.4f | %.4f | %.4f | %s |\n",
+                low, kSpeeds[key.first],
                 key.second == 2 ? "all"
                 : key.second    ? "loaded"
                                 : "not loaded",
                 t.n, t.fine / t.n, t.coarse / t.n, t.diff.Format().c_str(), t.loaded_fine / t.n,
-                t.loaded_coarse / t.n, t.scar_fine / t.n, t.scar_coarse / t.n);
+                t.loaded_coarse / t.n, t.scar_fine / t.n, t.scar_coarse / t.n, t.apex_fine / t.n,
+                t.apex.Format().c_str());
   }
   landing.Print(landing_speed, same_mark);
   if (!shown.empty())
