@@ -24,6 +24,13 @@ struct Contact {
   // the free motion carries below the terrain by the next midpoint but not below the tolerance;
   // gap_m is its own gap. It never splits a step.
   bool held = false;
+  // ContactHold::kHeld: the lift along n (>= 0) that the drift to the next midpoint gives the
+  // vertex of a closed or held contact beyond the straight line of its velocity, the turn's
+  // h^2 / 2 w x (w x arm), where gravity presses the vertex harder than the turn lifts it; the law
+  // lets the vertex move that much towards the terrain, gap_m + lift_m + dt gamma_N,E >= 0, so
+  // that a pivot the closed form loads keeps its load in every step (docs/model.md, "Held
+  // contacts"). 0 otherwise.
+  double lift_m = 0;
   int ground = 0;  // ground index at the contact point
   // Body frame: where the percussion acts; the vertex itself, or for a predicted contact with
   // SolverOptions::predicted_lever = kTouch the vertex turned to where it touches.
@@ -40,8 +47,8 @@ struct Contact {
   // contact gets when it carries the whole normal load; 0 otherwise (SolveContacts).
   double viscous_kg = 0;
   // Added to the end contact velocity in the laws: xi = gamma_E + eps gamma_B (Newton's law: a
-  // closed contact, or a predicted one reached within the step), else xi = gamma_E + (gap_m/dt,
-  // 0, 0).
+  // closed contact, or a predicted one reached within the step), else xi = gamma_E + ((gap_m +
+  // lift_m)/dt, 0, 0).
   Eigen::Vector3d velocity_bias = Eigen::Vector3d::Zero();
   Eigen::Vector3d percussion = Eigen::Vector3d::Zero();  // (P_N, P_T1, P_T2), N s
 };

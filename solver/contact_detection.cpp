@@ -81,6 +81,21 @@ void AddCornerContact(const Scene& scene, FrictionOfScar& friction, const Eigen:
   SetFrame(scene, friction, x_end, n, c);
 }
 
+// The lift along the unit normal n that the drift over the horizon h gives vertex b beyond the
+// straight line of its velocity, the turn's h^2 / 2 w x (w x arm) to second order (a pivot turning
+// at w lifts its vertex by h^2 w^2 R / 2 a step), when gravity presses the vertex into the terrain
+// harder than the turn lifts it: n . g + n . w x (w x arm) < 0, the free normal acceleration of a
+// vertex moving with the terrain (the angular acceleration of a free turn left out), whose sign
+// decides whether the continuous contact keeps its load. Otherwise 0: a vertex the turn carries
+// away (a strike, a fast pivot) keeps the plastic law. Contact::lift_m.
+double TurnLift(const Eigen::Matrix3d& rotation, const Eigen::Vector3d& omega_body,
+                const Eigen::Vector3d& b, const Eigen::Vector3d& n, double gravity_m_s2,
+                double horizon_s) {
+  const double centripetal = n.dot(rotation * omega_body.cross(omega_body.cross(b)));
+  if (centripetal <= 0 || centripetal >= gravity_m_s2 * n.z()) return 0;
+  return 0.5 * horizon_s * horizon_s * centripetal;
+}
+
 // Hulls of at least this many vertices are walked over to their lowest vertices first, which may
 // show that none can touch, or that few can: those are then searched from there instead of
 // looped over, when they lie within this share of the hull's extent from the lowest vertex
@@ -256,6 +271,7 @@ DetectResult DetectContacts(const Scene& scene, const RockShape& rock, const Roc
   // contacts; a held one's would rebound it from above the terrain).
   const bool hold =
       scene.options.contact_hold == ContactHold::kHeld && scene.options.normal_restitution == 0;
+  const double gravity = scene.options.gravity_m_s2;
   const Eigen::Vector3d m_body = rotation.transpose() * m;
   const Eigen::Vector3d rate_lever = m_body.cross(omega_rad_s);
 
@@ -292,6 +308,8 @@ DetectResult DetectContacts(const Scene& scene, const RockShape& rock, const Roc
       c.vertex = k;
       c.lever_m = b;
       c.gap_m = 0;
+      if (hold && depth == 0)
+        c.lift_m = TurnLift(rotation, omega_rad_s, b, normal, gravity, horizon_s);
       SetFrame(scene, friction, x, normal, c);
       if (horizon_s > 0 && depth == 0)
         AddCornerContact(scene, friction, rotation, velocity_m_s, omega_rad_s, horizon_s,
@@ -323,6 +341,7 @@ DetectResult DetectContacts(const Scene& scene, const RockShape& rock, const Roc
       c.vertex = k;
       c.gap_m = std::max(0.0, n.dot(x - on_plane));
       c.held = true;
+      c.lift_m = TurnLift(rotation, omega_rad_s, b, n, gravity, horizon_s);
       c.lever_m = b;
       SetFrame(scene, friction, x_end, n, c);
       return true;

@@ -32,6 +32,8 @@ inline double PredictionHorizon(const SolverOptions& options) { return options.d
 //   of the step before (workspace.last_closed), below the terrain after the horizon but not
 //   deeper than allowed_depth_m; frame as predicted, gap_m its own distance to that plane
 //   (>= 0): the vertex reaches the terrain by the next midpoint and goes no deeper.
+// Under ContactHold::kHeld closed and held contacts also get lift_m, the turn's lift over the
+// next drift where gravity presses the vertex harder than the turn lifts it (Contact::lift_m).
 // A rock whose bounding sphere clears the terrain's local plane, over the horizon, by more than
 // the terrain departs from that plane (Terrain::PlaneAround, over the box that the sphere reaches
 // within the horizon) costs one test (kClear); otherwise only the vertices within that departure

@@ -287,7 +287,7 @@ void PrepareContacts(const Scene& scene, const RockShape& rock, double dt_s,
     // Newton's law on a closed contact, and on a predicted one that the vertex reaches within the
     // step at its begin velocity (it rebounds from where it stands, short of the surface by less
     // than one step's travel); the plastic gap law on a predicted one it does not reach.
-    c.velocity_bias = Eigen::Vector3d(c.gap_m * inv_dt, 0, 0);
+    c.velocity_bias = Eigen::Vector3d((c.gap_m + c.lift_m) * inv_dt, 0, 0);
     if (with_restitution) {
       const Eigen::Vector3d gamma_begin =
           c.directions.transpose() * v_begin + c.arms.transpose() * omega_begin;
